@@ -1,0 +1,14 @@
+"""atomnav: hybrid quantum-classical inertial navigation.
+
+A Rust core (``atomnav._core``) does the numerical work; these Python modules configure
+it, validate input, and return numpy arrays / pandas DataFrames with units in the
+column names. Conventions (units, frames, signs) are in the README and in
+:mod:`atomnav.units`.
+"""
+
+from ._core import NumericalError
+from . import units, rotation, earth
+
+__version__ = "0.1.0"
+
+__all__ = ["NumericalError", "units", "rotation", "earth", "__version__"]

@@ -1,0 +1,96 @@
+"""Earth models: WGS-84 and PZ-90.11 ellipsoids, normal gravity, radii, Earth and
+transport rate, LLA ↔ ECEF ↔ NED.
+
+Positions are ``(lat rad, lon rad, h m)`` rows. Every function takes
+``ellipsoid="WGS84"`` or ``"PZ90.11"``.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+
+from . import _core
+from ._validate import rows, vector
+
+
+def ellipsoid(name: str = "WGS84") -> dict:
+    """Constants of an ellipsoid: a (m), f, gm (m³/s²), omega (rad/s), e2, b (m),
+    gamma_e and gamma_p (m/s², closed-form normal gravity at equator and pole)."""
+    return _core.ellipsoid_constants(name)
+
+
+def lla_to_ecef(lla, ellipsoid: str = "WGS84") -> np.ndarray:
+    """ECEF (m) of (lat rad, lon rad, h m) rows."""
+    r = _core.lla_to_ecef_rows(rows(lla, 3, "lla"), ellipsoid)
+    return r[0] if np.ndim(lla) == 1 else r
+
+
+def ecef_to_lla(ecef, ellipsoid: str = "WGS84") -> np.ndarray:
+    """(lat rad, lon rad, h m) of ECEF rows (m); latitude iterated to 1e-12 rad."""
+    r = _core.ecef_to_lla_rows(rows(ecef, 3, "ecef"), ellipsoid)
+    return r[0] if np.ndim(ecef) == 1 else r
+
+
+def ecef_to_ned(ecef, origin_lla, ellipsoid: str = "WGS84") -> np.ndarray:
+    """NED coordinates (m) of ECEF points relative to a geodetic origin."""
+    r = _core.ecef_to_ned_rows(rows(ecef, 3, "ecef"), vector(origin_lla, 3, "origin_lla"), ellipsoid)
+    return r[0] if np.ndim(ecef) == 1 else r
+
+
+def ned_to_ecef(ned, origin_lla, ellipsoid: str = "WGS84") -> np.ndarray:
+    """ECEF points (m) of NED coordinates relative to a geodetic origin."""
+    r = _core.ned_to_ecef_rows(rows(ned, 3, "ned"), vector(origin_lla, 3, "origin_lla"), ellipsoid)
+    return r[0] if np.ndim(ned) == 1 else r
+
+
+def lla_to_ned(lla, origin_lla, ellipsoid: str = "WGS84") -> np.ndarray:
+    """NED coordinates (m) of geodetic points relative to a geodetic origin."""
+    return ecef_to_ned(lla_to_ecef(lla, ellipsoid), origin_lla, ellipsoid)
+
+
+def dcm_ned_to_ecef(lat: float, lon: float) -> np.ndarray:
+    """C_n^e (3, 3): columns are the north, east, down axes in ECEF."""
+    return _core.dcm_ned_to_ecef_py(float(lat), float(lon))
+
+
+def parameters(lla, ellipsoid: str = "WGS84") -> pd.DataFrame:
+    """Radii of curvature, normal gravity and Schuler frequency at each position.
+
+    Columns: ``M_m`` (meridian radius), ``N_m`` (prime-vertical radius), ``gravity_mps2``
+    (Somigliana with height correction), ``dgravity_dlat_mps2_per_rad``,
+    ``schuler_rad_s`` (√(γ/(√(MN)+h)))."""
+    p = _core.earth_params_rows(rows(lla, 3, "lla"), ellipsoid)
+    return pd.DataFrame(p, columns=["M_m", "N_m", "gravity_mps2", "dgravity_dlat_mps2_per_rad", "schuler_rad_s"])
+
+
+def gravity(lat, h=0.0, ellipsoid: str = "WGS84") -> np.ndarray:
+    """Normal gravity magnitude γ (m/s², positive down) at latitude(s) ``lat`` (rad) and
+    height(s) ``h`` (m)."""
+    lat, h = np.broadcast_arrays(np.atleast_1d(np.asarray(lat, float)), np.atleast_1d(np.asarray(h, float)))
+    lla = np.column_stack([lat, np.zeros_like(lat), h])
+    g = _core.earth_params_rows(rows(lla, 3, "lla"), ellipsoid)[:, 2]
+    return g[0] if g.size == 1 else g
+
+
+def radii(lat, ellipsoid: str = "WGS84"):
+    """Meridian M and prime-vertical N radii of curvature (m) at latitude(s) (rad)."""
+    lat = np.atleast_1d(np.asarray(lat, float))
+    p = _core.earth_params_rows(rows(np.column_stack([lat, 0 * lat, 0 * lat]), 3, "lla"), ellipsoid)
+    m, n = p[:, 0], p[:, 1]
+    return (m[0], n[0]) if m.size == 1 else (m, n)
+
+
+def schuler_period(lat: float, h: float = 0.0, ellipsoid: str = "WGS84") -> float:
+    """Schuler period 2π/ω_s (s) with ω_s = √(γ/R₀), R₀ = √(MN) + h."""
+    w = _core.earth_params_rows(rows([lat, 0.0, h], 3, "lla"), ellipsoid)[0, 4]
+    return 2 * np.pi / w
+
+
+def navigation_rates(lla, vel_ned, ellipsoid: str = "WGS84") -> pd.DataFrame:
+    """Earth rate ω_ie^n and transport rate ω_en^n (rad/s) in NED for each position and
+    NED velocity (m/s)."""
+    x = np.hstack([rows(lla, 3, "lla"), rows(vel_ned, 3, "vel_ned")])
+    r = _core.nav_rates_rows(np.ascontiguousarray(x), ellipsoid)
+    cols = [f"{w}_{a}_rad_s" for w in ("earth_rate", "transport_rate") for a in ("N", "E", "D")]
+    return pd.DataFrame(r, columns=cols)

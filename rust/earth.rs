@@ -1,0 +1,237 @@
+//! Earth models: WGS-84 and PZ-90.11 ellipsoids, normal gravity, radii of curvature,
+//! Earth and transport rates, LLA ↔ ECEF ↔ NED. Equations: spec gnss-ins-tight §2.1.
+//!
+//! Positions are (latitude rad, longitude rad, ellipsoidal height m).
+
+use crate::error::{invalid, Result};
+use crate::math::{Mat3, Vec3};
+
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Ellipsoid {
+    pub name: &'static str,
+    /// Semi-major axis a (m).
+    pub a: f64,
+    /// Flattening f.
+    pub f: f64,
+    /// Gravitational constant GM (m³/s²).
+    pub gm: f64,
+    /// Earth rotation rate Ω (rad/s).
+    pub omega: f64,
+}
+
+/// WGS-84 (NIMA TR8350.2).
+pub const WGS84: Ellipsoid = Ellipsoid {
+    name: "WGS84",
+    a: 6378137.0,
+    f: 1.0 / 298.257223563,
+    gm: 3.986004418e14,
+    omega: 7.292115e-5,
+};
+
+/// PZ-90.11 (GLONASS ICD 2016, spec gnss-ins-tight §3).
+pub const PZ90_11: Ellipsoid = Ellipsoid {
+    name: "PZ90.11",
+    a: 6378136.0,
+    f: 1.0 / 298.25784,
+    gm: 3.986004418e14,
+    omega: 7.292115e-5,
+};
+
+impl Ellipsoid {
+    /// Look up an ellipsoid by name ("WGS84", "PZ90.11"; case and punctuation ignored).
+    pub fn by_name(name: &str) -> Result<Ellipsoid> {
+        let key: String = name.chars().filter(|c| c.is_alphanumeric()).collect::<String>().to_lowercase();
+        match key.as_str() {
+            "wgs84" => Ok(WGS84),
+            "pz9011" | "pz90" => Ok(PZ90_11),
+            _ => Err(invalid("ellipsoid", format!("unknown ellipsoid '{name}' (known: WGS84, PZ90.11)"))),
+        }
+    }
+
+    /// First eccentricity squared e² = f(2 − f).
+    pub fn e2(&self) -> f64 {
+        self.f * (2.0 - self.f)
+    }
+
+    /// Semi-minor axis b (m).
+    pub fn b(&self) -> f64 {
+        self.a * (1.0 - self.f)
+    }
+
+    /// m = Ω²a²b/GM.
+    pub fn m(&self) -> f64 {
+        self.omega * self.omega * self.a * self.a * self.b() / self.gm
+    }
+
+    /// Normal gravity at the equator and pole (γ_e, γ_p) from the closed (Pizzetti/Clairaut)
+    /// formulas of the level ellipsoid, Heiskanen & Moritz Eqs. 2-73 and 2-74.
+    pub fn gamma_equator_pole(&self) -> (f64, f64) {
+        let (a, b) = (self.a, self.b());
+        let ep = (a * a - b * b).sqrt() / b; // second eccentricity e'
+        let at = ep.atan();
+        let q0 = 0.5 * ((1.0 + 3.0 / (ep * ep)) * at - 3.0 / ep);
+        let q0p = 3.0 * (1.0 + 1.0 / (ep * ep)) * (1.0 - at / ep) - 1.0;
+        let m = self.m();
+        let ge = self.gm / (a * b) * (1.0 - m - m / 6.0 * ep * q0p / q0);
+        let gp = self.gm / (a * a) * (1.0 + m / 3.0 * ep * q0p / q0);
+        (ge, gp)
+    }
+
+    /// Meridian (M) and prime-vertical (N) radii of curvature (m) at latitude `lat`.
+    pub fn radii(&self, lat: f64) -> (f64, f64) {
+        let e2 = self.e2();
+        let s = lat.sin();
+        let w2 = 1.0 - e2 * s * s;
+        let w = w2.sqrt();
+        (self.a * (1.0 - e2) / (w2 * w), self.a / w)
+    }
+
+    /// Normal gravity magnitude γ (m/s², positive down): Somigliana with the second-order
+    /// height correction, spec gnss-ins-tight §2.1 Eq. 4.
+    pub fn gravity(&self, lat: f64, h: f64) -> f64 {
+        let (ge, gp) = self.gamma_equator_pole();
+        let (a, b, f, m) = (self.a, self.b(), self.f, self.m());
+        let s2 = lat.sin().powi(2);
+        let k = b * gp / (a * ge) - 1.0;
+        let g0 = ge * (1.0 + k * s2) / (1.0 - self.e2() * s2).sqrt();
+        g0 * (1.0 - 2.0 / a * (1.0 + f + m - 2.0 * f * s2) * h + 3.0 * h * h / (a * a))
+    }
+
+    /// ∂γ/∂φ at height h (m/s²/rad), by the analytic derivative of `gravity`.
+    pub fn gravity_dlat(&self, lat: f64, h: f64) -> f64 {
+        let (ge, gp) = self.gamma_equator_pole();
+        let (a, b, f, m, e2) = (self.a, self.b(), self.f, self.m(), self.e2());
+        let s2 = lat.sin().powi(2);
+        let ds2 = (2.0 * lat).sin(); // d(sin²φ)/dφ
+        let k = b * gp / (a * ge) - 1.0;
+        let w = (1.0 - e2 * s2).sqrt();
+        let g0 = ge * (1.0 + k * s2) / w;
+        let dg0 = ge * (k * ds2 / w + (1.0 + k * s2) * 0.5 * e2 * ds2 / (w * w * w));
+        let hc = 1.0 - 2.0 / a * (1.0 + f + m - 2.0 * f * s2) * h + 3.0 * h * h / (a * a);
+        let dhc = 4.0 * f * h / a * ds2;
+        dg0 * hc + g0 * dhc
+    }
+
+    /// Gravity vector in NED (m/s²): (0, 0, γ).
+    pub fn gravity_ned(&self, lat: f64, h: f64) -> Vec3 {
+        Vec3::new(0.0, 0.0, self.gravity(lat, h))
+    }
+
+    /// Earth rate in NED: ω_ie^n = Ω (cos φ, 0, −sin φ) (rad/s).
+    pub fn earth_rate_ned(&self, lat: f64) -> Vec3 {
+        Vec3::new(self.omega * lat.cos(), 0.0, -self.omega * lat.sin())
+    }
+
+    /// Transport rate ω_en^n = (v_E/R_P, −v_N/R_M, −v_E tan φ/R_P) (rad/s), R_M = M + h,
+    /// R_P = N + h.
+    pub fn transport_rate_ned(&self, lat: f64, h: f64, v_ned: &Vec3) -> Vec3 {
+        let (m, n) = self.radii(lat);
+        let (rm, rp) = (m + h, n + h);
+        Vec3::new(v_ned.y / rp, -v_ned.x / rm, -v_ned.y * lat.tan() / rp)
+    }
+
+    /// Rates of (lat, lon, h) for a NED velocity: φ̇ = v_N/R_M, λ̇ = v_E/(R_P cos φ), ḣ = −v_D.
+    pub fn lla_rate(&self, lat: f64, h: f64, v_ned: &Vec3) -> Vec3 {
+        let (m, n) = self.radii(lat);
+        Vec3::new(v_ned.x / (m + h), v_ned.y / ((n + h) * lat.cos()), -v_ned.z)
+    }
+
+    /// Schuler angular frequency ω_s = √(γ/R₀), R₀ = √(MN) (+h) (rad/s).
+    pub fn schuler_frequency(&self, lat: f64, h: f64) -> f64 {
+        let (m, n) = self.radii(lat);
+        (self.gravity(lat, h) / ((m * n).sqrt() + h)).sqrt()
+    }
+
+    /// ECEF (m) of geodetic (lat, lon, h).
+    pub fn lla_to_ecef(&self, lla: &Vec3) -> Vec3 {
+        let (lat, lon, h) = (lla.x, lla.y, lla.z);
+        let (_, n) = self.radii(lat);
+        let (sl, cl) = lat.sin_cos();
+        let (so, co) = lon.sin_cos();
+        Vec3::new((n + h) * cl * co, (n + h) * cl * so, (n * (1.0 - self.e2()) + h) * sl)
+    }
+
+    /// Geodetic (lat, lon, h) of an ECEF point, iterated until |Δφ| < 1e-12 rad.
+    pub fn ecef_to_lla(&self, r: &Vec3) -> Vec3 {
+        let e2 = self.e2();
+        let p = (r.x * r.x + r.y * r.y).sqrt();
+        let lon = r.y.atan2(r.x);
+        // height from whichever projection is better conditioned at this latitude
+        let height = |lat: f64| {
+            let (_, n) = self.radii(lat);
+            let (s, c) = lat.sin_cos();
+            if c.abs() > 0.5 { p / c - n } else { r.z / s - n * (1.0 - e2) }
+        };
+        let mut lat = r.z.atan2(p * (1.0 - e2));
+        for _ in 0..20 {
+            let (_, n) = self.radii(lat);
+            let new = r.z.atan2(p * (1.0 - e2 * n / (n + height(lat))));
+            let done = (new - lat).abs() < 1e-12;
+            lat = new;
+            if done {
+                break;
+            }
+        }
+        Vec3::new(lat, lon, height(lat))
+    }
+}
+
+/// C_n^e: columns are the N, E, D axes in ECEF (spec §2.1 Eq. 2).
+pub fn dcm_ned_to_ecef(lat: f64, lon: f64) -> Mat3 {
+    let (sl, cl) = lat.sin_cos();
+    let (so, co) = lon.sin_cos();
+    Mat3::new(-sl * co, -so, -cl * co, -sl * so, co, -cl * so, cl, 0.0, -sl)
+}
+
+/// Check a latitude (rad) is within [−π/2, π/2] and finite.
+pub fn check_latitude(field: &str, lat: f64, index: usize) -> Result<()> {
+    if lat.is_finite() && lat.abs() <= std::f64::consts::FRAC_PI_2 {
+        Ok(())
+    } else {
+        Err(invalid(field, format!("latitude {lat} rad at index {index} is outside [-pi/2, pi/2]")))
+    }
+}
+
+impl Ellipsoid {
+    /// NED coordinates (m) of ECEF point `r` relative to the geodetic origin `origin_lla`.
+    pub fn ecef_to_ned(&self, r: &Vec3, origin_lla: &Vec3) -> Vec3 {
+        let c = dcm_ned_to_ecef(origin_lla.x, origin_lla.y);
+        c.transpose() * (r - self.lla_to_ecef(origin_lla))
+    }
+
+    /// ECEF point of NED coordinates `ned` (m) relative to `origin_lla`.
+    pub fn ned_to_ecef(&self, ned: &Vec3, origin_lla: &Vec3) -> Vec3 {
+        self.lla_to_ecef(origin_lla) + dcm_ned_to_ecef(origin_lla.x, origin_lla.y) * ned
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn wgs84_normal_gravity_matches_published_constants() {
+        // NIMA TR8350.2 Table 3.4: γ_e = 9.7803253359, γ_p = 9.8321849378 m/s².
+        let (ge, gp) = WGS84.gamma_equator_pole();
+        assert!((ge - 9.7803253359).abs() < 1e-9, "{ge}");
+        assert!((gp - 9.8321849378).abs() < 1e-9, "{gp}");
+        assert!((WGS84.gravity(0.0, 0.0) - ge).abs() < 1e-12);
+        assert!((WGS84.gravity(std::f64::consts::FRAC_PI_2, 0.0) - gp).abs() < 1e-9);
+    }
+
+    #[test]
+    fn lla_ecef_round_trip() {
+        for &(lat, lon, h) in &[(0.97, 0.656, 200.0), (-1.5, -3.0, 9000.0), (0.0, 0.0, -50.0), (1.5707963, 1.0, 10.0)] {
+            let lla = Vec3::new(lat, lon, h);
+            let back = WGS84.ecef_to_lla(&WGS84.lla_to_ecef(&lla));
+            assert!((back.x - lat).abs() < 1e-12 && (back.y - lon).abs() < 1e-12 && (back.z - h).abs() < 1e-6, "{back:?}");
+        }
+    }
+
+    #[test]
+    fn gravity_derivative_matches_finite_difference() {
+        let (lat, h, d) = (0.7, 300.0, 1e-6);
+        let fd = (WGS84.gravity(lat + d, h) - WGS84.gravity(lat - d, h)) / (2.0 * d);
+        assert!((WGS84.gravity_dlat(lat, h) - fd).abs() < 1e-8);
+    }
+}

@@ -1,0 +1,3 @@
+//! IMU: ideal measurement generation from a reference trajectory, and the sensor error
+//! models / noise processes that turn ideal measurements into realistic ones.
+pub mod ideal;

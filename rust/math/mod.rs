@@ -1,0 +1,3 @@
+//! Small fixed-size algebra: rotations in every representation the papers use.
+pub mod rotation;
+pub use rotation::*;

@@ -1,0 +1,208 @@
+//! Rotations: quaternion ↔ DCM ↔ Euler (roll, pitch, heading) ↔ rotation vector.
+//!
+//! Conventions (README "Conventions"): Hamilton quaternions, scalar first, unit norm.
+//! `q_nb` rotates body-frame vectors into the navigation frame: v_n = C(q_nb) v_b.
+//! Euler angles are the aerospace z-y-x sequence: C_nb = Rz(yaw) Ry(pitch) Rx(roll).
+//! Composition: C(q_a ⊗ q_b) = C(q_a) C(q_b).
+
+use nalgebra::{Matrix3, Quaternion, Vector3};
+
+pub type Vec3 = Vector3<f64>;
+pub type Mat3 = Matrix3<f64>;
+/// Unit quaternion, Hamilton, stored by nalgebra as (w; i, j, k).
+pub type Quat = Quaternion<f64>;
+
+/// Skew-symmetric matrix [v×] with [v×] u = v × u.
+pub fn skew(v: &Vec3) -> Mat3 {
+    Mat3::new(0.0, -v.z, v.y, v.z, 0.0, -v.x, -v.y, v.x, 0.0)
+}
+
+/// Quaternion from scalar-first components [w, x, y, z].
+pub fn quat(w: f64, x: f64, y: f64, z: f64) -> Quat {
+    Quaternion::new(w, x, y, z)
+}
+
+/// Scalar-first array of a quaternion.
+pub fn quat_to_array(q: &Quat) -> [f64; 4] {
+    [q.w, q.i, q.j, q.k]
+}
+
+pub fn quat_normalize(q: &Quat) -> Quat {
+    let n = q.norm();
+    q / n
+}
+
+/// Hamilton product a ⊗ b.
+pub fn quat_mul(a: &Quat, b: &Quat) -> Quat {
+    a * b
+}
+
+/// Quaternion of the rotation vector φ (exponential map): [cos(|φ|/2), sin(|φ|/2) φ/|φ|].
+/// Uses the Taylor series below |φ| = 1e-4 so tiny rotations keep full relative accuracy.
+pub fn quat_from_rotvec(phi: &Vec3) -> Quat {
+    let th2 = phi.norm_squared();
+    let th = th2.sqrt();
+    let (c, s_over_th) = if th < 1e-4 {
+        // cos(θ/2) and sin(θ/2)/θ to O(θ⁶)
+        (1.0 - th2 / 8.0 + th2 * th2 / 384.0, 0.5 - th2 / 48.0 + th2 * th2 / 3840.0)
+    } else {
+        ((0.5 * th).cos(), (0.5 * th).sin() / th)
+    };
+    Quaternion::new(c, s_over_th * phi.x, s_over_th * phi.y, s_over_th * phi.z)
+}
+
+/// Rotation vector of a unit quaternion (logarithmic map), angle in [0, π].
+pub fn rotvec_from_quat(q: &Quat) -> Vec3 {
+    // q and −q are the same rotation: take the representative with w ≥ 0.
+    let (w, v) = if q.w < 0.0 { (-q.w, -q.imag()) } else { (q.w, q.imag()) };
+    let s = v.norm();
+    if s < 1e-8 {
+        // θ = 2 atan2(s, w); θ/s = 2/w (1 − s²/(3w²) + ...)
+        v * (2.0 / w) * (1.0 - s * s / (3.0 * w * w))
+    } else {
+        v * (2.0 * s.atan2(w) / s)
+    }
+}
+
+/// Direction cosine matrix C(q): v_n = C v_b for q = q_nb.
+pub fn dcm_from_quat(q: &Quat) -> Mat3 {
+    let (w, x, y, z) = (q.w, q.i, q.j, q.k);
+    Mat3::new(
+        w * w + x * x - y * y - z * z,
+        2.0 * (x * y - w * z),
+        2.0 * (x * z + w * y),
+        2.0 * (x * y + w * z),
+        w * w - x * x + y * y - z * z,
+        2.0 * (y * z - w * x),
+        2.0 * (x * z - w * y),
+        2.0 * (y * z + w * x),
+        w * w - x * x - y * y + z * z,
+    )
+}
+
+/// Quaternion of a rotation matrix (Shepperd's method: largest diagonal pivot), w ≥ 0.
+pub fn quat_from_dcm(c: &Mat3) -> Quat {
+    let tr = c.trace();
+    let diag = [c[(0, 0)], c[(1, 1)], c[(2, 2)]];
+    let q = if tr >= diag[0] && tr >= diag[1] && tr >= diag[2] {
+        let w = 0.5 * (1.0 + tr).sqrt();
+        let f = 0.25 / w;
+        quat(w, (c[(2, 1)] - c[(1, 2)]) * f, (c[(0, 2)] - c[(2, 0)]) * f, (c[(1, 0)] - c[(0, 1)]) * f)
+    } else if diag[0] >= diag[1] && diag[0] >= diag[2] {
+        let x = 0.5 * (1.0 + 2.0 * diag[0] - tr).sqrt();
+        let f = 0.25 / x;
+        quat((c[(2, 1)] - c[(1, 2)]) * f, x, (c[(0, 1)] + c[(1, 0)]) * f, (c[(0, 2)] + c[(2, 0)]) * f)
+    } else if diag[1] >= diag[2] {
+        let y = 0.5 * (1.0 + 2.0 * diag[1] - tr).sqrt();
+        let f = 0.25 / y;
+        quat((c[(0, 2)] - c[(2, 0)]) * f, (c[(0, 1)] + c[(1, 0)]) * f, y, (c[(1, 2)] + c[(2, 1)]) * f)
+    } else {
+        let z = 0.5 * (1.0 + 2.0 * diag[2] - tr).sqrt();
+        let f = 0.25 / z;
+        quat((c[(1, 0)] - c[(0, 1)]) * f, (c[(0, 2)] + c[(2, 0)]) * f, (c[(1, 2)] + c[(2, 1)]) * f, z)
+    };
+    if q.w < 0.0 { -q } else { q }
+}
+
+/// C_nb = Rz(yaw) Ry(pitch) Rx(roll), angles in rad.
+pub fn dcm_from_euler(roll: f64, pitch: f64, yaw: f64) -> Mat3 {
+    let (sr, cr) = roll.sin_cos();
+    let (sp, cp) = pitch.sin_cos();
+    let (sy, cy) = yaw.sin_cos();
+    Mat3::new(
+        cy * cp,
+        cy * sp * sr - sy * cr,
+        cy * sp * cr + sy * sr,
+        sy * cp,
+        sy * sp * sr + cy * cr,
+        sy * sp * cr - cy * sr,
+        -sp,
+        cp * sr,
+        cp * cr,
+    )
+}
+
+/// (roll, pitch, yaw) of C_nb; yaw in (−π, π], pitch in [−π/2, π/2].
+pub fn euler_from_dcm(c: &Mat3) -> Vec3 {
+    let roll = c[(2, 1)].atan2(c[(2, 2)]);
+    // asin loses accuracy near ±π/2; atan2 with the row norm keeps it.
+    let pitch = (-c[(2, 0)]).atan2((c[(2, 1)] * c[(2, 1)] + c[(2, 2)] * c[(2, 2)]).sqrt());
+    let yaw = c[(1, 0)].atan2(c[(0, 0)]);
+    Vec3::new(roll, pitch, yaw)
+}
+
+pub fn quat_from_euler(roll: f64, pitch: f64, yaw: f64) -> Quat {
+    let (sr, cr) = (0.5 * roll).sin_cos();
+    let (sp, cp) = (0.5 * pitch).sin_cos();
+    let (sy, cy) = (0.5 * yaw).sin_cos();
+    let q = quat(
+        cr * cp * cy + sr * sp * sy,
+        sr * cp * cy - cr * sp * sy,
+        cr * sp * cy + sr * cp * sy,
+        cr * cp * sy - sr * sp * cy,
+    );
+    if q.w < 0.0 { -q } else { q }
+}
+
+pub fn euler_from_quat(q: &Quat) -> Vec3 {
+    euler_from_dcm(&dcm_from_quat(q))
+}
+
+/// DCM of a rotation vector: exp([φ×]) (Rodrigues).
+pub fn dcm_from_rotvec(phi: &Vec3) -> Mat3 {
+    dcm_from_quat(&quat_from_rotvec(phi))
+}
+
+pub fn rotvec_from_dcm(c: &Mat3) -> Vec3 {
+    rotvec_from_quat(&quat_from_dcm(c))
+}
+
+/// Rotate a vector: C(q) v, without forming the matrix.
+pub fn quat_rotate(q: &Quat, v: &Vec3) -> Vec3 {
+    let u = q.imag();
+    let t = 2.0 * u.cross(v);
+    v + q.w * t + u.cross(&t)
+}
+
+/// Angle (rad) of the rotation that takes `b` into `a`: |log(a ⊗ b*)|.
+pub fn quat_angle_between(a: &Quat, b: &Quat) -> f64 {
+    rotvec_from_quat(&(a * b.conjugate())).norm()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn euler_dcm_quat_round_trip() {
+        for &(r, p, y) in &[(0.1, -0.4, 2.9), (-3.0, 1.2, -1.0), (0.0, 0.0, 0.0), (1e-9, -1e-9, 3.14159)] {
+            let c = dcm_from_euler(r, p, y);
+            let q = quat_from_euler(r, p, y);
+            assert!((dcm_from_quat(&q) - c).abs().max() < 1e-14);
+            assert!((quat_from_dcm(&c) - q).coords.abs().max() < 1e-14);
+            let e = euler_from_quat(&q);
+            assert!((e - Vec3::new(r, p, y)).abs().max() < 1e-12, "{e:?}");
+        }
+    }
+
+    #[test]
+    fn rotvec_matches_rodrigues() {
+        let phi = Vec3::new(0.3, -1.1, 0.7);
+        let th = phi.norm();
+        let k = skew(&(phi / th));
+        let rodrigues = Mat3::identity() + th.sin() * k + (1.0 - th.cos()) * k * k;
+        assert!((dcm_from_rotvec(&phi) - rodrigues).abs().max() < 1e-15);
+        assert!((rotvec_from_dcm(&rodrigues) - phi).abs().max() < 1e-14);
+        let tiny = Vec3::new(1e-9, 2e-10, -3e-9);
+        assert!((rotvec_from_quat(&quat_from_rotvec(&tiny)) - tiny).norm() < 1e-24);
+    }
+
+    #[test]
+    fn composition_and_rotation() {
+        let a = quat_from_euler(0.2, 0.1, -0.5);
+        let b = quat_from_euler(-0.3, 0.4, 1.5);
+        let v = Vec3::new(1.0, -2.0, 0.5);
+        assert!((dcm_from_quat(&quat_mul(&a, &b)) - dcm_from_quat(&a) * dcm_from_quat(&b)).abs().max() < 1e-15);
+        assert!((quat_rotate(&a, &v) - dcm_from_quat(&a) * v).norm() < 1e-15);
+    }
+}

@@ -1,0 +1,117 @@
+//! Bindings of earth.rs, vectorised over rows; every function takes an ellipsoid name.
+
+use super::convert::{rows, to_py_rows, vec3, vec3_rows, vec3_to_py};
+use crate::earth::{check_latitude, dcm_ned_to_ecef, Ellipsoid};
+use crate::math::Vec3;
+use numpy::{PyArray2, PyReadonlyArray1, PyReadonlyArray2};
+use pyo3::prelude::*;
+
+fn lla_rows(a: &PyReadonlyArray2<'_, f64>, field: &str) -> PyResult<Vec<Vec3>> {
+    let v = vec3_rows(a, field)?;
+    for (i, p) in v.iter().enumerate() {
+        check_latitude(field, p.x, i)?;
+    }
+    Ok(v)
+}
+
+#[pyfunction]
+#[pyo3(signature = (lla, ellipsoid="WGS84"))]
+fn lla_to_ecef_rows<'py>(py: Python<'py>, lla: PyReadonlyArray2<'py, f64>, ellipsoid: &str) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    let e = Ellipsoid::by_name(ellipsoid)?;
+    let p = lla_rows(&lla, "lla")?;
+    Ok(vec3_to_py(py, &p.iter().map(|x| e.lla_to_ecef(x)).collect::<Vec<_>>()))
+}
+
+#[pyfunction]
+#[pyo3(signature = (ecef, ellipsoid="WGS84"))]
+fn ecef_to_lla_rows<'py>(py: Python<'py>, ecef: PyReadonlyArray2<'py, f64>, ellipsoid: &str) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    let e = Ellipsoid::by_name(ellipsoid)?;
+    let r = vec3_rows(&ecef, "ecef")?;
+    Ok(vec3_to_py(py, &r.iter().map(|x| e.ecef_to_lla(x)).collect::<Vec<_>>()))
+}
+
+#[pyfunction]
+#[pyo3(signature = (ecef, origin_lla, ellipsoid="WGS84"))]
+fn ecef_to_ned_rows<'py>(py: Python<'py>, ecef: PyReadonlyArray2<'py, f64>, origin_lla: PyReadonlyArray1<'py, f64>, ellipsoid: &str) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    let e = Ellipsoid::by_name(ellipsoid)?;
+    let o = vec3(&origin_lla, "origin_lla")?;
+    check_latitude("origin_lla", o.x, 0)?;
+    let r = vec3_rows(&ecef, "ecef")?;
+    Ok(vec3_to_py(py, &r.iter().map(|x| e.ecef_to_ned(x, &o)).collect::<Vec<_>>()))
+}
+
+#[pyfunction]
+#[pyo3(signature = (ned, origin_lla, ellipsoid="WGS84"))]
+fn ned_to_ecef_rows<'py>(py: Python<'py>, ned: PyReadonlyArray2<'py, f64>, origin_lla: PyReadonlyArray1<'py, f64>, ellipsoid: &str) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    let e = Ellipsoid::by_name(ellipsoid)?;
+    let o = vec3(&origin_lla, "origin_lla")?;
+    check_latitude("origin_lla", o.x, 0)?;
+    let r = vec3_rows(&ned, "ned")?;
+    Ok(vec3_to_py(py, &r.iter().map(|x| e.ned_to_ecef(x, &o)).collect::<Vec<_>>()))
+}
+
+/// Per row of (lat, lon, h): [M, N, gravity γ, ∂γ/∂φ, Schuler ω_s].
+#[pyfunction]
+#[pyo3(signature = (lla, ellipsoid="WGS84"))]
+fn earth_params_rows<'py>(py: Python<'py>, lla: PyReadonlyArray2<'py, f64>, ellipsoid: &str) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    let e = Ellipsoid::by_name(ellipsoid)?;
+    let p = lla_rows(&lla, "lla")?;
+    let out: Vec<[f64; 5]> = p
+        .iter()
+        .map(|x| {
+            let (m, n) = e.radii(x.x);
+            [m, n, e.gravity(x.x, x.z), e.gravity_dlat(x.x, x.z), e.schuler_frequency(x.x, x.z)]
+        })
+        .collect();
+    Ok(to_py_rows(py, &out))
+}
+
+/// Per row of (lat, lon, h, v_N, v_E, v_D): [ω_ie^n (3), ω_en^n (3)] in rad/s.
+#[pyfunction]
+#[pyo3(signature = (lla_vel, ellipsoid="WGS84"))]
+fn nav_rates_rows<'py>(py: Python<'py>, lla_vel: PyReadonlyArray2<'py, f64>, ellipsoid: &str) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    let e = Ellipsoid::by_name(ellipsoid)?;
+    let p = rows::<6>(&lla_vel, "lla_vel")?;
+    let mut out = Vec::with_capacity(p.len());
+    for (i, r) in p.iter().enumerate() {
+        check_latitude("lla_vel", r[0], i)?;
+        let wie = e.earth_rate_ned(r[0]);
+        let wen = e.transport_rate_ned(r[0], r[2], &Vec3::new(r[3], r[4], r[5]));
+        out.push([wie.x, wie.y, wie.z, wen.x, wen.y, wen.z]);
+    }
+    Ok(to_py_rows(py, &out))
+}
+
+/// C_n^e for one (lat, lon) as a (3, 3) array.
+#[pyfunction]
+fn dcm_ned_to_ecef_py<'py>(py: Python<'py>, lat: f64, lon: f64) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    check_latitude("lat", lat, 0)?;
+    let c = dcm_ned_to_ecef(lat, lon);
+    let r: Vec<[f64; 3]> = (0..3).map(|i| [c[(i, 0)], c[(i, 1)], c[(i, 2)]]).collect();
+    Ok(to_py_rows(py, &r))
+}
+
+/// Ellipsoid constants as a dict (a, f, gm, omega, e2, b, gamma_e, gamma_p).
+#[pyfunction]
+fn ellipsoid_constants(py: Python<'_>, name: &str) -> PyResult<Py<PyAny>> {
+    let e = Ellipsoid::by_name(name)?;
+    let (ge, gp) = e.gamma_equator_pole();
+    let d = pyo3::types::PyDict::new(py);
+    for (k, v) in [("a", e.a), ("f", e.f), ("gm", e.gm), ("omega", e.omega), ("e2", e.e2()), ("b", e.b()), ("gamma_e", ge), ("gamma_p", gp)] {
+        d.set_item(k, v)?;
+    }
+    d.set_item("name", e.name)?;
+    Ok(d.into_any().unbind())
+}
+
+pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_function(wrap_pyfunction!(lla_to_ecef_rows, m)?)?;
+    m.add_function(wrap_pyfunction!(ecef_to_lla_rows, m)?)?;
+    m.add_function(wrap_pyfunction!(ecef_to_ned_rows, m)?)?;
+    m.add_function(wrap_pyfunction!(ned_to_ecef_rows, m)?)?;
+    m.add_function(wrap_pyfunction!(earth_params_rows, m)?)?;
+    m.add_function(wrap_pyfunction!(nav_rates_rows, m)?)?;
+    m.add_function(wrap_pyfunction!(dcm_ned_to_ecef_py, m)?)?;
+    m.add_function(wrap_pyfunction!(ellipsoid_constants, m)?)?;
+    Ok(())
+}

@@ -1,0 +1,45 @@
+//! pyo3 bindings only: numpy in/out, error mapping, GIL release. No algorithms here.
+
+use pyo3::prelude::*;
+
+mod convert;
+mod earth;
+mod imu;
+mod rotation;
+mod strapdown;
+mod trajectory;
+
+pyo3::create_exception!(
+    _core,
+    NumericalError,
+    pyo3::exceptions::PyArithmeticError,
+    "A computation failed on valid input (covariance lost positive definiteness, divergence)."
+);
+
+/// The unit factors of `units.rs` as a dict, so Python has no second copy of them.
+#[pyfunction]
+fn unit_constants(py: Python<'_>) -> PyResult<Py<PyAny>> {
+    use crate::units::*;
+    let d = pyo3::types::PyDict::new(py);
+    for (k, v) in [
+        ("G0", G0), ("DEG", DEG), ("ARCSEC", ARCSEC), ("ARCMIN", ARCMIN), ("HOUR", HOUR),
+        ("DEG_PER_HOUR", DEG_PER_HOUR), ("DEG_PER_SQRT_HOUR", DEG_PER_SQRT_HOUR),
+        ("MICRO_G", MICRO_G), ("MILLI_G", MILLI_G), ("MICRO_G_PER_SQRT_HZ", MICRO_G_PER_SQRT_HZ),
+        ("MPS_PER_SQRT_HOUR", MPS_PER_SQRT_HOUR), ("PPM", PPM),
+    ] {
+        d.set_item(k, v)?;
+    }
+    Ok(d.into_any().unbind())
+}
+
+#[pymodule]
+fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add("NumericalError", m.py().get_type::<NumericalError>())?;
+    m.add_function(wrap_pyfunction!(unit_constants, m)?)?;
+    rotation::register(m)?;
+    earth::register(m)?;
+    imu::register(m)?;
+    trajectory::register(m)?;
+    strapdown::register(m)?;
+    Ok(())
+}

@@ -1,0 +1,1 @@
+//! Strapdown mechanization in the local-level NED frame.

@@ -1,0 +1,1 @@
+//! Reference trajectories: continuous-time motion models sampled into truth records.
