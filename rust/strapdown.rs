@@ -1,1 +1,300 @@
-//! Strapdown mechanization in the local-level NED frame.
+//! Strapdown mechanization in the local-level NED frame (spec gnss-ins-tight §2.8):
+//! quaternion attitude with coning correction, velocity with rotation and sculling
+//! corrections, Coriolis, Earth and transport rate, normal gravity, optional baro-damped
+//! vertical channel. Second order in the step: gravity, Coriolis and the navigation-frame
+//! rotation are taken at the interval midpoint (predictor–corrector), and the specific
+//! force is rotated by [I − ½[ζ×]] for the navigation-frame rotation ζ over the step
+//! (Savage, Strapdown Analytics §7.2).
+//!
+//! One `Strapdown` object serves batch use (one call over a whole record) and streaming
+//! (successive chunks): it keeps the previous sample for coning/sculling.
+
+use crate::earth::{check_latitude, Ellipsoid};
+use crate::error::{invalid, Result};
+use crate::math::{quat_from_rotvec, quat_normalize, quat_rotate, Quat, Vec3};
+
+/// Kind of IMU output fed to the mechanization.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ImuKind {
+    /// Instantaneous specific force (m/s²) and angular rate (rad/s) at the sample times.
+    Rates,
+    /// Velocity (m/s) and angle (rad) increments over (t_{k−1}, t_k].
+    Increments,
+}
+
+impl ImuKind {
+    pub fn parse(s: &str) -> Result<ImuKind> {
+        match s {
+            "rates" => Ok(ImuKind::Rates),
+            "increments" => Ok(ImuKind::Increments),
+            _ => Err(invalid("kind", format!("unknown IMU output kind '{s}' (known: 'rates', 'increments')"))),
+        }
+    }
+}
+
+/// Navigation solution at one instant.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct NavState {
+    pub t: f64,
+    /// (lat rad, lon rad, h m).
+    pub lla: Vec3,
+    /// NED velocity (m/s).
+    pub vel: Vec3,
+    /// Attitude q_nb (Hamilton, scalar first).
+    pub q_nb: Quat,
+}
+
+/// Vertical channel: free (unstable, e-folding ≈ √(R/2g) ≈ 9.5 min) or damped by a
+/// reference altitude h_b (barometer) with gains K_v1 = 2ζω_v, K_v2 = ω_v² + 2γ/R₀
+/// (spec gnss-ins-tight Eq. 26; thesis' baro loop).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Vertical {
+    Free,
+    Damped { zeta: f64, omega: f64 },
+}
+
+#[derive(Debug, Clone)]
+pub struct Strapdown {
+    pub ell: Ellipsoid,
+    pub kind: ImuKind,
+    pub vertical: Vertical,
+    pub state: NavState,
+    /// Increments (Δθ, Δv) of the previous interval, for the two-interval coning and
+    /// sculling terms.
+    prev_increment: Option<(Vec3, Vec3)>,
+    /// Up to the last two rate samples (t, ω, f), to turn rates into increments.
+    rate_history: Vec<(f64, Vec3, Vec3)>,
+}
+
+impl Strapdown {
+    pub fn new(initial: NavState, kind: ImuKind, ell: Ellipsoid, vertical: Vertical) -> Result<Strapdown> {
+        check_latitude("initial lla", initial.lla.x, 0)?;
+        let finite = initial.lla.iter().chain(initial.vel.iter()).chain(initial.q_nb.coords.iter()).all(|x| x.is_finite());
+        if !finite || !initial.t.is_finite() {
+            return Err(invalid("initial state", "non-finite value"));
+        }
+        if initial.q_nb.norm() == 0.0 {
+            return Err(invalid("initial q_nb", "zero quaternion"));
+        }
+        if let Vertical::Damped { zeta, omega } = vertical {
+            if !(zeta.is_finite() && zeta > 0.0 && omega.is_finite() && omega > 0.0) {
+                return Err(invalid("vertical", format!("damping ratio and frequency must be > 0, got zeta={zeta}, omega={omega}")));
+            }
+        }
+        let state = NavState { q_nb: quat_normalize(&initial.q_nb), ..initial };
+        Ok(Strapdown { ell, kind, vertical, state, prev_increment: None, rate_history: Vec::new() })
+    }
+
+    /// Run over a chunk. `t[k]` is the sample time (rates) or the end of the interval
+    /// (increments); `gyro`, `accel` are rates (rad/s, m/s²) or increments (rad, m/s);
+    /// `h_ref` is the reference altitude (m) per sample, required with a damped vertical
+    /// channel. Returns the state after each sample. With rates, a first sample at the
+    /// initial time only primes the integrator (its output is the initial state).
+    pub fn run(&mut self, t: &[f64], gyro: &[Vec3], accel: &[Vec3], h_ref: Option<&[f64]>) -> Result<Vec<NavState>> {
+        self.validate(t, gyro, accel, h_ref)?;
+        let mut out = Vec::with_capacity(t.len());
+        for k in 0..t.len() {
+            let href = h_ref.map(|h| h[k]);
+            self.step(t[k], &gyro[k], &accel[k], href);
+            if self.state.lla.x.abs() > std::f64::consts::FRAC_PI_2 || !self.state.vel.iter().all(|v| v.is_finite()) {
+                return Err(crate::error::NavError::Numerical(format!(
+                    "navigation solution diverged at sample {k} (t = {} s): latitude {} rad, velocity {:?}",
+                    t[k], self.state.lla.x, self.state.vel
+                )));
+            }
+            out.push(self.state);
+        }
+        Ok(out)
+    }
+
+    fn validate(&self, t: &[f64], gyro: &[Vec3], accel: &[Vec3], h_ref: Option<&[f64]>) -> Result<()> {
+        let n = t.len();
+        if gyro.len() != n || accel.len() != n {
+            return Err(invalid("imu", format!("time has {n} samples but gyro {} and accel {}", gyro.len(), accel.len())));
+        }
+        let mut prev_t = self.state.t;
+        for (k, &tk) in t.iter().enumerate() {
+            if !tk.is_finite() {
+                return Err(invalid("time", format!("non-finite time {tk} at index {k}")));
+            }
+            // With rates the very first sample may coincide with the initial time.
+            let first_rate_sample = self.kind == ImuKind::Rates && self.rate_history.is_empty() && k == 0;
+            if first_rate_sample && tk != self.state.t {
+                return Err(invalid("time", format!("the first rate sample must be at the initial time {} s, got {tk} at index 0", self.state.t)));
+            }
+            if !first_rate_sample && tk <= prev_t {
+                let what = if tk == prev_t { "duplicated" } else { "decreasing" };
+                return Err(invalid("time", format!("time not strictly increasing: {what} stamp {tk} at index {k}")));
+            }
+            prev_t = tk;
+        }
+        for (name, data) in [("gyro", gyro), ("accel", accel)] {
+            if let Some(k) = data.iter().position(|v| !v.iter().all(|x| x.is_finite())) {
+                return Err(invalid(name, format!("non-finite value at index {k}: {:?}", data[k].as_slice())));
+            }
+        }
+        match (self.vertical, h_ref) {
+            (Vertical::Damped { .. }, None) => Err(invalid("h_ref", "a damped vertical channel needs a reference altitude per sample")),
+            (_, Some(h)) if h.len() != n => Err(invalid("h_ref", format!("expected {n} samples, got {}", h.len()))),
+            (_, Some(h)) => match h.iter().position(|x| !x.is_finite()) {
+                Some(k) => Err(invalid("h_ref", format!("non-finite value at index {k}"))),
+                None => Ok(()),
+            },
+            _ => Ok(()),
+        }
+    }
+
+    /// One mechanization step to time `t` with one IMU sample (rates or increments).
+    pub fn step(&mut self, t: f64, gyro: &Vec3, accel: &Vec3, h_ref: Option<f64>) {
+        let (dth, dv) = match self.kind {
+            ImuKind::Increments => (*gyro, *accel),
+            ImuKind::Rates => {
+                let inc = rates_to_increment(&self.rate_history, t, gyro, accel);
+                if self.rate_history.len() == 2 {
+                    self.rate_history.remove(0);
+                }
+                self.rate_history.push((t, *gyro, *accel));
+                match inc {
+                    Some(inc) => inc,
+                    None => return, // first rate sample at the initial time: nothing to integrate yet
+                }
+            }
+        };
+        let (phi, dv_body) = coning_sculling(self.prev_increment, &dth, &dv);
+        self.prev_increment = Some((dth, dv));
+        let dt = t - self.state.t;
+        self.integrate(t, dt, &phi, &dv_body, h_ref);
+    }
+
+    /// Attitude, velocity and position over one interval, given the body rotation vector
+    /// `phi` (coning included) and the body-frame velocity increment `dv_body` (rotation
+    /// and sculling included), both referred to the body frame at t_{k−1}.
+    fn integrate(&mut self, t: f64, dt: f64, phi: &Vec3, dv_body: &Vec3, h_ref: Option<f64>) {
+        let s0 = self.state;
+        let ell = &self.ell;
+        // Baro loop (spec Eq. 26): ḣ gets −K_v1(h − h_b), v̇_D gets +K_v2(h − h_b).
+        let (k1, k2, dh0) = match (self.vertical, h_ref) {
+            (Vertical::Damped { zeta, omega }, Some(hb)) => {
+                let (m, n) = ell.radii(s0.lla.x);
+                let r0 = (m * n).sqrt() + s0.lla.z;
+                (2.0 * zeta * omega, omega * omega + 2.0 * ell.gravity(s0.lla.x, s0.lla.z) / r0, s0.lla.z - hb)
+            }
+            _ => (0.0, 0.0, 0.0),
+        };
+        let dv_sf_b = quat_rotate(&s0.q_nb, dv_body); // C_nb(k−1) Δv
+        let advance = |lla_mid: &Vec3, v_mid: &Vec3| {
+            let w_ie = ell.earth_rate_ned(lla_mid.x);
+            let w_en = ell.transport_rate_ned(lla_mid.x, lla_mid.z, v_mid);
+            let zeta = (w_ie + w_en) * dt; // navigation-frame rotation over the step
+            let dv_sf = dv_sf_b - 0.5 * zeta.cross(&dv_sf_b);
+            let g = ell.gravity_ned(lla_mid.x, lla_mid.z);
+            let mut vel = s0.vel + dv_sf + (g - (2.0 * w_ie + w_en).cross(v_mid)) * dt;
+            vel.z += k2 * dh0 * dt;
+            let v_avg = 0.5 * (s0.vel + vel);
+            let mut lla = s0.lla + ell.lla_rate(lla_mid.x, lla_mid.z, &v_avg) * dt;
+            lla.z -= k1 * dh0 * dt;
+            (vel, lla, zeta)
+        };
+        // predictor with the values at t_{k−1}, corrector at the midpoint
+        let (v_pred, lla_pred, _) = advance(&s0.lla, &s0.vel);
+        let (vel, lla, zeta) = advance(&(0.5 * (s0.lla + lla_pred)), &(0.5 * (s0.vel + v_pred)));
+        // C_nb(k) = C_{n(k−1)}^{n(k)} C_nb(k−1) C_{b(k)}^{b(k−1)}
+        let q = quat_from_rotvec(&(-zeta)) * s0.q_nb * quat_from_rotvec(phi);
+        self.state = NavState { t, lla, vel, q_nb: quat_normalize(&q) };
+    }
+}
+
+/// Increments (∫ω dt, ∫f dt) over (t_{k−1}, t_k] from rate samples: the integral of the
+/// quadratic through the last three samples (trapezoid while only two exist). For uniform
+/// steps the weights are h/12·(−1, 8, 5); the local error is O(h⁴ y‴) instead of the
+/// trapezoid's O(h³ y″), which keeps a 10-minute run at the 10⁻³ m level.
+fn rates_to_increment(history: &[(f64, Vec3, Vec3)], t: f64, w: &Vec3, f: &Vec3) -> Option<(Vec3, Vec3)> {
+    match history {
+        [] => None,
+        [(t1, w1, f1)] => {
+            let h = t - t1;
+            Some((0.5 * h * (w1 + w), 0.5 * h * (f1 + f)))
+        }
+        [(t0, w0, f0), (t1, w1, f1)] => {
+            // Lagrange weights on nodes (−h₁, 0, h) integrated over [0, h]
+            let (h1, h) = (t1 - t0, t - t1);
+            let a = -h * h * h / (6.0 * h1 * (h1 + h));
+            let b = h * h / (6.0 * h1) + 0.5 * h;
+            let c = (h * h / 3.0 + 0.5 * h1 * h) / (h + h1);
+            Some((a * w0 + b * w1 + c * w, a * f0 + b * f1 + c * f))
+        }
+        _ => unreachable!("the rate history holds at most two samples"),
+    }
+}
+
+/// Two-interval coning and sculling (rates assumed linear across this and the previous
+/// interval): φ = Δθ + Δθ_{k−1}×Δθ/12; Δv_b = Δv + ½Δθ×Δv + ⅙Δθ×(Δθ×Δv)
+/// + (Δθ_{k−1}×Δv + Δv_{k−1}×Δθ)/12. The ⅙ term is the second-order rotation of the
+/// specific force within the step; it is rectified (always opposes f's component
+/// across the rotation axis), so leaving it out biases the vertical channel by
+/// ≈ ⅙|Δθ|²g/Δt (1.5e-7 m/s² for 0.03 rad/s at 100 Hz).
+fn coning_sculling(prev: Option<(Vec3, Vec3)>, dth: &Vec3, dv: &Vec3) -> (Vec3, Vec3) {
+    let rot = 0.5 * dth.cross(dv) + dth.cross(&dth.cross(dv)) / 6.0;
+    match prev {
+        Some((pth, pv)) => (dth + pth.cross(dth) / 12.0, dv + rot + (pth.cross(dv) + pv.cross(dth)) / 12.0),
+        None => (*dth, dv + rot),
+    }
+}
+
+/// Integrate body attitude only (no navigation-frame rotation) from increments with the
+/// two-interval coning correction: q_k = q_{k−1} ⊗ q(φ_k).
+pub fn integrate_attitude(q0: &Quat, dtheta: &[Vec3]) -> Vec<Quat> {
+    let mut q = quat_normalize(q0);
+    let mut prev = None;
+    dtheta
+        .iter()
+        .map(|d| {
+            let (phi, _) = coning_sculling(prev.map(|p| (p, Vec3::zeros())), d, &Vec3::zeros());
+            prev = Some(*d);
+            q = quat_normalize(&(q * quat_from_rotvec(&phi)));
+            q
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::earth::WGS84;
+    use crate::imu::ideal::{ideal_increments, ideal_rates};
+    use crate::math::quat_angle_between;
+    use crate::trajectory::generators::sinusoidal;
+
+    /// Free-vertical round trip: exact IMU of a sinusoidal motion integrated back.
+    fn round_trip(kind: ImuKind, seconds: f64) -> (f64, f64) {
+        let origin = Vec3::new(0.6, 0.2, 150.0);
+        let m = sinusoidal(origin, seconds, Vec3::new(20.0, 15.0, 2.0), Vec3::new(60.0, 45.0, 30.0), Vec3::new(0.1, 0.08, 0.3), Vec3::new(20.0, 25.0, 40.0), 0.5).unwrap();
+        let n = (seconds * 100.0) as usize + 1;
+        let times: Vec<f64> = (0..n).map(|k| k as f64 * 0.01).collect();
+        let truth = m.truth(&WGS84, &times).unwrap();
+        let init = NavState { t: 0.0, lla: truth[0].lla, vel: truth[0].vel, q_nb: truth[0].q_nb };
+        let mut sd = Strapdown::new(init, kind, WGS84, Vertical::Free).unwrap();
+        let out = match kind {
+            ImuKind::Rates => {
+                let (f, w, _) = ideal_rates(&m, &WGS84, &truth);
+                sd.run(&times, &w, &f, None).unwrap()
+            }
+            ImuKind::Increments => {
+                let (dv, dth) = ideal_increments(&m, &WGS84, &truth);
+                sd.run(&times[1..], &dth, &dv, None).unwrap()
+            }
+        };
+        let last = out.last().unwrap();
+        let tl = truth.last().unwrap();
+        let dpos = WGS84.lla_to_ecef(&last.lla) - WGS84.lla_to_ecef(&tl.lla);
+        (dpos.norm(), quat_angle_between(&last.q_nb, &tl.q_nb))
+    }
+
+    #[test]
+    fn round_trip_short_is_exact_to_mm() {
+        for kind in [ImuKind::Rates, ImuKind::Increments] {
+            let (dp, da) = round_trip(kind, 60.0);
+            assert!(dp < 1e-4 && da < 1e-9, "{kind:?}: {dp} m, {da} rad");
+        }
+    }
+}

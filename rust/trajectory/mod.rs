@@ -1,1 +1,8 @@
-//! Reference trajectories: continuous-time motion models sampled into truth records.
+//! Reference trajectories: continuous-time motion models (`motion`), their smooth
+//! building blocks (`profile`), and the named scenarios of the papers (`generators`).
+pub mod generators;
+pub mod motion;
+pub mod profile;
+
+pub use motion::{euler_chain, AxisRotation, Kinematics, Motion, TruthState};
+pub use profile::{Eval, Profile, StepShape, Term};
