@@ -1,6 +1,101 @@
-//! Bindings of strapdown.
-use pyo3::prelude::*;
+//! Bindings of strapdown.rs: a streaming mechanization object and attitude integration.
 
-pub fn register(_m: &Bound<'_, PyModule>) -> PyResult<()> {
+use super::convert::{quat_rows, quat_to_py, vec3, vec3_rows, vec3_to_py, vec_to_py, vector};
+use crate::earth::Ellipsoid;
+use crate::error::invalid;
+use crate::math::{quat, Vec3};
+use crate::strapdown::{integrate_attitude, ImuKind, NavState, Strapdown as Core, Vertical};
+use numpy::{PyArray2, PyReadonlyArray1, PyReadonlyArray2};
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+
+/// Streaming strapdown INS (NED). Feed chunks with `run`; state carries over.
+#[pyclass(module = "atomnav._core")]
+pub struct Strapdown {
+    inner: Core,
+}
+
+fn states_to_dict<'py>(py: Python<'py>, s: &[NavState]) -> PyResult<Bound<'py, PyDict>> {
+    let d = PyDict::new(py);
+    d.set_item("time", vec_to_py(py, s.iter().map(|x| x.t).collect()))?;
+    d.set_item("lla", vec3_to_py(py, &s.iter().map(|x| x.lla).collect::<Vec<_>>()))?;
+    d.set_item("vel_ned", vec3_to_py(py, &s.iter().map(|x| x.vel).collect::<Vec<_>>()))?;
+    d.set_item("q_nb", quat_to_py(py, &s.iter().map(|x| x.q_nb).collect::<Vec<_>>()))?;
+    Ok(d)
+}
+
+#[pymethods]
+impl Strapdown {
+    /// t0 (s), lla (lat rad, lon rad, h m), vel_ned (m/s), q_nb (scalar first); kind
+    /// "rates" or "increments"; vertical "free" or "damped" (baro loop with damping ratio
+    /// `zeta` and natural frequency `omega` rad/s).
+    #[new]
+    #[pyo3(signature = (t0, lla, vel_ned, q_nb, kind, ellipsoid="WGS84", vertical="free", zeta=0.707, omega=0.01))]
+    #[allow(clippy::too_many_arguments)]
+    fn new(
+        t0: f64,
+        lla: PyReadonlyArray1<'_, f64>,
+        vel_ned: PyReadonlyArray1<'_, f64>,
+        q_nb: PyReadonlyArray1<'_, f64>,
+        kind: &str,
+        ellipsoid: &str,
+        vertical: &str,
+        zeta: f64,
+        omega: f64,
+    ) -> PyResult<Self> {
+        let q = vector(&q_nb, "q_nb")?;
+        if q.len() != 4 {
+            return Err(invalid("q_nb", format!("expected 4 elements, got {}", q.len())).into());
+        }
+        let vertical = match vertical {
+            "free" => Vertical::Free,
+            "damped" => Vertical::Damped { zeta, omega },
+            other => return Err(invalid("vertical", format!("unknown option '{other}' (known: 'free', 'damped')")).into()),
+        };
+        let init = NavState { t: t0, lla: vec3(&lla, "lla")?, vel: vec3(&vel_ned, "vel_ned")?, q_nb: quat(q[0], q[1], q[2], q[3]) };
+        Ok(Strapdown { inner: Core::new(init, ImuKind::parse(kind)?, Ellipsoid::by_name(ellipsoid)?, vertical)? })
+    }
+
+    /// Integrate one chunk; returns the state after each sample (dict of arrays).
+    #[pyo3(signature = (time, gyro, accel, h_ref=None))]
+    fn run<'py>(
+        &mut self,
+        py: Python<'py>,
+        time: PyReadonlyArray1<'py, f64>,
+        gyro: PyReadonlyArray2<'py, f64>,
+        accel: PyReadonlyArray2<'py, f64>,
+        h_ref: Option<PyReadonlyArray1<'py, f64>>,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        let t: Vec<f64> = time.as_array().iter().copied().collect();
+        let g = vec3_rows(&gyro, "gyro")?;
+        let a = vec3_rows(&accel, "accel")?;
+        let h: Option<Vec<f64>> = h_ref.map(|h| h.as_array().iter().copied().collect());
+        let inner = &mut self.inner;
+        let out = py.detach(|| inner.run(&t, &g, &a, h.as_deref()))?;
+        states_to_dict(py, &out)
+    }
+
+    /// Current state as a dict (time, lla, vel_ned, q_nb).
+    fn state<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        states_to_dict(py, &[self.inner.state])
+    }
+}
+
+/// Body attitude from gyro increments with the two-interval coning correction
+/// (no navigation-frame rotation): q_k = q_{k−1} ⊗ q(Δθ_k + Δθ_{k−1}×Δθ_k/12).
+#[pyfunction]
+fn integrate_attitude_increments<'py>(py: Python<'py>, q0: PyReadonlyArray2<'py, f64>, dtheta: PyReadonlyArray2<'py, f64>) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    let q0 = quat_rows(&q0, "q0")?;
+    if q0.len() != 1 || q0[0].norm() == 0.0 {
+        return Err(invalid("q0", "expected one non-zero quaternion").into());
+    }
+    let d: Vec<Vec3> = vec3_rows(&dtheta, "dtheta")?;
+    let q = py.detach(|| integrate_attitude(&q0[0], &d));
+    Ok(quat_to_py(py, &q))
+}
+
+pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_class::<Strapdown>()?;
+    m.add_function(wrap_pyfunction!(integrate_attitude_increments, m)?)?;
     Ok(())
 }

@@ -1,6 +1,161 @@
-//! Bindings of trajectory.
-use pyo3::prelude::*;
+//! Bindings of trajectory/ (motion models and generators) and imu::ideal.
 
-pub fn register(_m: &Bound<'_, PyModule>) -> PyResult<()> {
-    Ok(())
+use super::convert::{quat_to_py, vec3, vec3_to_py, vec_to_py, vector};
+use crate::earth::{check_latitude, Ellipsoid};
+use crate::error::invalid;
+use crate::imu::ideal::{ideal_increments, ideal_rates};
+use crate::math::Vec3;
+use crate::trajectory::{generators, Motion as CoreMotion};
+use numpy::{PyReadonlyArray1, PyReadonlyArray2};
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+
+/// A continuous-time motion model (exact velocity, acceleration, attitude and body rate).
+#[pyclass(module = "atomnav._core", frozen)]
+pub struct Motion {
+    pub inner: CoreMotion,
+}
+
+fn origin(o: &PyReadonlyArray1<'_, f64>) -> PyResult<Vec3> {
+    let v = vec3(o, "origin")?;
+    check_latitude("origin", v.x, 0)?;
+    Ok(v)
+}
+
+fn wrap(m: CoreMotion) -> Motion {
+    Motion { inner: m }
+}
+
+#[pymethods]
+impl Motion {
+    #[getter]
+    fn name(&self) -> String {
+        self.inner.name.clone()
+    }
+    #[getter]
+    fn duration(&self) -> f64 {
+        self.inner.duration
+    }
+    #[getter]
+    fn origin_lla(&self) -> (f64, f64, f64) {
+        (self.inner.origin.x, self.inner.origin.y, self.inner.origin.z)
+    }
+
+    #[staticmethod]
+    fn stationary(origin_lla: PyReadonlyArray1<'_, f64>, duration: f64, euler: PyReadonlyArray1<'_, f64>) -> PyResult<Motion> {
+        crate::error::check_positive("duration", duration)?;
+        Ok(wrap(CoreMotion::stationary("stationary", origin(&origin_lla)?, duration, vec3(&euler, "euler")?)))
+    }
+
+    #[staticmethod]
+    #[allow(clippy::too_many_arguments)]
+    fn sinusoidal(
+        origin_lla: PyReadonlyArray1<'_, f64>,
+        duration: f64,
+        amp_ned: PyReadonlyArray1<'_, f64>,
+        period_ned: PyReadonlyArray1<'_, f64>,
+        amp_euler: PyReadonlyArray1<'_, f64>,
+        period_euler: PyReadonlyArray1<'_, f64>,
+        heading: f64,
+    ) -> PyResult<Motion> {
+        crate::error::check_positive("duration", duration)?;
+        Ok(wrap(generators::sinusoidal(
+            origin(&origin_lla)?,
+            duration,
+            vec3(&amp_ned, "amp_ned")?,
+            vec3(&period_ned, "period_ned")?,
+            vec3(&amp_euler, "amp_euler")?,
+            vec3(&period_euler, "period_euler")?,
+            heading,
+        )?))
+    }
+
+    #[staticmethod]
+    fn hexapod(origin_lla: PyReadonlyArray1<'_, f64>, max_tilt: f64, pitch_delay: f64, heading: f64) -> PyResult<Motion> {
+        if !(max_tilt.is_finite() && max_tilt.abs() < 0.5) {
+            return Err(invalid("max_tilt", format!("must be finite and below 0.5 rad, got {max_tilt}")).into());
+        }
+        Ok(wrap(generators::hexapod(origin(&origin_lla)?, max_tilt, pitch_delay, heading)))
+    }
+
+    #[staticmethod]
+    fn drive_with_yaw(origin_lla: PyReadonlyArray1<'_, f64>, speed: f64, yaw_rate_amp: f64, period: f64, duration: f64, heading: f64) -> PyResult<Motion> {
+        crate::error::check_positive("duration", duration)?;
+        Ok(wrap(generators::drive_with_yaw(origin(&origin_lla)?, speed, yaw_rate_amp, period, duration, heading)?))
+    }
+
+    #[staticmethod]
+    fn slalom(origin_lla: PyReadonlyArray1<'_, f64>, speed: f64, amp: f64, period: f64, duration: f64) -> PyResult<Motion> {
+        crate::error::check_positive("duration", duration)?;
+        Ok(wrap(generators::slalom(origin(&origin_lla)?, speed, amp, period, duration)?))
+    }
+
+    #[staticmethod]
+    fn car(origin_lla: PyReadonlyArray1<'_, f64>, heading: f64, vibration: bool) -> PyResult<Motion> {
+        Ok(wrap(generators::car(origin(&origin_lla)?, heading, vibration)))
+    }
+
+    #[staticmethod]
+    fn rotary_stand(
+        origin_lla: PyReadonlyArray1<'_, f64>,
+        states: PyReadonlyArray2<'_, f64>,
+        move_starts: PyReadonlyArray1<'_, f64>,
+        move_duration: f64,
+        duration: f64,
+    ) -> PyResult<Motion> {
+        let st: Vec<(f64, f64)> = super::convert::rows::<2>(&states, "states")?.into_iter().map(|r| (r[0], r[1])).collect();
+        let ms = vector(&move_starts, "move_starts")?;
+        Ok(wrap(generators::rotary_stand(origin(&origin_lla)?, &st, &ms, move_duration, duration)?))
+    }
+
+    #[staticmethod]
+    fn vasilyuk2024_stand(origin_lla: PyReadonlyArray1<'_, f64>) -> PyResult<Motion> {
+        Ok(wrap(generators::vasilyuk2024_stand(origin(&origin_lla)?)?))
+    }
+
+    /// Truth at `times` (s, increasing, within [0, duration]): dict of arrays
+    /// time, lla (N,3), vel_ned (N,3), acc_ned (N,3), q_nb (N,4), w_nb_b (N,3).
+    #[pyo3(signature = (times, ellipsoid="WGS84"))]
+    fn truth<'py>(&self, py: Python<'py>, times: PyReadonlyArray1<'py, f64>, ellipsoid: &str) -> PyResult<Bound<'py, PyDict>> {
+        let ell = Ellipsoid::by_name(ellipsoid)?;
+        let t = vector(&times, "times")?;
+        let truth = py.detach(|| self.inner.truth(&ell, &t))?;
+        let d = PyDict::new(py);
+        d.set_item("time", vec_to_py(py, t))?;
+        d.set_item("lla", vec3_to_py(py, &truth.iter().map(|s| s.lla).collect::<Vec<_>>()))?;
+        d.set_item("vel_ned", vec3_to_py(py, &truth.iter().map(|s| s.vel).collect::<Vec<_>>()))?;
+        d.set_item("acc_ned", vec3_to_py(py, &truth.iter().map(|s| s.acc).collect::<Vec<_>>()))?;
+        d.set_item("q_nb", quat_to_py(py, &truth.iter().map(|s| s.q_nb).collect::<Vec<_>>()))?;
+        d.set_item("w_nb_b", vec3_to_py(py, &truth.iter().map(|s| s.w_nb_b).collect::<Vec<_>>()))?;
+        Ok(d)
+    }
+
+    /// Error-free IMU output at `times`. kind "rates": gyro (rad/s), accel (m/s²) and
+    /// angular acceleration (rad/s²) at each time; kind "increments": dtheta (rad), dv (m/s)
+    /// over each interval (t_{k−1}, t_k], N − 1 rows.
+    #[pyo3(signature = (times, kind, ellipsoid="WGS84"))]
+    fn ideal_imu<'py>(&self, py: Python<'py>, times: PyReadonlyArray1<'py, f64>, kind: &str, ellipsoid: &str) -> PyResult<Bound<'py, PyDict>> {
+        let ell = Ellipsoid::by_name(ellipsoid)?;
+        let kind = crate::strapdown::ImuKind::parse(kind)?;
+        let t = vector(&times, "times")?;
+        let d = PyDict::new(py);
+        match kind {
+            crate::strapdown::ImuKind::Rates => {
+                let (f, w, wd) = py.detach(|| self.inner.truth(&ell, &t).map(|tr| ideal_rates(&self.inner, &ell, &tr)))?;
+                d.set_item("gyro", vec3_to_py(py, &w))?;
+                d.set_item("accel", vec3_to_py(py, &f))?;
+                d.set_item("angular_acceleration", vec3_to_py(py, &wd))?;
+            }
+            crate::strapdown::ImuKind::Increments => {
+                let (dv, dth) = py.detach(|| self.inner.truth(&ell, &t).map(|tr| ideal_increments(&self.inner, &ell, &tr)))?;
+                d.set_item("gyro", vec3_to_py(py, &dth))?;
+                d.set_item("accel", vec3_to_py(py, &dv))?;
+            }
+        }
+        Ok(d)
+    }
+}
+
+pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_class::<Motion>()
 }

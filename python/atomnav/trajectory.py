@@ -1,0 +1,246 @@
+"""Reference trajectories: the papers' named motions, and a :class:`Trajectory` type
+users build from their own data.
+
+A generated trajectory carries its continuous motion model, so its ideal IMU output is
+exact (:meth:`Trajectory.ideal_imu`). Angles in rad, positions (lat rad, lon rad, h m),
+velocities NED m/s, attitude ``q_nb`` scalar first.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from . import _core
+from ._validate import choice, increasing, positive, rows, vector
+from .rotation import euler_from_quat, quat_from_euler
+
+#: Column names of a trajectory table (units in the names).
+COLUMNS = ["time_s", "lat_rad", "lon_rad", "h_m", "vn_mps", "ve_mps", "vd_mps", "qw", "qx", "qy", "qz", "roll_rad", "pitch_rad", "yaw_rad"]
+#: IMU table columns for each output kind.
+IMU_COLUMNS = {
+    "rates": ["time_s", "gyro_x_rad_s", "gyro_y_rad_s", "gyro_z_rad_s", "accel_x_mps2", "accel_y_mps2", "accel_z_mps2"],
+    "increments": ["time_s", "dtheta_x_rad", "dtheta_y_rad", "dtheta_z_rad", "dv_x_mps", "dv_y_mps", "dv_z_mps"],
+}
+#: Default site: Moscow, 55.75°N 37.6°E, 200 m (spec gnss-ins-tight §3).
+MOSCOW = (np.deg2rad(55.75), np.deg2rad(37.6), 200.0)
+
+
+def nav_table(time, lla, vel_ned, q_nb) -> pd.DataFrame:
+    """A trajectory / navigation-solution table from arrays (Euler angles added)."""
+    q = rows(q_nb, 4, "q_nb")
+    e = euler_from_quat(q) if len(q) else np.zeros((0, 3))
+    data = np.column_stack([vector(time, None, "time"), rows(lla, 3, "lla"), rows(vel_ned, 3, "vel_ned"), q, e])
+    return pd.DataFrame(data, columns=COLUMNS)
+
+
+class Trajectory:
+    """A sampled trajectory (truth or user data) as a DataFrame with unit-named columns
+    (:data:`COLUMNS`), optionally backed by an exact motion model.
+
+    Build from data with :meth:`from_dataframe` / :meth:`from_csv`, or with the
+    generators of this module (:func:`sinusoidal`, :func:`hexapod`, ...)."""
+
+    def __init__(self, df: pd.DataFrame, motion: _core.Motion | None = None, ellipsoid: str = "WGS84"):
+        self.df = df
+        self.motion = motion
+        self.ellipsoid = ellipsoid
+
+    # ---- construction -------------------------------------------------------------
+    @classmethod
+    def from_motion(cls, motion: _core.Motion, rate_hz: float, ellipsoid: str = "WGS84") -> "Trajectory":
+        """Sample a motion model at ``rate_hz`` over its whole duration."""
+        rate_hz = positive(rate_hz, "rate_hz")
+        n = int(np.floor(motion.duration * rate_hz + 1e-9)) + 1
+        t = np.arange(n) / rate_hz
+        tr = motion.truth(t, ellipsoid)
+        return cls(nav_table(tr["time"], tr["lla"], tr["vel_ned"], tr["q_nb"]), motion, ellipsoid)
+
+    @classmethod
+    def from_dataframe(cls, df: pd.DataFrame, ellipsoid: str = "WGS84") -> "Trajectory":
+        """From a table with ``time_s, lat_rad, lon_rad, h_m, vn_mps, ve_mps, vd_mps`` and
+        either ``qw, qx, qy, qz`` or ``roll_rad, pitch_rad, yaw_rad``. Validated: finite
+        values, strictly increasing time, latitude within ±π/2."""
+        need = ["time_s", "lat_rad", "lon_rad", "h_m", "vn_mps", "ve_mps", "vd_mps"]
+        missing = [c for c in need if c not in df.columns]
+        if missing:
+            raise ValueError(f"trajectory: missing column(s) {missing}; expected {need} plus quaternion or Euler columns")
+        if all(c in df.columns for c in ("qw", "qx", "qy", "qz")):
+            q = df[["qw", "qx", "qy", "qz"]].to_numpy(float)
+        elif all(c in df.columns for c in ("roll_rad", "pitch_rad", "yaw_rad")):
+            q = quat_from_euler(rows(df[["roll_rad", "pitch_rad", "yaw_rad"]].to_numpy(float), 3, "euler"))
+        else:
+            raise ValueError("trajectory: needs attitude columns qw, qx, qy, qz or roll_rad, pitch_rad, yaw_rad")
+        t = vector(df["time_s"].to_numpy(float), None, "time_s")
+        increasing(t, "time_s")
+        lla = rows(df[["lat_rad", "lon_rad", "h_m"]].to_numpy(float), 3, "lla")
+        bad = np.nonzero(np.abs(lla[:, 0]) > np.pi / 2)[0]
+        if bad.size:
+            raise ValueError(f"lat_rad: latitude {lla[bad[0], 0]} rad at index {bad[0]} is outside [-pi/2, pi/2]")
+        return cls(nav_table(t, lla, df[["vn_mps", "ve_mps", "vd_mps"]].to_numpy(float), q), None, ellipsoid)
+
+    @classmethod
+    def from_csv(cls, path, ellipsoid: str = "WGS84", **read_csv_kwargs) -> "Trajectory":
+        """Read a CSV with the columns of :meth:`from_dataframe`."""
+        return cls.from_dataframe(pd.read_csv(path, **read_csv_kwargs), ellipsoid)
+
+    def to_csv(self, path) -> Path:
+        self.df.to_csv(path, index=False)
+        return Path(path)
+
+    # ---- access -------------------------------------------------------------------
+    def __len__(self) -> int:
+        return len(self.df)
+
+    def __repr__(self) -> str:
+        name = self.motion.name if self.motion is not None else "user data"
+        t = self.df["time_s"]
+        return f"Trajectory({name}, {len(self)} samples, {t.iloc[0]:.3f}..{t.iloc[-1]:.3f} s)"
+
+    @property
+    def time(self) -> np.ndarray:
+        return self.df["time_s"].to_numpy()
+
+    @property
+    def lla(self) -> np.ndarray:
+        return self.df[["lat_rad", "lon_rad", "h_m"]].to_numpy()
+
+    @property
+    def vel_ned(self) -> np.ndarray:
+        return self.df[["vn_mps", "ve_mps", "vd_mps"]].to_numpy()
+
+    @property
+    def q_nb(self) -> np.ndarray:
+        return self.df[["qw", "qx", "qy", "qz"]].to_numpy()
+
+    def initial_state(self) -> dict:
+        """The first sample as keyword arguments for :func:`atomnav.strapdown.integrate`."""
+        return {"t0": float(self.time[0]), "lla": self.lla[0], "vel_ned": self.vel_ned[0], "q_nb": self.q_nb[0]}
+
+    # ---- IMU ------------------------------------------------------------------------
+    def ideal_imu(self, kind: str = "increments") -> pd.DataFrame:
+        """Error-free IMU output at the trajectory's sample times, body axes FRD.
+
+        ``kind="rates"``: specific force (m/s²), angular rate (rad/s) and angular
+        acceleration (rad/s²) at each sample (N rows). ``kind="increments"``: Δθ (rad) and
+        Δv (m/s) over each interval (t_{k−1}, t_k], N − 1 rows stamped with t_k. Includes
+        Earth rate, transport rate and normal gravity. Needs a generated trajectory."""
+        choice(kind, IMU_COLUMNS, "kind")
+        if self.motion is None:
+            raise ValueError("ideal_imu: this trajectory was built from data and has no motion model; use a generator")
+        out = self.motion.ideal_imu(self.time, kind, self.ellipsoid)
+        t = self.time if kind == "rates" else self.time[1:]
+        df = pd.DataFrame(np.column_stack([t, out["gyro"], out["accel"]]), columns=IMU_COLUMNS[kind])
+        if kind == "rates":
+            for i, a in enumerate("xyz"):
+                df[f"angacc_{a}_rad_s2"] = out["angular_acceleration"][:, i]
+        return df
+
+    # ---- comparison -----------------------------------------------------------------
+    def errors(self, nav: pd.DataFrame) -> pd.DataFrame:
+        """Errors (estimate − truth) of a navigation solution at this trajectory's times:
+        NED position error (m), NED velocity error (m/s), attitude error ψ (rad, nav frame,
+        C_nb(est) = (I − [ψ×]) C_nb(true)). The solution must have the same time stamps."""
+        n = min(len(nav), len(self.df))
+        tt, tn = self.time[-n:], nav["time_s"].to_numpy()[-n:]
+        if not np.allclose(tt, tn, rtol=0, atol=1e-9):
+            raise ValueError("nav: time stamps differ from the trajectory's")
+        truth, est = self.df.iloc[-n:], nav.iloc[-n:]
+        from .earth import lla_to_ecef
+        from .rotation import quat_multiply, rotvec_from_quat
+
+        lla_t = truth[["lat_rad", "lon_rad", "h_m"]].to_numpy()
+        d_ecef = lla_to_ecef(est[["lat_rad", "lon_rad", "h_m"]].to_numpy(), self.ellipsoid) - lla_to_ecef(lla_t, self.ellipsoid)
+        d_ned = np.einsum("nji,nj->ni", _dcm_ned_to_ecef_vec(lla_t), d_ecef.reshape(-1, 3))
+        dv = est[["vn_mps", "ve_mps", "vd_mps"]].to_numpy() - truth[["vn_mps", "ve_mps", "vd_mps"]].to_numpy()
+        # C_est C_trueᵀ = I − [ψ×]  ⇒  ψ = −rotvec(q_est ⊗ q_true*)
+        qt = truth[["qw", "qx", "qy", "qz"]].to_numpy() * np.array([1, -1, -1, -1])
+        psi = -np.reshape(rotvec_from_quat(quat_multiply(est[["qw", "qx", "qy", "qz"]].to_numpy(), qt)), (-1, 3))
+        cols = ["time_s", "dpos_n_m", "dpos_e_m", "dpos_d_m", "dvel_n_mps", "dvel_e_mps", "dvel_d_mps", "psi_n_rad", "psi_e_rad", "psi_d_rad"]
+        return pd.DataFrame(np.column_stack([tt, d_ned, dv, psi]), columns=cols)
+
+    def plot(self, ax=None):
+        """Ground track (east vs north, m, relative to the start) coloured by time."""
+        import matplotlib.pyplot as plt
+        from .earth import lla_to_ned
+
+        if ax is None:
+            _, ax = plt.subplots(figsize=(5, 5))
+        ned = lla_to_ned(self.lla, self.lla[0], self.ellipsoid)
+        sc = ax.scatter(ned[:, 1], ned[:, 0], c=self.time, s=2)
+        ax.set_xlabel("east (m)")
+        ax.set_ylabel("north (m)")
+        ax.set_aspect("equal", adjustable="datalim")
+        ax.figure.colorbar(sc, ax=ax, label="time (s)")
+        return ax
+
+
+def _dcm_ned_to_ecef_vec(lla: np.ndarray) -> np.ndarray:
+    """C_n^e for every row of (lat, lon, h): (N, 3, 3), spec gnss-ins-tight Eq. 2."""
+    sl, cl = np.sin(lla[:, 0]), np.cos(lla[:, 0])
+    so, co = np.sin(lla[:, 1]), np.cos(lla[:, 1])
+    z = np.zeros_like(sl)
+    return np.stack([np.stack([-sl * co, -so, -cl * co], -1), np.stack([-sl * so, co, -cl * so], -1), np.stack([cl, z, -sl], -1)], 1)
+
+
+# ---- generators -----------------------------------------------------------------------
+
+def _origin(origin):
+    return vector(origin, 3, "origin")
+
+
+def stationary(duration: float, rate_hz: float = 100.0, origin=MOSCOW, euler=(0.0, 0.0, 0.0), ellipsoid: str = "WGS84") -> Trajectory:
+    """At rest at ``origin`` (lat rad, lon rad, h m) with constant (roll, pitch, yaw) rad."""
+    return Trajectory.from_motion(_core.Motion.stationary(_origin(origin), float(duration), vector(euler, 3, "euler")), rate_hz, ellipsoid)
+
+
+def sinusoidal(duration: float, rate_hz: float = 100.0, origin=MOSCOW, amp_ned=(20.0, 15.0, 2.0), period_ned=(60.0, 45.0, 30.0),
+               amp_euler=(0.1, 0.08, 0.3), period_euler=(20.0, 25.0, 40.0), heading: float = 0.5, ellipsoid: str = "WGS84") -> Trajectory:
+    """Sinusoidal motion: NED displacement amplitudes (m) and periods (s), roll/pitch/yaw
+    oscillation amplitudes (rad) and periods (s) about ``heading`` (rad)."""
+    m = _core.Motion.sinusoidal(_origin(origin), float(duration), vector(amp_ned, 3, "amp_ned"), vector(period_ned, 3, "period_ned"),
+                                vector(amp_euler, 3, "amp_euler"), vector(period_euler, 3, "period_euler"), float(heading))
+    return Trajectory.from_motion(m, rate_hz, ellipsoid)
+
+
+def hexapod(rate_hz: float = 1000.0, origin=MOSCOW, max_tilt: float = 0.0654, pitch_delay: float = 5.0, heading: float = 0.0, ellipsoid: str = "WGS84") -> Trajectory:
+    """Seed 000 §5.3 hexapod: 170 s of roll/pitch tilt steps up to ``max_tilt`` rad
+    (0.0654 rad = 3.75°), pitch delayed by ``pitch_delay`` s (spec cai-ekf decision 13)."""
+    return Trajectory.from_motion(_core.Motion.hexapod(_origin(origin), float(max_tilt), float(pitch_delay), float(heading)), rate_hz, ellipsoid)
+
+
+def drive_with_yaw(rate_hz: float = 200.0, origin=MOSCOW, speed: float = 1.0, yaw_rate_amp: float = 0.05, period: float = 50.0,
+                   duration: float = 50.0, heading: float = 0.0, ellipsoid: str = "WGS84") -> Trajectory:
+    """Seed 003 Fig. 7: straight drive at ``speed`` m/s with yaw rate
+    ``yaw_rate_amp``·sin(2πt/``period``) rad/s."""
+    m = _core.Motion.drive_with_yaw(_origin(origin), float(speed), float(yaw_rate_amp), float(period), float(duration), float(heading))
+    return Trajectory.from_motion(m, rate_hz, ellipsoid)
+
+
+def slalom(rate_hz: float = 200.0, origin=MOSCOW, speed: float = 5.0, amp: float = 2.0, period: float = 10.0, duration: float = 60.0,
+           ellipsoid: str = "WGS84") -> Trajectory:
+    """Seed 003 smooth slalom: north = speed·t, east = amp·sin(2πt/period), level, heading
+    along the path."""
+    return Trajectory.from_motion(_core.Motion.slalom(_origin(origin), float(speed), float(amp), float(period), float(duration)), rate_hz, ellipsoid)
+
+
+def car(rate_hz: float = 200.0, origin=MOSCOW, heading: float = 0.0, vibration: bool = True, ellipsoid: str = "WGS84") -> Trajectory:
+    """Seed 003 Fig. 9 car-like 40 s profile: static, accelerating, sliding and
+    coordinated turns, a shock at 26 s, vibration at 4.3/9.7/15.1 Hz."""
+    return Trajectory.from_motion(_core.Motion.car(_origin(origin), float(heading), bool(vibration)), rate_hz, ellipsoid)
+
+
+def rotary_stand(states, move_starts, move_duration: float, duration: float, rate_hz: float = 200.0, origin=MOSCOW, ellipsoid: str = "WGS84") -> Trajectory:
+    """Two-axis stand, C_nb = R_y(tilt) R_z(turntable): holds at ``states`` (K, 2) of
+    (tilt, turntable) rad, moving to the next state at ``move_starts`` (K − 1) s over
+    ``move_duration`` s with the quintic profile."""
+    m = _core.Motion.rotary_stand(_origin(origin), rows(states, 2, "states"), vector(move_starts, None, "move_starts"), float(move_duration), float(duration))
+    return Trajectory.from_motion(m, rate_hz, ellipsoid)
+
+
+def vasilyuk2024_stand(rate_hz: float = 200.0, origin=(np.deg2rad(55.6), np.deg2rad(38.2), 200.0), ellipsoid: str = "WGS84") -> Trajectory:
+    """Seed 001 calibration stand schedule: 13 states, 12 quintic moves, 73 camera epochs
+    21.0007 s apart (spec astro-calibration §5.1)."""
+    return Trajectory.from_motion(_core.Motion.vasilyuk2024_stand(_origin(origin)), rate_hz, ellipsoid)
