@@ -59,9 +59,9 @@ pub struct Strapdown {
     pub kind: ImuKind,
     pub vertical: Vertical,
     pub state: NavState,
-    /// Increments (Δθ, Δv) of the previous interval, for the two-interval coning and
-    /// sculling terms.
-    prev_increment: Option<(Vec3, Vec3)>,
+    /// Increments (Δθ, Δv) of up to the two previous intervals (most recent last), for
+    /// the multi-interval coning and sculling terms.
+    prev_increments: Vec<(Vec3, Vec3)>,
     /// Up to the last two rate samples (t, ω, f), to turn rates into increments.
     rate_history: Vec<(f64, Vec3, Vec3)>,
 }
@@ -82,7 +82,7 @@ impl Strapdown {
             }
         }
         let state = NavState { q_nb: quat_normalize(&initial.q_nb), ..initial };
-        Ok(Strapdown { ell, kind, vertical, state, prev_increment: None, rate_history: Vec::new() })
+        Ok(Strapdown { ell, kind, vertical, state, prev_increments: Vec::new(), rate_history: Vec::new() })
     }
 
     /// Run over a chunk. `t[k]` is the sample time (rates) or the end of the interval
@@ -150,18 +150,15 @@ impl Strapdown {
             ImuKind::Increments => (*gyro, *accel),
             ImuKind::Rates => {
                 let inc = rates_to_increment(&self.rate_history, t, gyro, accel);
-                if self.rate_history.len() == 2 {
-                    self.rate_history.remove(0);
-                }
-                self.rate_history.push((t, *gyro, *accel));
+                push_history(&mut self.rate_history, (t, *gyro, *accel));
                 match inc {
                     Some(inc) => inc,
                     None => return, // first rate sample at the initial time: nothing to integrate yet
                 }
             }
         };
-        let (phi, dv_body) = coning_sculling(self.prev_increment, &dth, &dv);
-        self.prev_increment = Some((dth, dv));
+        let (phi, dv_body) = coning_sculling(&self.prev_increments, &dth, &dv);
+        push_history(&mut self.prev_increments, (dth, dv));
         let dt = t - self.state.t;
         self.integrate(t, dt, &phi, &dv_body, h_ref);
     }
@@ -227,30 +224,54 @@ fn rates_to_increment(history: &[(f64, Vec3, Vec3)], t: f64, w: &Vec3, f: &Vec3)
     }
 }
 
-/// Two-interval coning and sculling (rates assumed linear across this and the previous
-/// interval): φ = Δθ + Δθ_{k−1}×Δθ/12; Δv_b = Δv + ½Δθ×Δv + ⅙Δθ×(Δθ×Δv)
-/// + (Δθ_{k−1}×Δv + Δv_{k−1}×Δθ)/12. The ⅙ term is the second-order rotation of the
-/// specific force within the step; it is rectified (always opposes f's component
-/// across the rotation axis), so leaving it out biases the vertical channel by
-/// ≈ ⅙|Δθ|²g/Δt (1.5e-7 m/s² for 0.03 rad/s at 100 Hz).
-fn coning_sculling(prev: Option<(Vec3, Vec3)>, dth: &Vec3, dv: &Vec3) -> (Vec3, Vec3) {
+/// Keep the last two entries of a short history.
+fn push_history<T>(history: &mut Vec<T>, item: T) {
+    if history.len() == 2 {
+        history.remove(0);
+    }
+    history.push(item);
+}
+
+/// Coning and sculling from this and the previous increments (most recent last).
+///
+/// Coning: φ = Δθ_k + (c₁Δθ_{k−1} + c₂Δθ_{k−2}) × Δθ_k. With two previous intervals
+/// c = (7/60, −1/60): matching the exact per-interval coning term ½ sin²β (λ − sin λ)
+/// (λ = ΩΔt) through λ⁵ leaves a drift O(sin²β Ω λ⁶); for linearly varying rates the sum
+/// c₁ + 2c₂ = 1/12 keeps it exact to third order. With one previous interval c₁ = 1/12,
+/// whose drift sin²β Ω λ⁴/60 is 5e-10 rad/s for a 1°, 1 Hz cone at 100 Hz. The first
+/// interval of a record has no coning term.
+///
+/// Velocity: Δv_b = Δv + ½Δθ×Δv + ⅙Δθ×(Δθ×Δv) + (Δθ_{k−1}×Δv + Δv_{k−1}×Δθ)/12. The ⅙
+/// term is the second-order rotation of the specific force within the step; it is
+/// rectified (always opposes f's component across the rotation axis), so leaving it
+/// out biases the vertical channel by ≈ ⅙|Δθ|²g/Δt (1.5e-7 m/s² for 0.03 rad/s at 100 Hz).
+fn coning_sculling(prev: &[(Vec3, Vec3)], dth: &Vec3, dv: &Vec3) -> (Vec3, Vec3) {
     let rot = 0.5 * dth.cross(dv) + dth.cross(&dth.cross(dv)) / 6.0;
     match prev {
-        Some((pth, pv)) => (dth + pth.cross(dth) / 12.0, dv + rot + (pth.cross(dv) + pv.cross(dth)) / 12.0),
-        None => (*dth, dv + rot),
+        [] => (*dth, dv + rot),
+        [.., (pth, pv)] => {
+            let coning = match prev {
+                [(ppth, _), _] => (7.0 / 60.0 * pth - 1.0 / 60.0 * ppth).cross(dth),
+                _ => pth.cross(dth) / 12.0,
+            };
+            (dth + coning, dv + rot + (pth.cross(dv) + pv.cross(dth)) / 12.0)
+        }
     }
 }
 
 /// Integrate body attitude only (no navigation-frame rotation) from increments with the
-/// two-interval coning correction: q_k = q_{k−1} ⊗ q(φ_k).
-pub fn integrate_attitude(q0: &Quat, dtheta: &[Vec3]) -> Vec<Quat> {
+/// coning correction of `coning_sculling`: q_k = q_{k−1} ⊗ q(φ_k). `dtheta_prev` holds
+/// the increments of up to two intervals before the first one, oldest first, when known
+/// (a running INS has them); without them the first steps have a lower-order coning
+/// term (a one-time error of about |Δθ₀ × Δθ₁|/12 on the first step).
+pub fn integrate_attitude(q0: &Quat, dtheta: &[Vec3], dtheta_prev: &[Vec3]) -> Vec<Quat> {
     let mut q = quat_normalize(q0);
-    let mut prev = None;
+    let mut prev: Vec<(Vec3, Vec3)> = dtheta_prev.iter().rev().take(2).rev().map(|d| (*d, Vec3::zeros())).collect();
     dtheta
         .iter()
         .map(|d| {
-            let (phi, _) = coning_sculling(prev.map(|p| (p, Vec3::zeros())), d, &Vec3::zeros());
-            prev = Some(*d);
+            let (phi, _) = coning_sculling(&prev, d, &Vec3::zeros());
+            push_history(&mut prev, (*d, Vec3::zeros()));
             q = quat_normalize(&(q * quat_from_rotvec(&phi)));
             q
         })

@@ -90,7 +90,13 @@ def integrate(imu, t0, lla, vel_ned, q_nb, kind: str = "increments", ellipsoid: 
     return pd.concat(parts, ignore_index=True) if parts else nav_table([], np.zeros((0, 3)), np.zeros((0, 3)), np.zeros((0, 4)))
 
 
-def integrate_attitude(q0, dtheta) -> np.ndarray:
-    """Body attitude from gyro increments (rad) with the two-interval coning correction,
-    no navigation-frame rotation: returns q (N, 4) after each increment."""
-    return _core.integrate_attitude_increments(rows(q0, 4, "q0"), rows(dtheta, 3, "dtheta"))
+def integrate_attitude(q0, dtheta, dtheta_prev=None) -> np.ndarray:
+    """Body attitude from gyro increments (rad) with the multi-interval coning correction
+    (see ``rust/strapdown.rs``), no navigation-frame rotation: q (N, 4) after each
+    increment.
+
+    ``dtheta_prev`` holds the increments of up to two intervals before the first one,
+    oldest first, if known (a running INS has them); without them the first step has no
+    coning term, a one-time error of about |Δθ₀ × Δθ₁|/12 rad."""
+    prev = None if dtheta_prev is None else rows(dtheta_prev, 3, "dtheta_prev")
+    return _core.integrate_attitude_increments(rows(q0, 4, "q0"), rows(dtheta, 3, "dtheta"), prev)

@@ -81,16 +81,26 @@ impl Strapdown {
     }
 }
 
-/// Body attitude from gyro increments with the two-interval coning correction
-/// (no navigation-frame rotation): q_k = q_{k−1} ⊗ q(Δθ_k + Δθ_{k−1}×Δθ_k/12).
+/// Body attitude from gyro increments with the multi-interval coning correction
+/// (no navigation-frame rotation); `dtheta_prev`: up to two earlier increments, oldest first.
 #[pyfunction]
-fn integrate_attitude_increments<'py>(py: Python<'py>, q0: PyReadonlyArray2<'py, f64>, dtheta: PyReadonlyArray2<'py, f64>) -> PyResult<Bound<'py, PyArray2<f64>>> {
+#[pyo3(signature = (q0, dtheta, dtheta_prev=None))]
+fn integrate_attitude_increments<'py>(
+    py: Python<'py>,
+    q0: PyReadonlyArray2<'py, f64>,
+    dtheta: PyReadonlyArray2<'py, f64>,
+    dtheta_prev: Option<PyReadonlyArray2<'py, f64>>,
+) -> PyResult<Bound<'py, PyArray2<f64>>> {
     let q0 = quat_rows(&q0, "q0")?;
     if q0.len() != 1 || q0[0].norm() == 0.0 {
         return Err(invalid("q0", "expected one non-zero quaternion").into());
     }
     let d: Vec<Vec3> = vec3_rows(&dtheta, "dtheta")?;
-    let q = py.detach(|| integrate_attitude(&q0[0], &d));
+    let prev = match dtheta_prev {
+        Some(p) => vec3_rows(&p, "dtheta_prev")?,
+        None => Vec::new(),
+    };
+    let q = py.detach(|| integrate_attitude(&q0[0], &d, &prev));
     Ok(quat_to_py(py, &q))
 }
 
