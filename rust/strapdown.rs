@@ -88,11 +88,12 @@ impl Strapdown {
     /// Run over a chunk. `t[k]` is the sample time (rates) or the end of the interval
     /// (increments); `gyro`, `accel` are rates (rad/s, m/s²) or increments (rad, m/s);
     /// `h_ref` is the reference altitude (m) per sample, required with a damped vertical
-    /// channel. Returns the state after each sample. With rates, a first sample at the
-    /// initial time only primes the integrator (its output is the initial state).
-    pub fn run(&mut self, t: &[f64], gyro: &[Vec3], accel: &[Vec3], h_ref: Option<&[f64]>) -> Result<Vec<NavState>> {
+    /// channel. Appends the state after each sample to `out`. With rates, a first sample
+    /// at the initial time only primes the integrator (its output is the initial state).
+    /// On divergence `out` keeps every state computed before it.
+    pub fn run(&mut self, t: &[f64], gyro: &[Vec3], accel: &[Vec3], h_ref: Option<&[f64]>, out: &mut Vec<NavState>) -> Result<()> {
         self.validate(t, gyro, accel, h_ref)?;
-        let mut out = Vec::with_capacity(t.len());
+        out.reserve(t.len());
         for k in 0..t.len() {
             let href = h_ref.map(|h| h[k]);
             self.step(t[k], &gyro[k], &accel[k], href);
@@ -104,7 +105,7 @@ impl Strapdown {
             }
             out.push(self.state);
         }
-        Ok(out)
+        Ok(())
     }
 
     fn validate(&self, t: &[f64], gyro: &[Vec3], accel: &[Vec3], h_ref: Option<&[f64]>) -> Result<()> {
@@ -298,11 +299,15 @@ mod tests {
         let out = match kind {
             ImuKind::Rates => {
                 let (f, w, _) = ideal_rates(&m, &WGS84, &truth);
-                sd.run(&times, &w, &f, None).unwrap()
+                let mut out = Vec::new();
+                sd.run(&times, &w, &f, None, &mut out).unwrap();
+                out
             }
             ImuKind::Increments => {
                 let (dv, dth) = ideal_increments(&m, &WGS84, &truth);
-                sd.run(&times[1..], &dth, &dv, None).unwrap()
+                let mut out = Vec::new();
+                sd.run(&times[1..], &dth, &dv, None, &mut out).unwrap();
+                out
             }
         };
         let last = out.last().unwrap();

@@ -68,8 +68,9 @@ def integrate(imu, t0, lla, vel_ned, q_nb, kind: str = "increments", ellipsoid: 
 
     ``h_ref`` (m, one per IMU row) is the reference altitude of a damped vertical
     channel. A progress bar shows for records over 10⁶ rows (``progress`` forces it on or
-    off). If the solution diverges, :class:`atomnav.NumericalError` is raised with the
-    rows already computed attached as ``err.partial``."""
+    off). If the solution diverges, :class:`atomnav.NumericalError` is raised with every
+    row computed before the failure attached as ``err.partial`` (a DataFrame)."""
+    choice(kind, IMU_COLUMNS, "kind")
     t, g, a = _imu_arrays(imu, kind)
     h = None if h_ref is None else vector(h_ref, len(t), "h_ref")
     sd = Strapdown(t0, lla, vel_ned, q_nb, kind, ellipsoid, vertical, zeta, omega)
@@ -83,7 +84,9 @@ def integrate(imu, t0, lla, vel_ned, q_nb, kind: str = "increments", ellipsoid: 
             try:
                 out = sd._core.run(t[sl], g[sl], a[sl], None if h is None else h[sl])
             except _core.NumericalError as err:
-                err.partial = pd.concat(parts, ignore_index=True) if parts else nav_table([], np.zeros((0, 3)), np.zeros((0, 3)), np.zeros((0, 4)))
+                p = err.partial
+                parts.append(nav_table(p["time"], p["lla"], p["vel_ned"], p["q_nb"]))
+                err.partial = pd.concat(parts, ignore_index=True)
                 raise
             parts.append(nav_table(out["time"], out["lla"], out["vel_ned"], out["q_nb"]))
             bar.update(len(out["time"]))

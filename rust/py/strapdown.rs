@@ -71,8 +71,18 @@ impl Strapdown {
         let a = vec3_rows(&accel, "accel")?;
         let h: Option<Vec<f64>> = h_ref.map(|h| h.as_array().iter().copied().collect());
         let inner = &mut self.inner;
-        let out = py.detach(|| inner.run(&t, &g, &a, h.as_deref()))?;
-        states_to_dict(py, &out)
+        let mut out = Vec::new();
+        let result = py.detach(|| inner.run(&t, &g, &a, h.as_deref(), &mut out));
+        match result {
+            Ok(()) => states_to_dict(py, &out),
+            Err(e @ crate::error::NavError::Numerical(_)) => {
+                // keep what was computed: the exception carries the rows before the failure
+                let err: PyErr = e.into();
+                err.value(py).setattr("partial", states_to_dict(py, &out)?)?;
+                Err(err)
+            }
+            Err(e) => Err(e.into()),
+        }
     }
 
     /// Current state as a dict (time, lla, vel_ned, q_nb).
