@@ -97,7 +97,9 @@ impl Strapdown {
         for k in 0..t.len() {
             let href = h_ref.map(|h| h[k]);
             self.step(t[k], &gyro[k], &accel[k], href);
-            if self.state.lla.x.abs() > std::f64::consts::FRAC_PI_2 || !self.state.vel.iter().all(|v| v.is_finite()) {
+            let s = &self.state;
+            let finite = s.lla.iter().chain(s.vel.iter()).chain(s.q_nb.coords.iter()).all(|x| x.is_finite());
+            if !finite || s.lla.x.abs() > std::f64::consts::FRAC_PI_2 {
                 return Err(crate::error::NavError::Numerical(format!(
                     "navigation solution diverged at sample {k} (t = {} s): latitude {} rad, velocity {:?}",
                     t[k], self.state.lla.x, self.state.vel

@@ -120,11 +120,11 @@ def test_time_outside_motion_span():
 
 
 def test_divergence_keeps_computed_rows(traj):
-    """A 1000 m/s² accelerometer error drives the solution over the pole within
-    seconds: NumericalError names the sample, and the rows before it are kept."""
+    """A (finite) absurd accelerometer stream overflows the velocity within a few hundred
+    samples: NumericalError names the sample, and the rows before it are kept."""
     long = an.trajectory.stationary(400.0, 10.0)
     imu = long.ideal_imu("increments")
-    imu["dv_x_mps"] += 1000.0 * 0.1
+    imu["dv_x_mps"] += 1e306
     with pytest.raises(an.NumericalError, match=r"diverged at sample (\d+)") as info:
         an.strapdown.integrate(imu, **long.initial_state(), progress=False)
     k = int(__import__("re").search(r"sample (\d+)", str(info.value)).group(1))
