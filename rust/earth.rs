@@ -17,6 +17,10 @@ pub struct Ellipsoid {
     pub gm: f64,
     /// Earth rotation rate Ω (rad/s).
     pub omega: f64,
+    /// Normal gravity at the equator and at the pole (m/s²); equal to
+    /// `gamma_equator_pole()` (the closed form), stored so gravity costs no `atan`.
+    pub gamma_e: f64,
+    pub gamma_p: f64,
 }
 
 /// WGS-84 (NIMA TR8350.2).
@@ -26,6 +30,8 @@ pub const WGS84: Ellipsoid = Ellipsoid {
     f: 1.0 / 298.257223563,
     gm: 3.986004418e14,
     omega: 7.292115e-5,
+    gamma_e: 9.7803253359,
+    gamma_p: 9.8321849378,
 };
 
 /// PZ-90.11 (GLONASS ICD 2016, spec gnss-ins-tight §3).
@@ -35,6 +41,9 @@ pub const PZ90_11: Ellipsoid = Ellipsoid {
     f: 1.0 / 298.25784,
     gm: 3.986004418e14,
     omega: 7.292115e-5,
+    // γ_e as published for PZ-90.11 (spec §3); γ_p from the closed form (no published value)
+    gamma_e: 9.7803284,
+    gamma_p: 9.832188005043,
 };
 
 impl Ellipsoid {
@@ -89,7 +98,7 @@ impl Ellipsoid {
     /// Normal gravity magnitude γ (m/s², positive down): Somigliana with the second-order
     /// height correction, spec gnss-ins-tight §2.1 Eq. 4.
     pub fn gravity(&self, lat: f64, h: f64) -> f64 {
-        let (ge, gp) = self.gamma_equator_pole();
+        let (ge, gp) = (self.gamma_e, self.gamma_p);
         let (a, b, f, m) = (self.a, self.b(), self.f, self.m());
         let s2 = lat.sin().powi(2);
         let k = b * gp / (a * ge) - 1.0;
@@ -99,7 +108,7 @@ impl Ellipsoid {
 
     /// ∂γ/∂φ at height h (m/s²/rad), by the analytic derivative of `gravity`.
     pub fn gravity_dlat(&self, lat: f64, h: f64) -> f64 {
-        let (ge, gp) = self.gamma_equator_pole();
+        let (ge, gp) = (self.gamma_e, self.gamma_p);
         let (a, b, f, m, e2) = (self.a, self.b(), self.f, self.m(), self.e2());
         let s2 = lat.sin().powi(2);
         let ds2 = (2.0 * lat).sin(); // d(sin²φ)/dφ
@@ -176,6 +185,34 @@ impl Ellipsoid {
     }
 }
 
+/// Earth quantities at one position (see `Ellipsoid::local`).
+#[derive(Debug, Clone, Copy)]
+pub struct Local {
+    pub sin: f64,
+    pub cos: f64,
+    /// R_M = M + h and R_P = N + h (m).
+    pub rm: f64,
+    pub rp: f64,
+    /// Normal gravity γ (m/s², down).
+    pub gravity: f64,
+    omega: f64,
+}
+
+impl Local {
+    /// ω_ie^n = Ω (cos φ, 0, −sin φ).
+    pub fn earth_rate(&self) -> Vec3 {
+        Vec3::new(self.omega * self.cos, 0.0, -self.omega * self.sin)
+    }
+    /// ω_en^n = (v_E/R_P, −v_N/R_M, −v_E tan φ/R_P).
+    pub fn transport_rate(&self, v: &Vec3) -> Vec3 {
+        Vec3::new(v.y / self.rp, -v.x / self.rm, -v.y * self.sin / (self.cos * self.rp))
+    }
+    /// (φ̇, λ̇, ḣ) = (v_N/R_M, v_E/(R_P cos φ), −v_D).
+    pub fn lla_rate(&self, v: &Vec3) -> Vec3 {
+        Vec3::new(v.x / self.rm, v.y / (self.rp * self.cos), -v.z)
+    }
+}
+
 /// C_n^e: columns are the N, E, D axes in ECEF (spec §2.1 Eq. 2).
 pub fn dcm_ned_to_ecef(lat: f64, lon: f64) -> Mat3 {
     let (sl, cl) = lat.sin_cos();
@@ -193,6 +230,20 @@ pub fn check_latitude(field: &str, lat: f64, index: usize) -> Result<()> {
 }
 
 impl Ellipsoid {
+    /// Everything the mechanization needs at one position, with one sin/cos and one sqrt.
+    pub fn local(&self, lat: f64, h: f64) -> Local {
+        let (sin, cos) = lat.sin_cos();
+        let e2 = self.e2();
+        let w2 = 1.0 - e2 * sin * sin;
+        let w = w2.sqrt();
+        let (m, n) = (self.a * (1.0 - e2) / (w2 * w), self.a / w);
+        let (a, f, mm, s2) = (self.a, self.f, self.m(), sin * sin);
+        let k = self.b() * self.gamma_p / (a * self.gamma_e) - 1.0;
+        let g0 = self.gamma_e * (1.0 + k * s2) / w;
+        let gravity = g0 * (1.0 - 2.0 / a * (1.0 + f + mm - 2.0 * f * s2) * h + 3.0 * h * h / (a * a));
+        Local { sin, cos, rm: m + h, rp: n + h, gravity, omega: self.omega }
+    }
+
     /// NED coordinates (m) of ECEF point `r` relative to the geodetic origin `origin_lla`.
     pub fn ecef_to_ned(&self, r: &Vec3, origin_lla: &Vec3) -> Vec3 {
         let c = dcm_ned_to_ecef(origin_lla.x, origin_lla.y);
@@ -215,7 +266,10 @@ mod tests {
         let (ge, gp) = WGS84.gamma_equator_pole();
         assert!((ge - 9.7803253359).abs() < 1e-9, "{ge}");
         assert!((gp - 9.8321849378).abs() < 1e-9, "{gp}");
-        assert!((WGS84.gravity(0.0, 0.0) - ge).abs() < 1e-12);
+        assert!((WGS84.gravity(0.0, 0.0) - ge).abs() < 1e-9);
+        // the stored PZ-90.11 values agree with its closed form
+        let (pe, pp) = PZ90_11.gamma_equator_pole();
+        assert!((pe - PZ90_11.gamma_e).abs() < 1e-7 && (pp - PZ90_11.gamma_p).abs() < 1e-11, "{pe} {pp}");
         assert!((WGS84.gravity(std::f64::consts::FRAC_PI_2, 0.0) - gp).abs() < 1e-9);
     }
 
@@ -226,6 +280,18 @@ mod tests {
             let back = WGS84.ecef_to_lla(&WGS84.lla_to_ecef(&lla));
             assert!((back.x - lat).abs() < 1e-12 && (back.y - lon).abs() < 1e-12 && (back.z - h).abs() < 1e-6, "{back:?}");
         }
+    }
+
+    #[test]
+    fn local_matches_the_separate_functions() {
+        let (lat, h, v) = (0.9, 250.0, Vec3::new(30.0, -12.0, 1.0));
+        let l = WGS84.local(lat, h);
+        let (m, n) = WGS84.radii(lat);
+        assert!((l.gravity - WGS84.gravity(lat, h)).abs() < 1e-13);
+        assert!((l.rm - m - h).abs() < 1e-8 && (l.rp - n - h).abs() < 1e-8);
+        assert!((l.earth_rate() - WGS84.earth_rate_ned(lat)).norm() < 1e-20);
+        assert!((l.transport_rate(&v) - WGS84.transport_rate_ned(lat, h, &v)).norm() < 1e-18);
+        assert!((l.lla_rate(&v) - WGS84.lla_rate(lat, h, &v)).norm() < 1e-18);
     }
 
     #[test]

@@ -4,7 +4,9 @@
 //! vertical channel. Second order in the step: gravity, Coriolis and the navigation-frame
 //! rotation are taken at the interval midpoint (predictor–corrector), and the specific
 //! force is rotated by [I − ½[ζ×]] for the navigation-frame rotation ζ over the step
-//! (Savage, Strapdown Analytics §7.2).
+//! (Savage, Strapdown Analytics §7.2). The midpoint is extrapolated from the previous
+//! step (position) and from this step's specific force plus the previous step's
+//! gravity–Coriolis term (velocity), so each step evaluates the Earth model once.
 //!
 //! One `Strapdown` object serves batch use (one call over a whole record) and streaming
 //! (successive chunks): it keeps the previous sample for coning/sculling.
@@ -64,6 +66,9 @@ pub struct Strapdown {
     prev_increments: Vec<(Vec3, Vec3)>,
     /// Up to the last two rate samples (t, ω, f), to turn rates into increments.
     rate_history: Vec<(f64, Vec3, Vec3)>,
+    /// Previous step: (Δlla, Δt, g − (2ω_ie + ω_en)×v at its midpoint), for the midpoint
+    /// extrapolation.
+    last_step: Option<(Vec3, f64, Vec3)>,
 }
 
 impl Strapdown {
@@ -82,7 +87,7 @@ impl Strapdown {
             }
         }
         let state = NavState { q_nb: quat_normalize(&initial.q_nb), ..initial };
-        Ok(Strapdown { ell, kind, vertical, state, prev_increments: Vec::new(), rate_history: Vec::new() })
+        Ok(Strapdown { ell, kind, vertical, state, prev_increments: Vec::new(), rate_history: Vec::new(), last_step: None })
     }
 
     /// Run over a chunk. `t[k]` is the sample time (rates) or the end of the interval
@@ -172,32 +177,36 @@ impl Strapdown {
     fn integrate(&mut self, t: f64, dt: f64, phi: &Vec3, dv_body: &Vec3, h_ref: Option<f64>) {
         let s0 = self.state;
         let ell = &self.ell;
-        // Baro loop (spec Eq. 26): ḣ gets −K_v1(h − h_b), v̇_D gets +K_v2(h − h_b).
+        let dv_sf_b = quat_rotate(&s0.q_nb, dv_body); // C_nb(k−1) Δv
+        // midpoint: position extrapolated from the previous step; velocity from this step's
+        // specific force and the previous gravity–Coriolis term (at t₀ on the first step)
+        let (lla_mid, gc_prev) = match self.last_step {
+            Some((dlla, dt_prev, gc)) => (s0.lla + dlla * (0.5 * dt / dt_prev), gc),
+            None => {
+                let e = ell.local(s0.lla.x, s0.lla.z);
+                (s0.lla, Vec3::new(0.0, 0.0, e.gravity) - (2.0 * e.earth_rate() + e.transport_rate(&s0.vel)).cross(&s0.vel))
+            }
+        };
+        let v_mid = s0.vel + 0.5 * (dv_sf_b + gc_prev * dt);
+        let earth = ell.local(lla_mid.x, lla_mid.z);
+        // Baro loop (spec Eq. 26): ḣ gets −K_v1(h − h_b), v̇_D gets +K_v2(h − h_b), with
+        // K_v1 = 2ζω_v, K_v2 = ω_v² + 2γ/R₀ (R₀ = √(R_M R_P)).
         let (k1, k2, dh0) = match (self.vertical, h_ref) {
             (Vertical::Damped { zeta, omega }, Some(hb)) => {
-                let (m, n) = ell.radii(s0.lla.x);
-                let r0 = (m * n).sqrt() + s0.lla.z;
-                (2.0 * zeta * omega, omega * omega + 2.0 * ell.gravity(s0.lla.x, s0.lla.z) / r0, s0.lla.z - hb)
+                (2.0 * zeta * omega, omega * omega + 2.0 * earth.gravity / (earth.rm * earth.rp).sqrt(), s0.lla.z - hb)
             }
             _ => (0.0, 0.0, 0.0),
         };
-        let dv_sf_b = quat_rotate(&s0.q_nb, dv_body); // C_nb(k−1) Δv
-        let advance = |lla_mid: &Vec3, v_mid: &Vec3| {
-            let w_ie = ell.earth_rate_ned(lla_mid.x);
-            let w_en = ell.transport_rate_ned(lla_mid.x, lla_mid.z, v_mid);
-            let zeta = (w_ie + w_en) * dt; // navigation-frame rotation over the step
-            let dv_sf = dv_sf_b - 0.5 * zeta.cross(&dv_sf_b);
-            let g = ell.gravity_ned(lla_mid.x, lla_mid.z);
-            let mut vel = s0.vel + dv_sf + (g - (2.0 * w_ie + w_en).cross(v_mid)) * dt;
-            vel.z += k2 * dh0 * dt;
-            let v_avg = 0.5 * (s0.vel + vel);
-            let mut lla = s0.lla + ell.lla_rate(lla_mid.x, lla_mid.z, &v_avg) * dt;
-            lla.z -= k1 * dh0 * dt;
-            (vel, lla, zeta)
-        };
-        // predictor with the values at t_{k−1}, corrector at the midpoint
-        let (v_pred, lla_pred, _) = advance(&s0.lla, &s0.vel);
-        let (vel, lla, zeta) = advance(&(0.5 * (s0.lla + lla_pred)), &(0.5 * (s0.vel + v_pred)));
+        let w_ie = earth.earth_rate();
+        let w_en = earth.transport_rate(&v_mid);
+        let zeta = (w_ie + w_en) * dt; // navigation-frame rotation over the step
+        let dv_sf = dv_sf_b - 0.5 * zeta.cross(&dv_sf_b);
+        let gc = Vec3::new(0.0, 0.0, earth.gravity) - (2.0 * w_ie + w_en).cross(&v_mid);
+        let mut vel = s0.vel + dv_sf + gc * dt;
+        vel.z += k2 * dh0 * dt;
+        let mut lla = s0.lla + earth.lla_rate(&(0.5 * (s0.vel + vel))) * dt;
+        lla.z -= k1 * dh0 * dt;
+        self.last_step = Some((lla - s0.lla, dt, gc));
         // C_nb(k) = C_{n(k−1)}^{n(k)} C_nb(k−1) C_{b(k)}^{b(k−1)}
         let q = quat_from_rotvec(&(-zeta)) * s0.q_nb * quat_from_rotvec(phi);
         self.state = NavState { t, lla, vel, q_nb: quat_normalize(&q) };

@@ -13,10 +13,15 @@ import pandas as pd
 
 from . import _core
 from ._validate import choice, rows, vector
-from .trajectory import IMU_COLUMNS, nav_table
+from .trajectory import COLUMNS, IMU_COLUMNS
 
 #: Rows per call into Rust: the progress bar's granularity for long runs.
-CHUNK = 200_000
+CHUNK = 500_000
+
+
+def _table(columns: np.ndarray) -> pd.DataFrame:
+    """DataFrame of a (14, N) column table from the core, without copying it."""
+    return pd.DataFrame(columns.T, columns=COLUMNS, copy=False)
 
 
 def _imu_arrays(imu, kind: str):
@@ -52,12 +57,10 @@ class Strapdown:
         :data:`atomnav.trajectory.IMU_COLUMNS`); returns the solution at each row."""
         t, g, a = _imu_arrays(imu, self.kind)
         h = None if h_ref is None else vector(h_ref, len(t), "h_ref")
-        out = self._core.run(t, g, a, h)
-        return nav_table(out["time"], out["lla"], out["vel_ned"], out["q_nb"])
+        return _table(self._core.run(t, g, a, h))
 
     def state(self) -> pd.DataFrame:
-        s = self._core.state()
-        return nav_table(s["time"], s["lla"], s["vel_ned"], s["q_nb"])
+        return _table(self._core.state())
 
 
 def integrate(imu, t0, lla, vel_ned, q_nb, kind: str = "increments", ellipsoid: str = "WGS84", vertical: str = "free",
@@ -84,13 +87,11 @@ def integrate(imu, t0, lla, vel_ned, q_nb, kind: str = "increments", ellipsoid: 
             try:
                 out = sd._core.run(t[sl], g[sl], a[sl], None if h is None else h[sl])
             except _core.NumericalError as err:
-                p = err.partial
-                parts.append(nav_table(p["time"], p["lla"], p["vel_ned"], p["q_nb"]))
-                err.partial = pd.concat(parts, ignore_index=True)
+                err.partial = _table(np.hstack(parts + [err.partial]))
                 raise
-            parts.append(nav_table(out["time"], out["lla"], out["vel_ned"], out["q_nb"]))
-            bar.update(len(out["time"]))
-    return pd.concat(parts, ignore_index=True) if parts else nav_table([], np.zeros((0, 3)), np.zeros((0, 3)), np.zeros((0, 4)))
+            parts.append(out)
+            bar.update(out.shape[1])
+    return _table(parts[0] if len(parts) == 1 else np.hstack(parts) if parts else np.zeros((len(COLUMNS), 0)))
 
 
 def integrate_attitude(q0, dtheta, dtheta_prev=None) -> np.ndarray:

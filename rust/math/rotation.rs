@@ -144,8 +144,13 @@ pub fn quat_from_euler(roll: f64, pitch: f64, yaw: f64) -> Quat {
     if q.w < 0.0 { -q } else { q }
 }
 
+/// (roll, pitch, yaw) of q_nb from the DCM elements that `euler_from_dcm` uses,
+/// written in quaternion components.
 pub fn euler_from_quat(q: &Quat) -> Vec3 {
-    euler_from_dcm(&dcm_from_quat(q))
+    let (w, x, y, z) = (q.w, q.i, q.j, q.k);
+    let (c20, c21, c22) = (2.0 * (x * z - w * y), 2.0 * (y * z + w * x), w * w - x * x - y * y + z * z);
+    let (c10, c00) = (2.0 * (x * y + w * z), w * w + x * x - y * y - z * z);
+    Vec3::new(c21.atan2(c22), (-c20).atan2((c21 * c21 + c22 * c22).sqrt()), c10.atan2(c00))
 }
 
 /// DCM of a rotation vector: exp([φ×]) (Rodrigues).

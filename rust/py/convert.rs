@@ -24,15 +24,24 @@ pub fn rows<const W: usize>(a: &PyReadonlyArray2<'_, f64>, field: &str) -> Resul
     }
     let view = a.as_array();
     let mut out = Vec::with_capacity(shape[0]);
-    for (i, row) in view.outer_iter().enumerate() {
-        let mut r = [0.0; W];
-        for (j, x) in row.iter().enumerate() {
-            if !x.is_finite() {
-                return Err(invalid(field, format!("non-finite value {x} at index {i} (column {j})")));
-            }
-            r[j] = *x;
+    match view.as_slice() {
+        // C-contiguous: one pass over the flat buffer
+        Some(flat) => {
+            check_finite(field, flat, W)?;
+            out.extend(flat.chunks_exact(W).map(|c| <[f64; W]>::try_from(c).expect("chunk of W")));
         }
-        out.push(r);
+        None => {
+            for (i, row) in view.outer_iter().enumerate() {
+                let mut r = [0.0; W];
+                for (j, x) in row.iter().enumerate() {
+                    if !x.is_finite() {
+                        return Err(invalid(field, format!("non-finite value {x} at index {i} (column {j})")));
+                    }
+                    r[j] = *x;
+                }
+                out.push(r);
+            }
+        }
     }
     Ok(out)
 }
@@ -62,8 +71,14 @@ pub fn vec3(a: &PyReadonlyArray1<'_, f64>, field: &str) -> Result<Vec3, NavError
 }
 
 pub fn to_py_rows<'py, const W: usize>(py: Python<'py>, rows: &[[f64; W]]) -> Bound<'py, PyArray2<f64>> {
-    let flat: Vec<f64> = rows.iter().flat_map(|r| r.iter().copied()).collect();
-    Array2::from_shape_vec((rows.len(), W), flat).expect("row length is W by construction").into_pyarray(py)
+    rows_to_py(py, rows.len(), W, rows.iter().flat_map(|r| r.iter().copied()))
+}
+
+/// An (n, w) array from a row-major stream of values, built without a second copy.
+pub fn rows_to_py<'py>(py: Python<'py>, n: usize, w: usize, values: impl Iterator<Item = f64>) -> Bound<'py, PyArray2<f64>> {
+    let mut flat = Vec::with_capacity(n * w);
+    flat.extend(values);
+    Array2::from_shape_vec((n, w), flat).expect("n·w values by construction").into_pyarray(py)
 }
 
 pub fn vec3_to_py<'py>(py: Python<'py>, v: &[Vec3]) -> Bound<'py, PyArray2<f64>> {

@@ -95,7 +95,7 @@ fn dcm_ned_to_ecef_py<'py>(py: Python<'py>, lat: f64, lon: f64) -> PyResult<Boun
 #[pyfunction]
 fn ellipsoid_constants(py: Python<'_>, name: &str) -> PyResult<Py<PyAny>> {
     let e = Ellipsoid::by_name(name)?;
-    let (ge, gp) = e.gamma_equator_pole();
+    let (ge, gp) = (e.gamma_e, e.gamma_p);
     let d = pyo3::types::PyDict::new(py);
     for (k, v) in [("a", e.a), ("f", e.f), ("gm", e.gm), ("omega", e.omega), ("e2", e.e2()), ("b", e.b()), ("gamma_e", ge), ("gamma_p", gp)] {
         d.set_item(k, v)?;

@@ -1,13 +1,12 @@
 //! Bindings of strapdown.rs: a streaming mechanization object and attitude integration.
 
-use super::convert::{quat_rows, quat_to_py, vec3, vec3_rows, vec3_to_py, vec_to_py, vector};
+use super::convert::{quat_rows, quat_to_py, rows_to_py, vec3, vec3_rows, vector};
 use crate::earth::Ellipsoid;
 use crate::error::invalid;
-use crate::math::{quat, Vec3};
+use crate::math::{euler_from_quat, quat, Vec3};
 use crate::strapdown::{integrate_attitude, ImuKind, NavState, Strapdown as Core, Vertical};
 use numpy::{PyArray2, PyReadonlyArray1, PyReadonlyArray2};
 use pyo3::prelude::*;
-use pyo3::types::PyDict;
 
 /// Streaming strapdown INS (NED). Feed chunks with `run`; state carries over.
 #[pyclass(module = "atomnav._core")]
@@ -15,13 +14,24 @@ pub struct Strapdown {
     inner: Core,
 }
 
-fn states_to_dict<'py>(py: Python<'py>, s: &[NavState]) -> PyResult<Bound<'py, PyDict>> {
-    let d = PyDict::new(py);
-    d.set_item("time", vec_to_py(py, s.iter().map(|x| x.t).collect()))?;
-    d.set_item("lla", vec3_to_py(py, &s.iter().map(|x| x.lla).collect::<Vec<_>>()))?;
-    d.set_item("vel_ned", vec3_to_py(py, &s.iter().map(|x| x.vel).collect::<Vec<_>>()))?;
-    d.set_item("q_nb", quat_to_py(py, &s.iter().map(|x| x.q_nb).collect::<Vec<_>>()))?;
-    Ok(d)
+/// Navigation states as a (14, N) array — one row per column of
+/// `atomnav.trajectory.COLUMNS` (time, lat, lon, h, v_N, v_E, v_D, q_nb (4), roll, pitch,
+/// yaw) — so that pandas can wrap its transpose without copying.
+fn states_to_columns<'py>(py: Python<'py>, s: &[NavState]) -> Bound<'py, PyArray2<f64>> {
+    let euler: Vec<Vec3> = s.iter().map(|x| euler_from_quat(&x.q_nb)).collect();
+    let column = |c: usize| {
+        s.iter().zip(&euler).map(move |(x, e)| match c {
+            0 => x.t,
+            1..=3 => x.lla[c - 1],
+            4..=6 => x.vel[c - 4],
+            7 => x.q_nb.w,
+            8 => x.q_nb.i,
+            9 => x.q_nb.j,
+            10 => x.q_nb.k,
+            _ => e[c - 11],
+        })
+    };
+    rows_to_py(py, 14, s.len(), (0..14).flat_map(column))
 }
 
 #[pymethods]
@@ -56,7 +66,7 @@ impl Strapdown {
         Ok(Strapdown { inner: Core::new(init, ImuKind::parse(kind)?, Ellipsoid::by_name(ellipsoid)?, vertical)? })
     }
 
-    /// Integrate one chunk; returns the state after each sample (dict of arrays).
+    /// Integrate one chunk; returns the state after each sample as a (14, N) column table.
     #[pyo3(signature = (time, gyro, accel, h_ref=None))]
     fn run<'py>(
         &mut self,
@@ -65,7 +75,7 @@ impl Strapdown {
         gyro: PyReadonlyArray2<'py, f64>,
         accel: PyReadonlyArray2<'py, f64>,
         h_ref: Option<PyReadonlyArray1<'py, f64>>,
-    ) -> PyResult<Bound<'py, PyDict>> {
+    ) -> PyResult<Bound<'py, PyArray2<f64>>> {
         let t: Vec<f64> = time.as_array().iter().copied().collect();
         let g = vec3_rows(&gyro, "gyro")?;
         let a = vec3_rows(&accel, "accel")?;
@@ -74,20 +84,20 @@ impl Strapdown {
         let mut out = Vec::new();
         let result = py.detach(|| inner.run(&t, &g, &a, h.as_deref(), &mut out));
         match result {
-            Ok(()) => states_to_dict(py, &out),
+            Ok(()) => Ok(states_to_columns(py, &out)),
             Err(e @ crate::error::NavError::Numerical(_)) => {
                 // keep what was computed: the exception carries the rows before the failure
                 let err: PyErr = e.into();
-                err.value(py).setattr("partial", states_to_dict(py, &out)?)?;
+                err.value(py).setattr("partial", states_to_columns(py, &out))?;
                 Err(err)
             }
             Err(e) => Err(e.into()),
         }
     }
 
-    /// Current state as a dict (time, lla, vel_ned, q_nb).
-    fn state<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
-        states_to_dict(py, &[self.inner.state])
+    /// Current state as a (14, 1) column table.
+    fn state<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
+        states_to_columns(py, &[self.inner.state])
     }
 }
 
