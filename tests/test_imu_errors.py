@@ -197,6 +197,29 @@ def test_flicker_psd_has_slope_minus_one_and_ieee_level_in_its_band():
     assert level == pytest.approx(1.0, abs=0.08)
 
 
+def _overlapping_adev(x, dt, m):
+    """Overlapping Allan deviation of rate samples at τ = mΔt (textbook cumulative-sum form)."""
+    c = np.concatenate([np.zeros((1, x.shape[1])), np.cumsum(x, axis=0)]) * dt
+    d = c[2 * m :] - 2 * c[m:-m] + c[: -2 * m]
+    return np.sqrt(np.mean(d**2, axis=0) / (2 * (m * dt) ** 2))
+
+
+def test_navigation_preset_allan_deviation_matches_seed003_spec():
+    # seed-003 spec §4 "Allan deviation of simulated IMU": 1 h at 200 Hz, ADEV_a(1 s) =
+    # 3.5355e-6 m/s² from white noise alone, and √(q_a/τ + q_ra τ/3) with the random walk; ±5 %
+    dt, n = 1 / 200, 720_000
+    nav = imu.ImuErrors.preset("navigation")
+    nav.accel.bias_sigma = 0.0
+    f_cols = imu.COLUMNS["rate"][0]
+    white_only = imu.ImuErrors(imu.TriadErrors(white=nav.accel.white))
+    a = imu.corrupt(*_zeros(n), errors=white_only, dt=dt, seed=13)[f_cols].to_numpy()
+    assert np.mean(_overlapping_adev(a, dt, 200)) == pytest.approx(3.5355e-6, rel=0.05)
+    a = imu.corrupt(*_zeros(n), errors=nav, dt=dt, seed=13)[f_cols].to_numpy()
+    for tau in (1.0, 10.0):
+        expect = math.sqrt(1.25e-11 / tau + 9e-10 * tau / 3)
+        assert np.mean(_overlapping_adev(a, dt, round(tau / dt))) == pytest.approx(expect, rel=0.05)
+
+
 # --------------------------------------------------------------------------- seeds and streaming
 
 
