@@ -165,23 +165,25 @@ impl Increment for White {
 /// Cov = Δt²/2, so W(Δt) = √Δt z₁ and ∫W = Δt^{3/2}(z₁/2 + z₂/(2√3)).
 #[derive(Debug, Clone)]
 pub struct RandomWalk {
-    k: f64,
     dt: f64,
+    /// K√Δt, σ of the step.
+    step: f64,
+    /// KΔt^{3/2}, scale of the in-interval integral.
+    int: f64,
     b: f64,
 }
 
 impl RandomWalk {
     pub fn new(density: f64, dt: f64) -> Self {
-        Self { k: density, dt, b: 0.0 }
+        Self { dt, step: density * dt.sqrt(), int: density * dt * dt.sqrt(), b: 0.0 }
     }
 }
 
 impl Increment for RandomWalk {
     fn step<R: Rng>(&mut self, rng: &mut R) -> f64 {
         let (z1, z2) = (normal(rng), normal(rng));
-        let sdt = self.dt.sqrt();
-        let integral = self.b * self.dt + self.k * self.dt * sdt * (0.5 * z1 + z2 / (2.0 * 3f64.sqrt()));
-        self.b += self.k * sdt * z1;
+        let integral = self.b * self.dt + self.int * (0.5 * z1 + z2 * (0.5 / 3f64.sqrt()));
+        self.b += self.step * z1;
         integral
     }
 }
