@@ -273,10 +273,12 @@ def test_accel_and_gyro_are_independent_streams():
     # term leaves the other terms' realisations untouched
     e2 = _errors(white=1.0)
     e2.accel.white = 3.0
-    e2.gyro.gauss_markov = imu.GaussMarkov(0.0, 1.0)
-    out2 = _measured(imu.corrupt(*_zeros(n), errors=e2, dt=1.0, seed=10))
+    e2.accel.gauss_markov = imu.GaussMarkov(0.5, 2.0)
+    df2 = imu.corrupt(*_zeros(n), errors=e2, dt=1.0, seed=10)
+    out2, bias2 = _measured(df2), _bias_truth(df2)
     np.testing.assert_array_equal(out2[:, 3:], out[:, 3:])
-    np.testing.assert_allclose(out2[:, :3], 3 * out[:, :3], rtol=1e-15)
+    # true input is zero, so measured − bias truth is the white noise alone
+    np.testing.assert_allclose(out2[:, :3] - bias2[:, :3], 3 * out[:, :3], rtol=0, atol=1e-12)
 
 
 def test_turn_on_bias_is_constant_per_run_with_the_given_sigma():
@@ -450,6 +452,13 @@ def test_bad_nan_bias_names_index():
 def test_bad_misalignment_shape():
     e = imu.ImuErrors(gyro=imu.TriadErrors(misalignment=np.zeros((2, 3))))
     _raises(r"gyro.misalignment: expected shape \(3, 3\), got \(2, 3\)", imu.ImuSimulator, e, 0.01)
+
+
+def test_bad_nan_misalignment_names_row_and_column():
+    m = np.zeros((3, 3))
+    m[2, 0] = np.nan
+    e = imu.ImuErrors(accel=imu.TriadErrors(misalignment=m))
+    _raises(r"accel.misalignment: non-finite value at index \(2, 0\)", imu.ImuSimulator, e, 0.01)
 
 
 def test_bad_misalignment_diagonal():

@@ -104,7 +104,7 @@ class TriadErrors:
             "bias": vector(self.bias, 3, f"{name}.bias").tolist(),
             "bias_sigma": float(self.bias_sigma),
             "scale": vector(self.scale, 3, f"{name}.scale").tolist(),
-            "misalignment": vector(m.ravel(), 9, f"{name}.misalignment").tolist(),
+            "misalignment": m.ravel().tolist(),  # finiteness and zero diagonal checked in Rust
             "white": float(self.white),
             "bias_rw": float(self.bias_rw),
             "gauss_markov": None if gm is None else (float(gm.sigma), float(gm.tau)),
@@ -163,12 +163,10 @@ class ImuErrors:
         °/√h, °/h/√h), one row per (sensor, parameter)."""
         sqrt_h = np.sqrt(units.HOUR)
         out = []
-        for sensor, t, u, u_name, dens_name in (
-            ("accel", self.accel, units.MICRO_G, "ug", "ug/sqrt(Hz)"),
-            ("gyro", self.gyro, units.DEG_PER_HOUR, "deg/h", "deg/sqrt(h)"),
+        for sensor, t, si, u, u_name, dens, dens_name in (
+            ("accel", self.accel, "m/s^2", units.MICRO_G, "ug", units.MICRO_G_PER_SQRT_HZ, "ug/sqrt(Hz)"),
+            ("gyro", self.gyro, "rad/s", units.DEG_PER_HOUR, "deg/h", units.DEG_PER_SQRT_HOUR, "deg/sqrt(h)"),
         ):
-            dens = units.MICRO_G_PER_SQRT_HZ if sensor == "accel" else units.DEG_PER_SQRT_HOUR
-            si = "m/s^2" if sensor == "accel" else "rad/s"
             gm, fl = t.gauss_markov, t.flicker
             items = [(f"bias_{a}", b, si, b / u, u_name) for a, b in zip(_AXES, t.bias)]
             items += [
