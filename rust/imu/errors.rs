@@ -358,9 +358,9 @@ mod tests {
         let (f, w) = stream_of(10);
         let out = ImuSimulator::new(&m, 0.01, OutputKind::Rate, 0).unwrap().corrupt(&f, &w).unwrap();
         let s = m.accel.sensor_matrix();
-        for k in 0..10 {
-            assert!((out.accel[k] - (s * f[k] + m.accel.bias)).norm() < 1e-15 * 10.0);
-            assert_eq!(out.gyro_bias[k], m.gyro.bias);
+        for ((meas, truth), bias) in out.accel.iter().zip(&f).zip(&out.gyro_bias) {
+            assert!((meas - (s * truth + m.accel.bias)).norm() < 1e-15 * 10.0);
+            assert_eq!(*bias, m.gyro.bias);
         }
     }
 
