@@ -191,10 +191,12 @@ def test_flicker_psd_has_slope_minus_one_and_ieee_level_in_its_band():
     psd = 2 * dt * spec.mean(axis=(0, 2)) / np.sum(win**2)
     f = np.fft.rfftfreq(seg, dt)
     band = (f >= 5e-3) & (f <= 0.5)
+    # spread over 5 seeds: slope −1.006 ± 0.004, level 0.995 ± 0.004; the model itself is
+    # within −1.4 % of B²/(πf) in the band
     slope = np.polyfit(np.log(f[band]), np.log(psd[band]), 1)[0]
-    assert slope == pytest.approx(-1.0, abs=0.05)
+    assert slope == pytest.approx(-1.0, abs=0.03)
     level = np.mean(psd[band] * math.pi * f[band] / b**2)  # oracle: B²/(πf)
-    assert level == pytest.approx(1.0, abs=0.08)
+    assert level == pytest.approx(1.0, abs=0.04)
 
 
 def _overlapping_adev(x, dt, m):

@@ -17,7 +17,8 @@ Parameters are continuous densities (two-sided, IEEE Std 952):
 - ``gauss_markov``: stationary σ (m/s², rad/s) and correlation time τ (s);
 - ``flicker``: bias instability B (m/s², rad/s), one-sided PSD B²/(πf) in [f_lo, f_hi] Hz,
   realised as a sum of Gauss–Markov processes with log-spaced correlation times (2 per
-  decade, 2 extra past each band edge; PSD within −3.4 % of B²/(πf) inside the band);
+  decade, 3 extra past each band edge; PSD within −1.4 %/+0.1 % of B²/(πf) inside the
+  band, flat below it, falling as 1/f² above it);
 - ``bias`` (fixed, per axis) and ``bias_sigma`` (σ of a random turn-on bias drawn once).
 
 The conversion functions below translate between densities and per-sample values; field
