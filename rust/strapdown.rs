@@ -13,26 +13,8 @@
 
 use crate::earth::{check_latitude, Ellipsoid};
 use crate::error::{invalid, Result};
+pub use crate::imu::ImuKind;
 use crate::math::{quat_from_rotvec, quat_normalize, quat_rotate, Quat, Vec3};
-
-/// Kind of IMU output fed to the mechanization.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum ImuKind {
-    /// Instantaneous specific force (m/s²) and angular rate (rad/s) at the sample times.
-    Rates,
-    /// Velocity (m/s) and angle (rad) increments over (t_{k−1}, t_k].
-    Increments,
-}
-
-impl ImuKind {
-    pub fn parse(s: &str) -> Result<ImuKind> {
-        match s {
-            "rates" => Ok(ImuKind::Rates),
-            "increments" => Ok(ImuKind::Increments),
-            _ => Err(invalid("kind", format!("unknown IMU output kind '{s}' (known: 'rates', 'increments')"))),
-        }
-    }
-}
 
 /// Navigation solution at one instant.
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -1,0 +1,299 @@
+"""IMU sensor errors: configuration, grade presets, noise conversions and a seeded,
+streamable simulator that corrupts an ideal IMU stream (Rust: ``rust/imu/``).
+
+Model per triad (measured = true + error)::
+
+    ỹ = (I + diag(scale) + misalignment) y + bias + b_rw(t) + m_gm(t) + m_flicker(t) + w
+
+``y`` is specific force f (m/s²) and angular rate ω (rad/s) for ``kind="rates"``, or the
+increments Δv (m/s) and Δθ (rad) over the sample interval Δt for ``kind="increments"``;
+for increments every error term is its exact integral over the interval (bias gives
+bias·Δt, white noise has σ = N·√Δt), and a rate sample is the increment divided by Δt.
+
+Parameters are continuous densities (two-sided, IEEE Std 952):
+
+- ``white`` N: VRW in m/s/√s (= m/s²/√Hz) or ARW in rad/√s; per-sample σ = N/√Δt (rate);
+- ``bias_rw`` K: m/s²/√s or rad/s/√s; Var b(t) = K² t;
+- ``gauss_markov``: stationary σ (m/s², rad/s) and correlation time τ (s);
+- ``flicker``: bias instability B (m/s², rad/s), one-sided PSD B²/(πf) in [f_lo, f_hi] Hz,
+  realised as a sum of Gauss–Markov processes with log-spaced correlation times (2 per
+  decade, 3 extra past each band edge; PSD within −1.4 %/+0.1 % of B²/(πf) inside the
+  band, flat below it, falling as 1/f² above it);
+- ``bias`` (fixed, per axis) and ``bias_sigma`` (σ of a random turn-on bias drawn once).
+
+The conversion functions below translate between densities and per-sample values; field
+units (°/h, °/√h, µg, µg/√Hz) are in :mod:`atomnav.units`.
+
+Randomness: one master ``seed``; the accelerometer and gyro triads and each noise term
+draw from their own ChaCha12 stream of that seed (see ``rust/imu/errors.rs``), so the
+same seed gives the same numbers on every machine, feeding the stream in chunks gives
+exactly the numbers of one batch call, and switching a term on or off does not change
+the others' realisations.
+
+Stream columns (DataFrame in and out): rate ``accel_{x,y,z}_mps2``, ``gyro_{x,y,z}_rad_s``;
+increment ``dv_{x,y,z}_mps``, ``dtheta_{x,y,z}_rad``; an optional ``time_s`` is carried
+through. The error truth is ``accel_bias_{x,y,z}_mps2`` and ``gyro_bias_{x,y,z}_rad_s``:
+the true bias (fixed + turn-on + random walk + Gauss–Markov + flicker) averaged over each
+sample interval, in rate units for both kinds.
+"""
+
+from __future__ import annotations
+
+import copy
+import operator
+from dataclasses import dataclass, field
+
+import numpy as np
+import pandas as pd
+
+from . import _core, units
+from ._validate import choice, rows, vector
+
+KINDS = ("rates", "increments")
+_AXES = ("x", "y", "z")
+COLUMNS = {
+    "rates": ([f"accel_{a}_mps2" for a in _AXES], [f"gyro_{a}_rad_s" for a in _AXES]),
+    "increments": ([f"dv_{a}_mps" for a in _AXES], [f"dtheta_{a}_rad" for a in _AXES]),
+}
+BIAS_COLUMNS = ([f"accel_bias_{a}_mps2" for a in _AXES], [f"gyro_bias_{a}_rad_s" for a in _AXES])
+
+
+@dataclass(frozen=True)
+class GaussMarkov:
+    """First-order Gauss–Markov term: stationary ``sigma`` (m/s² or rad/s) and correlation
+    time ``tau`` (s)."""
+
+    sigma: float
+    tau: float
+
+
+@dataclass(frozen=True)
+class Flicker:
+    """Flicker (1/f) term of bias instability ``b`` (m/s² or rad/s), valid between ``f_lo``
+    and ``f_hi`` (Hz; ``f_hi`` must not exceed the Nyquist frequency 1/(2Δt))."""
+
+    b: float
+    f_lo: float = 1e-4
+    f_hi: float = 0.1
+
+
+@dataclass
+class TriadErrors:
+    """Errors of one sensor triad (accelerometer: m/s² units, gyro: rad/s units).
+
+    ``bias`` (3,) fixed bias; ``bias_sigma`` σ of a random turn-on bias per axis;
+    ``scale`` (3,) scale-factor errors (1e-6 = 1 ppm); ``misalignment`` (3, 3) with zero
+    diagonal, measured = (I + diag(scale) + misalignment) · true; ``white`` density N
+    (m/s/√s or rad/√s); ``bias_rw`` density K (m/s²/√s or rad/s/√s); ``gauss_markov``;
+    ``flicker``."""
+
+    bias: tuple = (0.0, 0.0, 0.0)
+    bias_sigma: float = 0.0
+    scale: tuple = (0.0, 0.0, 0.0)
+    misalignment: np.ndarray = field(default_factory=lambda: np.zeros((3, 3)))
+    white: float = 0.0
+    bias_rw: float = 0.0
+    gauss_markov: GaussMarkov | None = None
+    flicker: Flicker | None = None
+
+    def _to_core(self, name: str) -> dict:
+        m = np.asarray(self.misalignment, dtype=float)
+        if m.shape != (3, 3):
+            raise ValueError(f"{name}.misalignment: expected shape (3, 3), got {m.shape}")
+        gm, fl = self.gauss_markov, self.flicker
+        return {
+            "bias": vector(self.bias, 3, f"{name}.bias").tolist(),
+            "bias_sigma": float(self.bias_sigma),
+            "scale": vector(self.scale, 3, f"{name}.scale").tolist(),
+            "misalignment": m.ravel().tolist(),  # finiteness and zero diagonal checked in Rust
+            "white": float(self.white),
+            "bias_rw": float(self.bias_rw),
+            "gauss_markov": None if gm is None else (float(gm.sigma), float(gm.tau)),
+            "flicker": None if fl is None else (float(fl.b), float(fl.f_lo), float(fl.f_hi)),
+        }
+
+    @classmethod
+    def _from_core(cls, d: dict) -> "TriadErrors":
+        gm, fl = d["gauss_markov"], d["flicker"]
+        return cls(
+            bias=tuple(d["bias"]),
+            bias_sigma=d["bias_sigma"],
+            scale=tuple(d["scale"]),
+            misalignment=np.asarray(d["misalignment"], dtype=float).reshape(3, 3),
+            white=d["white"],
+            bias_rw=d["bias_rw"],
+            gauss_markov=None if gm is None else GaussMarkov(*gm),
+            flicker=None if fl is None else Flicker(*fl),
+        )
+
+
+_USER_PRESETS: dict[str, "ImuErrors"] = {}
+
+
+@dataclass
+class ImuErrors:
+    """The error model of an IMU: ``accel`` and ``gyro`` triads. ``ImuErrors.preset(name)``
+    gives a named grade; :func:`register_preset` adds user grades."""
+
+    accel: TriadErrors = field(default_factory=TriadErrors)
+    gyro: TriadErrors = field(default_factory=TriadErrors)
+
+    def _to_core(self) -> tuple[dict, dict]:
+        return self.accel._to_core("accel"), self.gyro._to_core("gyro")
+
+    def validate(self) -> "ImuErrors":
+        """Raise ValueError naming the first invalid parameter (e.g. ``gyro.white``)."""
+        _core.imu_validate_errors(*self._to_core())
+        return self
+
+    @classmethod
+    def preset(cls, name: str) -> "ImuErrors":
+        """A copy of the named preset: built-in ``navigation`` (seed-003 RLG IMU),
+        ``tactical`` (typical class values), ``mems`` (seed-000 hexapod MEMS),
+        ``electrostatic_space`` / ``electrostatic_space_drift`` (seed-000 satellite
+        accelerometer), ``precise`` / ``medium`` / ``coarse`` (Demidov 2009 classes), or a
+        name added with :func:`register_preset`. Sources are in ``rust/imu/presets.rs``."""
+        choice(name, preset_names(), "preset")
+        if name in _USER_PRESETS:
+            return copy.deepcopy(_USER_PRESETS[name])
+        a, g = _core.imu_preset(name)
+        return cls(TriadErrors._from_core(a), TriadErrors._from_core(g))
+
+    def summary(self) -> pd.DataFrame:
+        """The parameters in SI and in the units datasheets use (µg, µg/√Hz, µg/√h, °/h,
+        °/√h, °/h/√h), one row per (sensor, parameter)."""
+        sqrt_h = np.sqrt(units.HOUR)
+        out = []
+        for sensor, t, si, u, u_name, dens, dens_name in (
+            ("accel", self.accel, "m/s^2", units.MICRO_G, "ug", units.MICRO_G_PER_SQRT_HZ, "ug/sqrt(Hz)"),
+            ("gyro", self.gyro, "rad/s", units.DEG_PER_HOUR, "deg/h", units.DEG_PER_SQRT_HOUR, "deg/sqrt(h)"),
+        ):
+            gm, fl = t.gauss_markov, t.flicker
+            items = [(f"bias_{a}", b, si, b / u, u_name) for a, b in zip(_AXES, t.bias)]
+            items += [
+                ("bias_sigma", t.bias_sigma, si, t.bias_sigma / u, u_name),
+                ("white", t.white, f"{si}*sqrt(s)", t.white / dens, dens_name),
+                ("bias_rw", t.bias_rw, f"{si}/sqrt(s)", t.bias_rw * sqrt_h / u, f"{u_name}/sqrt(h)"),
+                ("gauss_markov_sigma", gm.sigma if gm else 0.0, si, (gm.sigma if gm else 0.0) / u, u_name),
+                ("flicker_b", fl.b if fl else 0.0, si, (fl.b if fl else 0.0) / u, u_name),
+            ]
+            out += [dict(sensor=sensor, parameter=p, value_si=v, unit_si=us, value_field=vf, unit_field=uf) for p, v, us, vf, uf in items]
+        return pd.DataFrame(out)
+
+
+def preset_names() -> list[str]:
+    """Built-in preset names followed by user-registered ones."""
+    return list(_core.imu_preset_names()) + list(_USER_PRESETS)
+
+
+def register_preset(name: str, errors: ImuErrors) -> None:
+    """Add a named user preset (validated; a built-in name cannot be replaced)."""
+    if name in _core.imu_preset_names():
+        raise ValueError(f"preset: {name!r} is a built-in preset and cannot be replaced")
+    _USER_PRESETS[str(name)] = copy.deepcopy(errors.validate())
+
+
+def _seed(seed) -> int:
+    try:
+        s = operator.index(seed)
+    except TypeError:
+        raise ValueError(f"seed: must be an integer in [0, 2**64), got {seed!r}") from None
+    if not 0 <= s < 2**64:
+        raise ValueError(f"seed: must be an integer in [0, 2**64), got {s}")
+    return s
+
+
+class ImuSimulator:
+    """Seeded, stateful corruption of an ideal IMU stream with sampling interval ``dt``
+    (s) and output ``kind`` (``"rates"`` or ``"increments"``). Successive :meth:`corrupt`
+    calls continue the random processes, so chunks give the numbers of one batch call."""
+
+    def __init__(self, errors: ImuErrors | str, dt: float, kind: str = "rates", seed: int = 0):
+        if isinstance(errors, str):
+            errors = ImuErrors.preset(errors)
+        self.kind = choice(kind, KINDS, "kind")
+        self.dt = float(dt)
+        self.errors = copy.deepcopy(errors)
+        self._sim = _core.ImuErrorSimulator(*errors._to_core(), self.dt, self.kind, _seed(seed))
+        self._k = 0
+
+    def corrupt(self, accel, gyro=None) -> pd.DataFrame:
+        """Corrupt the next chunk. ``accel``, ``gyro``: (N, 3) true specific force (m/s²)
+        and angular rate (rad/s), or Δv (m/s) and Δθ (rad) for increments; or one DataFrame
+        with the stream columns of this kind (module docstring). Returns a DataFrame
+        indexed by the running sample number with the measured columns (same names) and the
+        bias truth columns."""
+        fcols, wcols = COLUMNS[self.kind]
+        t = None
+        if isinstance(accel, pd.DataFrame):
+            if gyro is not None:
+                raise ValueError("gyro: must be None when accel is a DataFrame")
+            missing = [c for c in fcols + wcols if c not in accel.columns]
+            if missing:
+                raise ValueError(f"accel: DataFrame lacks columns {missing} for kind {self.kind!r}")
+            t = accel["time_s"].to_numpy() if "time_s" in accel.columns else None
+            accel, gyro = accel[fcols].to_numpy(), accel[wcols].to_numpy()
+        elif gyro is None:
+            raise ValueError("gyro: required when accel is an array")
+        f, w = rows(accel, 3, "accel"), rows(gyro, 3, "gyro")
+        if len(w) != len(f):
+            raise ValueError(f"gyro: expected {len(f)} rows like accel, got {len(w)}")
+        fm, wm, fb, wb = self._sim.corrupt(f, w)
+        index = pd.RangeIndex(self._k, self._k + len(f), name="sample")
+        self._k += len(f)
+        df = pd.DataFrame(np.hstack([fm, wm, fb, wb]), columns=fcols + wcols + BIAS_COLUMNS[0] + BIAS_COLUMNS[1], index=index)
+        if t is not None:
+            df.insert(0, "time_s", t)
+        return df
+
+
+def corrupt(accel, gyro=None, *, errors: ImuErrors | str, dt: float, kind: str = "rates", seed: int = 0) -> pd.DataFrame:
+    """One-shot :class:`ImuSimulator` ``(errors, dt, kind, seed).corrupt(accel, gyro)``."""
+    return ImuSimulator(errors, dt, kind, seed).corrupt(accel, gyro)
+
+
+def white_sigma(density: float, dt: float, kind: str = "rates") -> float:
+    """Per-sample σ of white noise of density N at interval Δt: N/√Δt (rate, m/s² or
+    rad/s) or N·√Δt (increment, m/s or rad)."""
+    return _core.imu_white_sigma(float(density), float(dt), kind)
+
+
+def white_density(sigma: float, dt: float, kind: str = "rates") -> float:
+    """Density N (m/s/√s or rad/√s) of white noise with per-sample σ at Δt (inverse of
+    :func:`white_sigma`)."""
+    return _core.imu_white_density(float(sigma), float(dt), kind)
+
+
+def random_walk_step_sigma(density: float, dt: float) -> float:
+    """σ of the per-sample bias step K·√Δt of a random walk of density K."""
+    return _core.imu_random_walk_step_sigma(float(density), float(dt))
+
+
+def random_walk_density(step_sigma: float, dt: float) -> float:
+    """Density K of a random walk whose per-sample step has σ ``step_sigma`` at Δt."""
+    return _core.imu_random_walk_density(float(step_sigma), float(dt))
+
+
+def gauss_markov_driving_sigma(sigma: float, tau: float, dt: float) -> float:
+    """Per-sample driving σ_u = σ√(1 − e^{−2Δt/τ}) of m_{k+1} = e^{−Δt/τ} m_k + u_k."""
+    return _core.imu_gauss_markov_driving_sigma(float(sigma), float(tau), float(dt))
+
+
+def gauss_markov_sigma(driving_sigma: float, tau: float, dt: float) -> float:
+    """Stationary σ of the discrete Gauss–Markov with per-sample driving σ_u at Δt."""
+    return _core.imu_gauss_markov_sigma(float(driving_sigma), float(tau), float(dt))
+
+
+def gauss_markov_low_freq_asd(sigma: float, tau: float) -> float:
+    """Low-frequency amplitude spectral density σ√(2τ) of a Gauss–Markov process."""
+    return _core.imu_gauss_markov_low_freq_asd(float(sigma), float(tau))
+
+
+def flicker_psd(b: float, f: float) -> float:
+    """One-sided PSD B²/(πf) of flicker noise of bias instability B at f (Hz)."""
+    return _core.imu_flicker_psd(float(b), float(f))
+
+
+def flicker_allan_floor(b: float) -> float:
+    """Allan-deviation floor B·√(2 ln 2/π) of flicker noise."""
+    return _core.imu_flicker_allan_floor(float(b))
