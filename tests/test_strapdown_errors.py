@@ -2,43 +2,22 @@
 Schuler period and the closed-form linearised error solutions."""
 
 import numpy as np
-import pandas as pd
 import pytest
 
 import atomnav as an
 
-RATE = 10.0  # Hz: the vehicle is at rest, so a low rate is exact
-
-
-def _free_ins(lat, hours, dv0=(0.0, 0.0, 0.0), gyro_bias=(0, 0, 0), accel_bias=(0, 0, 0)):
-    traj = an.trajectory.stationary(hours * 3600.0, RATE, origin=(lat, 0.4, 100.0))
-    imu = traj.ideal_imu("increments")
-    dt = 1.0 / RATE
-    imu[["dtheta_x_rad", "dtheta_y_rad", "dtheta_z_rad"]] += np.asarray(gyro_bias) * dt
-    imu[["dv_x_mps", "dv_y_mps", "dv_z_mps"]] += np.asarray(accel_bias) * dt
-    init = traj.initial_state()
-    init["vel_ned"] = init["vel_ned"] + np.asarray(dv0)
-    nav = an.strapdown.integrate(imu, **init, vertical="damped", h_ref=traj.df["h_m"].to_numpy()[1:])
-    return traj, traj.errors(pd.concat([traj.df.iloc[:1], nav], ignore_index=True))
-
-
-def _zero_crossing_periods(t, v):
-    s = np.sign(v)
-    idx = np.nonzero(s[:-1] * s[1:] < 0)[0]
-    tc = t[idx] - v[idx] * (t[idx + 1] - t[idx]) / (v[idx + 1] - v[idx])
-    return 2.0 * np.diff(tc)  # spec gnss-ins-tight Eq. 44: T = 2·Δt between crossings
+LAT = np.deg2rad(55.75)
 
 
 @pytest.fixture(scope="module")
 def schuler_run():
-    lat = np.deg2rad(55.75)
-    return lat, _free_ins(lat, 4.5, dv0=(200.0, 0.0, 0.0))
+    return an.diagnostics.schuler_test(LAT, v0=200.0, hours=4.5, h=100.0)
 
 
 def test_schuler_period(schuler_run):
-    lat, (traj, err) = schuler_run
-    periods = _zero_crossing_periods(err["time_s"].to_numpy(), err["dvel_n_mps"].to_numpy())[:3] / 60.0
-    theory = an.earth.schuler_period(lat, 100.0) / 60.0  # 2π√((√(MN)+h)/γ)
+    periods = schuler_run["periods_min"][:3]
+    m, n = an.earth.radii(LAT)
+    theory = 2 * np.pi * np.sqrt((np.sqrt(m * n) + 100.0) / an.earth.gravity(LAT, 100.0)) / 60.0
     assert abs(theory - 84.4) / 84.4 < 0.005
     for p in periods:
         assert abs(p - theory) / theory < 0.005, f"zero-crossing period {p} min vs 2π√(R/g) = {theory} min"
@@ -50,13 +29,11 @@ def test_schuler_amplitudes(schuler_run):
     """Spec §4 row 2: position amplitude 200/ω_s ≈ 161 km, tilt 200/(ω_s R₀) ≈ 1.45° (±3 %).
     The Foucault rotation moves part of the oscillation to east within the first period,
     so the amplitude is taken as the horizontal norm."""
-    lat, (traj, err) = schuler_run
-    ws = 2 * np.pi / an.earth.schuler_period(lat, 100.0)
-    first = err["time_s"] < 2 * np.pi / ws
-    pos = np.hypot(err["dpos_n_m"], err["dpos_e_m"])[first].max()
-    tilt = np.hypot(err["psi_n_rad"], err["psi_e_rad"])[first].max()
-    m, n = an.earth.radii(lat)
+    m, n = an.earth.radii(LAT)
     r0 = np.sqrt(m * n) + 100.0
+    ws = np.sqrt(an.earth.gravity(LAT, 100.0) / r0)
+    pos, tilt = schuler_run["position_peak_m"], schuler_run["tilt_peak_rad"]
+    assert abs(200.0 / ws - 161e3) / 161e3 < 0.01  # the spec's number
     # δr = (v0/ω_s) sin ω_s t peaks at v0/ω_s; ψ = −(v0/(ω_s R₀)) sin ω_s t at v0/(ω_s R₀)
     assert abs(pos - 200.0 / ws) / (200.0 / ws) < 0.03, (pos, 200.0 / ws)
     assert abs(tilt - 200.0 / (ws * r0)) / (200.0 / (ws * r0)) < 0.03, (np.rad2deg(tilt), np.rad2deg(200 / (ws * r0)))
@@ -81,7 +58,7 @@ def _east_channel_closed_form(t, ba_e=0.0, bg_n=0.0, h=100.0):
     ids=["accel_bias_east", "gyro_bias_north"],
 )
 def test_error_growth_matches_closed_form(bias):
-    traj, err = _free_ins(0.0, 2.0, **bias)
+    err = an.diagnostics.stationary_errors(0.0, 2.0, **bias)
     t = err["time_s"].to_numpy()
     dr, psi = _east_channel_closed_form(t, ba_e=bias.get("accel_bias", (0, 0, 0))[1], bg_n=bias.get("gyro_bias", (0, 0, 0))[0])
     for name, sim, cf in [("dpos_e_m", err["dpos_e_m"].to_numpy(), dr), ("psi_n_rad", err["psi_n_rad"].to_numpy(), psi)]:

@@ -1,0 +1,58 @@
+"""Free-inertial diagnostics of the strapdown INS: a stationary INS with injected
+initial errors or sensor biases, and the Schuler-period test of spec gnss-ins-tight §2.13
+(the factory test of seed 004, Ch. 1)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+
+from . import earth, strapdown, trajectory
+
+
+def stationary_errors(lat: float, hours: float, rate_hz: float = 10.0, h: float = 100.0, dv0=(0.0, 0.0, 0.0),
+                      gyro_bias=(0.0, 0.0, 0.0), accel_bias=(0.0, 0.0, 0.0), vertical: str = "damped") -> pd.DataFrame:
+    """Errors (:meth:`atomnav.trajectory.Trajectory.errors`) of a level, north-pointing INS at
+    rest at latitude ``lat`` (rad) and height ``h`` (m) over ``hours``, started with NED
+    velocity error ``dv0`` (m/s), with constant body-frame gyro (rad/s) and accelerometer
+    (m/s²) biases. The vertical channel is held to the true height by default (baro loop).
+    The vehicle is at rest, so a low ``rate_hz`` is exact."""
+    traj = trajectory.stationary(hours * 3600.0, rate_hz, origin=(lat, 0.4, h))
+    imu = traj.ideal_imu("increments")
+    dt = 1.0 / rate_hz
+    imu[["dtheta_x_rad", "dtheta_y_rad", "dtheta_z_rad"]] += np.asarray(gyro_bias, float) * dt
+    imu[["dv_x_mps", "dv_y_mps", "dv_z_mps"]] += np.asarray(accel_bias, float) * dt
+    init = traj.initial_state()
+    init["vel_ned"] = init["vel_ned"] + np.asarray(dv0, float)
+    h_ref = traj.df["h_m"].to_numpy()[1:] if vertical == "damped" else None
+    nav = strapdown.integrate(imu, **init, vertical=vertical, h_ref=h_ref)
+    first = strapdown.Strapdown(**init).state()  # the perturbed initial state
+    return traj.errors(pd.concat([first, nav], ignore_index=True))
+
+
+def zero_crossing_periods(t: np.ndarray, v: np.ndarray) -> np.ndarray:
+    """Oscillation periods (s) from the zero crossings of ``v(t)`` (linear interpolation):
+    T = 2·Δt between successive crossings (spec gnss-ins-tight Eq. 44)."""
+    t, v = np.asarray(t, float), np.asarray(v, float)
+    s = np.sign(v)
+    idx = np.nonzero(s[:-1] * s[1:] < 0)[0]
+    tc = t[idx] - v[idx] * (t[idx + 1] - t[idx]) / (v[idx + 1] - v[idx])
+    return 2.0 * np.diff(tc)
+
+
+def schuler_test(lat: float = np.deg2rad(55.75), v0: float = 200.0, hours: float = 4.5, h: float = 100.0) -> dict:
+    """The Schuler test: a stationary INS started with a ``v0`` m/s north velocity error.
+    Returns the error table and the measured quantities: zero-crossing periods of v_N
+    (min), the Schuler period 2π√((√(MN)+h)/γ) (min), and the first-period peaks of the
+    horizontal position error (m) and tilt (rad)."""
+    err = stationary_errors(lat, hours, dv0=(v0, 0.0, 0.0), h=h)
+    periods = zero_crossing_periods(err["time_s"].to_numpy(), err["dvel_n_mps"].to_numpy()) / 60.0
+    ts = earth.schuler_period(lat, h)
+    first = err["time_s"] < ts
+    return {
+        "errors": err,
+        "periods_min": periods,
+        "schuler_period_min": ts / 60.0,
+        "position_peak_m": float(np.hypot(err["dpos_n_m"], err["dpos_e_m"])[first].max()),
+        "tilt_peak_rad": float(np.hypot(err["psi_n_rad"], err["psi_e_rad"])[first].max()),
+    }
