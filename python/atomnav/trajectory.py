@@ -140,14 +140,17 @@ class Trajectory:
 
     # ---- comparison -----------------------------------------------------------------
     def errors(self, nav: pd.DataFrame) -> pd.DataFrame:
-        """Errors (estimate − truth) of a navigation solution at this trajectory's times:
-        NED position error (m), NED velocity error (m/s), attitude error ψ (rad, nav frame,
-        C_nb(est) = (I − [ψ×]) C_nb(true)). The solution must have the same time stamps."""
-        n = min(len(nav), len(self.df))
-        tt, tn = self.time[-n:], nav["time_s"].to_numpy()[-n:]
-        if not np.allclose(tt, tn, rtol=0, atol=1e-9):
-            raise ValueError("nav: time stamps differ from the trajectory's")
-        truth, est = self.df.iloc[-n:], nav.iloc[-n:]
+        """Errors (estimate − truth) of a navigation solution: NED position error (m), NED
+        velocity error (m/s), attitude error ψ (rad, nav frame, C_nb(est) = (I − [ψ×])
+        C_nb(true)), one row per solution row. Every solution time stamp must be one of
+        the trajectory's (an increments-driven solution, which starts one step after the
+        initial state, is fine)."""
+        tn = nav["time_s"].to_numpy()
+        idx = np.clip(np.searchsorted(self.time, tn), 0, len(self.time) - 1)
+        off = np.nonzero(np.abs(self.time[idx] - tn) > 1e-9)[0]
+        if off.size:
+            raise ValueError(f"nav: time stamp {tn[off[0]]} at index {off[0]} is not a time stamp of the trajectory")
+        truth, est = self.df.iloc[idx], nav
         from .earth import lla_to_ecef
         from .rotation import quat_multiply, rotvec_from_quat
 
@@ -159,7 +162,7 @@ class Trajectory:
         qt = truth[["qw", "qx", "qy", "qz"]].to_numpy() * np.array([1, -1, -1, -1])
         psi = -np.reshape(rotvec_from_quat(quat_multiply(est[["qw", "qx", "qy", "qz"]].to_numpy(), qt)), (-1, 3))
         cols = ["time_s", "dpos_n_m", "dpos_e_m", "dpos_d_m", "dvel_n_mps", "dvel_e_mps", "dvel_d_mps", "psi_n_rad", "psi_e_rad", "psi_d_rad"]
-        return pd.DataFrame(np.column_stack([tt, d_ned, dv, psi]), columns=cols)
+        return pd.DataFrame(np.column_stack([tn, d_ned, dv, psi]), columns=cols)
 
     def plot(self, ax=None):
         """Ground track (east vs north, m, relative to the start) coloured by time."""
