@@ -74,10 +74,15 @@ pub fn to_py_rows<'py, const W: usize>(py: Python<'py>, rows: &[[f64; W]]) -> Bo
     rows_to_py(py, rows.len(), W, rows.iter().flat_map(|r| r.iter().copied()))
 }
 
-/// An (n, w) array from a row-major stream of values, built without a second copy.
+/// An (n, w) array from a row-major stream of values.
 pub fn rows_to_py<'py>(py: Python<'py>, n: usize, w: usize, values: impl Iterator<Item = f64>) -> Bound<'py, PyArray2<f64>> {
     let mut flat = Vec::with_capacity(n * w);
     flat.extend(values);
+    flat_to_py(py, n, w, flat)
+}
+
+/// An (n, w) array that takes ownership of a row-major buffer (no copy).
+pub fn flat_to_py<'py>(py: Python<'py>, n: usize, w: usize, flat: Vec<f64>) -> Bound<'py, PyArray2<f64>> {
     Array2::from_shape_vec((n, w), flat).expect("n·w values by construction").into_pyarray(py)
 }
 

@@ -1,6 +1,6 @@
 //! Bindings of strapdown.rs: a streaming mechanization object and attitude integration.
 
-use super::convert::{quat_rows, quat_to_py, rows_to_py, vec3, vec3_rows, vector};
+use super::convert::{flat_to_py, quat_rows, quat_to_py, vec3, vec3_rows, vector};
 use crate::earth::Ellipsoid;
 use crate::error::invalid;
 use crate::math::{euler_from_quat, quat, Vec3};
@@ -18,20 +18,17 @@ pub struct Strapdown {
 /// `atomnav.trajectory.COLUMNS` (time, lat, lon, h, v_N, v_E, v_D, q_nb (4), roll, pitch,
 /// yaw) — so that pandas can wrap its transpose without copying.
 fn states_to_columns<'py>(py: Python<'py>, s: &[NavState]) -> Bound<'py, PyArray2<f64>> {
-    let euler: Vec<Vec3> = s.iter().map(|x| euler_from_quat(&x.q_nb)).collect();
-    let column = |c: usize| {
-        s.iter().zip(&euler).map(move |(x, e)| match c {
-            0 => x.t,
-            1..=3 => x.lla[c - 1],
-            4..=6 => x.vel[c - 4],
-            7 => x.q_nb.w,
-            8 => x.q_nb.i,
-            9 => x.q_nb.j,
-            10 => x.q_nb.k,
-            _ => e[c - 11],
-        })
-    };
-    rows_to_py(py, 14, s.len(), (0..14).flat_map(column))
+    let n = s.len();
+    let mut buf = vec![0.0; 14 * n];
+    for (i, x) in s.iter().enumerate() {
+        let e = euler_from_quat(&x.q_nb);
+        let q = &x.q_nb;
+        let row = [x.t, x.lla.x, x.lla.y, x.lla.z, x.vel.x, x.vel.y, x.vel.z, q.w, q.i, q.j, q.k, e.x, e.y, e.z];
+        for (c, v) in row.into_iter().enumerate() {
+            buf[c * n + i] = v;
+        }
+    }
+    flat_to_py(py, 14, n, buf)
 }
 
 #[pymethods]
