@@ -270,8 +270,3 @@ pub fn ml_windows(x: &[f64], phi: &[f64], amp: &[f64], cfg: &MlConfig, batch: us
     }
     Ok(out)
 }
-
-/// Readout variance (E21) σ_p²(φ) = A² sin²φ σ_φ² + σ_p0² + cos²φ σ_A² → R.
-pub fn readout_variance(theta: &[f64; 3], amp: f64, phi: f64) -> f64 {
-    (amp * phi.sin() * theta[1]).powi(2) + theta[0] * theta[0] + (phi.cos() * theta[2]).powi(2)
-}
