@@ -98,7 +98,7 @@ pub struct MlResult {
     /// Identifiable combinations a = σ_p0² + σ_A², b = Ā²σ_φ² − σ_A² (Ā = mean amplitude).
     pub a: f64,
     pub b: f64,
-    /// Eigenvalues (ascending) of the 3 × 3 Hessian of ln L w.r.t. (σ_p0², σ_φ², σ_A²)
+    /// Eigenvalues (ascending in magnitude) of the 3 × 3 Hessian of ln L w.r.t. (σ_p0², σ_φ², σ_A²)
     /// at the estimate: one is ≈ 0 (the unidentifiable direction).
     pub hessian_eigenvalues: [f64; 3],
 }
@@ -235,7 +235,7 @@ pub fn ml_identify(x: &[f64], phi: &[f64], amp: &[f64], cfg: &MlConfig) -> Resul
         hv += w * Vector3::from(data.c[i]) * Vector3::from(data.c[i]).transpose();
     }
     let mut eig: Vec<f64> = hv.symmetric_eigen().eigenvalues.iter().copied().collect();
-    eig.sort_by(f64::total_cmp);
+    eig.sort_by(|p, q| p.abs().total_cmp(&q.abs()));
     let a_mean2 = (amp.iter().sum::<f64>() / n as f64).powi(2);
     Ok(MlResult {
         theta: th,

@@ -273,7 +273,12 @@ fn check_channels(channels: &[Channel]) -> Result<()> {
 fn check_series(field: &str, v: &[Vec3], t: &[f64], shots: &[f64], t_sep: f64) -> Result<()> {
     if let Some(i) = v.iter().position(|x| x.iter().any(|c| !c.is_finite())) {
         let ti = t[i];
-        let shot = shots.iter().position(|&s| ti >= s - t_sep && ti <= s + 3.0 * t_sep);
+        // the shot containing the sample, else one whose interpolation/derivative stencil may
+        // reach it
+        let shot = shots
+            .iter()
+            .position(|&s| ti >= s && ti <= s + 2.0 * t_sep)
+            .or_else(|| shots.iter().position(|&s| ti >= s - t_sep && ti <= s + 3.0 * t_sep));
         let where_ = shot.map_or(String::from("outside every shot"), |s| format!("used by shot {s}"));
         return Err(invalid(field, format!("non-finite value {:?} at index {i} (t = {ti} s, {where_})", [v[i].x, v[i].y, v[i].z])));
     }

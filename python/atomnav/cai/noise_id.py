@@ -56,9 +56,9 @@ def identify_noise(x, phi, amplitude, *, free=("p0", "phi"), theta0=(0.02, 0.2, 
 
     One row per estimate: ``sigma_p0``, ``sigma_phi_rad``, ``sigma_A``, the identifiable
     ``a`` = σ_p0² + σ_A², ``b`` = Ā²σ_φ² − σ_A², ``R_mid`` = a + b (readout variance at
-    mid-fringe), ``iterations``, ``converged``, ``log_likelihood`` and ``hessian_min_eig``
-    (smallest eigenvalue of the Hessian in the three variances, ≈ 0: the unidentifiable
-    direction)."""
+    mid-fringe), ``iterations``, ``converged``, ``log_likelihood`` and ``hessian_eig_ratio``
+    (smallest / largest eigenvalue magnitude of the Hessian of ln L in the three variances,
+    ≈ 0: the unidentifiable direction)."""
     choice(method, ("gradient", "newton"), "method")
     for f in free:
         choice(f, _NAMES, "free")
@@ -72,7 +72,7 @@ def identify_noise(x, phi, amplitude, *, free=("p0", "phi"), theta0=(0.02, 0.2, 
         "sigma_p0": th[:, 0], "sigma_phi_rad": th[:, 1], "sigma_A": th[:, 2],
         "a": res["a"], "b": res["b"], "R_mid": res["a"] + res["b"],
         "iterations": res["iterations"], "converged": res["converged"],
-        "log_likelihood": res["log_likelihood"], "hessian_min_eig": res["hessian_eigenvalues"][:, 0],
+        "log_likelihood": res["log_likelihood"], "hessian_eig_ratio": np.abs(res["hessian_eigenvalues"][:, 0] / res["hessian_eigenvalues"][:, 2]),
     })
 
 
