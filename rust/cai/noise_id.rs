@@ -74,7 +74,8 @@ pub enum Method {
     /// halved until ln L increases.
     Gradient,
     /// Newton–Raphson (E20) with the observed Hessian, Fisher scoring where the Hessian is
-    /// not negative definite, step halving until ln L increases.
+    /// not negative definite, pseudo-inverse for singular directions, step halving until
+    /// ln L increases.
     Newton,
 }
 
@@ -200,7 +201,11 @@ pub fn ml_identify(x: &[f64], phi: &[f64], amp: &[f64], cfg: &MlConfig) -> Resul
             Method::Newton => {
                 let neg_def = hs.clone().symmetric_eigen().eigenvalues.iter().all(|&e| e < 0.0);
                 let m = if neg_def { -hs } else { fs };
-                m.lu().solve(&gs).ok_or_else(|| NavError::Numerical("ML Newton step: singular Hessian".into()))?
+                // damped pseudo-inverse (spec Decision 9): singular directions (a component
+                // at 0) get no step
+                let svd = m.svd(true, true);
+                let eps = 1e-12 * svd.singular_values.max();
+                svd.solve(&gs, eps).map_err(|e| NavError::Numerical(format!("ML Newton step: {e}")))?
             }
         };
         let mut scale = 1.0;
