@@ -6,7 +6,10 @@ use atomnav::math::{Mat3, Vec3};
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
 use std::hint::black_box;
 
-fn setup(n: usize) -> (Vec<f64>, Vec<Vec3>, Vec<Vec3>, Vec<f64>, Vec<Channel>) {
+/// (t, specific force, angular rate, shot starts, channels)
+type Setup = (Vec<f64>, Vec<Vec3>, Vec<Vec3>, Vec<f64>, Vec<Channel>);
+
+fn setup(n: usize) -> Setup {
     let t: Vec<f64> = (0..n).map(|i| i as f64 * 1e-3).collect();
     let f = t.iter().map(|&s| Vec3::new(0.3 * (4.3 * s).sin(), 0.1 * (9.7 * s).cos(), -9.81)).collect();
     let w = t.iter().map(|&s| Vec3::new(0.01 * (1.3 * s).sin(), 0.02, 0.05 * (0.1 * s).cos())).collect();

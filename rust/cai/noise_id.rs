@@ -234,10 +234,11 @@ pub fn ml_identify(x: &[f64], phi: &[f64], amp: &[f64], cfg: &MlConfig) -> Resul
     }
     // Hessian w.r.t. the variances s_j = θ_j²: ∂²lnL/∂s_j∂s_m = Σ (1/(2σ⁴) − x²/σ⁶) c_ij c_im.
     let mut hv = Matrix3::zeros();
-    for i in 0..n {
-        let s2 = data.var(i, &th);
-        let w = 0.5 / (s2 * s2) - x[i] * x[i] / (s2 * s2 * s2);
-        hv += w * Vector3::from(data.c[i]) * Vector3::from(data.c[i]).transpose();
+    for (xi, ci) in x.iter().zip(&data.c) {
+        let c = Vector3::from(*ci);
+        let s2: f64 = (0..3).map(|j| c[j] * th[j] * th[j]).sum();
+        let w = 0.5 / (s2 * s2) - xi * xi / (s2 * s2 * s2);
+        hv += w * c * c.transpose();
     }
     let mut eig: Vec<f64> = hv.symmetric_eigen().eigenvalues.iter().copied().collect();
     eig.sort_by(|p, q| p.abs().total_cmp(&q.abs()));

@@ -13,6 +13,9 @@ use numpy::{PyArray1, PyArray2, PyReadonlyArray1, PyReadonlyArray2, PyReadonlyAr
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
+type Arr1<'py> = Bound<'py, PyArray1<f64>>;
+type Arr2<'py> = Bound<'py, PyArray2<f64>>;
+
 fn mat3(a: &PyReadonlyArray2<'_, f64>, field: &str) -> PyResult<Mat3> {
     let r = rows::<3>(a, field)?;
     if r.len() != 3 {
@@ -251,7 +254,7 @@ fn cai_motion_imu<'py>(
     g0: PyReadonlyArray1<'py, f64>,
     gradient: Option<PyReadonlyArray2<'py, f64>>,
     t_ref: f64,
-) -> PyResult<(Bound<'py, PyArray2<f64>>, Bound<'py, PyArray2<f64>>, Bound<'py, PyArray2<f64>>)> {
+) -> PyResult<(Arr2<'py>, Arr2<'py>, Arr2<'py>)> {
     let m = motion(kind, &params, &pos_poly, &pos_sines, &att_poly, &att_sines)?;
     let t = vector(&t, "t")?;
     let g = gravity(&g0, gradient, t_ref)?;
@@ -319,7 +322,7 @@ fn cai_phase_closed_form<'py>(
 
 /// Sensitivity g(t) and response f(t) at times t (pulse centred at 0).
 #[pyfunction]
-fn cai_sensitivity<'py>(py: Python<'py>, t: PyReadonlyArray1<'py, f64>, t_dark: f64, tau: f64) -> PyResult<(Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<f64>>)> {
+fn cai_sensitivity<'py>(py: Python<'py>, t: PyReadonlyArray1<'py, f64>, t_dark: f64, tau: f64) -> PyResult<(Arr1<'py>, Arr1<'py>)> {
     let p = Pulses::new(t_dark, tau)?;
     let t = vector(&t, "t")?;
     Ok((vec_to_py(py, t.iter().map(|&x| p.g(x)).collect()), vec_to_py(py, t.iter().map(|&x| p.f(x)).collect())))

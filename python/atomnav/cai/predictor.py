@@ -75,6 +75,8 @@ class Channels:
 
 def _predictor_args(t, specific_force, angular_rate, shots, T, channels, angular_acceleration, omega_dot,
                     savgol_half_width, interpolation, substeps, gradient, bias_a, bias_g):
+    if omega_dot is None:
+        omega_dot = "savgol" if angular_acceleration is None else "given"
     choice(omega_dot, ("zero", "pwl", "savgol", "given"), "omega_dot")
     choice(interpolation, ("linear", "cubic"), "interpolation")
     t = vector(t, None, "t")
@@ -88,6 +90,8 @@ def _predictor_args(t, specific_force, angular_rate, shots, T, channels, angular
         wd = np.ascontiguousarray(np.asarray(angular_acceleration, float))
         if wd.shape != (len(t), 3):
             raise ValueError(f"angular_acceleration: expected shape ({len(t)}, 3), got {wd.shape}")
+        if omega_dot != "given":
+            raise ValueError(f"angular_acceleration: given, but omega_dot = {omega_dot!r} would ignore it")
     shots = np.atleast_1d(np.asarray(shots, float))
     g = None if gradient is None else np.ascontiguousarray(np.asarray(gradient, float).reshape(3, 3))
     return (t, f, w, np.ascontiguousarray(shots), channels.k, channels.lever, channels.c_sb, channels.v0, float(T),
@@ -118,17 +122,18 @@ class PhasePrediction:
 
 
 def predict_phase(t, specific_force, angular_rate, shots, T: float, channels: Channels, *, angular_acceleration=None,
-                  omega_dot: str = "savgol", savgol_half_width: int = 2, interpolation: str = "linear",
+                  omega_dot: str | None = None, savgol_half_width: int = 2, interpolation: str = "linear",
                   substeps: int = 1, gradient=None, bias_a=0.0, bias_g=0.0) -> PhasePrediction:
     """Atom strapdown phase of every shot and channel (spec (E5)–(E7)), with breakdown.
 
     t (N,) s; specific_force (N, 3) m/s² and angular_rate (N, 3) rad/s in the IMU body
     frame; shots: start times (s) of non-overlapping shots (pulses at t_s, t_s + T,
     t_s + 2T, inside the record; need not coincide with samples); T pulse separation (s).
-    omega_dot: source of ω̇ for the Euler terms — "savgol" (5-point quadratic
-    Savitzky–Golay derivative of the gyro, half width ``savgol_half_width``), "pwl"
-    (derivative of the gyro interpolant), "given" (``angular_acceleration`` (N, 3) rad/s²),
-    "zero" (no Euler terms). interpolation "linear" (spec) or "cubic" (error ∝ h⁴ instead
+    omega_dot: source of ω̇ for the Euler terms — "given" (default when
+    ``angular_acceleration`` (N, 3) rad/s² is passed, e.g. from a simulator), "savgol"
+    (default otherwise: 5-point quadratic Savitzky–Golay derivative of the gyro, half width
+    ``savgol_half_width``), "pwl"
+    (derivative of the gyro interpolant), "zero" (no Euler terms). interpolation "linear" (spec) or "cubic" (error ∝ h⁴ instead
     of h²). gradient: Γ_s (3, 3) 1/s² in s. bias_a (m/s²), bias_g (rad/s): estimated IMU
     biases, subtracted from the inputs.
     """
@@ -139,7 +144,7 @@ def predict_phase(t, specific_force, angular_rate, shots, T: float, channels: Ch
 
 
 def phase_jacobian(t, specific_force, angular_rate, shots, T: float, channels: Channels, *, euler: bool = False,
-                   fd_steps=None, angular_acceleration=None, omega_dot: str = "savgol", savgol_half_width: int = 2,
+                   fd_steps=None, angular_acceleration=None, omega_dot: str | None = None, savgol_half_width: int = 2,
                    interpolation: str = "linear", substeps: int = 1, gradient=None, bias_a=0.0,
                    bias_g=0.0) -> np.ndarray:
     """∂φ/∂(b_a, b_g, l, γ) (n_shots, n_channels, 12), columns :data:`JACOBIAN_PARAMS`, units
