@@ -166,3 +166,28 @@ def _c_ib(m, t):
     ang = np.array([np.polyval(m.attitude_poly[a][::-1], t) + sum(
         s[1] * np.sin(2 * np.pi * s[2] * t + s[3]) for s in m.attitude_sines if s[0] == a) for a in range(3)])
     return rotation.dcm_from_euler(ang).reshape(3, 3)
+
+
+def test_angular_acceleration_sources():
+    """ω̇ for the Euler terms: the Savitzky–Golay derivative of the gyro (default for measured
+    data) and the derivative of the gyro interpolant ("pwl") approach the simulator's exact
+    ω̇; the 5-point formula is exact for a quadratic rate."""
+    m = vib_motion()
+    t = np.arange(0, 2001) / 2000.0
+    f, w, wd = cai.motion_imu(m, t, gravity=(0, 0, 9.81))
+    ch = channels()
+    exact = cai.predict_phase(t, f, w, SHOTS, T, ch, angular_acceleration=wd, interpolation="cubic")
+    for src, tol in (("savgol", 1e-3), ("pwl", 1e-3)):
+        p = cai.predict_phase(t, f, w, SHOTS, T, ch, omega_dot=src, interpolation="cubic")
+        assert np.abs(p.terms["eul"] - exact.terms["eul"]).max() < tol * np.abs(exact.terms["eul"]).max()
+    # quadratic rate: ω = c t², ω̇ = 2ct exactly from the 5-point derivative
+    n = 101
+    tq = np.arange(n) * 1e-3
+    wq = np.zeros((n, 3))
+    wq[:, 2] = 0.5 * tq**2
+    wdq = np.zeros((n, 3))
+    wdq[:, 2] = tq
+    chl = cai.Channels.cyclic(lever=(1.0, 0, 0))
+    a = cai.predict_phase(tq, np.zeros((n, 3)), wq, [0.03], T, chl, omega_dot="savgol")
+    b = cai.predict_phase(tq, np.zeros((n, 3)), wq, [0.03], T, chl, angular_acceleration=wdq)
+    np.testing.assert_allclose(a.total, b.total, rtol=1e-12, atol=1e-9)
