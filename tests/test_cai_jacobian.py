@@ -67,3 +67,27 @@ def test_readout_jacobian_mid_fringe():
     phi = cai.predict_phase(t, f, w, [0.0113], T, ch).total
     jr = cai.readout_jacobian(jp, phi, cai.steer_mid_fringe(phi), contrast=0.6)
     np.testing.assert_allclose(jr, 0.3 * jp, rtol=1e-9)
+
+
+def test_paper_mode_terms_vs_tangent_linear():
+    """(E29)/(E30) term by term vs the exact tangent-linear Jacobian at constant dynamics
+    (lever arm, misalignment): ∂φ/∂b_a to 5e-4 relative (next order 7/4 (ωT)² = 1.5e-4); the lever-arm part of ∂φ/∂b_g
+    (J(l) − J(0)) equals centrifugal + mixed-centrifugal terms to 1e-3 relative; the whole
+    ∂φ/∂b_g to 2e-3 of its largest entry (the paper omits the 3T³k·(ω×(ω×v0)) term)."""
+    n = 101
+    t = np.arange(n) * 1e-3
+    f0, w0 = np.array([0.3, -0.2, -9.81]), np.array([0.2, -0.1, 0.3])
+    ch = channels()
+    ch0 = cai.Channels(ch.k, (0, 0, 0), ch.c_sb, ch.v0)
+
+    def exact(c):
+        return cai.phase_jacobian(t, np.tile(f0, (n, 1)), np.tile(w0, (n, 1)), [0.02], T, c, omega_dot="zero")[0]
+
+    ex, ex0 = exact(ch), exact(ch0)
+    pm = cai.paper_jacobian(ch, f0, w0, T)
+    np.testing.assert_allclose(pm["ba"], ex[:, 0:3], atol=5e-4 * np.abs(ex[:, 0:3]).max())
+    lever_part = ex[:, 3:6] - ex0[:, 3:6]
+    np.testing.assert_allclose(pm["centrifugal"] + pm["mixed_cen"], lever_part, atol=1e-3 * np.abs(lever_part).max())
+    np.testing.assert_allclose(pm["bg"], ex[:, 3:6], atol=2e-2 * np.abs(ex[:, 3:6]).max())
+    p0 = cai.paper_jacobian(ch0, f0, w0, T)
+    assert np.abs(p0["centrifugal"]).max() == 0 and np.abs(p0["mixed_cen"]).max() == 0

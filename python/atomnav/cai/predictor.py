@@ -176,6 +176,38 @@ def readout_jacobian(phase_jac, phi_hat, phi0, contrast: float = 1.0) -> np.ndar
     return s[..., None] * np.asarray(phase_jac)
 
 
+def paper_jacobian(channels: Channels, specific_force, angular_rate, T: float, *, angular_acceleration=(0.0, 0.0, 0.0),
+                   euler: bool = False) -> dict:
+    """Paper-mode phase Jacobians for constant dynamics (seed 003 (P-27), (P-31); spec
+    (E29)/(E30)), term by term, per channel: ∂φ/∂b_a = T²k^T(I − 2T[ω_s×])C_sb and ∂φ/∂b_g
+    as the sum of ``centrifugal`` (terms 1–2), ``coriolis`` (3), ``mixed_acc`` (4),
+    ``mixed_cen`` (5–7) and, with ``euler``, ``mixed_euler`` (8). Inputs in the body frame:
+    f_b (m/s²), ω_b (rad/s), ω̇_b (rad/s²). Returns arrays (C, 3) in rad per (m/s²) /
+    (rad/s); the readout Jacobian is (C/2)× these at mid-fringe (P-25/26). The exact
+    tangent-linear derivative is :func:`phase_jacobian`."""
+    T = positive(T, "T")
+    f = vector(specific_force, 3, "specific_force")
+    w = vector(angular_rate, 3, "angular_rate")
+    wd = vector(angular_acceleration, 3, "angular_acceleration")
+
+    def sk(v):
+        return np.array([[0, -v[2], v[1]], [v[2], 0, -v[0]], [-v[1], v[0], 0]])
+
+    out = {k: [] for k in ("ba", "centrifugal", "coriolis", "mixed_acc", "mixed_cen", "mixed_euler")}
+    for k, l, c, v0 in zip(channels.k, channels.lever, channels.c_sb, channels.v0):
+        ws = c @ w
+        cen_jac = sk(w) @ sk(l) + sk(np.cross(w, l))  # ∂[ω×(ω×l)]/∂ω up to sign (E30) 1–2
+        out["ba"].append(T**2 * k @ (np.eye(3) - 2 * T * sk(ws)) @ c)
+        out["centrifugal"].append(-T**2 * k @ c @ cen_jac)
+        out["coriolis"].append(-2 * T**2 * k @ sk(v0) @ c)
+        out["mixed_acc"].append(2 * T**3 * k @ sk(c @ f) @ c)
+        out["mixed_cen"].append(2 * T**3 * k @ (sk(c @ np.cross(w, np.cross(w, l))) @ c + sk(ws) @ c @ cen_jac))
+        out["mixed_euler"].append(2 * T**3 * k @ sk(c @ np.cross(wd, l)) @ c if euler else np.zeros(3))
+    res = {k: np.array(v) for k, v in out.items()}
+    res["bg"] = sum(res[k] for k in ("centrifugal", "coriolis", "mixed_acc", "mixed_cen", "mixed_euler"))
+    return res
+
+
 # --- analytic motions and the inertial oracle ------------------------------------------
 
 _EMPTY_SINES = np.zeros((0, 4))
