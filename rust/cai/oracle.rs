@@ -248,9 +248,9 @@ pub fn oracle_phase(m: &dyn BodyMotion, shots: &[f64], t_sep: f64, channels: &[C
     let mut out = Vec::with_capacity(shots.len() * channels.len());
     for &ts in shots {
         let (c_ib0, w0, _) = m.attitude(ts);
-        for ch in channels {
+        for (j, ch) in channels.iter().enumerate() {
             if ch.k.norm() == 0.0 {
-                return Err(invalid("channels.k", "zero wave vector"));
+                return Err(invalid(&format!("channels[{j}].k"), "zero wave vector (k must be non-zero)"));
             }
             let c_is0 = c_ib0 * ch.c_sb.transpose();
             let lever_i0 = c_ib0 * ch.lever;
