@@ -74,3 +74,15 @@ def test_sliding_window_warm_start(data):
     assert s.sigma_phi_rad.iloc[-1] == pytest.approx(last.sigma_phi_rad[0], rel=1e-5)
     assert s.iterations.iloc[1:].mean() < last.iterations[0] + 1
     np.testing.assert_allclose(cai.readout_variance(s.a, s.b, np.pi / 2), s.R_mid)
+
+
+def test_sliding_window_leaves_zero_boundary(data):
+    """A window whose ML σ_φ reaches 0 must not trap the warm-started windows after it (the
+    gradient in θ vanishes at θ = 0): over the whole record the last sliding window equals a
+    fresh estimate on the same 200 samples."""
+    x, phi, amp = cai.residuals(*data)
+    s = cai.identify_noise(x, phi, amp, batch=200, sliding=True)
+    assert (s.sigma_phi_rad < 1e-3).any()  # this record has windows at the boundary
+    fresh = cai.identify_noise(x[-200:], phi[-200:], amp[-200:])
+    assert s.sigma_phi_rad.iloc[-1] == pytest.approx(fresh.sigma_phi_rad[0], rel=1e-4)
+    assert s.sigma_p0.iloc[-1] == pytest.approx(fresh.sigma_p0[0], rel=1e-4)

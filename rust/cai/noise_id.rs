@@ -256,7 +256,8 @@ pub fn ml_identify(x: &[f64], phi: &[f64], amp: &[f64], cfg: &MlConfig) -> Resul
 
 /// ML over consecutive batches of `batch` samples (each from `cfg.theta0`), or over a
 /// sliding window of `batch` samples ending at every sample from `batch − 1` on, each
-/// warm-started from the previous estimate (`sliding`).
+/// warm-started from the previous estimate (`sliding`; free components floored at 10 % of
+/// `cfg.theta0`).
 pub fn ml_windows(x: &[f64], phi: &[f64], amp: &[f64], cfg: &MlConfig, batch: usize, sliding: bool) -> Result<Vec<MlResult>> {
     if batch < 3 || batch > x.len() {
         return Err(invalid("batch", format!("must be in [3, {}], got {batch}", x.len())));
@@ -266,7 +267,11 @@ pub fn ml_windows(x: &[f64], phi: &[f64], amp: &[f64], cfg: &MlConfig, batch: us
         let mut c = cfg.clone();
         for end in batch..=x.len() {
             let r = ml_identify(&x[end - batch..end], &phi[end - batch..end], &amp[end - batch..end], &c)?;
-            c.theta0 = r.theta;
+            // warm start, floored at 10 % of the initial value: J_j ∝ θ_j, so a component
+            // that reached the boundary 0 in one window could never leave it again
+            for j in 0..3 {
+                c.theta0[j] = if cfg.free[j] { r.theta[j].max(0.1 * cfg.theta0[j]) } else { cfg.theta0[j] };
+            }
             out.push(r);
         }
     } else {
