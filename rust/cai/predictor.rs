@@ -386,56 +386,78 @@ fn prepare<'a>(imu: Imu<'a>, shots: &[f64], channels: &[Channel], cfg: &Predicto
     Ok(Record { imu, wd, interpolation: cfg.interpolation, bias_a: cfg.bias_a, bias_g: cfg.bias_g, t_sep, substeps: cfg.substeps, shots })
 }
 
-/// Phase of one shot and channel with its breakdown, in the order of [`TERM_NAMES`].
-fn shot_phase(rec: &Record, stages: &[([BodyStage; 3], bool)], ch: &Channel, gradient: Option<&Mat3>) -> [f64; 7] {
-    // y = [x_h, v_h, x_p, v_p, x_g, v_g]: homogeneous (v0, Γ = 0), forced (Γ = 0), full (Γ).
-    let mut y = [Vec3::zeros(), ch.v0, Vec3::zeros(), Vec3::zeros(), Vec3::zeros(), ch.v0];
-    let mut x_mid = [Vec3::zeros(); 3];
-    let (mut acc, mut cen, mut eul) = (0.0, 0.0, 0.0);
+/// Per-shot solutions shared by all channels with the same (C_sb, l): the solution of the
+/// linear ODE (E5) is x = Φ(t) v0 + x_p(t), so the transition block Φ (homogeneous
+/// solutions for v0 = e_1, e_2, e_3) and the forced solution x_p serve every k and v0.
+struct GeometrySolution {
+    /// x(T) and x(2T) of [Φ e_1, Φ e_2, Φ e_3, x_p], Γ = 0.
+    mid: [Vec3; 4],
+    end: [Vec3; 4],
+    /// The same with the gravity gradient (when given).
+    mid_g: [Vec3; 4],
+    end_g: [Vec3; 4],
+    /// −∫ w f dτ of the acceleration, centrifugal and Euler forces (vectors; dot with k).
+    acc: Vec3,
+    cen: Vec3,
+    eul: Vec3,
+}
+
+/// Right-hand side for [Φ e_1, Φ e_2, Φ e_3, x_p] and their velocities (8 vectors).
+fn block_rhs(s: &ChStage, y: &[Vec3; 8], force: &Vec3, gradient: Option<&Mat3>) -> [Vec3; 8] {
+    let zero = Vec3::zeros();
+    let mut d = [zero; 8];
+    for c in 0..4 {
+        let f = if c == 3 { force } else { &zero };
+        d[2 * c] = y[2 * c + 1];
+        d[2 * c + 1] = atom_accel(s, &y[2 * c], &y[2 * c + 1], f, gradient);
+    }
+    d
+}
+
+fn solve_geometry(rec: &Record, stages: &[([BodyStage; 3], bool)], ch: &Channel, gradient: Option<&Mat3>) -> GeometrySolution {
+    let zero = Vec3::zeros();
+    let init = [zero, Vec3::x(), zero, Vec3::y(), zero, Vec3::z(), zero, zero];
+    let (mut y, mut yg) = (init, init);
+    let (mut mid, mut mid_g) = (init, init);
+    let (mut acc, mut cen, mut eul) = (zero, zero, zero);
     for (st, pulse) in stages {
         let cs = [0, 1, 2].map(|i| ChStage::new(&st[i], ch, gradient));
         let h = cs[2].tau - cs[0].tau;
-        // Simpson's rule for (E12)–(E14), −∫ w k·f dτ.
-        let simpson = |g: &dyn Fn(&ChStage) -> Vec3| -> f64 {
-            -h / 6.0 * (0..3).map(|i| [1.0, 4.0, 1.0][i] * rec.weight(cs[i].tau) * ch.k.dot(&g(&cs[i]))).sum::<f64>()
-        };
-        acc += simpson(&|c| c.f_acc);
-        cen += simpson(&|c| c.f_cen);
-        eul += simpson(&|c| c.f_eul);
-        let zero = Vec3::zeros();
-        match gradient {
-            None => rk4(&mut y, h, [&cs[0], &cs[1], &cs[2]], |s, y| {
-                let fs = s.f_s();
-                [y[1], atom_accel(s, &y[0], &y[1], &zero, None), y[3], atom_accel(s, &y[2], &y[3], &fs, None), zero, zero]
-            }),
-            Some(g) => rk4(&mut y, h, [&cs[0], &cs[1], &cs[2]], |s, y| {
-                let fs = s.f_s();
-                let ff = fs + s.f_gl;
-                [
-                    y[1],
-                    atom_accel(s, &y[0], &y[1], &zero, None),
-                    y[3],
-                    atom_accel(s, &y[2], &y[3], &fs, None),
-                    y[5],
-                    atom_accel(s, &y[4], &y[5], &ff, Some(g)),
-                ]
-            }),
+        // Simpson's rule for (E12)–(E14), −∫ w f dτ (exact for the piecewise-polynomial
+        // integrands of linear inputs).
+        for (c, s) in cs.iter().zip([1.0, 4.0, 1.0]) {
+            let wk = -h / 6.0 * s * rec.weight(c.tau);
+            acc += wk * c.f_acc;
+            cen += wk * c.f_cen;
+            eul += wk * c.f_eul;
+        }
+        let refs = [&cs[0], &cs[1], &cs[2]];
+        rk4(&mut y, h, refs, |s, y| block_rhs(s, y, &s.f_s(), None));
+        if let Some(g) = gradient {
+            rk4(&mut yg, h, refs, |s, y| block_rhs(s, y, &(s.f_s() + s.f_gl), Some(g)));
         }
         if *pulse {
-            x_mid = [y[0], y[2], y[4]];
+            (mid, mid_g) = (y, yg);
         }
     }
-    // φ = k·D[x] with x(0) = 0 (E4).
-    let d = |mid: &Vec3, end: &Vec3| ch.k.dot(&(end - 2.0 * mid));
-    let rot = d(&x_mid[0], &y[0]);
-    let forced = d(&x_mid[1], &y[2]);
+    let pos = |y: &[Vec3; 8]| [y[0], y[2], y[4], y[6]];
+    GeometrySolution { mid: pos(&mid), end: pos(&y), mid_g: pos(&mid_g), end_g: pos(&yg), acc, cen, eul }
+}
+
+/// Phase of one channel with its breakdown, in the order of [`TERM_NAMES`].
+fn channel_phase(g: &GeometrySolution, ch: &Channel, gradient: bool) -> [f64; 7] {
+    // φ = k·D[x] with x(0) = 0 (E4), x = Φ v0 + x_p.
+    let d = |mid: &[Vec3; 4], end: &[Vec3; 4], c: usize| ch.k.dot(&(end[c] - 2.0 * mid[c]));
+    let hom = |mid: &[Vec3; 4], end: &[Vec3; 4]| (0..3).map(|c| ch.v0[c] * d(mid, end, c)).sum::<f64>();
+    let rot = hom(&g.mid, &g.end);
+    let forced = d(&g.mid, &g.end, 3);
+    let (acc, cen, eul) = (ch.k.dot(&g.acc), ch.k.dot(&g.cen), ch.k.dot(&g.eul));
     let no_grad = rot + forced;
-    let (total, gg) = match gradient {
-        None => (no_grad, 0.0),
-        Some(_) => {
-            let full = d(&x_mid[2], &y[4]);
-            (full, full - no_grad)
-        }
+    let (total, gg) = if gradient {
+        let full = hom(&g.mid_g, &g.end_g) + d(&g.mid_g, &g.end_g, 3);
+        (full, full - no_grad)
+    } else {
+        (no_grad, 0.0)
     };
     [total, acc, rot, cen, eul, forced - acc - cen - eul, gg]
 }
@@ -444,11 +466,25 @@ fn shot_phase(rec: &Record, stages: &[([BodyStage; 3], bool)], ch: &Channel, gra
 /// `shot * channels.len() + channel`, columns [`TERM_NAMES`].
 pub fn predict(imu: Imu, shots: &[f64], channels: &[Channel], cfg: &PredictorConfig) -> Result<Vec<[f64; 7]>> {
     let rec = prepare(imu, shots, channels, cfg)?;
+    // channels with identical (C_sb, l) share one GeometrySolution
+    let mut reps: Vec<usize> = Vec::new();
+    let mut group = Vec::with_capacity(channels.len());
+    for (j, ch) in channels.iter().enumerate() {
+        match reps.iter().position(|&r| channels[r].c_sb == ch.c_sb && channels[r].lever == ch.lever) {
+            Some(g) => group.push(g),
+            None => {
+                reps.push(j);
+                group.push(reps.len() - 1);
+            }
+        }
+    }
+    let grad = cfg.gradient.as_ref();
     let mut out = Vec::with_capacity(shots.len() * channels.len());
     for s in 0..shots.len() {
         let stages = rec.stages(s);
-        for ch in channels {
-            out.push(shot_phase(&rec, &stages, ch, cfg.gradient.as_ref()));
+        let sols: Vec<GeometrySolution> = reps.iter().map(|&r| solve_geometry(&rec, &stages, &channels[r], grad)).collect();
+        for (ch, &g) in channels.iter().zip(&group) {
+            out.push(channel_phase(&sols[g], ch, grad.is_some()));
         }
     }
     Ok(out)
