@@ -105,3 +105,46 @@ def test_series_gradient_terms_vs_predictor():
     v_term, f_term = 0.025**3 * K * gam * 2.8, -7 / 12 * 0.025**4 * K * gam * f[0, 2]
     assert v_term == pytest.approx(2.174e-3, rel=1e-3) and f_term == pytest.approx(1.111e-4, rel=1e-3)
     assert p.terms["gg"][0, 0] == pytest.approx(v_term + f_term, rel=1e-6)
+
+
+def test_in_shot_imu_noise_phase():
+    """(E38) with the (E36) PSDs q_a = 1.25e-11 m²/s³, q_g = 1.0576e-12 rad²/s at T = 25 ms:
+    0.1838 rad (accel), 0.2994 rad (gyro); checked by Monte Carlo through the predictor
+    (2000 shots of 2 kHz white noise with per-sample σ = √(q/Δt), spec (E33)), ±5 %."""
+    s = cai.in_shot_noise_phase(1.25e-11, 1.0576e-12, 0.025)
+    assert s["accel"] == pytest.approx(0.1838, rel=1e-3) and s["gyro"] == pytest.approx(0.2994, rel=1e-3)
+    rng = np.random.default_rng(7)
+    dt, T, shots = 5e-4, 0.025, 2000
+    n = int(shots * 2 * T / dt) + 1
+    t = np.arange(n) * dt
+    ch = cai.Channels(np.array([[K, 0, 0]]), (0, 0, 0), np.eye(3), [0, 2.8, 0])
+    starts = np.arange(shots) * 2 * T
+    fa = rng.normal(0, np.sqrt(1.25e-11 / dt), (n, 3))
+    pa = cai.predict_phase(t, fa, np.zeros((n, 3)), starts, T, ch, omega_dot="zero").total[:, 0]
+    wg = rng.normal(0, np.sqrt(1.0576e-12 / dt), (n, 3))
+    pg = cai.predict_phase(t, np.zeros((n, 3)), wg, starts, T, ch, omega_dot="zero").total[:, 0]
+    assert np.std(pa) == pytest.approx(s["accel"], rel=0.05)
+    assert np.std(pg) == pytest.approx(s["gyro"], rel=0.05)
+
+
+def test_in_shot_noise_covariance_six_channels():
+    """Full 6 × 6 covariance (A/B correlated) vs Monte Carlo through the predictor with
+    white noise on all IMU axes, misaligned C_sb: diagonal ±6 %, correlations ±0.05."""
+    from atomnav import rotation
+
+    c_sb = rotation.dcm_from_euler(np.array([0.1, -0.2, 0.3])).reshape(3, 3)
+    ch = cai.Channels.cyclic(c_sb=c_sb)
+    qa, qg, T = 1.25e-11, 1.0576e-12, 0.025
+    cov = cai.in_shot_noise_covariance(ch, qa, qg, T)
+    np.testing.assert_allclose(np.sqrt(cov[0, 0]), np.hypot(*cai.in_shot_noise_phase(qa, qg, T).values()), rtol=1e-12)
+    rng = np.random.default_rng(8)
+    dt, shots = 5e-4, 2000
+    n = int(shots * 2 * T / dt) + 1
+    t = np.arange(n) * dt
+    f = rng.normal(0, np.sqrt(qa / dt), (n, 3))
+    w = rng.normal(0, np.sqrt(qg / dt), (n, 3))
+    p = cai.predict_phase(t, f, w, np.arange(shots) * 2 * T, T, ch, omega_dot="zero").total
+    emp = np.cov(p.T)
+    np.testing.assert_allclose(np.diag(emp), np.diag(cov), rtol=0.12)  # variance: ±6 % in σ
+    d = np.sqrt(np.diag(cov))
+    np.testing.assert_allclose(emp / np.outer(np.sqrt(np.diag(emp)), np.sqrt(np.diag(emp))), cov / np.outer(d, d), atol=0.05)

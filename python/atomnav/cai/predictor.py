@@ -345,6 +345,30 @@ def capture_limits(T: float, k: float = K_RB87, v0: float = 2.8) -> dict:
     return {"accelerometer": 0.5 * np.pi / s["acceleration"], "gyro": 0.5 * np.pi / s["sagnac"]}
 
 
+def in_shot_noise_phase(q_accel: float, q_gyro: float, T: float, k: float = K_RB87, v0: float = 2.8) -> dict:
+    """Phase standard deviation (rad) caused by IMU white noise inside one shot (seed 003
+    spec (E38)): ``accel`` k√(2q_a/3) T^{3/2} and ``gyro`` (Sagnac) 2kv0√(2q_g/3) T^{3/2},
+    with q the white-noise PSDs (m²/s³, rad²/s), from Var = q k² ∫w² dt, ∫w² = 2T³/3."""
+    T = positive(T, "T")
+    for name, q in (("q_accel", q_accel), ("q_gyro", q_gyro)):
+        if not (np.isfinite(q) and q >= 0):
+            raise ValueError(f"{name}: must be finite and >= 0, got {q}")
+    return {"accel": k * np.sqrt(2 * q_accel / 3) * T**1.5, "gyro": 2 * k * v0 * np.sqrt(2 * q_gyro / 3) * T**1.5}
+
+
+def in_shot_noise_covariance(channels: Channels, q_accel: float, q_gyro: float, T: float) -> np.ndarray:
+    """Covariance (C, C) (rad²) of the predicted phases of one shot caused by white IMU noise
+    of PSD q_accel (m²/s³) and q_gyro (rad²/s) per body axis, for R inflation (seed 000 spec
+    Decision 14, full matrix including the A/B correlation). To leading order the noise acts
+    as an atom acceleration −C_sb n_a (phase −∫w k·C_sb n_a) and a Coriolis acceleration
+    −2(C_sb n_g)×v0 (phase −2∫w n_g·C_sbᵀ(v0×k)), so with ∫w² = 2T³/3:
+    Σ = (2T³/3) [q_a K Kᵀ + 4 q_g V Vᵀ],  K_j = C_sb,jᵀ k_j,  V_j = C_sb,jᵀ (v0_j × k_j)."""
+    in_shot_noise_phase(q_accel, q_gyro, T)  # validates q and T
+    kb = np.einsum("cji,cj->ci", channels.c_sb, channels.k)
+    vb = np.einsum("cji,cj->ci", channels.c_sb, np.cross(channels.v0, channels.k))
+    return 2 * T**3 / 3 * (q_accel * kb @ kb.T + 4 * q_gyro * vb @ vb.T)
+
+
 def phase_noise(sigma_p: float, contrast: float = 1.0) -> float:
     """Phase noise (rad) of a mid-fringe readout with population noise σ_p: 2σ_p/C."""
     return 2.0 * positive(sigma_p, "sigma_p") / positive(contrast, "contrast")
