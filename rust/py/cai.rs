@@ -5,7 +5,7 @@ use super::convert::{rows, to_py_rows, vec3, vec3_rows, vec3_to_py, vec_to_py, v
 use crate::cai::closed_form::{phase_constant, phase_seed000, phase_series};
 use crate::cai::noise_id::{fringe_track, ml_windows, FringeEkf, Method, MlConfig};
 use crate::cai::oracle::{imu_from_motion, oracle_phase, BodyMotion, Gravity, SineMotion, Signal, YawDrive};
-use crate::cai::predictor::{jacobian, jacobian_fd, predict, Channel, Imu, Interpolation, OmegaDot, PredictorConfig};
+use crate::cai::predictor::{jacobian, jacobian_fd, predict, Channel, Imu, Interpolation, OmegaDot, PredictorConfig, JACOBIAN_PARAMS, TERM_NAMES};
 use crate::cai::sensitivity::{convolution_phase, ideal_transfer, Pulses};
 use crate::error::invalid;
 use crate::math::{Mat3, Vec3};
@@ -413,6 +413,9 @@ fn cai_ml_identify<'py>(
 }
 
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    // column names of cai_predict / cai_jacobian (single source of truth)
+    m.add("CAI_TERMS", TERM_NAMES.to_vec())?;
+    m.add("CAI_JACOBIAN_PARAMS", JACOBIAN_PARAMS.to_vec())?;
     m.add_function(wrap_pyfunction!(cai_predict, m)?)?;
     m.add_function(wrap_pyfunction!(cai_jacobian, m)?)?;
     m.add_function(wrap_pyfunction!(cai_motion_imu, m)?)?;

@@ -21,11 +21,11 @@ from .._validate import choice, positive, rows, vector
 LAMBDA_RB87 = 780.241e-9
 K_RB87 = 4.0 * np.pi / LAMBDA_RB87
 
-#: Columns of the phase breakdown (spec (E12)–(E17)); they sum to ``total``.
-TERMS = ("total", "acc", "rot", "cen", "eul", "mix", "gg")
+#: Columns of the phase breakdown (spec (E12)–(E17)); the terms after ``total`` sum to it.
+TERMS = tuple(_core.CAI_TERMS)
 #: Columns of the Jacobians: accelerometer bias (m/s²), gyro bias (rad/s), lever arm (m),
 #: misalignment γ (rad, C_sb = exp(−[γ×]) C_sb,0).
-JACOBIAN_PARAMS = ("ba_x", "ba_y", "ba_z", "bg_x", "bg_y", "bg_z", "l_x", "l_y", "l_z", "gamma_x", "gamma_y", "gamma_z")
+JACOBIAN_PARAMS = tuple(_core.CAI_JACOBIAN_PARAMS)
 
 
 def k_eff(wavelength: float = LAMBDA_RB87) -> float:
@@ -156,7 +156,7 @@ def phase_jacobian(t, specific_force, angular_rate, shots, T: float, channels: C
                         savgol_half_width, interpolation, substeps, gradient, bias_a, bias_g)
     steps = None if fd_steps is None else vector(fd_steps, 4, "fd_steps")
     out = _core.cai_jacobian(*a, bool(euler), steps)
-    return out.reshape(len(a[3]), len(channels), 12)
+    return out.reshape(len(a[3]), len(channels), len(JACOBIAN_PARAMS))
 
 
 def check_jacobian(*args, fd_steps=(1e-3, 1e-4, 1e-3, 1e-4), **kwargs) -> dict:
