@@ -6,11 +6,13 @@
 //!   ẍ = −f_s − 2ω×ẋ − ω×(ω×x) − ω̇×x + Γ_s x,   x(0) = 0, ẋ(0) = v0,
 //! with (E6) f_s = C_sb (f_b + ω̇_b×l + ω_b×(ω_b×l)) − Γ_s C_sb l and (E7) ω = C_sb ω_b.
 //! The IMU inputs are interpolated between samples (linear per spec §2.3, or cubic) and
-//! bias-corrected with the current estimates; the ODE is integrated with RK4 on a grid made of the IMU sample times and
-//! the pulse times (`substeps` RK4 steps per grid interval); φ = k·D[x].
+//! bias-corrected with the current estimates; the ODE is integrated with RK4 on a grid made
+//! of the IMU sample times and the pulse times (`substeps` RK4 steps per grid interval);
+//! φ = k·D[x].
 //!
 //! Breakdown (exact decomposition of (E9), spec §2.4): the solution of the linear ODE is
-//! x = x_h + x_p (homogeneous part with v0, forced part with zero initial state), so
+//! x = x_h + x_p, x_h = Φ(t) v0 (homogeneous part; Φ shared by all channels with the same
+//! C_sb and l), x_p the forced part with zero initial state, so
 //!   φ_rot = k·D[x_h] (E15),   φ_acc, φ_cen, φ_eul = −∫ w k·(…) dτ (E12)–(E14) by
 //!   Simpson's rule (exact for the piecewise-polynomial integrands),
 //!   φ_mix = k·D[x_p] − φ_acc − φ_cen − φ_eul (E16),   φ_gg = φ(Γ) − φ(Γ = 0) (E17),
