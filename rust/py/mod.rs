@@ -2,6 +2,7 @@
 
 use pyo3::prelude::*;
 
+mod cai;
 mod convert;
 mod earth;
 mod imu;
@@ -41,5 +42,6 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     imu::register(m)?;
     trajectory::register(m)?;
     strapdown::register(m)?;
+    cai::register(m)?;
     Ok(())
 }

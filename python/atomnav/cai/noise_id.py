@@ -1,0 +1,81 @@
+"""Fringe noise identification (seed 000 §3; spec ``cai-ekf-tennstedt2021.md`` (E15)–(E21)).
+
+Readout p_i = p0 + A cos(φ + ψ_i) with noise on offset (σ_p0), phase (σ_φ, rad) and
+amplitude (σ_A); ψ_i is the known phase of shot i (from a vibration sensor). The residual
+variance is a + b sin²φ_i with a = σ_p0² + σ_A², b = A²σ_φ² − σ_A²: only (a, b) are
+identifiable, so (σ_p0, σ_φ, σ_A) are estimated with at least one of them fixed; asking
+for all three raises a ``ValueError`` that says so.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+
+from .. import _core
+from .._validate import choice, vector
+
+_NAMES = ("p0", "phi", "A")
+
+
+def simulate_fringe(n: int, *, p0: float = 0.5, phi: float = 1.0, amplitude: float = 0.15, sigma_p0: float = 0.025,
+                    sigma_phi: float = 0.23, sigma_A: float = 0.02, seed=None):
+    """n readouts of the nonlinear model (P-17) p = (p0 + n_p0) + (A + n_A) cos(φ + ψ + n_φ)
+    with ψ uniform on [0, 2π) (fringe scanned by vibration). Returns (p, ψ)."""
+    rng = np.random.default_rng(seed)
+    psi = rng.uniform(0.0, 2 * np.pi, n)
+    p = (p0 + rng.normal(0, sigma_p0, n)) + (amplitude + rng.normal(0, sigma_A, n)) * np.cos(phi + psi + rng.normal(0, sigma_phi, n))
+    return p, psi
+
+
+def fringe_track(p, psi, *, zeta0=(0.5, 0.0, 0.1), sigma0=(0.1, 1.0, 0.1), q=(1e-9, 1e-7, 1e-9),
+                 r: float = 1e-3) -> pd.DataFrame:
+    """Fringe-tracking EKF (E15)/(E16) on ζ = [p0, φ, A]: columns ``p0``, ``phi_rad``, ``A``
+    after each readout (A kept > 0, φ wrapped to (−π, π]). q: random-walk variance per
+    shot, r: readout variance."""
+    z = _core.cai_fringe_track(vector(p, None, "p"), vector(psi, None, "psi"), vector(zeta0, 3, "zeta0"),
+                               vector(sigma0, 3, "sigma0"), vector(q, 3, "q"), float(r))
+    return pd.DataFrame({"p0": z[:, 0], "phi_rad": z[:, 1], "A": z[:, 2]})
+
+
+def residuals(p, psi, track: pd.DataFrame):
+    """Residuals x_i = p_i − (p̂0 + Â cos φ_i), fringe phases φ_i = φ̂ + ψ_i and amplitudes Â."""
+    phase = track["phi_rad"].to_numpy() + np.asarray(psi, float)
+    amp = track["A"].to_numpy()
+    return np.asarray(p, float) - (track["p0"].to_numpy() + amp * np.cos(phase)), phase, amp
+
+
+def identify_noise(x, phi, amplitude, *, free=("p0", "phi"), theta0=(0.02, 0.2, 0.02), method: str = "newton",
+                   batch: int | None = None, sliding: bool = False, max_iter: int = 100,
+                   tol: float = 1e-6) -> pd.DataFrame:
+    """Maximum-likelihood (σ_p0, σ_φ, σ_A) from residuals x, fringe phases φ (rad) and
+    amplitudes (E17)–(E20). ``free``: the estimated components (at most two; the others
+    stay at ``theta0``); method "gradient" (E19) or "newton" (E20); ``batch`` samples per
+    estimate (default: all; seed 000 uses 200), consecutive batches or, with ``sliding``, a
+    window ending at every sample (warm-started).
+
+    One row per estimate: ``sigma_p0``, ``sigma_phi_rad``, ``sigma_A``, the identifiable
+    ``a`` = σ_p0² + σ_A², ``b`` = Ā²σ_φ² − σ_A², ``R_mid`` = a + b (readout variance at
+    mid-fringe), ``iterations``, ``converged``, ``log_likelihood`` and ``hessian_eig_ratio``
+    (smallest / largest eigenvalue magnitude of the Hessian of ln L in the three variances,
+    ≈ 0: the unidentifiable direction)."""
+    choice(method, ("gradient", "newton"), "method")
+    for f in free:
+        choice(f, _NAMES, "free")
+    x = vector(x, None, "x")
+    mask = [n in free for n in _NAMES]
+    n = len(x)
+    res = _core.cai_ml_identify(x, vector(phi, n, "phi"), vector(amplitude, n, "amplitude"), method, mask,
+                                vector(theta0, 3, "theta0"), int(max_iter), float(tol), int(batch or n), bool(sliding))
+    th = res["theta"]
+    return pd.DataFrame({
+        "sigma_p0": th[:, 0], "sigma_phi_rad": th[:, 1], "sigma_A": th[:, 2],
+        "a": res["a"], "b": res["b"], "R_mid": res["a"] + res["b"],
+        "iterations": res["iterations"], "converged": res["converged"],
+        "log_likelihood": res["log_likelihood"], "hessian_eig_ratio": np.abs(res["hessian_eigenvalues"][:, 0] / res["hessian_eigenvalues"][:, 2]),
+    })
+
+
+def readout_variance(a: float, b: float, phi) -> np.ndarray:
+    """Readout variance σ_p²(φ) = a + b sin²φ (E21), the measurement variance R."""
+    return a + b * np.sin(np.asarray(phi, float)) ** 2

@@ -1,0 +1,379 @@
+"""Atom strapdown: CAI phase prediction from an IMU stream (seed 003), its Jacobians, the
+inertial oracle with analytic body motions, and the constant-input closed forms.
+
+Conventions (spec ``atom-strapdown-tennstedt2023.md``): pulses at t_s, t_s + T, t_s + 2T;
+φ = k·(x(0) − 2x(T) + x(2T)) with x the atom position in the sensor frame s; the atom
+is driven by the SPECIFIC FORCE at the s origin, so a constant specific force f_s gives
+φ = −T² k·f_s. measured = true + bias; estimated biases are subtracted.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+import pandas as pd
+
+from .. import _core
+from .._validate import choice, positive, rows, vector
+
+#: ⁸⁷Rb D2 wavelength (m) and the two-photon effective wave number 4π/λ (rad/m).
+LAMBDA_RB87 = 780.241e-9
+K_RB87 = 4.0 * np.pi / LAMBDA_RB87
+
+#: Columns of the phase breakdown (spec (E12)–(E17)); the terms after ``total`` sum to it.
+TERMS = tuple(_core.CAI_TERMS)
+#: Columns of the Jacobians: accelerometer bias (m/s²), gyro bias (rad/s), lever arm (m),
+#: misalignment γ (rad, C_sb = exp(−[γ×]) C_sb,0).
+JACOBIAN_PARAMS = tuple(_core.CAI_JACOBIAN_PARAMS)
+
+
+def k_eff(wavelength: float = LAMBDA_RB87) -> float:
+    """Effective two-photon wave number 4π/λ (rad/m) of a wavelength λ (m)."""
+    return 4.0 * np.pi / positive(wavelength, "wavelength")
+
+
+@dataclass
+class Channels:
+    """Interferometer channels: k (C, 3) rad/m in s, lever (C, 3) m from the IMU to the
+    release point in b, c_sb (C, 3, 3) rotation b → s, v0 (C, 3) m/s initial atom velocity
+    relative to s, and a name per channel."""
+
+    k: np.ndarray
+    lever: np.ndarray
+    c_sb: np.ndarray
+    v0: np.ndarray
+    names: list = field(default_factory=list)
+
+    def __post_init__(self):
+        self.k = rows(self.k, 3, "k")
+        n = len(self.k)
+        self.lever = rows(np.broadcast_to(np.asarray(self.lever, float), (n, 3)), 3, "lever")
+        self.v0 = rows(np.broadcast_to(np.asarray(self.v0, float), (n, 3)), 3, "v0")
+        c = np.asarray(self.c_sb, float)
+        self.c_sb = np.ascontiguousarray(np.broadcast_to(c, (n, 3, 3)))
+        if not self.names:
+            self.names = [f"ch{j}" for j in range(n)]
+        if len(self.names) != n:
+            raise ValueError(f"names: expected {n} names, got {len(self.names)}")
+
+    def __len__(self) -> int:
+        return len(self.k)
+
+    @classmethod
+    def cyclic(cls, k: float = K_RB87, v0: float = 2.8, lever=(0.0, 0.0, 0.0), c_sb=None) -> "Channels":
+        """Six channels of the seed-003 multi-axis sensor (spec §2.2): k along e_j, ensembles
+        A/B with v0 = ±v0 e_{(j+1) mod 3}; names x_A, x_B, y_A, ..."""
+        ks, vs, names = [], [], []
+        for j, ax in enumerate("xyz"):
+            for s, ab in ((1.0, "A"), (-1.0, "B")):
+                ks.append(np.eye(3)[j] * k)
+                vs.append(np.eye(3)[(j + 1) % 3] * s * v0)
+                names.append(f"{ax}_{ab}")
+        return cls(np.array(ks), lever, np.eye(3) if c_sb is None else c_sb, np.array(vs), names)
+
+
+def _predictor_args(t, specific_force, angular_rate, shots, T, channels, angular_acceleration, omega_dot,
+                    savgol_half_width, interpolation, substeps, gradient, bias_a, bias_g):
+    if omega_dot is None:
+        omega_dot = "savgol" if angular_acceleration is None else "given"
+    choice(omega_dot, ("zero", "pwl", "savgol", "given"), "omega_dot")
+    choice(interpolation, ("linear", "cubic"), "interpolation")
+    t = vector(t, None, "t")
+    f = np.ascontiguousarray(np.asarray(specific_force, float))
+    w = np.ascontiguousarray(np.asarray(angular_rate, float))
+    for name, a in (("specific_force", f), ("angular_rate", w)):
+        if a.shape != (len(t), 3):
+            raise ValueError(f"{name}: expected shape ({len(t)}, 3), got {a.shape}")
+    wd = None
+    if angular_acceleration is not None:
+        wd = np.ascontiguousarray(np.asarray(angular_acceleration, float))
+        if wd.shape != (len(t), 3):
+            raise ValueError(f"angular_acceleration: expected shape ({len(t)}, 3), got {wd.shape}")
+        if omega_dot != "given":
+            raise ValueError(f"angular_acceleration: given, but omega_dot = {omega_dot!r} would ignore it")
+    shots = np.atleast_1d(np.asarray(shots, float))
+    g = None if gradient is None else np.ascontiguousarray(np.asarray(gradient, float).reshape(3, 3))
+    return (t, f, w, np.ascontiguousarray(shots), channels.k, channels.lever, channels.c_sb, channels.v0, float(T),
+            omega_dot, wd, int(savgol_half_width), interpolation, int(substeps), g,
+            vector(np.broadcast_to(np.asarray(bias_a, float), 3).copy(), 3, "bias_a"),
+            vector(np.broadcast_to(np.asarray(bias_g, float), 3).copy(), 3, "bias_g"))
+
+
+@dataclass
+class PhasePrediction:
+    """Predicted phases (rad), each array (n_shots, n_channels); ``total`` is the sum of the
+    terms acc, rot, cen, eul, mix, gg (spec (E12)–(E17))."""
+
+    shots: np.ndarray
+    channels: Channels
+    terms: dict
+
+    @property
+    def total(self) -> np.ndarray:
+        return self.terms["total"]
+
+    def frame(self) -> pd.DataFrame:
+        """Long table: shot_start_s, channel, and one ``<term>_rad`` column per term."""
+        n, c = self.total.shape
+        d = {"shot_start_s": np.repeat(self.shots, c), "channel": np.tile(self.channels.names, n)}
+        d.update({f"{k}_rad": v.ravel() for k, v in self.terms.items()})
+        return pd.DataFrame(d)
+
+
+def predict_phase(t, specific_force, angular_rate, shots, T: float, channels: Channels, *, angular_acceleration=None,
+                  omega_dot: str | None = None, savgol_half_width: int = 2, interpolation: str = "linear",
+                  substeps: int = 1, gradient=None, bias_a=0.0, bias_g=0.0) -> PhasePrediction:
+    """Atom strapdown phase of every shot and channel (spec (E5)–(E7)), with breakdown.
+
+    t (N,) s; specific_force (N, 3) m/s² and angular_rate (N, 3) rad/s in the IMU body
+    frame; shots: start times (s) of non-overlapping shots (pulses at t_s, t_s + T,
+    t_s + 2T, inside the record; need not coincide with samples); T pulse separation (s).
+    omega_dot: source of ω̇ for the Euler terms — "given" (default when
+    ``angular_acceleration`` (N, 3) rad/s² is passed, e.g. from a simulator), "savgol"
+    (default otherwise: 5-point quadratic Savitzky–Golay derivative of the gyro, half width
+    ``savgol_half_width``), "pwl"
+    (derivative of the gyro interpolant), "zero" (no Euler terms). interpolation "linear" (spec) or "cubic" (error ∝ h⁴ instead
+    of h²). gradient: Γ_s (3, 3) 1/s² in s. bias_a (m/s²), bias_g (rad/s): estimated IMU
+    biases, subtracted from the inputs.
+    """
+    a = _predictor_args(t, specific_force, angular_rate, shots, T, channels, angular_acceleration, omega_dot,
+                        savgol_half_width, interpolation, substeps, gradient, bias_a, bias_g)
+    out = _core.cai_predict(*a).reshape(len(a[3]), len(channels), len(TERMS))
+    return PhasePrediction(a[3], channels, {k: out[:, :, i] for i, k in enumerate(TERMS)})
+
+
+def phase_jacobian(t, specific_force, angular_rate, shots, T: float, channels: Channels, *, euler: bool = False,
+                   fd_steps=None, angular_acceleration=None, omega_dot: str | None = None, savgol_half_width: int = 2,
+                   interpolation: str = "linear", substeps: int = 1, gradient=None, bias_a=0.0,
+                   bias_g=0.0) -> np.ndarray:
+    """∂φ/∂(b_a, b_g, l, γ) (n_shots, n_channels, 12), columns :data:`JACOBIAN_PARAMS`, units
+    rad per (m/s², rad/s, m, rad). Analytic tangent-linear derivative of the predictor at
+    the given bias estimates; Euler terms (ω̇) are excluded from the linearisation unless
+    ``euler``. With ``fd_steps = (db_a, db_g, dl, dγ)`` the same derivative is computed by
+    central finite differences of :func:`predict_phase` (the checker)."""
+    a = _predictor_args(t, specific_force, angular_rate, shots, T, channels, angular_acceleration, omega_dot,
+                        savgol_half_width, interpolation, substeps, gradient, bias_a, bias_g)
+    steps = None if fd_steps is None else vector(fd_steps, 4, "fd_steps")
+    out = _core.cai_jacobian(*a, bool(euler), steps)
+    return out.reshape(len(a[3]), len(channels), len(JACOBIAN_PARAMS))
+
+
+def check_jacobian(*args, fd_steps=(1e-3, 1e-4, 1e-3, 1e-4), **kwargs) -> dict:
+    """Compare :func:`phase_jacobian` with its finite-difference version. Returns the
+    analytic and FD arrays and the maximum relative difference per parameter."""
+    an = phase_jacobian(*args, **kwargs)
+    fd = phase_jacobian(*args, fd_steps=fd_steps, **kwargs)
+    scale = np.maximum(np.abs(an), 1e-12 + 1e-9 * np.abs(an).max())
+    rel = (np.abs(an - fd) / scale).reshape(-1, 12).max(axis=0)
+    return {"analytic": an, "finite_difference": fd, "max_rel_diff": dict(zip(JACOBIAN_PARAMS, rel))}
+
+
+def readout_jacobian(phase_jac, phi_hat, phi0, contrast: float = 1.0) -> np.ndarray:
+    """∂p/∂θ of p = o − (C/2) cos(φ̂ + φ0) (seed 000 (P-10)): (C/2) sin(φ̂ + φ0) ∂φ/∂θ;
+    at mid-fringe (φ̂ + φ0 = π/2) it is (C/2) ∂φ/∂θ. Shapes broadcast over (shots, channels)."""
+    s = 0.5 * contrast * np.sin(np.asarray(phi_hat) + np.asarray(phi0))
+    return s[..., None] * np.asarray(phase_jac)
+
+
+def paper_jacobian(channels: Channels, specific_force, angular_rate, T: float, *, angular_acceleration=(0.0, 0.0, 0.0),
+                   euler: bool = False) -> dict:
+    """Paper-mode phase Jacobians for constant dynamics (seed 003 (P-27), (P-31); spec
+    (E29)/(E30)), term by term, per channel: ∂φ/∂b_a = T²k^T(I − 2T[ω_s×])C_sb and ∂φ/∂b_g
+    as the sum of ``centrifugal`` (terms 1–2), ``coriolis`` (3), ``mixed_acc`` (4),
+    ``mixed_cen`` (5–7) and, with ``euler``, ``mixed_euler`` (8). Inputs in the body frame:
+    f_b (m/s²), ω_b (rad/s), ω̇_b (rad/s²). Returns arrays (C, 3) in rad per (m/s²) /
+    (rad/s); the readout Jacobian is (C/2)× these at mid-fringe (P-25/26). The exact
+    tangent-linear derivative is :func:`phase_jacobian`."""
+    T = positive(T, "T")
+    f = vector(specific_force, 3, "specific_force")
+    w = vector(angular_rate, 3, "angular_rate")
+    wd = vector(angular_acceleration, 3, "angular_acceleration")
+
+    def sk(v):
+        return np.array([[0, -v[2], v[1]], [v[2], 0, -v[0]], [-v[1], v[0], 0]])
+
+    out = {k: [] for k in ("ba", "centrifugal", "coriolis", "mixed_acc", "mixed_cen", "mixed_euler")}
+    for k, l, c, v0 in zip(channels.k, channels.lever, channels.c_sb, channels.v0):
+        ws = c @ w
+        cen_jac = sk(w) @ sk(l) + sk(np.cross(w, l))  # ∂[ω×(ω×l)]/∂ω up to sign (E30) 1–2
+        out["ba"].append(T**2 * k @ (np.eye(3) - 2 * T * sk(ws)) @ c)
+        out["centrifugal"].append(-T**2 * k @ c @ cen_jac)
+        out["coriolis"].append(-2 * T**2 * k @ sk(v0) @ c)
+        out["mixed_acc"].append(2 * T**3 * k @ sk(c @ f) @ c)
+        out["mixed_cen"].append(2 * T**3 * k @ (sk(c @ np.cross(w, np.cross(w, l))) @ c + sk(ws) @ c @ cen_jac))
+        out["mixed_euler"].append(2 * T**3 * k @ sk(c @ np.cross(wd, l)) @ c if euler else np.zeros(3))
+    res = {k: np.array(v) for k, v in out.items()}
+    res["bg"] = sum(res[k] for k in ("centrifugal", "coriolis", "mixed_acc", "mixed_cen", "mixed_euler"))
+    return res
+
+
+# --- analytic motions and the inertial oracle ------------------------------------------
+
+_EMPTY_SINES = np.zeros((0, 4))
+
+
+@dataclass
+class SineMotion:
+    """IMU motion in an inertial frame: per axis c0 + c1 t + c2 t² + Σ A sin(2πft + ϕ) for the
+    position (m) and for the z-y-x Euler angles roll, pitch, yaw (rad). ``*_poly`` (3, 3):
+    row = axis, columns c0, c1, c2; ``*_sines`` rows [axis, amplitude, frequency Hz,
+    phase rad]."""
+
+    position_poly: np.ndarray = field(default_factory=lambda: np.zeros((3, 3)))
+    position_sines: np.ndarray = field(default_factory=lambda: _EMPTY_SINES)
+    attitude_poly: np.ndarray = field(default_factory=lambda: np.zeros((3, 3)))
+    attitude_sines: np.ndarray = field(default_factory=lambda: _EMPTY_SINES)
+
+    def _args(self):
+        return ("sine", np.zeros(3), rows(self.position_poly, 3, "position_poly"),
+                np.ascontiguousarray(np.asarray(self.position_sines, float).reshape(-1, 4)),
+                rows(self.attitude_poly, 3, "attitude_poly"),
+                np.ascontiguousarray(np.asarray(self.attitude_sines, float).reshape(-1, 4)))
+
+
+@dataclass
+class YawDrive:
+    """Seed-003 Fig. 7 drive: forward speed (m/s) along body x, level, yaw rate
+    ω_z = amplitude · sin(2πt/period) (rad/s)."""
+
+    speed: float = 1.0
+    yaw_rate_amplitude: float = 0.05
+    period: float = 50.0
+
+    def _args(self):
+        return ("yaw_drive", np.array([self.speed, self.yaw_rate_amplitude, self.period], float),
+                np.zeros((3, 3)), _EMPTY_SINES, np.zeros((3, 3)), _EMPTY_SINES)
+
+
+def _gravity(gravity, gradient):
+    g0 = vector(np.asarray(gravity, float), 3, "gravity")
+    g = None if gradient is None else np.ascontiguousarray(np.asarray(gradient, float).reshape(3, 3))
+    return g0, g
+
+
+def motion_imu(motion, t, *, gravity=(0.0, 0.0, 0.0), gradient=None, t_ref: float = 0.0):
+    """Ideal IMU output of an analytic motion at times t (s): specific force (N, 3) m/s²,
+    angular rate (N, 3) rad/s and angular acceleration (N, 3) rad/s², body frame.
+    gravity: uniform g (m/s², inertial; zero = kinematic mode); gradient Γ_i (3, 3) 1/s²
+    about the IMU position at ``t_ref``."""
+    g0, g = _gravity(gravity, gradient)
+    return _core.cai_motion_imu(*motion._args(), vector(t, None, "t"), g0, g, float(t_ref))
+
+
+def oracle_phase(motion, shots, T: float, channels: Channels, *, gravity=(0.0, 0.0, 0.0), gradient=None,
+                 t_ref: float = 0.0) -> np.ndarray:
+    """Exact phase (rad) (n_shots, n_channels) from the inertial oracle (spec (E8)): ballistic
+    atom in the inertial frame, transformed into the rotating sensor frame at the pulses."""
+    g0, g = _gravity(gravity, gradient)
+    shots = np.atleast_1d(np.asarray(shots, float))
+    out = _core.cai_oracle(*motion._args(), vector(shots, None, "shots"), float(T), channels.k, channels.lever,
+                           channels.c_sb, channels.v0, g0, g, float(t_ref))
+    return out.reshape(len(shots), len(channels))
+
+
+# --- closed forms ----------------------------------------------------------------------
+
+
+def _closed(kind, k, v0, angular_rate, specific_force, T, angular_acceleration=(0, 0, 0), gradient=None):
+    k = rows(k, 3, "k")
+    v0 = rows(np.broadcast_to(np.asarray(v0, float), k.shape), 3, "v0")
+    g = np.zeros((3, 3)) if gradient is None else np.asarray(gradient, float).reshape(3, 3)
+    return _core.cai_phase_closed_form(kind, k, v0, vector(angular_rate, 3, "angular_rate"),
+                                       vector(specific_force, 3, "specific_force"),
+                                       vector(angular_acceleration, 3, "angular_acceleration"),
+                                       np.ascontiguousarray(g), float(T))
+
+
+def phase_constant(k, v0, angular_rate, specific_force, T: float) -> np.ndarray:
+    """Exact phase (rad) per row of k (C, 3) for constant ω_s (rad/s) and f_s (m/s²) in s
+    (spec (E10))."""
+    return _closed("exact", k, v0, angular_rate, specific_force, T)
+
+
+def phase_series(k, v0, angular_rate, specific_force, T: float, angular_acceleration=(0.0, 0.0, 0.0),
+                 gradient=None) -> np.ndarray:
+    """Fourth-order series (spec (E11)) incl. ω̇ (rad/s²) and gradient Γ (1/s²) terms."""
+    return _closed("series", k, v0, angular_rate, specific_force, T, angular_acceleration, gradient)
+
+
+def phase_seed000(k, vbar, angular_rate, specific_force, T_total: float) -> np.ndarray:
+    """Seed 000 (P-52) in the paper's convention: k·(¼ f − ½ ω×v̄) T0², T0 = total
+    interrogation time. Equals the library's first-order phase with k → −k, v0 = −v̄,
+    T = T0/2."""
+    return _closed("seed000", k, vbar, angular_rate, specific_force, T_total)
+
+
+def phase_first_order(k, v0, angular_rate, specific_force, T: float) -> np.ndarray:
+    """Library first-order phase −T² k·f_s − 2T² k·(ω×v0) (rad) (seed 000 spec (E10))."""
+    k = rows(k, 3, "k")
+    v0 = np.broadcast_to(np.asarray(v0, float), k.shape)
+    return -T**2 * k @ np.asarray(specific_force, float) + sagnac_phase(k, v0, angular_rate, T)
+
+
+def sagnac_phase(k, v0, angular_rate, T: float) -> np.ndarray:
+    """Sagnac (Coriolis) term −2T² k·(ω×v0) (rad)."""
+    return -2.0 * T**2 * np.einsum("ij,ij->i", np.atleast_2d(k), np.cross(np.asarray(angular_rate, float), np.atleast_2d(v0)))
+
+
+def t_sep_from_total(T_total: float) -> float:
+    """Pulse separation T = T0/2 of seed 000's total interrogation time T0 (s)."""
+    return 0.5 * positive(T_total, "T_total")
+
+
+def total_from_t_sep(T: float) -> float:
+    """Seed 000's total interrogation time T0 = 2T (s)."""
+    return 2.0 * positive(T, "T")
+
+
+def scale_factors(T: float, k: float = K_RB87, v0: float = 2.8) -> dict:
+    """Phase scale factors: ``acceleration`` kT² (rad per m/s²), ``sagnac`` 2kv0T² (rad per
+    rad/s), ``euler`` kv0T³ (rad per rad/s²)."""
+    T = positive(T, "T")
+    return {"acceleration": k * T**2, "sagnac": 2 * k * v0 * T**2, "euler": k * v0 * T**3}
+
+
+def dynamic_range(T: float, k: float = K_RB87) -> float:
+    """Acceleration span of one fringe flank, π/(kT²) (m/s²) (spec (E3))."""
+    return np.pi / (positive(k, "k") * positive(T, "T") ** 2)
+
+
+def capture_limits(T: float, k: float = K_RB87, v0: float = 2.8) -> dict:
+    """Largest bias errors keeping the phase error below π/2: accelerometer π/(2kT²) (m/s²),
+    gyro π/(2·2kv0T²) (rad/s) (seed 000 spec §2.8)."""
+    s = scale_factors(T, k, v0)
+    return {"accelerometer": 0.5 * np.pi / s["acceleration"], "gyro": 0.5 * np.pi / s["sagnac"]}
+
+
+def in_shot_noise_phase(q_accel: float, q_gyro: float, T: float, k: float = K_RB87, v0: float = 2.8) -> dict:
+    """Phase standard deviation (rad) caused by IMU white noise inside one shot (seed 003
+    spec (E38)): ``accel`` k√(2q_a/3) T^{3/2} and ``gyro`` (Sagnac) 2kv0√(2q_g/3) T^{3/2},
+    with q the white-noise PSDs (m²/s³, rad²/s), from Var = q k² ∫w² dt, ∫w² = 2T³/3."""
+    T = positive(T, "T")
+    for name, q in (("q_accel", q_accel), ("q_gyro", q_gyro)):
+        if not (np.isfinite(q) and q >= 0):
+            raise ValueError(f"{name}: must be finite and >= 0, got {q}")
+    return {"accel": k * np.sqrt(2 * q_accel / 3) * T**1.5, "gyro": 2 * k * v0 * np.sqrt(2 * q_gyro / 3) * T**1.5}
+
+
+def in_shot_noise_covariance(channels: Channels, q_accel: float, q_gyro: float, T: float) -> np.ndarray:
+    """Covariance (C, C) (rad²) of the predicted phases of one shot caused by white IMU noise
+    of PSD q_accel (m²/s³) and q_gyro (rad²/s) per body axis, for R inflation (seed 000 spec
+    Decision 14, full matrix including the A/B correlation). To leading order the noise acts
+    as an atom acceleration −C_sb n_a (phase −∫w k·C_sb n_a) and a Coriolis acceleration
+    −2(C_sb n_g)×v0 (phase −2∫w n_g·C_sbᵀ(v0×k)), so with ∫w² = 2T³/3:
+    Σ = (2T³/3) [q_a K Kᵀ + 4 q_g V Vᵀ],  K_j = C_sb,jᵀ k_j,  V_j = C_sb,jᵀ (v0_j × k_j)."""
+    in_shot_noise_phase(q_accel, q_gyro, T)  # validates q and T
+    kb = np.einsum("cji,cj->ci", channels.c_sb, channels.k)
+    vb = np.einsum("cji,cj->ci", channels.c_sb, np.cross(channels.v0, channels.k))
+    return 2 * T**3 / 3 * (q_accel * kb @ kb.T + 4 * q_gyro * vb @ vb.T)
+
+
+def phase_noise(sigma_p: float, contrast: float = 1.0) -> float:
+    """Phase noise (rad) of a mid-fringe readout with population noise σ_p: 2σ_p/C."""
+    return 2.0 * positive(sigma_p, "sigma_p") / positive(contrast, "contrast")
+
+
+def acceleration_noise(sigma_phi: float, T: float, k: float = K_RB87) -> float:
+    """Acceleration noise (m/s²) of a phase noise σ_φ (rad): σ_φ/(kT²)."""
+    return sigma_phi / scale_factors(T, k)["acceleration"]

@@ -1,0 +1,63 @@
+"""CAI readout and fringe handling (spec ``cai-ekf-tennstedt2021.md`` (E3)–(E6), Decision 4):
+population p = o − (C/2) cos(φ + φ0), offset o, contrast C ∈ (0, 1], laser phase φ0."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .._validate import finite
+
+
+def _contrast(contrast) -> np.ndarray:
+    c = np.asarray(contrast, float)
+    bad = ~((c > 0) & (c <= 1)) | ~np.isfinite(c)
+    if bad.any():
+        i = np.argwhere(np.atleast_1d(bad))[0][0]
+        raise ValueError(f"contrast: must be in (0, 1], got {np.atleast_1d(c)[i]} at index {i}")
+    return c
+
+
+def readout(phi, phi0=0.0, *, offset=0.5, contrast=1.0, sigma_p: float = 0.0, sigma_phi: float = 0.0,
+            sigma_contrast: float = 0.0, seed=None) -> np.ndarray:
+    """Population p = o − (C/2) cos(φ + φ0 + n_φ) + n_p with C → C + n_C; noise σ's are
+    per-shot standard deviations (population, rad, contrast), drawn with ``seed``."""
+    phi = np.asarray(phi, float)
+    finite(np.atleast_1d(phi), "phi")
+    c = _contrast(contrast)
+    for name, s in (("sigma_p", sigma_p), ("sigma_phi", sigma_phi), ("sigma_contrast", sigma_contrast)):
+        if not (np.isfinite(s) and s >= 0):
+            raise ValueError(f"{name}: must be finite and >= 0, got {s}")
+    rng = np.random.default_rng(seed)
+    shape = np.broadcast(phi, np.asarray(phi0), c).shape
+    n_phi = rng.normal(0.0, sigma_phi, shape) if sigma_phi else 0.0
+    n_c = rng.normal(0.0, sigma_contrast, shape) if sigma_contrast else 0.0
+    n_p = rng.normal(0.0, sigma_p, shape) if sigma_p else 0.0
+    return offset - 0.5 * (c + n_c) * np.cos(phi + phi0 + n_phi) + n_p
+
+
+def steer_mid_fringe(phi_hat) -> np.ndarray:
+    """Laser phase φ0 = (π/2 − φ̂) mod 2π (rad) putting the predicted phase at mid-fringe."""
+    return np.mod(np.pi / 2 - np.asarray(phi_hat, float), 2 * np.pi)
+
+
+def invert_readout(p, phi0=0.0, *, offset=0.5, contrast=1.0, flank: str = "rising") -> np.ndarray:
+    """Phase φ (rad) of a readout on a known flank: φ + φ0 ∈ [0, π] ("rising", p grows with
+    φ) or [−π, 0] ("falling"). Readouts beyond the fringe extremes are clipped to them."""
+    if flank not in ("rising", "falling"):
+        raise ValueError(f"flank: unknown option {flank!r}; choose 'falling', 'rising'")
+    c = _contrast(contrast)
+    u = np.clip(2.0 * (offset - np.asarray(p, float)) / c, -1.0, 1.0)
+    psi = np.arccos(u)
+    return (psi if flank == "rising" else -psi) - phi0
+
+
+def fringes_crossed(phi) -> np.ndarray:
+    """Number of whole fringes (2π) between zero phase and each predicted phase (rad)."""
+    return np.floor(np.abs(np.asarray(phi, float)) / (2 * np.pi)).astype(int)
+
+
+def capture_region(delta) -> np.ndarray:
+    """Capture region of a true-minus-predicted phase Δ (rad) (seed 000 Fig. 3):
+    "A" |Δ| < π/2 (correct update), "B" π/2 ≤ |Δ| < π (right sign, too small), "slip"."""
+    a = np.abs(np.asarray(delta, float))
+    return np.where(a < np.pi / 2, "A", np.where(a < np.pi, "B", "slip"))

@@ -1,0 +1,16 @@
+//! Cold-atom interferometer (CAI): the "atom strapdown" phase predictor (seed 003), its
+//! inertial oracle, constant-input closed forms, the sensitivity function / convolution
+//! predictor, and the fringe noise identification of seed 000 §3.
+//!
+//! Conventions (spec `atom-strapdown-tennstedt2023.md` §2, binding): pulses at 0, T, 2T of
+//! a shot; φ = k·D[x], D[x] = x(0) − 2x(T) + x(2T); atom position x in the sensor frame s
+//! (origin at the release point); atom motion driven by the SPECIFIC FORCE (E5);
+//! measured = true + bias, the estimated bias is subtracted.
+
+pub mod closed_form;
+pub mod noise_id;
+pub mod oracle;
+pub mod predictor;
+pub mod sensitivity;
+
+pub use predictor::{Channel, OmegaDot, PredictorConfig};

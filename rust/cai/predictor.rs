@@ -1,0 +1,668 @@
+//! Atom strapdown phase predictor (seed 003 §2; spec `atom-strapdown-tennstedt2023.md`
+//! (E5)–(E7), (E12)–(E17)) and its tangent-linear Jacobians ((E29)–(E31), default mode).
+//!
+//! Per shot (pulses at t_s, t_s + T, t_s + 2T) and per interferometer channel the atom
+//! position x in the sensor frame s obeys (E5)
+//!   ẍ = −f_s − 2ω×ẋ − ω×(ω×x) − ω̇×x + Γ_s x,   x(0) = 0, ẋ(0) = v0,
+//! with (E6) f_s = C_sb (f_b + ω̇_b×l + ω_b×(ω_b×l)) − Γ_s C_sb l and (E7) ω = C_sb ω_b.
+//! The IMU inputs are interpolated between samples (linear per spec §2.3, or cubic) and
+//! bias-corrected with the current estimates; the ODE is integrated with RK4 on a grid made
+//! of the IMU sample times and the pulse times (`substeps` RK4 steps per grid interval);
+//! φ = k·D[x].
+//!
+//! Breakdown (exact decomposition of (E9), spec §2.4): the solution of the linear ODE is
+//! x = x_h + x_p, x_h = Φ(t) v0 (homogeneous part; Φ shared by all channels with the same
+//! C_sb and l), x_p the forced part with zero initial state, so
+//!   φ_rot = k·D[x_h] (E15),   φ_acc, φ_cen, φ_eul = −∫ w k·(…) dτ (E12)–(E14) by
+//!   Simpson's rule (exact for the piecewise-polynomial integrands),
+//!   φ_mix = k·D[x_p] − φ_acc − φ_cen − φ_eul (E16),   φ_gg = φ(Γ) − φ(Γ = 0) (E17),
+//! and the six terms add up to the total by construction.
+
+use crate::error::{check_finite, check_increasing, check_positive, invalid, Result};
+use crate::math::{dcm_from_rotvec, Mat3, Vec3};
+
+/// One interferometer channel: effective wave vector k (rad/m, in s), lever arm l from the
+/// IMU to the release point (m, in b), C_sb (rotation b → s, may carry misalignment) and
+/// the initial atom velocity v0 relative to s (m/s, in s).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Channel {
+    pub k: Vec3,
+    pub lever: Vec3,
+    pub c_sb: Mat3,
+    pub v0: Vec3,
+}
+
+/// Source of the angular acceleration ω̇_b used in the Euler terms (spec §2.2).
+#[derive(Clone, Debug, PartialEq)]
+pub enum OmegaDot {
+    /// Euler terms omitted (ω̇ ≡ 0).
+    Zero,
+    /// Derivative of the gyro interpolant (for linear interpolation constant on each IMU
+    /// interval; exactly consistent with an oracle fed the same interpolated rate).
+    Pwl,
+    /// Quadratic Savitzky–Golay derivative over 2m+1 samples:
+    /// ω̇_k = Σ_{j=−m..m} j ω_{k+j} / (Δt Σ j²); m = 2 gives
+    /// (−2ω_{k−2} − ω_{k−1} + ω_{k+1} + 2ω_{k+2}) / (10Δt). Windows are clamped at the
+    /// record ends; Δt is the local mean spacing of the window.
+    Savgol { half_width: usize },
+    /// Given per-sample values (rad/s², body frame), e.g. from a simulator.
+    Given(Vec<Vec3>),
+}
+
+/// Interpolation of the IMU samples between sample times.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Interpolation {
+    /// Piecewise linear (spec §2.3): integrated error ∝ h² (relative (hΩ)²/12 for a
+    /// sinusoid of angular frequency Ω).
+    Linear,
+    /// Cubic Hermite with central-difference tangents (Catmull–Rom on non-uniform grids,
+    /// one-sided at the record ends): error ∝ h⁴ for smooth signals.
+    Cubic,
+}
+
+/// Settings shared by all shots of a record.
+#[derive(Clone, Debug)]
+pub struct PredictorConfig {
+    /// Pulse separation T (s).
+    pub t_sep: f64,
+    /// RK4 steps per grid interval (≥ 1).
+    pub substeps: usize,
+    /// Gravity-gradient tensor Γ_s in the sensor frame (1/s²); None = no gradient.
+    pub gradient: Option<Mat3>,
+    /// Estimated accelerometer bias (m/s²) subtracted from the specific force.
+    pub bias_a: Vec3,
+    /// Estimated gyro bias (rad/s) subtracted from the angular rate.
+    pub bias_g: Vec3,
+    pub omega_dot: OmegaDot,
+    pub interpolation: Interpolation,
+}
+
+/// The IMU record: time (s), specific force f_b (m/s²), angular rate ω_b (rad/s).
+#[derive(Clone, Copy, Debug)]
+pub struct Imu<'a> {
+    pub t: &'a [f64],
+    pub f: &'a [Vec3],
+    pub w: &'a [Vec3],
+}
+
+/// Column order of [`predict`]'s output.
+pub const TERM_NAMES: [&str; 7] = ["total", "acc", "rot", "cen", "eul", "mix", "gg"];
+/// Column order of [`jacobian`]'s output: ∂φ/∂(b_a, b_g, l, γ), γ = small rotation with
+/// C_sb = exp(−[γ×]) C_sb,0.
+pub const JACOBIAN_PARAMS: [&str; 12] =
+    ["ba_x", "ba_y", "ba_z", "bg_x", "bg_y", "bg_z", "l_x", "l_y", "l_z", "gamma_x", "gamma_y", "gamma_z"];
+
+/// Body-frame inputs at one RK4 stage.
+#[derive(Clone, Copy)]
+struct BodyStage {
+    tau: f64,
+    f: Vec3,
+    w: Vec3,
+    wd: Vec3,
+}
+
+/// Sensor-frame quantities of one channel at one stage.
+#[derive(Clone, Copy)]
+struct ChStage {
+    tau: f64,
+    w: Vec3,
+    wd: Vec3,
+    f_acc: Vec3,
+    f_cen: Vec3,
+    f_eul: Vec3,
+    /// −Γ_s C_sb l (gravity gradient acting over the lever arm).
+    f_gl: Vec3,
+}
+
+impl ChStage {
+    fn new(b: &BodyStage, ch: &Channel, gradient: Option<&Mat3>) -> Self {
+        let c = &ch.c_sb;
+        let l = &ch.lever;
+        ChStage {
+            tau: b.tau,
+            w: c * b.w,
+            wd: c * b.wd,
+            f_acc: c * b.f,
+            f_cen: c * b.w.cross(&b.w.cross(l)),
+            f_eul: c * b.wd.cross(l),
+            f_gl: gradient.map_or(Vec3::zeros(), |g| -(g * (c * l))),
+        }
+    }
+    fn f_s(&self) -> Vec3 {
+        self.f_acc + self.f_cen + self.f_eul
+    }
+}
+
+/// (E5) right-hand side of the atom acceleration.
+#[inline]
+fn atom_accel(s: &ChStage, x: &Vec3, v: &Vec3, force: &Vec3, gradient: Option<&Mat3>) -> Vec3 {
+    let mut a = -force - 2.0 * s.w.cross(v) - s.w.cross(&s.w.cross(x)) - s.wd.cross(x);
+    if let Some(g) = gradient {
+        a += g * x;
+    }
+    a
+}
+
+/// One classical RK4 step of y' = rhs(stage, y) with stages at the start, middle, end.
+#[inline]
+fn rk4<S, const N: usize>(y: &mut [Vec3; N], h: f64, s: [&S; 3], rhs: impl Fn(&S, &[Vec3; N]) -> [Vec3; N]) {
+    let axpy = |y: &[Vec3; N], a: f64, k: &[Vec3; N]| -> [Vec3; N] { std::array::from_fn(|i| y[i] + a * k[i]) };
+    let k1 = rhs(s[0], y);
+    let k2 = rhs(s[1], &axpy(y, 0.5 * h, &k1));
+    let k3 = rhs(s[1], &axpy(y, 0.5 * h, &k2));
+    let k4 = rhs(s[2], &axpy(y, h, &k3));
+    for i in 0..N {
+        y[i] += h / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]);
+    }
+}
+
+/// One integration interval of a shot: [a, b] (times relative to the shot start), inside
+/// IMU interval `imu`; `pulse` is true when b is the middle pulse.
+#[derive(Clone, Copy, Debug)]
+struct Segment {
+    a: f64,
+    b: f64,
+    imu: usize,
+    pulse: bool,
+}
+
+/// Angular acceleration samples or per-interval values in the body frame.
+enum Wd {
+    Zero,
+    Interpolant,
+    PerSample(Vec<Vec3>),
+}
+
+/// Validated record, ready for shot integration.
+struct Record<'a> {
+    imu: Imu<'a>,
+    wd: Wd,
+    interpolation: Interpolation,
+    bias_a: Vec3,
+    bias_g: Vec3,
+    t_sep: f64,
+    substeps: usize,
+    /// Grid segments of each shot.
+    shots: Vec<(f64, Vec<Segment>)>,
+}
+
+impl Record<'_> {
+    /// Value and time derivative of the interpolant of `v` at absolute time `t` in IMU
+    /// interval i.
+    fn interp(&self, v: &[Vec3], i: usize, t: f64) -> (Vec3, Vec3) {
+        let ts = self.imu.t;
+        let h = ts[i + 1] - ts[i];
+        let s = ((t - ts[i]) / h).clamp(0.0, 1.0);
+        match self.interpolation {
+            Interpolation::Linear => (v[i] + s * (v[i + 1] - v[i]), (v[i + 1] - v[i]) / h),
+            Interpolation::Cubic => {
+                let n = ts.len();
+                let tangent = |j: usize| {
+                    let (a, b) = (j.saturating_sub(1), (j + 1).min(n - 1));
+                    (v[b] - v[a]) / (ts[b] - ts[a])
+                };
+                let (m0, m1) = (tangent(i) * h, tangent(i + 1) * h);
+                let (s2, s3) = (s * s, s * s * s);
+                let val = (2.0 * s3 - 3.0 * s2 + 1.0) * v[i] + (s3 - 2.0 * s2 + s) * m0 + (3.0 * s2 - 2.0 * s3) * v[i + 1] + (s3 - s2) * m1;
+                let der = ((6.0 * s2 - 6.0 * s) * v[i] + (3.0 * s2 - 4.0 * s + 1.0) * m0 + (6.0 * s - 6.0 * s2) * v[i + 1]
+                    + (3.0 * s2 - 2.0 * s) * m1)
+                    / h;
+                (val, der)
+            }
+        }
+    }
+
+    fn body(&self, ts: f64, seg: &Segment, t: f64) -> BodyStage {
+        let i = seg.imu;
+        let abs_t = ts + t;
+        let (f, _) = self.interp(self.imu.f, i, abs_t);
+        let (w, w_rate) = self.interp(self.imu.w, i, abs_t);
+        let wd = match &self.wd {
+            Wd::Zero => Vec3::zeros(),
+            Wd::Interpolant => w_rate,
+            Wd::PerSample(v) => self.interp(v, i, abs_t).0,
+        };
+        BodyStage { tau: t, f: f - self.bias_a, w: w - self.bias_g, wd }
+    }
+
+    /// The three RK4 stage inputs of each sub-step of each segment of a shot.
+    fn stages(&self, shot: usize) -> Vec<([BodyStage; 3], bool)> {
+        let (ts, segs) = &self.shots[shot];
+        let mut out = Vec::with_capacity(segs.len() * self.substeps);
+        for seg in segs {
+            let h = (seg.b - seg.a) / self.substeps as f64;
+            for j in 0..self.substeps {
+                let a = seg.a + j as f64 * h;
+                let b = if j + 1 == self.substeps { seg.b } else { a + h };
+                let st = [self.body(*ts, seg, a), self.body(*ts, seg, 0.5 * (a + b)), self.body(*ts, seg, b)];
+                out.push((st, seg.pulse && j + 1 == self.substeps));
+            }
+        }
+        out
+    }
+
+    /// Triangle weight w(τ) of (E4): τ on [0, T], 2T − τ on [T, 2T].
+    fn weight(&self, tau: f64) -> f64 {
+        if tau <= self.t_sep { tau } else { 2.0 * self.t_sep - tau }
+    }
+}
+
+fn check_channels(channels: &[Channel]) -> Result<()> {
+    if channels.is_empty() {
+        return Err(invalid("channels", "at least one interferometer channel is required"));
+    }
+    for (j, ch) in channels.iter().enumerate() {
+        for (name, v) in [("k", &ch.k), ("lever", &ch.lever), ("v0", &ch.v0)] {
+            if v.iter().any(|x| !x.is_finite()) {
+                return Err(invalid(&format!("channels[{j}].{name}"), "non-finite value"));
+            }
+        }
+        if ch.k.norm() == 0.0 {
+            return Err(invalid(&format!("channels[{j}].k"), "zero wave vector (k must be non-zero)"));
+        }
+        if ch.c_sb.iter().any(|x| !x.is_finite()) {
+            return Err(invalid(&format!("channels[{j}].c_sb"), "non-finite value"));
+        }
+        let orth = (ch.c_sb.transpose() * ch.c_sb - Mat3::identity()).abs().max();
+        if orth > 1e-9 || ch.c_sb.determinant() < 0.0 {
+            return Err(invalid(&format!("channels[{j}].c_sb"), format!("not a rotation matrix (|CᵀC − I| = {orth:.3e})")));
+        }
+    }
+    Ok(())
+}
+
+/// NaN/inf in an IMU series: name the field, the sample index and the shot that uses it.
+fn check_series(field: &str, v: &[Vec3], t: &[f64], shots: &[f64], t_sep: f64) -> Result<()> {
+    if let Some(i) = v.iter().position(|x| x.iter().any(|c| !c.is_finite())) {
+        let ti = t[i];
+        // the shot containing the sample, else one whose interpolation/derivative stencil may
+        // reach it
+        let shot = shots
+            .iter()
+            .position(|&s| ti >= s && ti <= s + 2.0 * t_sep)
+            .or_else(|| shots.iter().position(|&s| ti >= s - t_sep && ti <= s + 3.0 * t_sep));
+        let where_ = shot.map_or(String::from("outside every shot"), |s| format!("used by shot {s}"));
+        return Err(invalid(field, format!("non-finite value {:?} at index {i} (t = {ti} s, {where_})", [v[i].x, v[i].y, v[i].z])));
+    }
+    Ok(())
+}
+
+fn savgol(t: &[f64], w: &[Vec3], m: usize) -> Result<Vec<Vec3>> {
+    if m == 0 {
+        return Err(invalid("omega_dot", "Savitzky-Golay half width must be >= 1"));
+    }
+    let n = t.len();
+    if n < 2 * m + 1 {
+        return Err(invalid("omega_dot", format!("Savitzky-Golay window of {} samples needs at least as many IMU samples, got {n}", 2 * m + 1)));
+    }
+    let s2: f64 = (1..=m).map(|j| 2.0 * (j * j) as f64).sum();
+    Ok((0..n)
+        .map(|k| {
+            let c = k.clamp(m, n - 1 - m);
+            let dt = (t[c + m] - t[c - m]) / (2 * m) as f64;
+            let num = (1..=m).fold(Vec3::zeros(), |acc, j| acc + j as f64 * (w[c + j] - w[c - j]));
+            num / (s2 * dt)
+        })
+        .collect())
+}
+
+/// Validate everything and build the per-shot integration grids.
+fn prepare<'a>(imu: Imu<'a>, shots: &[f64], channels: &[Channel], cfg: &PredictorConfig) -> Result<Record<'a>> {
+    check_positive("T", cfg.t_sep)?;
+    if cfg.substeps == 0 {
+        return Err(invalid("substeps", "must be >= 1"));
+    }
+    let n = imu.t.len();
+    if n < 2 {
+        return Err(invalid("t", format!("need at least 2 IMU samples, got {n}")));
+    }
+    if imu.f.len() != n || imu.w.len() != n {
+        return Err(invalid("specific_force", format!("length {} / angular_rate length {} differ from t length {n}", imu.f.len(), imu.w.len())));
+    }
+    check_increasing("t", imu.t)?;
+    check_finite("shots", shots, 1)?;
+    check_channels(channels)?;
+    for (name, v) in [("bias_a", &cfg.bias_a), ("bias_g", &cfg.bias_g)] {
+        check_finite(name, v.as_slice(), 3)?;
+    }
+    if let Some(g) = &cfg.gradient {
+        check_finite("gradient", g.as_slice(), 3)?;
+    }
+    let t_sep = cfg.t_sep;
+    let (t_first, t_last) = (imu.t[0], imu.t[n - 1]);
+    let eps = 1e-9 * t_sep;
+    for (s, &ts) in shots.iter().enumerate() {
+        if ts < t_first - eps || ts + 2.0 * t_sep > t_last + eps {
+            return Err(invalid(
+                "shots",
+                format!("shot {s}: pulse times [{ts}, {}] s outside the IMU record [{t_first}, {t_last}] s", ts + 2.0 * t_sep),
+            ));
+        }
+        if s > 0 && ts < shots[s - 1] + 2.0 * t_sep - eps {
+            return Err(invalid(
+                "shots",
+                format!("shot {s} starts at {ts} s, before shot {} ends at {} s (shots must not overlap)", s - 1, shots[s - 1] + 2.0 * t_sep),
+            ));
+        }
+    }
+    check_series("specific_force", imu.f, imu.t, shots, t_sep)?;
+    check_series("angular_rate", imu.w, imu.t, shots, t_sep)?;
+    let wd = match &cfg.omega_dot {
+        OmegaDot::Zero => Wd::Zero,
+        OmegaDot::Pwl => Wd::Interpolant,
+        OmegaDot::Savgol { half_width } => Wd::PerSample(savgol(imu.t, imu.w, *half_width)?),
+        OmegaDot::Given(v) => {
+            if v.len() != n {
+                return Err(invalid("angular_acceleration", format!("length {} differs from t length {n}", v.len())));
+            }
+            check_series("angular_acceleration", v, imu.t, shots, t_sep)?;
+            Wd::PerSample(v.clone())
+        }
+    };
+    let shots = shots
+        .iter()
+        .map(|&ts| {
+            let mut knots: Vec<(f64, bool)> = vec![(0.0, false), (t_sep, true), (2.0 * t_sep, false)];
+            let i0 = imu.t.partition_point(|&x| x <= ts);
+            for &ti in &imu.t[i0..] {
+                let tau = ti - ts;
+                if tau >= 2.0 * t_sep {
+                    break;
+                }
+                if (tau - t_sep).abs() > eps && tau > eps && 2.0 * t_sep - tau > eps {
+                    knots.push((tau, false));
+                }
+            }
+            knots.sort_by(|a, b| a.0.total_cmp(&b.0));
+            let segs = knots
+                .windows(2)
+                .map(|w| {
+                    let mid = ts + 0.5 * (w[0].0 + w[1].0);
+                    let imu_i = imu.t.partition_point(|&x| x <= mid).clamp(1, n - 1) - 1;
+                    Segment { a: w[0].0, b: w[1].0, imu: imu_i, pulse: w[1].1 }
+                })
+                .collect();
+            (ts, segs)
+        })
+        .collect();
+    Ok(Record { imu, wd, interpolation: cfg.interpolation, bias_a: cfg.bias_a, bias_g: cfg.bias_g, t_sep, substeps: cfg.substeps, shots })
+}
+
+/// Per-shot solutions shared by all channels with the same (C_sb, l): the solution of the
+/// linear ODE (E5) is x = Φ(t) v0 + x_p(t), so the transition block Φ (homogeneous
+/// solutions for v0 = e_1, e_2, e_3) and the forced solution x_p serve every k and v0.
+struct GeometrySolution {
+    /// x(T) and x(2T) of [Φ e_1, Φ e_2, Φ e_3, x_p], Γ = 0.
+    mid: [Vec3; 4],
+    end: [Vec3; 4],
+    /// The same with the gravity gradient (when given).
+    mid_g: [Vec3; 4],
+    end_g: [Vec3; 4],
+    /// −∫ w f dτ of the acceleration, centrifugal and Euler forces (vectors; dot with k).
+    acc: Vec3,
+    cen: Vec3,
+    eul: Vec3,
+}
+
+/// Right-hand side for [Φ e_1, Φ e_2, Φ e_3, x_p] and their velocities (8 vectors).
+fn block_rhs(s: &ChStage, y: &[Vec3; 8], force: &Vec3, gradient: Option<&Mat3>) -> [Vec3; 8] {
+    let zero = Vec3::zeros();
+    let mut d = [zero; 8];
+    for c in 0..4 {
+        let f = if c == 3 { force } else { &zero };
+        d[2 * c] = y[2 * c + 1];
+        d[2 * c + 1] = atom_accel(s, &y[2 * c], &y[2 * c + 1], f, gradient);
+    }
+    d
+}
+
+fn solve_geometry(rec: &Record, stages: &[([BodyStage; 3], bool)], ch: &Channel, gradient: Option<&Mat3>) -> GeometrySolution {
+    let zero = Vec3::zeros();
+    let init = [zero, Vec3::x(), zero, Vec3::y(), zero, Vec3::z(), zero, zero];
+    let (mut y, mut yg) = (init, init);
+    let (mut mid, mut mid_g) = (init, init);
+    let (mut acc, mut cen, mut eul) = (zero, zero, zero);
+    for (st, pulse) in stages {
+        let cs = [0, 1, 2].map(|i| ChStage::new(&st[i], ch, gradient));
+        let h = cs[2].tau - cs[0].tau;
+        // Simpson's rule for (E12)–(E14), −∫ w f dτ (exact for the piecewise-polynomial
+        // integrands of linear inputs).
+        for (c, s) in cs.iter().zip([1.0, 4.0, 1.0]) {
+            let wk = -h / 6.0 * s * rec.weight(c.tau);
+            acc += wk * c.f_acc;
+            cen += wk * c.f_cen;
+            eul += wk * c.f_eul;
+        }
+        let refs = [&cs[0], &cs[1], &cs[2]];
+        rk4(&mut y, h, refs, |s, y| block_rhs(s, y, &s.f_s(), None));
+        if let Some(g) = gradient {
+            rk4(&mut yg, h, refs, |s, y| block_rhs(s, y, &(s.f_s() + s.f_gl), Some(g)));
+        }
+        if *pulse {
+            (mid, mid_g) = (y, yg);
+        }
+    }
+    let pos = |y: &[Vec3; 8]| [y[0], y[2], y[4], y[6]];
+    GeometrySolution { mid: pos(&mid), end: pos(&y), mid_g: pos(&mid_g), end_g: pos(&yg), acc, cen, eul }
+}
+
+/// Phase of one channel with its breakdown, in the order of [`TERM_NAMES`].
+fn channel_phase(g: &GeometrySolution, ch: &Channel, gradient: bool) -> [f64; 7] {
+    // φ = k·D[x] with x(0) = 0 (E4), x = Φ v0 + x_p.
+    let d = |mid: &[Vec3; 4], end: &[Vec3; 4], c: usize| ch.k.dot(&(end[c] - 2.0 * mid[c]));
+    let hom = |mid: &[Vec3; 4], end: &[Vec3; 4]| (0..3).map(|c| ch.v0[c] * d(mid, end, c)).sum::<f64>();
+    let rot = hom(&g.mid, &g.end);
+    let forced = d(&g.mid, &g.end, 3);
+    let (acc, cen, eul) = (ch.k.dot(&g.acc), ch.k.dot(&g.cen), ch.k.dot(&g.eul));
+    let no_grad = rot + forced;
+    let (total, gg) = if gradient {
+        let full = hom(&g.mid_g, &g.end_g) + d(&g.mid_g, &g.end_g, 3);
+        (full, full - no_grad)
+    } else {
+        (no_grad, 0.0)
+    };
+    [total, acc, rot, cen, eul, forced - acc - cen - eul, gg]
+}
+
+/// Predicted phase (rad) of every shot and channel with its breakdown: row
+/// `shot * channels.len() + channel`, columns [`TERM_NAMES`].
+pub fn predict(imu: Imu, shots: &[f64], channels: &[Channel], cfg: &PredictorConfig) -> Result<Vec<[f64; 7]>> {
+    let rec = prepare(imu, shots, channels, cfg)?;
+    // channels with identical (C_sb, l) share one GeometrySolution
+    let mut reps: Vec<usize> = Vec::new();
+    let mut group = Vec::with_capacity(channels.len());
+    for (j, ch) in channels.iter().enumerate() {
+        match reps.iter().position(|&r| channels[r].c_sb == ch.c_sb && channels[r].lever == ch.lever) {
+            Some(g) => group.push(g),
+            None => {
+                reps.push(j);
+                group.push(reps.len() - 1);
+            }
+        }
+    }
+    let grad = cfg.gradient.as_ref();
+    let mut out = Vec::with_capacity(shots.len() * channels.len());
+    for s in 0..shots.len() {
+        let stages = rec.stages(s);
+        let sols: Vec<GeometrySolution> = reps.iter().map(|&r| solve_geometry(&rec, &stages, &channels[r], grad)).collect();
+        for (ch, &g) in channels.iter().zip(&group) {
+            out.push(channel_phase(&sols[g], ch, grad.is_some()));
+        }
+    }
+    Ok(out)
+}
+
+/// Per-stage sensitivities of (ω_s, ω̇_s, forcing F) to the 12 Jacobian parameters.
+struct Tangent {
+    dw: [Vec3; 12],
+    dwd: [Vec3; 12],
+    df: [Vec3; 12],
+}
+
+fn tangent(b: &BodyStage, s: &ChStage, ch: &Channel, gradient: Option<&Mat3>) -> Tangent {
+    let c = &ch.c_sb;
+    let l = &ch.lever;
+    let zero = Vec3::zeros();
+    let mut t = Tangent { dw: [zero; 12], dwd: [zero; 12], df: [zero; 12] };
+    let f_body_lever = s.f_s(); // C_sb (f_b + ω̇×l + ω×(ω×l))
+    for j in 0..3 {
+        let e = Vec3::ith(j, 1.0);
+        // b_a: f_b → f_b − b_a.
+        t.df[j] = -(c * e);
+        // b_g: ω_b → ω_b − b_g (ω̇ derived from the gyro is bias-free).
+        let dwb = -e;
+        t.dw[3 + j] = c * dwb;
+        t.df[3 + j] = c * (dwb.cross(&b.w.cross(l)) + b.w.cross(&dwb.cross(l)));
+        // lever arm.
+        t.df[6 + j] = c * (b.wd.cross(&e) + b.w.cross(&b.w.cross(&e))) - gradient.map_or(zero, |g| g * (c * e));
+        // misalignment: δC_sb = −[e×] C_sb.
+        t.dw[9 + j] = -e.cross(&s.w);
+        t.dwd[9 + j] = -e.cross(&s.wd);
+        t.df[9 + j] = -e.cross(&f_body_lever) + gradient.map_or(zero, |g| g * e.cross(&(c * l)));
+    }
+    t
+}
+
+/// Tangent-linear (forward-mode) derivative of the predicted phase with respect to
+/// [`JACOBIAN_PARAMS`] (b_a, b_g, l, γ) at the configured estimates: row
+/// `shot * channels.len() + channel`. Euler terms (ω̇) are removed from the linearisation
+/// point unless `euler` (spec (E30) item 8, Decision 9); use [`jacobian_fd`] to check.
+pub fn jacobian(imu: Imu, shots: &[f64], channels: &[Channel], cfg: &PredictorConfig, euler: bool) -> Result<Vec<[f64; 12]>> {
+    let cfg = jacobian_config(cfg, euler);
+    let rec = prepare(imu, shots, channels, &cfg)?;
+    let grad = cfg.gradient.as_ref();
+    let mut out = Vec::with_capacity(shots.len() * channels.len());
+    for s in 0..shots.len() {
+        let stages = rec.stages(s);
+        for ch in channels {
+            // y[0..2] = base (x, v); y[2+2p..4+2p] = tangent (δx, δv) of parameter p.
+            let mut y = [Vec3::zeros(); 26];
+            y[1] = ch.v0;
+            let mut mid = [Vec3::zeros(); 13];
+            for (st, pulse) in &stages {
+                let cs = [0, 1, 2].map(|i| ChStage::new(&st[i], ch, grad));
+                let tg = [0, 1, 2].map(|i| tangent(&st[i], &cs[i], ch, grad));
+                let h = cs[2].tau - cs[0].tau;
+                let pairs = [(&cs[0], &tg[0]), (&cs[1], &tg[1]), (&cs[2], &tg[2])];
+                rk4(&mut y, h, [&pairs[0], &pairs[1], &pairs[2]], |(s, tg), y| {
+                    let (x, v) = (y[0], y[1]);
+                    let force = s.f_s() + s.f_gl;
+                    let mut d = [Vec3::zeros(); 26];
+                    d[0] = v;
+                    d[1] = atom_accel(s, &x, &v, &force, grad);
+                    for p in 0..12 {
+                        let (dx, dv) = (y[2 + 2 * p], y[3 + 2 * p]);
+                        let (dw, dwd) = (tg.dw[p], tg.dwd[p]);
+                        d[2 + 2 * p] = dv;
+                        // δ of (E5): linear part on (δx, δv) plus the input perturbation.
+                        d[3 + 2 * p] = atom_accel(s, &dx, &dv, &tg.df[p], grad)
+                            - 2.0 * dw.cross(&v)
+                            - dw.cross(&s.w.cross(&x))
+                            - s.w.cross(&dw.cross(&x))
+                            - dwd.cross(&x);
+                    }
+                    d
+                });
+                if *pulse {
+                    for p in 0..13 {
+                        mid[p] = y[2 * p];
+                    }
+                }
+            }
+            out.push(std::array::from_fn(|p| ch.k.dot(&(y[2 + 2 * p] - 2.0 * mid[1 + p]))));
+        }
+    }
+    Ok(out)
+}
+
+fn jacobian_config(cfg: &PredictorConfig, euler: bool) -> PredictorConfig {
+    let mut c = cfg.clone();
+    if !euler {
+        c.omega_dot = OmegaDot::Zero;
+    }
+    c
+}
+
+/// Central finite differences of the predicted total phase with respect to
+/// [`JACOBIAN_PARAMS`], with steps `step_a` (m/s²), `step_g` (rad/s), `step_l` (m) and
+/// `step_gamma` (rad); same linearisation point and Euler switch as [`jacobian`].
+pub fn jacobian_fd(
+    imu: Imu,
+    shots: &[f64],
+    channels: &[Channel],
+    cfg: &PredictorConfig,
+    euler: bool,
+    steps: [f64; 4],
+) -> Result<Vec<[f64; 12]>> {
+    for (name, s) in ["step_a", "step_g", "step_l", "step_gamma"].iter().zip(steps) {
+        check_positive(name, s)?;
+    }
+    let base = jacobian_config(cfg, euler);
+    let nch = channels.len();
+    let mut out = vec![[0.0; 12]; shots.len() * nch];
+    for p in 0..12 {
+        let (group, axis) = (p / 3, p % 3);
+        let h = steps[group];
+        let phase = |sign: f64| -> Result<Vec<[f64; 7]>> {
+            let d = Vec3::ith(axis, sign * h);
+            let mut c = base.clone();
+            let mut chs = channels.to_vec();
+            match group {
+                0 => c.bias_a += d,
+                1 => c.bias_g += d,
+                2 => chs.iter_mut().for_each(|ch| ch.lever += d),
+                _ => chs.iter_mut().for_each(|ch| ch.c_sb = dcm_from_rotvec(&-d) * ch.c_sb),
+            }
+            predict(imu, shots, &chs, &c)
+        };
+        let (plus, minus) = (phase(1.0)?, phase(-1.0)?);
+        for r in 0..out.len() {
+            out[r][p] = (plus[r][0] - minus[r][0]) / (2.0 * h);
+        }
+    }
+    Ok(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::math::dcm_from_euler;
+
+    /// Analytic tangent-linear Jacobian vs central differences, with lever arm,
+    /// misalignment, time-varying rate and gradient; Euler terms off and on.
+    #[test]
+    fn jacobian_matches_finite_differences() {
+        let t: Vec<f64> = (0..=120).map(|i| i as f64 * 1e-3).collect();
+        let f: Vec<Vec3> = t.iter().map(|&s| Vec3::new(0.3 + 0.2 * (9.0 * s).sin(), -0.2, -9.81 + 0.1 * s)).collect();
+        let w: Vec<Vec3> = t.iter().map(|&s| Vec3::new(0.05 + 0.3 * s, -0.03, 0.2 * (5.0 * s).cos())).collect();
+        let chs: Vec<Channel> = (0..3)
+            .map(|j| Channel {
+                k: Vec3::ith(j, 1.610576e7),
+                lever: Vec3::new(0.3, -0.1, 0.2),
+                c_sb: dcm_from_euler(0.01, -0.02, 0.03),
+                v0: Vec3::ith((j + 1) % 3, 2.8),
+            })
+            .collect();
+        for euler in [false, true] {
+            let cfg = PredictorConfig {
+                t_sep: 0.025,
+                substeps: 2,
+                gradient: Some(Mat3::from_diagonal(&Vec3::new(-1.5e-6, -1.5e-6, 3.086e-6))),
+                bias_a: Vec3::new(1e-4, -2e-4, 3e-4),
+                bias_g: Vec3::new(1e-5, 2e-5, -1e-5),
+                omega_dot: OmegaDot::Savgol { half_width: 2 },
+                interpolation: Interpolation::Cubic,
+            };
+            let imu = Imu { t: &t, f: &f, w: &w };
+            let shots = [0.0103, 0.0607];
+            let j = jacobian(imu, &shots, &chs, &cfg, euler).unwrap();
+            let fd = jacobian_fd(imu, &shots, &chs, &cfg, euler, [1e-3, 1e-4, 1e-3, 1e-4]).unwrap();
+            for (r, (a, b)) in j.iter().zip(&fd).enumerate() {
+                let scale = a.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+                for p in 0..12 {
+                    assert!((a[p] - b[p]).abs() < 1e-6 * a[p].abs().max(1e-6 * scale), "euler {euler}, row {r}, {}: {} vs {}", JACOBIAN_PARAMS[p], a[p], b[p]);
+                }
+            }
+        }
+    }
+}
