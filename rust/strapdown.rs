@@ -85,7 +85,8 @@ impl Strapdown {
             let href = h_ref.map(|h| h[k]);
             self.step(t[k], &gyro[k], &accel[k], href);
             let s = &self.state;
-            let finite = s.lla.iter().chain(s.vel.iter()).chain(s.q_nb.coords.iter()).all(|x| x.is_finite());
+            // a sum is finite iff every term is (NaN and ±inf propagate)
+            let finite = (s.lla.sum() + s.vel.sum() + s.q_nb.coords.sum()).is_finite();
             if !finite || s.lla.x.abs() > std::f64::consts::FRAC_PI_2 {
                 return Err(crate::error::NavError::Numerical(format!(
                     "navigation solution diverged at sample {k} (t = {} s): latitude {} rad, velocity {:?}",
