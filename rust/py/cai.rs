@@ -160,18 +160,23 @@ fn signal(poly: &[f64], sines: &[[f64; 4]], axis: usize) -> Signal {
     }
 }
 
-fn gravity(g0: &PyReadonlyArray1<'_, f64>, gradient: Option<PyReadonlyArray2<'_, f64>>, t_ref: f64) -> PyResult<Gravity> {
-    Ok(Gravity { g0: vec3(g0, "gravity")?, gradient: gradient_tensor(gradient)?, t_ref })
+/// Uniform gravity g0 (m/s², inertial) and an optional gradient (3, 3) 1/s² about the IMU
+/// position at t_ref (s), validated once.
+#[pyclass(module = "atomnav._core", frozen)]
+struct CaiGravity(Gravity);
+
+#[pymethods]
+impl CaiGravity {
+    #[new]
+    fn new(g0: PyReadonlyArray1<'_, f64>, gradient: Option<PyReadonlyArray2<'_, f64>>, t_ref: f64) -> PyResult<Self> {
+        Ok(CaiGravity(Gravity { g0: vec3(&g0, "gravity")?, gradient: gradient_tensor(gradient)?, t_ref }))
+    }
 }
 
-/// An analytic body motion under uniform gravity g0 (m/s²) and an optional gradient (3, 3)
-/// 1/s² about the IMU at t_ref, validated once; its ideal IMU (`imu`) and the
-/// inertial-oracle phases (`oracle`).
+/// An analytic body motion, validated once; its ideal IMU (`imu`) and the inertial-oracle
+/// phases (`oracle`) under a gravity model.
 #[pyclass(module = "atomnav._core", frozen)]
-struct CaiMotion {
-    motion: Box<dyn BodyMotion + Send + Sync>,
-    gravity: Gravity,
-}
+struct CaiMotion(Box<dyn BodyMotion + Send + Sync>);
 
 #[pymethods]
 impl CaiMotion {
@@ -183,9 +188,6 @@ impl CaiMotion {
         position_sines: PyReadonlyArray2<'_, f64>,
         attitude_poly: PyReadonlyArray2<'_, f64>,
         attitude_sines: PyReadonlyArray2<'_, f64>,
-        g0: PyReadonlyArray1<'_, f64>,
-        gradient: Option<PyReadonlyArray2<'_, f64>>,
-        t_ref: f64,
     ) -> PyResult<Self> {
         let (pp, ps) = (rows::<3>(&position_poly, "position_poly")?, rows::<4>(&position_sines, "position_sines")?);
         let (ap, as_) = (rows::<3>(&attitude_poly, "attitude_poly")?, rows::<4>(&attitude_sines, "attitude_sines")?);
@@ -198,27 +200,27 @@ impl CaiMotion {
             }
         }
         let motion = SineMotion { position: [0, 1, 2].map(|a| signal(&pp[a], &ps, a)), euler: [0, 1, 2].map(|a| signal(&ap[a], &as_, a)) };
-        Ok(CaiMotion { motion: Box::new(motion), gravity: gravity(&g0, gradient, t_ref)? })
+        Ok(CaiMotion(Box::new(motion)))
     }
 
     /// Forward speed (m/s), yaw-rate amplitude (rad/s), period (s) of the yaw rate sine.
     #[staticmethod]
-    fn yaw_drive(speed: f64, yaw_rate_amplitude: f64, period: f64, g0: PyReadonlyArray1<'_, f64>, gradient: Option<PyReadonlyArray2<'_, f64>>, t_ref: f64) -> PyResult<Self> {
+    fn yaw_drive(speed: f64, yaw_rate_amplitude: f64, period: f64) -> PyResult<Self> {
         crate::error::check_positive("period", period)?;
-        Ok(CaiMotion { motion: Box::new(YawDrive { speed, yaw_rate_amplitude, period }), gravity: gravity(&g0, gradient, t_ref)? })
+        Ok(CaiMotion(Box::new(YawDrive { speed, yaw_rate_amplitude, period })))
     }
 
     /// Ideal IMU (f_b, ω_b, ω̇_b) at times t.
-    fn imu<'py>(&self, py: Python<'py>, t: PyReadonlyArray1<'py, f64>) -> PyResult<(Arr2<'py>, Arr2<'py>, Arr2<'py>)> {
+    fn imu<'py>(&self, py: Python<'py>, t: PyReadonlyArray1<'py, f64>, gravity: &CaiGravity) -> PyResult<(Arr2<'py>, Arr2<'py>, Arr2<'py>)> {
         let t = vector(&t, "t")?;
-        let (f, w, wd) = py.detach(|| imu_from_motion(self.motion.as_ref(), &t, &self.gravity))?;
+        let (f, w, wd) = py.detach(|| imu_from_motion(self.0.as_ref(), &t, &gravity.0))?;
         Ok((vec3_to_py(py, &f), vec3_to_py(py, &w), vec3_to_py(py, &wd)))
     }
 
     /// Oracle phases (shots · channels).
-    fn oracle<'py>(&self, py: Python<'py>, shots: PyReadonlyArray1<'py, f64>, t_sep: f64, channels: &CaiChannels) -> PyResult<Arr1<'py>> {
+    fn oracle<'py>(&self, py: Python<'py>, shots: PyReadonlyArray1<'py, f64>, t_sep: f64, channels: &CaiChannels, gravity: &CaiGravity) -> PyResult<Arr1<'py>> {
         let shots = vector(&shots, "shots")?;
-        let out = py.detach(|| oracle_phase(self.motion.as_ref(), &shots, t_sep, &channels.0, &self.gravity))?;
+        let out = py.detach(|| oracle_phase(self.0.as_ref(), &shots, t_sep, &channels.0, &gravity.0))?;
         Ok(vec_to_py(py, out))
     }
 }
@@ -350,6 +352,7 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("CAI_JACOBIAN_PARAMS", JACOBIAN_PARAMS.to_vec())?;
     m.add_class::<CaiChannels>()?;
     m.add_class::<CaiSetup>()?;
+    m.add_class::<CaiGravity>()?;
     m.add_class::<CaiMotion>()?;
     m.add_function(wrap_pyfunction!(cai_phase_closed_form, m)?)?;
     m.add_function(wrap_pyfunction!(cai_sensitivity, m)?)?;

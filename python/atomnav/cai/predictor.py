@@ -233,12 +233,11 @@ class SineMotion:
     attitude_poly: np.ndarray = field(default_factory=lambda: np.zeros((3, 3)))
     attitude_sines: np.ndarray = field(default_factory=lambda: _EMPTY_SINES)
 
-    def _native(self, g0, gradient, t_ref):
+    def _native(self):
         return _core.CaiMotion.sine(rows(self.position_poly, 3, "position_poly"),
                                     np.ascontiguousarray(np.asarray(self.position_sines, float).reshape(-1, 4)),
                                     rows(self.attitude_poly, 3, "attitude_poly"),
-                                    np.ascontiguousarray(np.asarray(self.attitude_sines, float).reshape(-1, 4)),
-                                    g0, gradient, t_ref)
+                                    np.ascontiguousarray(np.asarray(self.attitude_sines, float).reshape(-1, 4)))
 
 
 @dataclass
@@ -250,14 +249,13 @@ class YawDrive:
     yaw_rate_amplitude: float = 0.05
     period: float = 50.0
 
-    def _native(self, g0, gradient, t_ref):
-        return _core.CaiMotion.yaw_drive(float(self.speed), float(self.yaw_rate_amplitude), float(self.period),
-                                         g0, gradient, t_ref)
+    def _native(self):
+        return _core.CaiMotion.yaw_drive(float(self.speed), float(self.yaw_rate_amplitude), float(self.period))
 
 
-def _native_motion(motion, gravity, gradient, t_ref):
-    """The core motion of ``motion`` (SineMotion / YawDrive) under uniform gravity and gradient."""
-    return motion._native(vector(np.asarray(gravity, float), 3, "gravity"), _gradient(gradient), float(t_ref))
+def _gravity(gravity, gradient, t_ref):
+    """The core gravity model: uniform g (m/s²) and gradient (1/s²) about the IMU at t_ref (s)."""
+    return _core.CaiGravity(vector(np.asarray(gravity, float), 3, "gravity"), _gradient(gradient), float(t_ref))
 
 
 def motion_imu(motion, t, *, gravity=(0.0, 0.0, 0.0), gradient=None, t_ref: float = 0.0):
@@ -265,17 +263,17 @@ def motion_imu(motion, t, *, gravity=(0.0, 0.0, 0.0), gradient=None, t_ref: floa
     angular rate (N, 3) rad/s and angular acceleration (N, 3) rad/s², body frame.
     gravity: uniform g (m/s², inertial; zero = kinematic mode); gradient Γ_i (3, 3) 1/s²
     about the IMU position at ``t_ref``."""
-    t = vector(t, None, "t")
-    return _native_motion(motion, gravity, gradient, t_ref).imu(t)
+    g = _gravity(gravity, gradient, t_ref)
+    return motion._native().imu(vector(t, None, "t"), g)
 
 
 def oracle_phase(motion, shots, T: float, channels: Channels, *, gravity=(0.0, 0.0, 0.0), gradient=None,
                  t_ref: float = 0.0) -> np.ndarray:
     """Exact phase (rad) (n_shots, n_channels) from the inertial oracle (spec (E8)): ballistic
     atom in the inertial frame, transformed into the rotating sensor frame at the pulses."""
-    shots = vector(np.atleast_1d(np.asarray(shots, float)), None, "shots")
-    m = _native_motion(motion, gravity, gradient, t_ref)
-    out = m.oracle(shots, float(T), channels._native())
+    g = _gravity(gravity, gradient, t_ref)
+    shots = np.atleast_1d(np.asarray(shots, float))
+    out = motion._native().oracle(vector(shots, None, "shots"), float(T), channels._native(), g)
     return out.reshape(len(shots), len(channels))
 
 
