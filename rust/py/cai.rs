@@ -24,24 +24,33 @@ fn mat3(a: &PyReadonlyArray2<'_, f64>, field: &str) -> PyResult<Mat3> {
     Ok(Mat3::from_fn(|i, j| r[i][j]))
 }
 
-/// Channels from k (C, 3), lever (C, 3), c_sb (C, 3, 3), v0 (C, 3).
-fn channels(
-    k: &PyReadonlyArray2<'_, f64>,
-    lever: &PyReadonlyArray2<'_, f64>,
-    c_sb: &PyReadonlyArray3<'_, f64>,
-    v0: &PyReadonlyArray2<'_, f64>,
-) -> PyResult<Vec<Channel>> {
-    let (k, l, v) = (vec3_rows(k, "k")?, vec3_rows(lever, "lever")?, vec3_rows(v0, "v0")?);
-    let s = c_sb.shape();
-    if s[0] != k.len() || s[1] != 3 || s[2] != 3 || l.len() != k.len() || v.len() != k.len() {
-        return Err(invalid("channels", format!("k, lever, v0 must be (C, 3) and c_sb (C, 3, 3) with the same C = {}", k.len())).into());
-    }
-    let c = c_sb.as_array();
-    Ok((0..k.len()).map(|j| Channel { k: k[j], lever: l[j], c_sb: Mat3::from_fn(|r, q| c[[j, r, q]]), v0: v[j] }).collect())
+/// Optional gravity-gradient tensor (3, 3) 1/s².
+fn gradient_tensor(g: Option<PyReadonlyArray2<'_, f64>>) -> PyResult<Option<Mat3>> {
+    g.map(|g| mat3(&g, "gradient")).transpose()
 }
 
-/// Predictor inputs shared by predict / jacobian / jacobian_fd.
-struct Args {
+/// Interferometer channels, validated once; shared by the predictor and the oracle.
+#[pyclass(module = "atomnav._core", frozen)]
+struct CaiChannels(Vec<Channel>);
+
+#[pymethods]
+impl CaiChannels {
+    /// Channels from k (C, 3), lever (C, 3), c_sb (C, 3, 3), v0 (C, 3).
+    #[new]
+    fn new(k: PyReadonlyArray2<'_, f64>, lever: PyReadonlyArray2<'_, f64>, c_sb: PyReadonlyArray3<'_, f64>, v0: PyReadonlyArray2<'_, f64>) -> PyResult<Self> {
+        let (k, l, v) = (vec3_rows(&k, "k")?, vec3_rows(&lever, "lever")?, vec3_rows(&v0, "v0")?);
+        let s = c_sb.shape();
+        if s[0] != k.len() || s[1] != 3 || s[2] != 3 || l.len() != k.len() || v.len() != k.len() {
+            return Err(invalid("channels", format!("k, lever, v0 must be (C, 3) and c_sb (C, 3, 3) with the same C = {}", k.len())).into());
+        }
+        let c = c_sb.as_array();
+        Ok(CaiChannels((0..k.len()).map(|j| Channel { k: k[j], lever: l[j], c_sb: Mat3::from_fn(|r, q| c[[j, r, q]]), v0: v[j] }).collect()))
+    }
+}
+
+/// Predictor inputs, validated once at construction; `predict` and `jacobian` run on them.
+#[pyclass(module = "atomnav._core", frozen)]
+struct CaiSetup {
     t: Vec<f64>,
     f: Vec<Vec3>,
     w: Vec<Vec3>,
@@ -50,143 +59,98 @@ struct Args {
     cfg: PredictorConfig,
 }
 
-#[allow(clippy::too_many_arguments)]
-fn args(
-    t: PyReadonlyArray1<'_, f64>,
-    f: PyReadonlyArray2<'_, f64>,
-    w: PyReadonlyArray2<'_, f64>,
-    shots: PyReadonlyArray1<'_, f64>,
-    k: PyReadonlyArray2<'_, f64>,
-    lever: PyReadonlyArray2<'_, f64>,
-    c_sb: PyReadonlyArray3<'_, f64>,
-    v0: PyReadonlyArray2<'_, f64>,
-    t_sep: f64,
-    omega_dot: &str,
-    wdot: Option<PyReadonlyArray2<'_, f64>>,
-    savgol_half_width: usize,
-    interpolation: &str,
-    substeps: usize,
-    gradient: Option<PyReadonlyArray2<'_, f64>>,
-    bias_a: PyReadonlyArray1<'_, f64>,
-    bias_g: PyReadonlyArray1<'_, f64>,
-) -> PyResult<Args> {
-    // NaN in the IMU stream is reported by the predictor with the shot that uses it, so the
-    // IMU arrays are read without the finiteness check here.
-    let raw3 = |a: &PyReadonlyArray2<'_, f64>, field: &str| -> PyResult<Vec<Vec3>> {
-        let s = a.shape();
-        if s[1] != 3 {
-            return Err(invalid(field, format!("expected shape (N, 3), got ({}, {})", s[0], s[1])).into());
-        }
-        Ok(a.as_array().outer_iter().map(|r| Vec3::new(r[0], r[1], r[2])).collect())
-    };
-    let omega_dot = match omega_dot {
-        "zero" => OmegaDot::Zero,
-        "pwl" => OmegaDot::Pwl,
-        "savgol" => OmegaDot::Savgol { half_width: savgol_half_width },
-        "given" => match &wdot {
-            Some(a) => OmegaDot::Given(raw3(a, "angular_acceleration")?),
-            None => return Err(invalid("angular_acceleration", "required when omega_dot = 'given'").into()),
-        },
-        other => return Err(invalid("omega_dot", format!("unknown option {other:?}; choose zero, pwl, savgol, given")).into()),
-    };
-    let interpolation = match interpolation {
-        "linear" => Interpolation::Linear,
-        "cubic" => Interpolation::Cubic,
-        other => return Err(invalid("interpolation", format!("unknown option {other:?}; choose linear, cubic")).into()),
-    };
-    Ok(Args {
-        t: t.as_array().iter().copied().collect(),
-        f: raw3(&f, "specific_force")?,
-        w: raw3(&w, "angular_rate")?,
-        shots: shots.as_array().iter().copied().collect(),
-        channels: channels(&k, &lever, &c_sb, &v0)?,
-        cfg: PredictorConfig {
-            t_sep,
-            substeps,
-            gradient: gradient.map(|g| mat3(&g, "gradient")).transpose()?,
-            bias_a: vec3(&bias_a, "bias_a")?,
-            bias_g: vec3(&bias_g, "bias_g")?,
-            omega_dot,
-            interpolation,
-        },
-    })
-}
-
-impl Args {
+impl CaiSetup {
     fn imu(&self) -> Imu<'_> {
         Imu { t: &self.t, f: &self.f, w: &self.w }
     }
 }
 
-/// Predicted phases: (shots · channels, 7) array, columns total, acc, rot, cen, eul, mix, gg.
-#[pyfunction]
-#[allow(clippy::too_many_arguments)]
-fn cai_predict<'py>(
-    py: Python<'py>,
-    t: PyReadonlyArray1<'py, f64>,
-    f: PyReadonlyArray2<'py, f64>,
-    w: PyReadonlyArray2<'py, f64>,
-    shots: PyReadonlyArray1<'py, f64>,
-    k: PyReadonlyArray2<'py, f64>,
-    lever: PyReadonlyArray2<'py, f64>,
-    c_sb: PyReadonlyArray3<'py, f64>,
-    v0: PyReadonlyArray2<'py, f64>,
-    t_sep: f64,
-    omega_dot: &str,
-    wdot: Option<PyReadonlyArray2<'py, f64>>,
-    savgol_half_width: usize,
-    interpolation: &str,
-    substeps: usize,
-    gradient: Option<PyReadonlyArray2<'py, f64>>,
-    bias_a: PyReadonlyArray1<'py, f64>,
-    bias_g: PyReadonlyArray1<'py, f64>,
-) -> PyResult<Bound<'py, PyArray2<f64>>> {
-    let a = args(t, f, w, shots, k, lever, c_sb, v0, t_sep, omega_dot, wdot, savgol_half_width, interpolation, substeps, gradient, bias_a, bias_g)?;
-    let out = py.detach(|| predict(a.imu(), &a.shots, &a.channels, &a.cfg))?;
-    Ok(to_py_rows(py, &out))
-}
-
-/// ∂φ/∂(b_a, b_g, l, γ): (shots · channels, 12); `fd_steps` given → central differences.
-#[pyfunction]
-#[allow(clippy::too_many_arguments)]
-fn cai_jacobian<'py>(
-    py: Python<'py>,
-    t: PyReadonlyArray1<'py, f64>,
-    f: PyReadonlyArray2<'py, f64>,
-    w: PyReadonlyArray2<'py, f64>,
-    shots: PyReadonlyArray1<'py, f64>,
-    k: PyReadonlyArray2<'py, f64>,
-    lever: PyReadonlyArray2<'py, f64>,
-    c_sb: PyReadonlyArray3<'py, f64>,
-    v0: PyReadonlyArray2<'py, f64>,
-    t_sep: f64,
-    omega_dot: &str,
-    wdot: Option<PyReadonlyArray2<'py, f64>>,
-    savgol_half_width: usize,
-    interpolation: &str,
-    substeps: usize,
-    gradient: Option<PyReadonlyArray2<'py, f64>>,
-    bias_a: PyReadonlyArray1<'py, f64>,
-    bias_g: PyReadonlyArray1<'py, f64>,
-    euler: bool,
-    fd_steps: Option<PyReadonlyArray1<'py, f64>>,
-) -> PyResult<Bound<'py, PyArray2<f64>>> {
-    let a = args(t, f, w, shots, k, lever, c_sb, v0, t_sep, omega_dot, wdot, savgol_half_width, interpolation, substeps, gradient, bias_a, bias_g)?;
-    let steps = match fd_steps {
-        None => None,
-        Some(s) => {
-            let v = vector(&s, "fd_steps")?;
-            if v.len() != 4 {
-                return Err(invalid("fd_steps", format!("expected 4 steps (b_a, b_g, l, gamma), got {}", v.len())).into());
+#[pymethods]
+impl CaiSetup {
+    #[new]
+    #[allow(clippy::too_many_arguments)]
+    fn new(
+        t: PyReadonlyArray1<'_, f64>,
+        f: PyReadonlyArray2<'_, f64>,
+        w: PyReadonlyArray2<'_, f64>,
+        shots: PyReadonlyArray1<'_, f64>,
+        channels: &CaiChannels,
+        t_sep: f64,
+        omega_dot: &str,
+        wdot: Option<PyReadonlyArray2<'_, f64>>,
+        savgol_half_width: usize,
+        interpolation: &str,
+        substeps: usize,
+        gradient: Option<PyReadonlyArray2<'_, f64>>,
+        bias_a: PyReadonlyArray1<'_, f64>,
+        bias_g: PyReadonlyArray1<'_, f64>,
+    ) -> PyResult<Self> {
+        // NaN in the IMU stream is reported by the predictor with the shot that uses it, so the
+        // IMU arrays are read without the finiteness check here.
+        let raw3 = |a: &PyReadonlyArray2<'_, f64>, field: &str| -> PyResult<Vec<Vec3>> {
+            let s = a.shape();
+            if s[1] != 3 {
+                return Err(invalid(field, format!("expected shape (N, 3), got ({}, {})", s[0], s[1])).into());
             }
-            Some([v[0], v[1], v[2], v[3]])
-        }
-    };
-    let out = py.detach(|| match steps {
-        None => jacobian(a.imu(), &a.shots, &a.channels, &a.cfg, euler),
-        Some(s) => jacobian_fd(a.imu(), &a.shots, &a.channels, &a.cfg, euler, s),
-    })?;
-    Ok(to_py_rows(py, &out))
+            Ok(a.as_array().outer_iter().map(|r| Vec3::new(r[0], r[1], r[2])).collect())
+        };
+        let omega_dot = match omega_dot {
+            "zero" => OmegaDot::Zero,
+            "pwl" => OmegaDot::Pwl,
+            "savgol" => OmegaDot::Savgol { half_width: savgol_half_width },
+            "given" => match &wdot {
+                Some(a) => OmegaDot::Given(raw3(a, "angular_acceleration")?),
+                None => return Err(invalid("angular_acceleration", "required when omega_dot = 'given'").into()),
+            },
+            other => return Err(invalid("omega_dot", format!("unknown option {other:?}; choose zero, pwl, savgol, given")).into()),
+        };
+        let interpolation = match interpolation {
+            "linear" => Interpolation::Linear,
+            "cubic" => Interpolation::Cubic,
+            other => return Err(invalid("interpolation", format!("unknown option {other:?}; choose linear, cubic")).into()),
+        };
+        Ok(CaiSetup {
+            t: t.as_array().iter().copied().collect(),
+            f: raw3(&f, "specific_force")?,
+            w: raw3(&w, "angular_rate")?,
+            shots: shots.as_array().iter().copied().collect(),
+            channels: channels.0.clone(),
+            cfg: PredictorConfig {
+                t_sep,
+                substeps,
+                gradient: gradient_tensor(gradient)?,
+                bias_a: vec3(&bias_a, "bias_a")?,
+                bias_g: vec3(&bias_g, "bias_g")?,
+                omega_dot,
+                interpolation,
+            },
+        })
+    }
+
+    /// Predicted phases: (shots · channels, 7) array, columns total, acc, rot, cen, eul, mix, gg.
+    fn predict<'py>(&self, py: Python<'py>) -> PyResult<Arr2<'py>> {
+        let out = py.detach(|| predict(self.imu(), &self.shots, &self.channels, &self.cfg))?;
+        Ok(to_py_rows(py, &out))
+    }
+
+    /// ∂φ/∂(b_a, b_g, l, γ): (shots · channels, 12); `fd_steps` given → central differences.
+    fn jacobian<'py>(&self, py: Python<'py>, euler: bool, fd_steps: Option<PyReadonlyArray1<'py, f64>>) -> PyResult<Arr2<'py>> {
+        let steps = match fd_steps {
+            None => None,
+            Some(s) => {
+                let v = vector(&s, "fd_steps")?;
+                if v.len() != 4 {
+                    return Err(invalid("fd_steps", format!("expected 4 steps (b_a, b_g, l, gamma), got {}", v.len())).into());
+                }
+                Some([v[0], v[1], v[2], v[3]])
+            }
+        };
+        let out = py.detach(|| match steps {
+            None => jacobian(self.imu(), &self.shots, &self.channels, &self.cfg, euler),
+            Some(s) => jacobian_fd(self.imu(), &self.shots, &self.channels, &self.cfg, euler, s),
+        })?;
+        Ok(to_py_rows(py, &out))
+    }
 }
 
 fn signal(poly: &[f64], sines: &[[f64; 4]], axis: usize) -> Signal {
@@ -196,99 +160,69 @@ fn signal(poly: &[f64], sines: &[[f64; 4]], axis: usize) -> Signal {
     }
 }
 
-/// An analytic motion: kind "sine" (position / Euler-angle polynomials (3, 3) and sine rows
-/// [axis, amplitude, frequency Hz, phase rad]) or "yaw_drive" (params [speed, yaw-rate
-/// amplitude, period]).
-fn motion(
-    kind: &str,
-    params: &PyReadonlyArray1<'_, f64>,
-    pos_poly: &PyReadonlyArray2<'_, f64>,
-    pos_sines: &PyReadonlyArray2<'_, f64>,
-    att_poly: &PyReadonlyArray2<'_, f64>,
-    att_sines: &PyReadonlyArray2<'_, f64>,
-) -> PyResult<Box<dyn BodyMotion + Send + Sync>> {
-    match kind {
-        "yaw_drive" => {
-            let p = vector(params, "params")?;
-            if p.len() != 3 || p[2] <= 0.0 {
-                return Err(invalid("params", "yaw_drive needs [speed, yaw_rate_amplitude, period > 0]").into());
-            }
-            Ok(Box::new(YawDrive { speed: p[0], yaw_rate_amplitude: p[1], period: p[2] }))
-        }
-        "sine" => {
-            let (pp, ps) = (rows::<3>(pos_poly, "position_poly")?, rows::<4>(pos_sines, "position_sines")?);
-            let (ap, as_) = (rows::<3>(att_poly, "attitude_poly")?, rows::<4>(att_sines, "attitude_sines")?);
-            if pp.len() != 3 || ap.len() != 3 {
-                return Err(invalid("position_poly", "position_poly and attitude_poly must be (3, 3)").into());
-            }
-            for (name, s) in [("position_sines", &ps), ("attitude_sines", &as_)] {
-                if let Some(i) = s.iter().position(|r| !(r[0] == 0.0 || r[0] == 1.0 || r[0] == 2.0)) {
-                    return Err(invalid(name, format!("axis column must be 0, 1 or 2 (row {i})")).into());
-                }
-            }
-            Ok(Box::new(SineMotion {
-                position: [0, 1, 2].map(|a| signal(&pp[a], &ps, a)),
-                euler: [0, 1, 2].map(|a| signal(&ap[a], &as_, a)),
-            }))
-        }
-        other => Err(invalid("motion", format!("unknown kind {other:?}; choose sine, yaw_drive")).into()),
+/// Uniform gravity g0 (m/s², inertial) and an optional gradient (3, 3) 1/s² about the IMU
+/// position at t_ref (s), validated once.
+#[pyclass(module = "atomnav._core", frozen)]
+struct CaiGravity(Gravity);
+
+#[pymethods]
+impl CaiGravity {
+    #[new]
+    fn new(g0: PyReadonlyArray1<'_, f64>, gradient: Option<PyReadonlyArray2<'_, f64>>, t_ref: f64) -> PyResult<Self> {
+        Ok(CaiGravity(Gravity { g0: vec3(&g0, "gravity")?, gradient: gradient_tensor(gradient)?, t_ref }))
     }
 }
 
-fn gravity(g0: &PyReadonlyArray1<'_, f64>, gradient: Option<PyReadonlyArray2<'_, f64>>, t_ref: f64) -> PyResult<Gravity> {
-    Ok(Gravity { g0: vec3(g0, "gravity")?, gradient: gradient.map(|g| mat3(&g, "gradient")).transpose()?, t_ref })
-}
+/// An analytic body motion, validated once; its ideal IMU (`imu`) and the inertial-oracle
+/// phases (`oracle`) under a gravity model.
+#[pyclass(module = "atomnav._core", frozen)]
+struct CaiMotion(Box<dyn BodyMotion + Send + Sync>);
 
-/// Ideal IMU (f_b, ω_b, ω̇_b) of an analytic motion at times t.
-#[pyfunction]
-#[allow(clippy::too_many_arguments)]
-fn cai_motion_imu<'py>(
-    py: Python<'py>,
-    kind: &str,
-    params: PyReadonlyArray1<'py, f64>,
-    pos_poly: PyReadonlyArray2<'py, f64>,
-    pos_sines: PyReadonlyArray2<'py, f64>,
-    att_poly: PyReadonlyArray2<'py, f64>,
-    att_sines: PyReadonlyArray2<'py, f64>,
-    t: PyReadonlyArray1<'py, f64>,
-    g0: PyReadonlyArray1<'py, f64>,
-    gradient: Option<PyReadonlyArray2<'py, f64>>,
-    t_ref: f64,
-) -> PyResult<(Arr2<'py>, Arr2<'py>, Arr2<'py>)> {
-    let m = motion(kind, &params, &pos_poly, &pos_sines, &att_poly, &att_sines)?;
-    let t = vector(&t, "t")?;
-    let g = gravity(&g0, gradient, t_ref)?;
-    let (f, w, wd) = py.detach(|| imu_from_motion(m.as_ref(), &t, &g))?;
-    Ok((vec3_to_py(py, &f), vec3_to_py(py, &w), vec3_to_py(py, &wd)))
-}
+#[pymethods]
+impl CaiMotion {
+    /// Position / Euler-angle polynomials (3, 3) and sine rows [axis, amplitude, frequency Hz,
+    /// phase rad].
+    #[staticmethod]
+    fn sine(
+        position_poly: PyReadonlyArray2<'_, f64>,
+        position_sines: PyReadonlyArray2<'_, f64>,
+        attitude_poly: PyReadonlyArray2<'_, f64>,
+        attitude_sines: PyReadonlyArray2<'_, f64>,
+    ) -> PyResult<Self> {
+        let (pp, ps) = (rows::<3>(&position_poly, "position_poly")?, rows::<4>(&position_sines, "position_sines")?);
+        let (ap, as_) = (rows::<3>(&attitude_poly, "attitude_poly")?, rows::<4>(&attitude_sines, "attitude_sines")?);
+        if pp.len() != 3 || ap.len() != 3 {
+            return Err(invalid("position_poly", "position_poly and attitude_poly must be (3, 3)").into());
+        }
+        for (name, s) in [("position_sines", &ps), ("attitude_sines", &as_)] {
+            if let Some(i) = s.iter().position(|r| !(r[0] == 0.0 || r[0] == 1.0 || r[0] == 2.0)) {
+                return Err(invalid(name, format!("axis column must be 0, 1 or 2 (row {i})")).into());
+            }
+        }
+        let motion = SineMotion { position: [0, 1, 2].map(|a| signal(&pp[a], &ps, a)), euler: [0, 1, 2].map(|a| signal(&ap[a], &as_, a)) };
+        Ok(CaiMotion(Box::new(motion)))
+    }
 
-/// Oracle phases (shots · channels) of an analytic motion.
-#[pyfunction]
-#[allow(clippy::too_many_arguments)]
-fn cai_oracle<'py>(
-    py: Python<'py>,
-    kind: &str,
-    params: PyReadonlyArray1<'py, f64>,
-    pos_poly: PyReadonlyArray2<'py, f64>,
-    pos_sines: PyReadonlyArray2<'py, f64>,
-    att_poly: PyReadonlyArray2<'py, f64>,
-    att_sines: PyReadonlyArray2<'py, f64>,
-    shots: PyReadonlyArray1<'py, f64>,
-    t_sep: f64,
-    k: PyReadonlyArray2<'py, f64>,
-    lever: PyReadonlyArray2<'py, f64>,
-    c_sb: PyReadonlyArray3<'py, f64>,
-    v0: PyReadonlyArray2<'py, f64>,
-    g0: PyReadonlyArray1<'py, f64>,
-    gradient: Option<PyReadonlyArray2<'py, f64>>,
-    t_ref: f64,
-) -> PyResult<Bound<'py, PyArray1<f64>>> {
-    let m = motion(kind, &params, &pos_poly, &pos_sines, &att_poly, &att_sines)?;
-    let shots = vector(&shots, "shots")?;
-    let chs = channels(&k, &lever, &c_sb, &v0)?;
-    let g = gravity(&g0, gradient, t_ref)?;
-    let out = py.detach(|| oracle_phase(m.as_ref(), &shots, t_sep, &chs, &g))?;
-    Ok(vec_to_py(py, out))
+    /// Forward speed (m/s), yaw-rate amplitude (rad/s), period (s) of the yaw rate sine.
+    #[staticmethod]
+    fn yaw_drive(speed: f64, yaw_rate_amplitude: f64, period: f64) -> PyResult<Self> {
+        crate::error::check_positive("period", period)?;
+        Ok(CaiMotion(Box::new(YawDrive { speed, yaw_rate_amplitude, period })))
+    }
+
+    /// Ideal IMU (f_b, ω_b, ω̇_b) at times t.
+    fn imu<'py>(&self, py: Python<'py>, t: PyReadonlyArray1<'py, f64>, gravity: &CaiGravity) -> PyResult<(Arr2<'py>, Arr2<'py>, Arr2<'py>)> {
+        let t = vector(&t, "t")?;
+        let (f, w, wd) = py.detach(|| imu_from_motion(self.0.as_ref(), &t, &gravity.0))?;
+        Ok((vec3_to_py(py, &f), vec3_to_py(py, &w), vec3_to_py(py, &wd)))
+    }
+
+    /// Oracle phases (shots · channels).
+    fn oracle<'py>(&self, py: Python<'py>, shots: PyReadonlyArray1<'py, f64>, t_sep: f64, channels: &CaiChannels, gravity: &CaiGravity) -> PyResult<Arr1<'py>> {
+        let shots = vector(&shots, "shots")?;
+        let out = py.detach(|| oracle_phase(self.0.as_ref(), &shots, t_sep, &channels.0, &gravity.0))?;
+        Ok(vec_to_py(py, out))
+    }
 }
 
 /// Closed forms per channel row: kind "exact" (E10), "series" (E11), "seed000" (P-52).
@@ -302,14 +236,14 @@ fn cai_phase_closed_form<'py>(
     w: PyReadonlyArray1<'py, f64>,
     f: PyReadonlyArray1<'py, f64>,
     wd: PyReadonlyArray1<'py, f64>,
-    gradient: PyReadonlyArray2<'py, f64>,
+    gradient: Option<PyReadonlyArray2<'py, f64>>,
     t: f64,
 ) -> PyResult<Bound<'py, PyArray1<f64>>> {
     let (k, v0) = (vec3_rows(&k, "k")?, vec3_rows(&v0, "v0")?);
     if k.len() != v0.len() {
         return Err(invalid("v0", format!("expected {} rows like k, got {}", k.len(), v0.len())).into());
     }
-    let (w, f, wd, g) = (vec3(&w, "angular_rate")?, vec3(&f, "specific_force")?, vec3(&wd, "angular_acceleration")?, mat3(&gradient, "gradient")?);
+    let (w, f, wd, g) = (vec3(&w, "angular_rate")?, vec3(&f, "specific_force")?, vec3(&wd, "angular_acceleration")?, gradient_tensor(gradient)?.unwrap_or_else(Mat3::zeros));
     crate::error::check_positive("T", t)?;
     let out: Vec<f64> = match kind {
         "exact" => k.iter().zip(&v0).map(|(k, v)| phase_constant(k, &w, &f, v, t)).collect(),
@@ -413,13 +347,13 @@ fn cai_ml_identify<'py>(
 }
 
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
-    // column names of cai_predict / cai_jacobian (single source of truth)
+    // column names of CaiSetup.predict / CaiSetup.jacobian (single source of truth)
     m.add("CAI_TERMS", TERM_NAMES.to_vec())?;
     m.add("CAI_JACOBIAN_PARAMS", JACOBIAN_PARAMS.to_vec())?;
-    m.add_function(wrap_pyfunction!(cai_predict, m)?)?;
-    m.add_function(wrap_pyfunction!(cai_jacobian, m)?)?;
-    m.add_function(wrap_pyfunction!(cai_motion_imu, m)?)?;
-    m.add_function(wrap_pyfunction!(cai_oracle, m)?)?;
+    m.add_class::<CaiChannels>()?;
+    m.add_class::<CaiSetup>()?;
+    m.add_class::<CaiGravity>()?;
+    m.add_class::<CaiMotion>()?;
     m.add_function(wrap_pyfunction!(cai_phase_closed_form, m)?)?;
     m.add_function(wrap_pyfunction!(cai_sensitivity, m)?)?;
     m.add_function(wrap_pyfunction!(cai_convolution_phase, m)?)?;

@@ -60,6 +60,10 @@ class Channels:
     def __len__(self) -> int:
         return len(self.k)
 
+    def _native(self):
+        """The channels as validated by the Rust core (for the predictor and the oracle)."""
+        return _core.CaiChannels(self.k, self.lever, self.c_sb, self.v0)
+
     @classmethod
     def cyclic(cls, k: float = K_RB87, v0: float = 2.8, lever=(0.0, 0.0, 0.0), c_sb=None) -> "Channels":
         """Six channels of the seed-003 multi-axis sensor (spec §2.2): k along e_j, ensembles
@@ -73,8 +77,14 @@ class Channels:
         return cls(np.array(ks), lever, np.eye(3) if c_sb is None else c_sb, np.array(vs), names)
 
 
-def _predictor_args(t, specific_force, angular_rate, shots, T, channels, angular_acceleration, omega_dot,
-                    savgol_half_width, interpolation, substeps, gradient, bias_a, bias_g):
+def _gradient(gradient):
+    """Gravity-gradient tensor (3, 3) 1/s² as the core takes it; None = no gradient."""
+    return None if gradient is None else np.ascontiguousarray(np.asarray(gradient, float).reshape(3, 3))
+
+
+def _setup(t, specific_force, angular_rate, shots, T, channels, angular_acceleration, omega_dot,
+           savgol_half_width, interpolation, substeps, gradient, bias_a, bias_g):
+    """Validated shot start times (s) and the core predictor set up on them."""
     if omega_dot is None:
         omega_dot = "savgol" if angular_acceleration is None else "given"
     choice(omega_dot, ("zero", "pwl", "savgol", "given"), "omega_dot")
@@ -92,12 +102,11 @@ def _predictor_args(t, specific_force, angular_rate, shots, T, channels, angular
             raise ValueError(f"angular_acceleration: expected shape ({len(t)}, 3), got {wd.shape}")
         if omega_dot != "given":
             raise ValueError(f"angular_acceleration: given, but omega_dot = {omega_dot!r} would ignore it")
-    shots = np.atleast_1d(np.asarray(shots, float))
-    g = None if gradient is None else np.ascontiguousarray(np.asarray(gradient, float).reshape(3, 3))
-    return (t, f, w, np.ascontiguousarray(shots), channels.k, channels.lever, channels.c_sb, channels.v0, float(T),
-            omega_dot, wd, int(savgol_half_width), interpolation, int(substeps), g,
-            vector(np.broadcast_to(np.asarray(bias_a, float), 3).copy(), 3, "bias_a"),
-            vector(np.broadcast_to(np.asarray(bias_g, float), 3).copy(), 3, "bias_g"))
+    shots = np.ascontiguousarray(np.atleast_1d(np.asarray(shots, float)))
+    return shots, _core.CaiSetup(t, f, w, shots, channels._native(), float(T), omega_dot, wd, int(savgol_half_width),
+                                 interpolation, int(substeps), _gradient(gradient),
+                                 vector(np.broadcast_to(np.asarray(bias_a, float), 3).copy(), 3, "bias_a"),
+                                 vector(np.broadcast_to(np.asarray(bias_g, float), 3).copy(), 3, "bias_g"))
 
 
 @dataclass
@@ -137,10 +146,10 @@ def predict_phase(t, specific_force, angular_rate, shots, T: float, channels: Ch
     of h²). gradient: Γ_s (3, 3) 1/s² in s. bias_a (m/s²), bias_g (rad/s): estimated IMU
     biases, subtracted from the inputs.
     """
-    a = _predictor_args(t, specific_force, angular_rate, shots, T, channels, angular_acceleration, omega_dot,
-                        savgol_half_width, interpolation, substeps, gradient, bias_a, bias_g)
-    out = _core.cai_predict(*a).reshape(len(a[3]), len(channels), len(TERMS))
-    return PhasePrediction(a[3], channels, {k: out[:, :, i] for i, k in enumerate(TERMS)})
+    shots, setup = _setup(t, specific_force, angular_rate, shots, T, channels, angular_acceleration, omega_dot,
+                          savgol_half_width, interpolation, substeps, gradient, bias_a, bias_g)
+    out = setup.predict().reshape(len(shots), len(channels), len(TERMS))
+    return PhasePrediction(shots, channels, {k: out[:, :, i] for i, k in enumerate(TERMS)})
 
 
 def phase_jacobian(t, specific_force, angular_rate, shots, T: float, channels: Channels, *, euler: bool = False,
@@ -152,11 +161,10 @@ def phase_jacobian(t, specific_force, angular_rate, shots, T: float, channels: C
     the given bias estimates; Euler terms (ω̇) are excluded from the linearisation unless
     ``euler``. With ``fd_steps = (db_a, db_g, dl, dγ)`` the same derivative is computed by
     central finite differences of :func:`predict_phase` (the checker)."""
-    a = _predictor_args(t, specific_force, angular_rate, shots, T, channels, angular_acceleration, omega_dot,
-                        savgol_half_width, interpolation, substeps, gradient, bias_a, bias_g)
+    shots, setup = _setup(t, specific_force, angular_rate, shots, T, channels, angular_acceleration, omega_dot,
+                          savgol_half_width, interpolation, substeps, gradient, bias_a, bias_g)
     steps = None if fd_steps is None else vector(fd_steps, 4, "fd_steps")
-    out = _core.cai_jacobian(*a, bool(euler), steps)
-    return out.reshape(len(a[3]), len(channels), len(JACOBIAN_PARAMS))
+    return setup.jacobian(bool(euler), steps).reshape(len(shots), len(channels), len(JACOBIAN_PARAMS))
 
 
 def check_jacobian(*args, fd_steps=(1e-3, 1e-4, 1e-3, 1e-4), **kwargs) -> dict:
@@ -225,11 +233,11 @@ class SineMotion:
     attitude_poly: np.ndarray = field(default_factory=lambda: np.zeros((3, 3)))
     attitude_sines: np.ndarray = field(default_factory=lambda: _EMPTY_SINES)
 
-    def _args(self):
-        return ("sine", np.zeros(3), rows(self.position_poly, 3, "position_poly"),
-                np.ascontiguousarray(np.asarray(self.position_sines, float).reshape(-1, 4)),
-                rows(self.attitude_poly, 3, "attitude_poly"),
-                np.ascontiguousarray(np.asarray(self.attitude_sines, float).reshape(-1, 4)))
+    def _native(self):
+        return _core.CaiMotion.sine(rows(self.position_poly, 3, "position_poly"),
+                                    np.ascontiguousarray(np.asarray(self.position_sines, float).reshape(-1, 4)),
+                                    rows(self.attitude_poly, 3, "attitude_poly"),
+                                    np.ascontiguousarray(np.asarray(self.attitude_sines, float).reshape(-1, 4)))
 
 
 @dataclass
@@ -241,15 +249,13 @@ class YawDrive:
     yaw_rate_amplitude: float = 0.05
     period: float = 50.0
 
-    def _args(self):
-        return ("yaw_drive", np.array([self.speed, self.yaw_rate_amplitude, self.period], float),
-                np.zeros((3, 3)), _EMPTY_SINES, np.zeros((3, 3)), _EMPTY_SINES)
+    def _native(self):
+        return _core.CaiMotion.yaw_drive(float(self.speed), float(self.yaw_rate_amplitude), float(self.period))
 
 
-def _gravity(gravity, gradient):
-    g0 = vector(np.asarray(gravity, float), 3, "gravity")
-    g = None if gradient is None else np.ascontiguousarray(np.asarray(gradient, float).reshape(3, 3))
-    return g0, g
+def _gravity(gravity, gradient, t_ref):
+    """The core gravity model: uniform g (m/s²) and gradient (1/s²) about the IMU at t_ref (s)."""
+    return _core.CaiGravity(vector(np.asarray(gravity, float), 3, "gravity"), _gradient(gradient), float(t_ref))
 
 
 def motion_imu(motion, t, *, gravity=(0.0, 0.0, 0.0), gradient=None, t_ref: float = 0.0):
@@ -257,18 +263,17 @@ def motion_imu(motion, t, *, gravity=(0.0, 0.0, 0.0), gradient=None, t_ref: floa
     angular rate (N, 3) rad/s and angular acceleration (N, 3) rad/s², body frame.
     gravity: uniform g (m/s², inertial; zero = kinematic mode); gradient Γ_i (3, 3) 1/s²
     about the IMU position at ``t_ref``."""
-    g0, g = _gravity(gravity, gradient)
-    return _core.cai_motion_imu(*motion._args(), vector(t, None, "t"), g0, g, float(t_ref))
+    g = _gravity(gravity, gradient, t_ref)
+    return motion._native().imu(vector(t, None, "t"), g)
 
 
 def oracle_phase(motion, shots, T: float, channels: Channels, *, gravity=(0.0, 0.0, 0.0), gradient=None,
                  t_ref: float = 0.0) -> np.ndarray:
     """Exact phase (rad) (n_shots, n_channels) from the inertial oracle (spec (E8)): ballistic
     atom in the inertial frame, transformed into the rotating sensor frame at the pulses."""
-    g0, g = _gravity(gravity, gradient)
+    g = _gravity(gravity, gradient, t_ref)
     shots = np.atleast_1d(np.asarray(shots, float))
-    out = _core.cai_oracle(*motion._args(), vector(shots, None, "shots"), float(T), channels.k, channels.lever,
-                           channels.c_sb, channels.v0, g0, g, float(t_ref))
+    out = motion._native().oracle(vector(shots, None, "shots"), float(T), channels._native(), g)
     return out.reshape(len(shots), len(channels))
 
 
@@ -278,11 +283,10 @@ def oracle_phase(motion, shots, T: float, channels: Channels, *, gravity=(0.0, 0
 def _closed(kind, k, v0, angular_rate, specific_force, T, angular_acceleration=(0, 0, 0), gradient=None):
     k = rows(k, 3, "k")
     v0 = rows(np.broadcast_to(np.asarray(v0, float), k.shape), 3, "v0")
-    g = np.zeros((3, 3)) if gradient is None else np.asarray(gradient, float).reshape(3, 3)
     return _core.cai_phase_closed_form(kind, k, v0, vector(angular_rate, 3, "angular_rate"),
                                        vector(specific_force, 3, "specific_force"),
                                        vector(angular_acceleration, 3, "angular_acceleration"),
-                                       np.ascontiguousarray(g), float(T))
+                                       _gradient(gradient), float(T))
 
 
 def phase_constant(k, v0, angular_rate, specific_force, T: float) -> np.ndarray:
