@@ -8,6 +8,7 @@ pub mod earth;
 pub mod error;
 pub mod imu;
 pub mod math;
+pub mod noise;
 pub mod strapdown;
 pub mod trajectory;
 pub mod units;

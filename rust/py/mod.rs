@@ -5,6 +5,7 @@ use pyo3::prelude::*;
 mod convert;
 mod earth;
 mod imu;
+mod noise;
 mod rotation;
 mod strapdown;
 mod trajectory;
@@ -41,5 +42,6 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     imu::register(m)?;
     trajectory::register(m)?;
     strapdown::register(m)?;
+    noise::register(m)?;
     Ok(())
 }
