@@ -126,48 +126,50 @@ pub fn resolve_m(set: &TauSet, kind: Kind, np: usize) -> Result<Vec<usize>> {
 /// Removing the mean does not change any of the three variances and avoids cancellation.
 fn rate_to_phase(y: &[f64]) -> Vec<f64> {
     let mean = y.iter().sum::<f64>() / y.len() as f64;
-    let mut x = Vec::with_capacity(y.len() + 1);
+    let mut x = vec![0.0; y.len() + 1];
     let mut acc = 0.0;
-    x.push(0.0);
-    for v in y {
+    for (o, v) in x[1..].iter_mut().zip(y) {
         acc += v - mean;
-        x.push(acc);
+        *o = acc;
     }
     x
 }
 
-/// Σ of squares with four independent accumulators (lets the compiler vectorise).
+/// Σ_i (Σ_k c_k s_k[i])² over the common length of the K slices, with eight
+/// independent accumulators over fixed-size blocks so the loop vectorises.
 #[inline]
-fn sum_sq(n: usize, f: impl Fn(usize) -> f64) -> f64 {
-    let mut acc = [0.0f64; 4];
-    let n4 = n / 4 * 4;
-    let mut i = 0;
-    while i < n4 {
-        for (l, a) in acc.iter_mut().enumerate() {
-            let v = f(i + l);
-            *a += v * v;
+fn sum_sq<const K: usize>(s: [&[f64]; K], c: [f64; K]) -> f64 {
+    const L: usize = 8;
+    let n = s[0].len();
+    let mut acc = [0.0f64; L];
+    let blocks = n / L;
+    for blk in 0..blocks {
+        let b: [&[f64; L]; K] = std::array::from_fn(|k| s[k][blk * L..blk * L + L].try_into().expect("block of L"));
+        for l in 0..L {
+            let mut v = 0.0;
+            for k in 0..K {
+                v += c[k] * b[k][l];
+            }
+            acc[l] += v * v;
         }
-        i += 4;
     }
-    for k in n4..n {
-        let v = f(k);
+    for i in blocks * L..n {
+        let v: f64 = (0..K).map(|k| c[k] * s[k][i]).sum();
         acc[0] += v * v;
     }
-    (acc[0] + acc[1]) + (acc[2] + acc[3])
+    acc.iter().sum()
 }
 
 /// Σ of (x_{i+2m} − 2x_{i+m} + x_i)², i < Np − 2m.
 fn allan_sum(x: &[f64], m: usize) -> f64 {
     let n = x.len() - 2 * m;
-    let (x0, x1, x2) = (&x[..n], &x[m..m + n], &x[2 * m..2 * m + n]);
-    sum_sq(n, |i| x2[i] - 2.0 * x1[i] + x0[i])
+    sum_sq([&x[..n], &x[m..m + n], &x[2 * m..2 * m + n]], [1.0, -2.0, 1.0])
 }
 
 /// Σ of (x_{i+3m} − 3x_{i+2m} + 3x_{i+m} − x_i)², i < Np − 3m.
 fn hadamard_sum(x: &[f64], m: usize) -> f64 {
     let n = x.len() - 3 * m;
-    let (x0, x1, x2, x3) = (&x[..n], &x[m..m + n], &x[2 * m..2 * m + n], &x[3 * m..3 * m + n]);
-    sum_sq(n, |i| x3[i] - 3.0 * x2[i] + 3.0 * x1[i] - x0[i])
+    sum_sq([&x[..n], &x[m..m + n], &x[2 * m..2 * m + n], &x[3 * m..3 * m + n]], [-1.0, 3.0, -3.0, 1.0])
 }
 
 /// Σ_j v_j², v_j = Σ_{i=j}^{j+m−1} (x_{i+2m} − 2x_{i+m} + x_i), updated by

@@ -6,7 +6,7 @@
 //! d = (1−L)^D ω. Measurement H = [1 0 … 0]: the filter observes ω_k directly.
 
 use crate::error::{check_finite, check_positive, invalid, NavError, Result};
-use nalgebra::{Complex, DMatrix};
+use nalgebra::{Complex, DMatrix, SMatrix, SVector};
 
 /// How the ARMA innovations enter the state (spec D5).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -192,67 +192,198 @@ pub struct FilterOutput {
     pub gain: Vec<f64>,
 }
 
-/// Stateful Kalman filter on an ARIMA state-space model (seed 002 Eq. 15).
+/// Largest state dimension the filter supports (ARMA orders p, q ≤ 3 need at most 7).
+pub const MAX_DIM: usize = 8;
+
+const FADING_RHO: f64 = 0.95;
+
+/// Measurement-variance bookkeeping shared by every state dimension.
 #[derive(Debug, Clone)]
-pub struct Kalman {
-    n: usize,
-    phi: Vec<f64>,
-    qd: Vec<f64>,
+struct RState {
     mode: RMode,
-    x0: X0,
-    record: bool,
-    x: Vec<f64>,
-    p: Vec<f64>,
     r: f64,
     r_floor: f64,
     k: usize,
     allan: RunningAllanR,
     last: Option<f64>,
-    /// Sage–Husa: b^k and the fading-factor innovation power V_k.
+    /// Sage–Husa: b^k, and the fading-factor innovation power V_k.
     bk: f64,
     v: f64,
-    // Scratch buffers (no allocation per step).
-    xp: Vec<f64>,
-    fpf: Vec<f64>,
-    tmp: Vec<f64>,
-    gain: Vec<f64>,
 }
 
-const FADING_RHO: f64 = 0.95;
+impl RState {
+    /// Eq. 17 readings: R_k from the running Allan variance including sample k.
+    fn eq17(&mut self, z: f64) {
+        let y = match self.mode {
+            RMode::Literal => Some(z),
+            RMode::Differenced => self.last.map(|prev| z - prev),
+            _ => None,
+        };
+        self.last = Some(z);
+        if let Some(r) = y.and_then(|y| self.allan.update(y)) {
+            self.r = r;
+        }
+    }
+
+    /// Sage–Husa weight d_k = (1−b)/(1−b^k).
+    fn sage_husa_weight(&self, b: f64) -> f64 {
+        (1.0 - b) / (1.0 - self.bk)
+    }
+}
+
+/// The filter at a fixed state dimension N (fixed-size algebra, no allocation per step).
+#[derive(Debug, Clone)]
+struct Core<const N: usize> {
+    /// Φ = e₀cᵀ + shifts: first row c, row i ≥ 1 copies row i−1 where `shift[i]`.
+    c: SVector<f64, N>,
+    shift: [bool; N],
+    qd: SMatrix<f64, N, N>,
+    x: SVector<f64, N>,
+    p: SMatrix<f64, N, N>,
+    gain: SVector<f64, N>,
+    first: bool,
+}
+
+impl<const N: usize> Core<N> {
+    fn new(model: &ArimaStateSpace, p0: f64, first: bool) -> Core<N> {
+        Core {
+            c: SVector::from_fn(|j, _| model.phi[(0, j)]),
+            shift: std::array::from_fn(|i| i > 0 && model.phi[(i, i - 1)] == 1.0),
+            qd: SMatrix::from_fn(|i, j| model.qd[(i, j)]),
+            x: SVector::zeros(),
+            p: SMatrix::identity() * p0,
+            gain: SVector::zeros(),
+            first,
+        }
+    }
+
+    /// Φ M using the companion structure (2N² instead of 2N³ operations).
+    fn phi_left(&self, m: &SMatrix<f64, N, N>) -> SMatrix<f64, N, N> {
+        SMatrix::from_fn(|i, j| {
+            if i == 0 {
+                (0..N).map(|l| self.c[l] * m[(l, j)]).sum()
+            } else if self.shift[i] {
+                m[(i - 1, j)]
+            } else {
+                0.0
+            }
+        })
+    }
+
+    /// One step of seed 002 Eq. 15 with R_k chosen by `rs`.
+    fn step(&mut self, z: f64, rs: &mut RState) -> Result<f64> {
+        rs.k += 1;
+        if rs.k == 1 && self.first {
+            self.x.fill(z);
+        }
+        // Predict: X⁻ = Φ X̂, F = Φ P Φᵀ.
+        let xp = SVector::from_fn(|i, _| if i == 0 { self.c.dot(&self.x) } else if self.shift[i] { self.x[i - 1] } else { 0.0 });
+        let fpf = self.phi_left(&self.phi_left(&self.p).transpose()).transpose();
+        let eps = z - xp[0];
+        let r_prev = rs.r;
+        rs.eq17(z);
+        let mut lambda = 1.0;
+        if let RMode::SageHusa { b, fading, .. } = rs.mode {
+            if fading {
+                // Strong-tracking fading factor (spec E11).
+                rs.v = if rs.k == 1 { eps * eps } else { (FADING_RHO * rs.v + eps * eps) / (1.0 + FADING_RHO) };
+                if fpf[(0, 0)] > 0.0 {
+                    lambda = ((rs.v - self.qd[(0, 0)] - r_prev) / fpf[(0, 0)]).max(1.0);
+                }
+            }
+            let pm00 = lambda * fpf[(0, 0)] + self.qd[(0, 0)];
+            rs.bk *= b;
+            let dk = rs.sage_husa_weight(b);
+            // Sage–Husa: R̂_k = (1−d_k) R̂_{k−1} + d_k (ε² − H P⁻ Hᵀ); drop the subtraction if ≤ 0.
+            let r = (1.0 - dk) * r_prev + dk * (eps * eps - pm00);
+            rs.r = if r > 0.0 { r } else { (1.0 - dk) * r_prev + dk * eps * eps };
+        }
+        // spec D8: R floor.
+        rs.r = rs.r.max(rs.r_floor);
+        let pm = fpf * lambda + self.qd;
+        let s = pm[(0, 0)] + rs.r;
+        if !(s > 0.0 && s.is_finite()) {
+            return Err(NavError::Numerical(format!("innovation variance {s} at step {}", rs.k)));
+        }
+        self.gain = pm.column(0) / s;
+        self.x = xp + self.gain * eps;
+        // P = (I − K H) P⁻, symmetrised (spec D10).
+        let p = pm - self.gain * pm.row(0);
+        self.p = (p + p.transpose()) * 0.5;
+        if let RMode::SageHusa { b, adapt_q: true, .. } = rs.mode {
+            // Sage–Husa Q: Q_k = (1−d_k) Q_{k−1} + d_k (K ε² Kᵀ + P_k − Φ P_{k−1} Φᵀ), kept
+            // only if its diagonal stays non-negative (the standard form can lose
+            // positive semi-definiteness, e.g. right after P₀).
+            let dk = rs.sage_husa_weight(b);
+            let q = self.qd * (1.0 - dk) + (self.gain * self.gain.transpose() * (eps * eps) + self.p - fpf) * dk;
+            if q.diagonal().iter().all(|&d| d >= 0.0) {
+                self.qd = q;
+            }
+        }
+        if !self.x[0].is_finite() {
+            return Err(NavError::Numerical(format!("state diverged at step {}", rs.k)));
+        }
+        Ok(self.x[0])
+    }
+}
+
+/// The filter relies on Φ having the form built by [`ArimaStateSpace::from_arma`]: a
+/// dense first row and, below it, rows that are zero or copy the previous state.
+fn check_companion(phi: &DMatrix<f64>) -> Result<()> {
+    for i in 1..phi.nrows() {
+        for j in 0..phi.ncols() {
+            let v = phi[(i, j)];
+            if v != 0.0 && !(j + 1 == i && v == 1.0) {
+                return Err(invalid("model", format!("Φ row {i} is not a shift row (entry {v} at column {j})")));
+            }
+        }
+    }
+    Ok(())
+}
+
+macro_rules! cores {
+    ($($v:ident = $n:literal),*) => {
+        #[derive(Debug, Clone)]
+        enum AnyCore { $($v(Core<$n>)),* }
+
+        impl AnyCore {
+            fn new(model: &ArimaStateSpace, p0: f64, first: bool) -> Result<AnyCore> {
+                check_companion(&model.phi)?;
+                match model.dim() {
+                    $($n => Ok(AnyCore::$v(Core::new(model, p0, first))),)*
+                    n => Err(invalid("model", format!("state dimension {n} exceeds the supported maximum {MAX_DIM}"))),
+                }
+            }
+
+            fn step(&mut self, z: f64, rs: &mut RState) -> Result<f64> {
+                match self { $(AnyCore::$v(c) => c.step(z, rs),)* }
+            }
+
+            fn gain(&self) -> &[f64] {
+                match self { $(AnyCore::$v(c) => c.gain.as_slice(),)* }
+            }
+        }
+    };
+}
+
+cores!(D1 = 1, D2 = 2, D3 = 3, D4 = 4, D5 = 5, D6 = 6, D7 = 7, D8 = 8);
+
+/// Stateful Kalman filter on an ARIMA state-space model (seed 002 Eq. 15); feed chunks
+/// with [`Kalman::update`] for streaming, or use [`kalman`] for a whole series.
+#[derive(Debug, Clone)]
+pub struct Kalman {
+    core: AnyCore,
+    rs: RState,
+    record: bool,
+}
 
 impl Kalman {
     /// `r0`: initial (and fixed) measurement variance; `p0`: P₀ = p0·I.
     pub fn new(model: &ArimaStateSpace, r0: f64, mode: RMode, x0: X0, p0: f64, record: bool) -> Result<Kalman> {
         check_positive("r0", r0)?;
         check_positive("p0", p0)?;
-        let n = model.dim();
-        let flat = |m: &DMatrix<f64>| (0..n * n).map(|i| m[(i / n, i % n)]).collect::<Vec<f64>>();
-        let mut p = vec![0.0; n * n];
-        for i in 0..n {
-            p[i * n + i] = p0;
-        }
-        Ok(Kalman {
-            n,
-            phi: flat(&model.phi),
-            qd: flat(&model.qd),
-            mode,
-            x0,
-            record,
-            x: vec![0.0; n],
-            p,
-            r: r0,
-            // spec D8: R floor 1e-12·Q
-            r_floor: 1e-12 * model.sigma2,
-            k: 0,
-            allan: RunningAllanR::default(),
-            last: None,
-            bk: 1.0,
-            v: 0.0,
-            xp: vec![0.0; n],
-            fpf: vec![0.0; n * n],
-            tmp: vec![0.0; n * n],
-            gain: vec![0.0; n],
-        })
+        let rs = RState { mode, r: r0, r_floor: 1e-12 * model.sigma2, k: 0, allan: RunningAllanR::default(), last: None, bk: 1.0, v: 0.0 };
+        Ok(Kalman { core: AnyCore::new(model, p0, x0 == X0::First)?, rs, record })
     }
 
     /// Filter the next chunk of measurements, appending to `out`.
@@ -260,123 +391,13 @@ impl Kalman {
         check_finite("omega", z, 1)?;
         out.xhat.reserve(z.len());
         for &zk in z {
-            let xh = self.step(zk)?;
-            out.xhat.push(xh);
+            out.xhat.push(self.core.step(zk, &mut self.rs)?);
             if self.record {
-                out.r.push(self.r);
-                out.gain.extend_from_slice(&self.gain);
+                out.r.push(self.rs.r);
+                out.gain.extend_from_slice(self.core.gain());
             }
         }
         Ok(())
-    }
-
-    /// One step of seed 002 Eq. 15 with the configured R_k.
-    fn step(&mut self, z: f64) -> Result<f64> {
-        let n = self.n;
-        self.k += 1;
-        if self.k == 1 && self.x0 == X0::First {
-            for i in 0..n {
-                self.x[i] = z;
-            }
-        }
-        // Predict: X⁻ = Φ X̂, F = Φ P Φᵀ.
-        for i in 0..n {
-            self.xp[i] = (0..n).map(|j| self.phi[i * n + j] * self.x[j]).sum();
-        }
-        for i in 0..n {
-            for j in 0..n {
-                self.tmp[i * n + j] = (0..n).map(|l| self.phi[i * n + l] * self.p[l * n + j]).sum();
-            }
-        }
-        for i in 0..n {
-            for j in 0..n {
-                self.fpf[i * n + j] = (0..n).map(|l| self.tmp[i * n + l] * self.phi[j * n + l]).sum();
-            }
-        }
-        let eps = z - self.xp[0];
-        let r_prev = self.r;
-        // Choose R_k (computed before K_k, including sample k).
-        match self.mode {
-            RMode::Fixed => {}
-            RMode::Literal => {
-                if let Some(r) = self.allan.update(z) {
-                    self.r = r;
-                }
-            }
-            RMode::Differenced => {
-                if let Some(prev) = self.last {
-                    if let Some(r) = self.allan.update(z - prev) {
-                        self.r = r;
-                    }
-                }
-            }
-            RMode::SageHusa { .. } => {}
-        }
-        self.last = Some(z);
-        let mut lambda = 1.0;
-        if let RMode::SageHusa { b, fading, .. } = self.mode {
-            if fading {
-                // Strong-tracking fading factor (spec E11).
-                self.v = if self.k == 1 { eps * eps } else { (FADING_RHO * self.v + eps * eps) / (1.0 + FADING_RHO) };
-                let den = self.fpf[0];
-                if den > 0.0 {
-                    lambda = ((self.v - self.qd[0] - r_prev) / den).max(1.0);
-                }
-            }
-            let pm00 = lambda * self.fpf[0] + self.qd[0];
-            self.bk *= b;
-            let dk = (1.0 - b) / (1.0 - self.bk);
-            // Sage–Husa: R̂_k = (1−d_k) R̂_{k−1} + d_k (ε² − H P⁻ Hᵀ); drop the subtraction if ≤ 0.
-            let r = (1.0 - dk) * r_prev + dk * (eps * eps - pm00);
-            self.r = if r > 0.0 { r } else { (1.0 - dk) * r_prev + dk * eps * eps };
-        }
-        self.r = self.r.max(self.r_floor);
-        // P⁻ = λ Φ P Φᵀ + B Q Bᵀ (stored in tmp).
-        for i in 0..n * n {
-            self.tmp[i] = lambda * self.fpf[i] + self.qd[i];
-        }
-        let s = self.tmp[0] + self.r;
-        if !(s > 0.0) || !s.is_finite() {
-            return Err(NavError::Numerical(format!("innovation variance {s} at step {}", self.k)));
-        }
-        for i in 0..n {
-            self.gain[i] = self.tmp[i * n] / s;
-        }
-        for i in 0..n {
-            self.x[i] = self.xp[i] + self.gain[i] * eps;
-        }
-        // P = (I − K H) P⁻, then symmetrised (spec D10); p holds P_{k−1} until here.
-        for i in 0..n {
-            for j in 0..n {
-                self.p[i * n + j] = self.tmp[i * n + j] - self.gain[i] * self.tmp[j];
-            }
-        }
-        for i in 0..n {
-            for j in 0..i {
-                let a = 0.5 * (self.p[i * n + j] + self.p[j * n + i]);
-                self.p[i * n + j] = a;
-                self.p[j * n + i] = a;
-            }
-        }
-        if let RMode::SageHusa { b, adapt_q: true, .. } = self.mode {
-            // Sage–Husa Q: Q_k = (1−d_k) Q_{k−1} + d_k (K ε² Kᵀ + P_k − Φ P_{k−1} Φᵀ).
-            // The update is kept only if its diagonal stays non-negative (the standard
-            // form can lose positive semi-definiteness, e.g. right after P₀).
-            let dk = (1.0 - b) / (1.0 - self.bk);
-            for i in 0..n {
-                for j in 0..n {
-                    let inc = self.gain[i] * self.gain[j] * eps * eps + self.p[i * n + j] - self.fpf[i * n + j];
-                    self.tmp[i * n + j] = (1.0 - dk) * self.qd[i * n + j] + dk * inc;
-                }
-            }
-            if (0..n).all(|i| self.tmp[i * n + i] >= 0.0) {
-                self.qd.copy_from_slice(&self.tmp);
-            }
-        }
-        if !self.x[0].is_finite() {
-            return Err(NavError::Numerical(format!("state diverged at step {}", self.k)));
-        }
-        Ok(self.x[0])
     }
 }
 

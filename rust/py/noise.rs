@@ -46,8 +46,8 @@ fn allan_var<'py>(
     m: Option<Vec<usize>>,
 ) -> PyResult<(Bound<'py, PyArray1<usize>>, Arr<'py>, Arr<'py>, Bound<'py, PyArray1<usize>>)> {
     let (dt, k, ts) = (DataType::by_name(data_type)?, Kind::by_name(kind)?, tau_set(set, m)?);
-    let x: Vec<f64> = data.as_array().iter().copied().collect();
-    let r = py.detach(|| allan::variance(&x, tau0, dt, k, &ts))?;
+    let x = data.as_slice().map_err(|_| invalid("data", "array must be C-contiguous"))?;
+    let r = py.detach(|| allan::variance(x, tau0, dt, k, &ts))?;
     Ok(result_to_py(py, r))
 }
 
@@ -195,8 +195,8 @@ fn kalman_filter<'py>(
     record: bool,
 ) -> PyResult<(Arr<'py>, Arr<'py>, Bound<'py, PyArray2<f64>>)> {
     let c = filter_config(ar, ma, sigma2, d, noise_form, r0.unwrap_or(sigma2), mode, b, adapt_q, fading, x0, p0)?;
-    let w: Vec<f64> = omega.as_array().iter().copied().collect();
-    let out = py.detach(|| arma_filter::kalman(&w, &c.model, c.r0, c.mode, c.x0, c.p0, record))?;
+    let w = omega.as_slice().map_err(|_| invalid("omega", "array must be C-contiguous"))?;
+    let out = py.detach(|| arma_filter::kalman(w, &c.model, c.r0, c.mode, c.x0, c.p0, record))?;
     output_to_py(py, out, c.model.dim())
 }
 
