@@ -16,6 +16,6 @@ Eqs. 9, 11–12), d_k = ω_k − ω_{k−1} the differenced series (the paper's 
 10–11, and the "y" of the differenced reading of Eq. 17), a_k the ARMA innovation.
 """
 
-from . import allan, filters, arma, baselines, synth
+from . import allan, filters, arma, baselines, synth, report
 
 __all__ = ["allan", "filters", "arma", "baselines", "synth", "report"]
