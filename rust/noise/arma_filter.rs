@@ -6,7 +6,7 @@
 //! d = (1−L)^D ω. Measurement H = [1 0 … 0]: the filter observes ω_k directly.
 
 use crate::error::{check_finite, check_positive, invalid, NavError, Result};
-use nalgebra::{Complex, DMatrix, SMatrix, SVector};
+use nalgebra::{DMatrix, SMatrix, SVector};
 
 /// How the ARMA innovations enter the state (spec D5).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -113,11 +113,6 @@ impl ArimaStateSpace {
 
     pub fn dim(&self) -> usize {
         self.phi.nrows()
-    }
-
-    /// Eigenvalues of Φ (roots of the integrated AR polynomial, plus zeros).
-    pub fn eigenvalues(&self) -> Vec<Complex<f64>> {
-        self.phi.complex_eigenvalues().iter().copied().collect()
     }
 }
 
@@ -453,15 +448,6 @@ mod tests {
         }
         assert!((m.qd[(0, 0)] - 0.0693035).abs() < 1e-12);
         assert_eq!(m.qd.iter().filter(|v| **v != 0.0).count(), 1);
-    }
-
-    #[test]
-    fn eigenvalues_of_phi() {
-        let mut ev: Vec<f64> = paper().eigenvalues().iter().map(|c| c.re).collect();
-        ev.sort_by(f64::total_cmp);
-        for (a, e) in ev.iter().zip([-0.1795315, 0.1615315, 1.0]) {
-            assert!((a - e).abs() < 1e-7, "{ev:?}");
-        }
     }
 
     #[test]

@@ -131,7 +131,7 @@ fn model(ar: Vec<f64>, ma: Vec<f64>, sigma2: f64, d: usize, noise_form: &str) ->
     Ok(ArimaStateSpace::from_arma(&ar, &ma, sigma2, d, NoiseForm::by_name(noise_form)?)?)
 }
 
-/// Φ, B, Q, BQBᵀ and the eigenvalues (re, im) of an ARIMA(p,d,q) state-space model.
+/// Φ, B, Q and BQBᵀ of an ARIMA(p,d,q) state-space model.
 #[pyfunction]
 #[pyo3(signature = (ar, ma, sigma2, d=1, noise_form="paper"))]
 fn arima_state_space<'py>(py: Python<'py>, ar: Vec<f64>, ma: Vec<f64>, sigma2: f64, d: usize, noise_form: &str) -> PyResult<Bound<'py, PyDict>> {
@@ -141,9 +141,6 @@ fn arima_state_space<'py>(py: Python<'py>, ar: Vec<f64>, ma: Vec<f64>, sigma2: f
     out.set_item("b", mat_to_py(py, &s.b))?;
     out.set_item("q", mat_to_py(py, &s.q))?;
     out.set_item("qd", mat_to_py(py, &s.qd))?;
-    let ev = s.eigenvalues();
-    out.set_item("eig_re", ev.iter().map(|c| c.re).collect::<Vec<f64>>())?;
-    out.set_item("eig_im", ev.iter().map(|c| c.im).collect::<Vec<f64>>())?;
     Ok(out)
 }
 

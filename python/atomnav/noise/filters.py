@@ -91,8 +91,9 @@ class ArimaStateSpace:
 
     @property
     def eigenvalues(self) -> np.ndarray:
-        """Eigenvalues of Φ (complex)."""
-        return np.asarray(self._m["eig_re"]) + 1j * np.asarray(self._m["eig_im"])
+        """Eigenvalues of Φ (complex): the roots of the integrated AR polynomial, one of
+        them 1 per difference."""
+        return np.linalg.eigvals(self.phi)
 
     def _args(self) -> tuple:
         return (list(self.ar), list(self.ma), self.sigma2, int(self.d), self.noise_form)
