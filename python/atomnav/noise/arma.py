@@ -78,9 +78,12 @@ def stationarity(z, regression: str = "c", alpha: float = 0.05) -> Stationarity:
 
     regression = choice(regression, ("c", "ct"), "regression")
     x = _series(z, "z", 20)
-    adf = adfuller(x, regression=regression, autolag="AIC")
     with warnings.catch_warnings():
+        # KPSS p-values outside its table are clipped (documented above); newer
+        # statsmodels announce a result-object return type (FutureWarning).
         warnings.simplefilter("ignore", InterpolationWarning)
+        warnings.simplefilter("ignore", FutureWarning)
+        adf = adfuller(x, regression=regression, autolag="AIC")
         k = kpss(x, regression=regression, nlags="auto")
     return Stationarity(float(adf[0]), float(adf[1]), float(k[0]), float(k[1]), alpha)
 
