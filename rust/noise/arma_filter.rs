@@ -252,20 +252,20 @@ impl<const N: usize> Core<N> {
         }
     }
 
-    /// Φ M using the companion structure (2N² instead of 2N³ operations).
-    fn phi_left(&self, m: &SMatrix<f64, N, N>) -> SMatrix<f64, N, N> {
-        SMatrix::from_fn(|i, j| {
-            if i == 0 {
-                (0..N).map(|l| self.c[l] * m[(l, j)]).sum()
-            } else if self.shift[i] {
-                m[(i - 1, j)]
-            } else {
-                0.0
+    /// Filter a chunk (the per-step loop is monomorphised for N).
+    fn run(&mut self, z: &[f64], rs: &mut RState, out: &mut FilterOutput, record: bool) -> Result<()> {
+        for &zk in z {
+            out.xhat.push(self.step(zk, rs)?);
+            if record {
+                out.r.push(rs.r);
+                out.gain.extend_from_slice(self.gain.as_slice());
             }
-        })
+        }
+        Ok(())
     }
 
     /// One step of seed 002 Eq. 15 with R_k chosen by `rs`.
+    #[inline(always)]
     fn step(&mut self, z: f64, rs: &mut RState) -> Result<f64> {
         rs.k += 1;
         if rs.k == 1 && self.first {
@@ -273,7 +273,16 @@ impl<const N: usize> Core<N> {
         }
         // Predict: X⁻ = Φ X̂, F = Φ P Φᵀ.
         let xp = SVector::from_fn(|i, _| if i == 0 { self.c.dot(&self.x) } else if self.shift[i] { self.x[i - 1] } else { 0.0 });
-        let fpf = self.phi_left(&self.phi_left(&self.p).transpose()).transpose();
+        // Φ P Φᵀ from the structure Φ = e₀cᵀ + shifts and symmetric P, with u = P c:
+        // (0,0) = cᵀu, (i,0) = (0,i) = u_{i−1}, (i,j) = P_{i−1,j−1} on shifted rows.
+        let u = self.p * self.c;
+        let sh = |i: usize| self.shift[i];
+        let fpf = SMatrix::<f64, N, N>::from_fn(|i, j| match (i, j) {
+            (0, 0) => self.c.dot(&u),
+            (0, j) => if sh(j) { u[j - 1] } else { 0.0 },
+            (i, 0) => if sh(i) { u[i - 1] } else { 0.0 },
+            (i, j) => if sh(i) && sh(j) { self.p[(i - 1, j - 1)] } else { 0.0 },
+        });
         let eps = z - xp[0];
         let r_prev = rs.r;
         rs.eq17(z);
@@ -350,12 +359,8 @@ macro_rules! cores {
                 }
             }
 
-            fn step(&mut self, z: f64, rs: &mut RState) -> Result<f64> {
-                match self { $(AnyCore::$v(c) => c.step(z, rs),)* }
-            }
-
-            fn gain(&self) -> &[f64] {
-                match self { $(AnyCore::$v(c) => c.gain.as_slice(),)* }
+            fn run(&mut self, z: &[f64], rs: &mut RState, out: &mut FilterOutput, record: bool) -> Result<()> {
+                match self { $(AnyCore::$v(c) => c.run(z, rs, out, record),)* }
             }
         }
     };
@@ -385,14 +390,7 @@ impl Kalman {
     pub fn update(&mut self, z: &[f64], out: &mut FilterOutput) -> Result<()> {
         check_finite("omega", z, 1)?;
         out.xhat.reserve(z.len());
-        for &zk in z {
-            out.xhat.push(self.core.step(zk, &mut self.rs)?);
-            if self.record {
-                out.r.push(self.rs.r);
-                out.gain.extend_from_slice(self.core.gain());
-            }
-        }
-        Ok(())
+        self.core.run(z, &mut self.rs, out, self.record)
     }
 }
 
