@@ -191,6 +191,7 @@ fn rate_to_phase(y: &[f64]) -> Vec<f64> {
 /// Σ_i (Σ_k c_k s_k[i])² over the common length of the K slices, with eight
 /// independent accumulators over fixed-size blocks so the loop vectorises.
 #[inline(always)]
+#[allow(clippy::needless_range_loop)] // index i runs across the K slices
 fn sum_sq_impl<const K: usize>(s: [&[f64]; K], c: [f64; K]) -> f64 {
     const L: usize = 8;
     let n = s[0].len();

@@ -348,6 +348,7 @@ fn check_companion(phi: &DMatrix<f64>) -> Result<()> {
 macro_rules! cores {
     ($($v:ident = $n:literal),*) => {
         #[derive(Debug, Clone)]
+        #[allow(clippy::large_enum_variant)] // one per filter; boxing would add an indirection per step
         enum AnyCore { $($v(Core<$n>)),* }
 
         impl AnyCore {

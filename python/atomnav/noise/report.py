@@ -2,7 +2,19 @@
 differenced data, fixed and adaptive Kalman filters, Sage–Husa, low-pass and wavelet
 baselines; bias, bias stability, SS, LS and improvement ratios; Allan and PSD plots.
 
-Units (spec D16): rate in °/h, τ in s, SS in °/√h, LS and BS in °/h."""
+Units (spec D16): rate in °/h, τ in s, SS in °/√h, LS and BS in °/h.
+
+Unit caveat (spec §5): the paper's headline numbers are mutually inconsistent. With τ
+in hours, SS = 0.015 °/√h means white noise of 0.1248 °/h per 52 s sample, above the
+reported BS = 0.0766 °/h, so the paper's BS must average at least 3 samples; model B
+therefore matches SS at w = 1 and BS at w = 3, and does not attempt LS = 3.56e-4 °/h
+(13 h of data cannot measure such a floor).
+
+Claims that do not reproduce with the paper's stated settings (spec §4c), reported as
+such by :func:`compare` (``claims``) and ``atomnav reproduce``: the LS improvements
+(every KF raises the fitted LS on model-B data: the suppressed short-τ points move
+weight into A₀), and "adaptive KF ≳ WD > LPF" (with a 0.002 Hz cutoff on 52 s data and
+the universal threshold at N = 900 both baselines smooth far more than the KF)."""
 
 from __future__ import annotations
 
