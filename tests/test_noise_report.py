@@ -105,3 +105,13 @@ def test_baselines_keep_bias():
     w = synth.model_b()
     for y in (baselines.butterworth_lowpass(w, 52.0), baselines.wavelet_denoise(w)):
         assert abs(y.mean() - w.mean()) <= 0.001
+
+
+@pytest.mark.slow
+def test_reproduce_section_quick(tmp_path):
+    from atomnav import reproduce
+
+    t = reproduce.run(tmp_path, only=["noise_niu2025"], quick=True)
+    assert (t["verdict"] != "FAIL").all()
+    assert (tmp_path / "noise_niu2025_allan.png").exists() and (tmp_path / "noise_niu2025_psd.png").exists()
+    assert t["verdict"].str.contains("NOT reproduced").any()
