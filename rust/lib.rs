@@ -9,6 +9,7 @@ pub mod earth;
 pub mod error;
 pub mod imu;
 pub mod math;
+pub mod noise;
 pub mod strapdown;
 pub mod trajectory;
 pub mod units;

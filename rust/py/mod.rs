@@ -6,6 +6,7 @@ mod cai;
 mod convert;
 mod earth;
 mod imu;
+mod noise;
 mod rotation;
 mod strapdown;
 mod trajectory;
@@ -43,5 +44,6 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     trajectory::register(m)?;
     strapdown::register(m)?;
     cai::register(m)?;
+    noise::register(m)?;
     Ok(())
 }

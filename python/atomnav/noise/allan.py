@@ -1,0 +1,223 @@
+"""Allan family and the metrics of seed 002 (spec E14–E18, D15–D17).
+
+All functions are unit-agnostic: a rate series in some unit U sampled every ``tau0``
+seconds gives variances in U², fit coefficients A_k in U²·s^k, ARW in U·√s, bias
+instability in U, RRW in U/√s. :meth:`AllanFit.arw_in` converts with the factors of
+:mod:`atomnav.units` (e.g. U = °/h → ARW in rad/√s or °/√h).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+import pandas as pd
+
+from .. import _core, units
+from .._validate import choice, positive, vector
+
+KINDS = ("allan", "modified", "hadamard")
+DATA_TYPES = ("rate", "phase")
+TAU_SETS = ("octave", "decade", "all")
+NOISE_TYPES = ("white_pm", "flicker_pm", "white_fm", "flicker_fm", "random_walk_fm")
+#: Names of the five-term coefficients A₋₂ … A₂ (seed 002 Eq. 19).
+TERMS = ("quantization", "arw", "bias_instability", "rrw", "ramp")
+
+
+def _series(x, name: str, min_len: int = 1) -> np.ndarray:
+    a = vector(x, None, name)
+    if a.size < min_len:
+        raise ValueError(f"{name}: series of {a.size} samples is too short; at least {min_len} are needed")
+    return a
+
+
+def _m_list(m, taus, tau0: float):
+    """Averaging factors from ``m`` (a set name or integers) or ``taus`` (seconds)."""
+    if taus is not None:
+        t = vector(taus, None, "taus")
+        mm = np.rint(t / tau0)
+        bad = np.nonzero((mm < 1) | (np.abs(mm * tau0 - t) > 1e-9 * np.maximum(t, tau0)))[0]
+        if bad.size:
+            raise ValueError(f"taus: τ = {t[bad[0]]} s at index {bad[0]} is not a positive multiple of tau0 = {tau0} s")
+        return "list", [int(v) for v in mm]
+    if isinstance(m, str):
+        return choice(m, TAU_SETS, "m"), None
+    mm = np.asarray(m)
+    if mm.ndim != 1 or not np.issubdtype(mm.dtype, np.integer):
+        raise ValueError(f"m: expected 'octave', 'decade', 'all' or a 1-D sequence of integers, got {m!r}")
+    bad = np.nonzero(mm < 1)[0]
+    if bad.size:
+        raise ValueError(f"m: averaging factor {mm[bad[0]]} at index {bad[0]} must be ≥ 1")
+    return "list", [int(v) for v in mm]
+
+
+def _table(m, tau, var, n, kind: str, n_phase: int, noise: str, confidence: float) -> pd.DataFrame:
+    from scipy.stats import chi2
+
+    edf = _core.allan_edf(kind, noise, n_phase, [int(v) for v in m])
+    alpha = 1.0 - confidence
+    lo = var * edf / chi2.ppf(1.0 - alpha / 2.0, edf)
+    hi = var * edf / chi2.ppf(alpha / 2.0, edf)
+    return pd.DataFrame({"m": m, "tau_s": tau, "var": var, "dev": np.sqrt(var), "n_terms": n, "edf": edf, "dev_lo": np.sqrt(lo), "dev_hi": np.sqrt(hi)})
+
+
+def allan_variance(data, tau0: float, m="octave", kind: str = "allan", data_type: str = "rate", taus=None, noise: str = "white_fm", confidence: float = 0.683) -> pd.DataFrame:
+    """Allan-family variance of a rate series (or of a phase/angle series) sampled every
+    ``tau0`` s.
+
+    ``kind``: "allan" (overlapping), "modified" or "hadamard" (overlapping).
+    ``m``: "octave" (1, 2, 4, …), "decade" (1, 2, 4, 10, 20, 40, …), "all", or a list of
+    averaging factors; alternatively ``taus`` in seconds (multiples of tau0). Factors
+    that leave fewer than two terms are dropped from the named sets and rejected (with
+    ValueError) in a user list.
+    ``data_type="phase"``: data are the integral of the rate (e.g. angle in rad), the
+    variance is then of the rate (rad/s)².
+
+    Columns: ``m``, ``tau_s``, ``var`` (rate unit²), ``dev``, ``n_terms``, ``edf``
+    (equivalent degrees of freedom: Howe's approximation for the overlapping Allan
+    variance with the given ``noise`` type; the conservative non-overlapping count for
+    modified and Hadamard), and the χ² confidence interval ``dev_lo``, ``dev_hi`` at
+    ``confidence``.
+    """
+    tau0 = positive(tau0, "tau0")
+    kind = choice(kind, KINDS, "kind")
+    data_type = choice(data_type, DATA_TYPES, "data_type")
+    noise = choice(noise, NOISE_TYPES, "noise")
+    x = _series(data, "data")
+    set_name, ms = _m_list(m, taus, tau0)
+    mm, tau, var, n = _core.allan_var(x, tau0, data_type, kind, set_name, ms)
+    n_phase = x.size + 1 if data_type == "rate" else x.size
+    return _table(mm, tau, var, n, kind, n_phase, noise, confidence)
+
+
+class AllanStream:
+    """Streaming Allan, modified Allan and Hadamard variance at fixed averaging factors,
+    for records that do not fit in memory (memory: 3·max(m)+1 samples).
+
+    >>> s = AllanStream([1, 2, 4], tau0=1.0)
+    >>> for chunk in chunks: s.update(chunk)
+    >>> s.result("allan")
+    """
+
+    def __init__(self, m, tau0: float, data_type: str = "rate", noise: str = "white_fm", confidence: float = 0.683):
+        self.tau0 = positive(tau0, "tau0")
+        self.data_type = choice(data_type, DATA_TYPES, "data_type")
+        self.noise = choice(noise, NOISE_TYPES, "noise")
+        self.confidence = confidence
+        _, ms = _m_list(m, None, self.tau0)
+        if ms is None:
+            raise ValueError("m: give explicit averaging factors for a stream (the record length is unknown)")
+        self._s = _core.AllanStream(ms, self.tau0, self.data_type)
+        self.n_samples = 0
+
+    def update(self, chunk) -> None:
+        """Add the next samples (same units as construction)."""
+        c = _series(chunk, "chunk")
+        self._s.update(c)
+        self.n_samples += c.size
+
+    def result(self, kind: str = "allan") -> pd.DataFrame:
+        """The table of :func:`allan_variance` for the samples seen so far."""
+        kind = choice(kind, KINDS, "kind")
+        mm, tau, var, n = self._s.result(kind)
+        n_phase = self.n_samples + 1 if self.data_type == "rate" else self.n_samples
+        return _table(mm, tau, var, n, kind, n_phase, self.noise, self.confidence)
+
+
+@dataclass
+class AllanFit:
+    """Five-term fit σ²(τ) = Σ_{k=−2}^{2} A_k τ^k (seed 002 Eq. 19, IEEE Std 952).
+
+    With rate unit U and τ in s: ``coeffs`` A₋₂…A₂ in U²·s^k; ``quantization`` Q_q =
+    √(A₋₂/3) (U·s); ``arw`` N = √A₋₁ (U·√s), the paper's SS (Eq. 20);
+    ``bias_instability`` B = √(πA₀/(2 ln 2)) (U), the paper's LS (Eq. 21); ``rrw`` K =
+    √(3A₁) (U/√s); ``ramp`` R = √(2A₂) (U/s)."""
+
+    coeffs: np.ndarray
+    quantization: float
+    arw: float
+    bias_instability: float
+    rrw: float
+    ramp: float
+    points: int
+    tau_min: float
+    tau_max: float
+    table: pd.DataFrame = field(repr=False)
+
+    def curve(self, tau) -> np.ndarray:
+        """Fitted Allan variance at ``tau`` (s)."""
+        t = np.asarray(tau, dtype=float)
+        return sum(self.coeffs[k] * t ** (k - 2) for k in range(5))
+
+    def arw_in(self, rate_unit: float, arw_unit: float) -> float:
+        """ARW converted: ``rate_unit`` is the SI factor of the data's unit (e.g.
+        ``units.DEG_PER_HOUR``), ``arw_unit`` the SI factor of the wanted unit (e.g.
+        ``units.DEG_PER_SQRT_HOUR``, or 1.0 for rad/√s)."""
+        return self.arw * rate_unit / arw_unit
+
+
+def fit_allan_table(table: pd.DataFrame, n_samples: int, terms=TERMS, tau_min: float | None = None, tau_max: float | None = None) -> AllanFit:
+    """Five-term fit to an :func:`allan_variance` table (overlapping Allan, spec D15):
+    weighted NNLS with weights 1/σ_j², σ_j = AVAR_j/√max(1, ⌊N/m_j⌋ − 1); only the
+    named ``terms`` are free, only points with tau_min ≤ τ ≤ tau_max (s) and positive
+    variance are used."""
+    bad = [t for t in terms if t not in TERMS]
+    if bad:
+        raise ValueError(f"terms: unknown term {bad[0]!r}; choose from {TERMS}")
+    mask = [t in terms for t in TERMS]
+    lo = 0.0 if tau_min is None else float(tau_min)
+    hi = np.inf if tau_max is None else float(tau_max)
+    d = _core.allan_fit([int(v) for v in table["m"]], np.ascontiguousarray(table["tau_s"], dtype=float), np.ascontiguousarray(table["var"], dtype=float), int(n_samples), mask, lo, hi)
+    return AllanFit(np.asarray(d["coeffs"]), d["quantization"], d["arw"], d["bias_instability"], d["rrw"], d["ramp"], d["points"], lo, hi, table)
+
+
+def fit_allan(omega, tau0: float, terms=TERMS, tau_min: float | None = None, tau_max: float | None = None, m="octave") -> AllanFit:
+    """Overlapping Allan variance of the rate series ``omega`` at ``m`` (default octave τ)
+    and its five-term fit (:func:`fit_allan_table`)."""
+    x = _series(omega, "omega")
+    return fit_allan_table(allan_variance(x, tau0, m=m), x.size, terms, tau_min, tau_max)
+
+
+def short_term_sensitivity(omega, tau0: float, **fit_kw) -> float:
+    """SS = √A₋₁ (seed 002 Eq. 20) in U·√s; divide by 60 for °/√h when U = °/h and τ in s
+    (or use :meth:`AllanFit.arw_in`)."""
+    return fit_allan(omega, tau0, **fit_kw).arw
+
+
+def long_term_stability(omega, tau0: float, **fit_kw) -> float:
+    """LS = √(π A₀ / (2 ln 2)) (seed 002 Eq. 21) in the rate unit."""
+    return fit_allan(omega, tau0, **fit_kw).bias_instability
+
+
+def ss_deg_per_sqrt_hour(fit: AllanFit) -> float:
+    """SS of a fit to a rate in °/h with τ in s, in °/√h (spec D16: √A₋₁/60)."""
+    return fit.arw_in(units.DEG_PER_HOUR, units.DEG_PER_SQRT_HOUR)
+
+
+def bias(omega) -> float:
+    """Bias: the mean of the series (spec E17), in the rate unit."""
+    return float(np.mean(_series(omega, "omega")))
+
+
+def bias_stability(omega, window: int = 1) -> float:
+    """Bias stability (spec E17, D17): standard deviation (ddof = 1) of the ⌊N/w⌋
+    non-overlapping means of ``window`` samples (incomplete tail dropped), in the rate
+    unit. Report ``window`` with the value."""
+    if int(window) != window or window < 1:
+        raise ValueError(f"window: must be an integer ≥ 1, got {window}")
+    w = int(window)
+    x = _series(omega, "omega", min_len=2 * w)
+    k = x.size // w
+    return float(np.std(x[: k * w].reshape(k, w).mean(axis=1), ddof=1))
+
+
+def improvement_ratio(before, after, absolute: bool = False):
+    """Improvement ratio in percent (seed 002 Eq. 18): (M_raw − M_filt)/M_raw·100, signed
+    by default (spec D11: negative means the filter made the metric worse);
+    ``absolute=True`` gives the paper's |M_raw − M_filt|/M_raw·100."""
+    b = np.asarray(before, dtype=float)
+    a = np.asarray(after, dtype=float)
+    if np.any(b == 0):
+        raise ValueError("before: metric is zero, the ratio is undefined")
+    r = (b - a) / b * 100.0
+    return np.abs(r) if absolute else r

@@ -1,0 +1,195 @@
+"""ARMA identification on statsmodels (spec E2–E6, E19, D2–D3): differencing and its
+inverse, ADF and KPSS with a plain verdict, ACF/PACF with bands, the AIC/BIC order grid,
+exact-ML fit and residual diagnostics. Nothing here re-implements statsmodels."""
+
+from __future__ import annotations
+
+import warnings
+from dataclasses import dataclass
+
+import numpy as np
+import pandas as pd
+
+from .._validate import choice, vector
+
+
+def _series(x, name: str, min_len: int) -> np.ndarray:
+    a = vector(x, None, name)
+    if a.size < min_len:
+        raise ValueError(f"{name}: series of {a.size} samples is too short; at least {min_len} are needed")
+    if np.all(a == a[0]):
+        raise ValueError(f"{name}: constant series (every value is {a[0]}); nothing to model")
+    return a
+
+
+def difference(omega, d: int = 1) -> np.ndarray:
+    """d-th difference (spec E2, D1): d_k = ω_k − ω_{k−1}, length N − d."""
+    if int(d) != d or d < 0:
+        raise ValueError(f"d: must be an integer ≥ 0, got {d}")
+    x = vector(omega, None, "omega")
+    if x.size <= d:
+        raise ValueError(f"omega: series of {x.size} samples is too short to difference {d} times")
+    return np.diff(x, n=int(d))
+
+
+def undifference(diffs, initial) -> np.ndarray:
+    """Inverse of :func:`difference` for d = 1: ω = [ω₁, ω₁ + cumsum(d)]."""
+    dd = vector(diffs, None, "diffs")
+    return np.concatenate([[float(initial)], float(initial) + np.cumsum(dd)])
+
+
+@dataclass
+class Stationarity:
+    """ADF (H₀: unit root) and KPSS (H₀: level-stationary) results. ``passed`` when ADF
+    rejects its null (p < alpha) and KPSS does not reject its null (p > alpha) (spec E3).
+    KPSS p-values are clipped by statsmodels to [0.01, 0.10]."""
+
+    adf_stat: float
+    adf_p: float
+    kpss_stat: float
+    kpss_p: float
+    alpha: float
+
+    @property
+    def adf_rejects_unit_root(self) -> bool:
+        return self.adf_p < self.alpha
+
+    @property
+    def kpss_stationary(self) -> bool:
+        return self.kpss_p > self.alpha
+
+    @property
+    def passed(self) -> bool:
+        return self.adf_rejects_unit_root and self.kpss_stationary
+
+    @property
+    def verdict(self) -> str:
+        adf = f"ADF {'rejects' if self.adf_rejects_unit_root else 'does not reject'} a unit root (stat {self.adf_stat:.3f}, p = {self.adf_p:.3g})"
+        kp = f"KPSS {'does not reject' if self.kpss_stationary else 'rejects'} stationarity (stat {self.kpss_stat:.3f}, p {'≥' if self.kpss_p >= 0.1 else '≤' if self.kpss_p <= 0.01 else '='} {self.kpss_p:.3g})"
+        return f"{'stationary' if self.passed else 'NOT shown stationary'}: {adf}; {kp}"
+
+
+def stationarity(z, regression: str = "c", alpha: float = 0.05) -> Stationarity:
+    """ADF (``adfuller(regression, autolag='AIC')``) and KPSS (``kpss(regression,
+    nlags='auto')``) on the series z (spec D2). ``regression``: "c" (level) or "ct"
+    (trend); Matlab's defaults differ, hence exposed."""
+    from statsmodels.tsa.stattools import adfuller, kpss
+    from statsmodels.tools.sm_exceptions import InterpolationWarning
+
+    regression = choice(regression, ("c", "ct"), "regression")
+    x = _series(z, "z", 20)
+    with warnings.catch_warnings():
+        # KPSS p-values outside its table are clipped (documented above); newer
+        # statsmodels announce a result-object return type (FutureWarning).
+        warnings.simplefilter("ignore", InterpolationWarning)
+        warnings.simplefilter("ignore", FutureWarning)
+        adf = adfuller(x, regression=regression, autolag="AIC")
+        k = kpss(x, regression=regression, nlags="auto")
+    return Stationarity(float(adf[0]), float(adf[1]), float(k[0]), float(k[1]), alpha)
+
+
+def acf_pacf(z, nlags: int = 40) -> pd.DataFrame:
+    """ACF (``acf(fft=True)``) and PACF (``pacf(method='ywadjusted')``) to ``nlags`` with the
+    ±1.96/√N white-noise band. Columns: lag, acf, pacf, band."""
+    from statsmodels.tsa.stattools import acf, pacf
+
+    x = _series(z, "z", 2 * nlags + 2)
+    band = 1.96 / np.sqrt(x.size)
+    return pd.DataFrame({"lag": np.arange(nlags + 1), "acf": acf(x, nlags=nlags, fft=True), "pacf": pacf(x, nlags=nlags, method="ywadjusted"), "band": band})
+
+
+def _min_len(p: int, q: int) -> int:
+    # p + q + 1 parameters (σ² included); ask for ten observations per parameter.
+    return 10 * (p + q + 1)
+
+
+def _arima(d, p: int, q: int):
+    from statsmodels.tsa.arima.model import ARIMA
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        return ARIMA(d, order=(p, 0, q), trend="n").fit()
+
+
+def select_arma(d, max_p: int = 3, max_q: int = 3) -> pd.DataFrame:
+    """AIC and BIC of ARMA(p, q) fits to the (already differenced) series d for every
+    p ≤ max_p, q ≤ max_q (spec D3). AIC = 2n_p − 2 ln L, BIC = n_p ln n − 2 ln L, n_p
+    including σ². Columns: p, q, llf, aic, bic, sorted by BIC."""
+    x = _series(d, "d", _min_len(max_p, max_q))
+    rows = []
+    for p in range(max_p + 1):
+        for q in range(max_q + 1):
+            r = _arima(x, p, q)
+            rows.append({"p": p, "q": q, "llf": r.llf, "aic": r.aic, "bic": r.bic})
+    return pd.DataFrame(rows).sort_values("bic", ignore_index=True)
+
+
+@dataclass
+class ArmaFit:
+    """Exact-ML ARMA(p, q) fit of d (statsmodels). ``ar`` φ, ``ma`` β, ``sigma2`` σ_a²;
+    ``se`` standard errors by parameter name (``ar.L1``, ``ma.L1``, ``sigma2``);
+    ``residuals`` the one-step residuals; ``dw`` their Durbin–Watson statistic;
+    ``ljung_box`` the Ljung–Box table; ``aic``, ``bic``."""
+
+    order: tuple
+    ar: np.ndarray
+    ma: np.ndarray
+    sigma2: float
+    se: dict
+    residuals: np.ndarray
+    dw: float
+    ljung_box: pd.DataFrame
+    aic: float
+    bic: float
+
+
+def fit_arma(omega, order=(2, 1), differenced: bool = False, lags: int = 10) -> ArmaFit:
+    """Fit ARMA(p, q) = ``order`` by exact ML to the first difference of ``omega`` (i.e.
+    ARIMA(p,1,q) on ω), or to ``omega`` itself when ``differenced=True``.
+    ``ARIMA(d, order=(p,0,q), trend='n')`` (spec D2)."""
+    p, q = (int(v) for v in order)
+    if p < 0 or q < 0:
+        raise ValueError(f"order: p and q must be ≥ 0, got {order}")
+    need = _min_len(p, q) + (0 if differenced else 1)
+    w = _series(omega, "omega", need)
+    d = w if differenced else np.diff(w)
+    if np.all(d == d[0]):
+        raise ValueError("omega: the differenced series is constant (a pure ramp); nothing to model")
+    r = _arima(d, p, q)
+    names = list(r.model.param_names)
+    par = dict(zip(names, np.asarray(r.params)))
+    se = dict(zip(names, np.asarray(r.bse)))
+    res = np.asarray(r.resid)
+    return ArmaFit(
+        (p, q),
+        np.array([par[f"ar.L{i}"] for i in range(1, p + 1)]),
+        np.array([par[f"ma.L{i}"] for i in range(1, q + 1)]),
+        float(par["sigma2"]),
+        se,
+        res,
+        durbin_watson(res),
+        ljung_box(res, lags),
+        float(r.aic),
+        float(r.bic),
+    )
+
+
+def durbin_watson(e) -> float:
+    """DW = Σ(e_k − e_{k−1})² / Σe_k² (seed 002 Eq. 13); 2 for white residuals, 0 for a
+    constant series."""
+    from statsmodels.stats.stattools import durbin_watson as dw
+
+    x = vector(e, None, "e")
+    if x.size < 2:
+        raise ValueError(f"e: series of {x.size} samples is too short; at least 2 are needed")
+    return float(dw(x))
+
+
+def ljung_box(e, lags: int = 10) -> pd.DataFrame:
+    """Ljung–Box Q test of the residuals at lags 1…``lags`` (columns lb_stat, lb_pvalue)."""
+    from statsmodels.stats.diagnostic import acorr_ljungbox
+
+    x = vector(e, None, "e")
+    if x.size <= lags + 1:
+        raise ValueError(f"e: series of {x.size} samples is too short for {lags} lags")
+    return acorr_ljungbox(x, lags=lags)

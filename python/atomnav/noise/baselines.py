@@ -1,0 +1,48 @@
+"""Non-model baselines of seed 002 §5.2 with the spec's settings (D13, D14)."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .._validate import choice, positive, vector
+
+
+def butterworth_lowpass(omega, tau0: float, fc: float = 0.002, order: int = 2, zero_phase: bool = True) -> np.ndarray:
+    """Butterworth low-pass at cutoff ``fc`` (Hz) of a series sampled every ``tau0`` s:
+    ``butter(order, fc, fs=1/tau0, output='sos')`` with ``sosfiltfilt`` (zero phase, the
+    default: |H|⁴, no lag) or causal ``sosfilt`` started at the first sample (spec D13)."""
+    from scipy.signal import butter, sosfilt, sosfilt_zi, sosfiltfilt
+
+    x = vector(omega, None, "omega")
+    fs = 1.0 / positive(tau0, "tau0")
+    fc = positive(fc, "fc")
+    if fc >= fs / 2:
+        raise ValueError(f"fc: cutoff {fc} Hz must be below the Nyquist frequency {fs / 2} Hz")
+    sos = butter(int(order), fc, fs=fs, output="sos")
+    if zero_phase:
+        need = 3 * (2 * sos.shape[0] + 1)
+        if x.size <= need:
+            raise ValueError(f"omega: series of {x.size} samples is too short for zero-phase filtering (needs > {need})")
+        return sosfiltfilt(sos, x)
+    y, _ = sosfilt(sos, x, zi=sosfilt_zi(sos) * x[0])
+    return y
+
+
+def wavelet_denoise(omega, wavelet: str = "db4", level: int = 5, threshold: str = "universal", mode: str = "soft") -> np.ndarray:
+    """Wavelet-threshold denoising (VisuShrink, spec E13/D14): ``wavedec(ω, wavelet,
+    level, mode='symmetric')``; σ̂ = median|cD₁|/0.6745; λ = σ̂√(2 ln N); ``mode``
+    ("soft" or "hard") threshold on every detail level, approximation kept; inverse
+    transform truncated to N."""
+    import pywt
+
+    x = vector(omega, None, "omega")
+    choice(threshold, ("universal",), "threshold")
+    choice(mode, ("soft", "hard"), "mode")
+    max_level = pywt.dwt_max_level(x.size, pywt.Wavelet(wavelet).dec_len)
+    if level > max_level:
+        raise ValueError(f"omega: series of {x.size} samples is too short for a {level}-level {wavelet} decomposition (max {max_level})")
+    coeffs = pywt.wavedec(x, wavelet, level=level, mode="symmetric")
+    sigma = np.median(np.abs(coeffs[-1])) / 0.6745
+    lam = sigma * np.sqrt(2.0 * np.log(x.size))
+    out = [coeffs[0]] + [pywt.threshold(c, lam, mode=mode) for c in coeffs[1:]]
+    return pywt.waverec(out, wavelet, mode="symmetric")[: x.size]

@@ -1,0 +1,623 @@
+//! Allan family: overlapping Allan, modified Allan and overlapping Hadamard variance of
+//! rate or phase (angle) data, batch and streaming; equivalent degrees of freedom; the
+//! five-term IEEE Std 952 fit (seed 002 Eqs. 19–21, spec E14–E16, D15).
+//!
+//! Everything works on phase x (the integral of the rate): rate data y become
+//! x₀ = 0, x_{i+1} = x_i + (y_i − ȳ) in units of rate·τ₀, so that all three statistics
+//! are O(N) per τ with no prefix-sum cancellation (NIST SP 1065 Eqs. 11, 15, 18):
+//!   AVAR(mτ₀)  = Σ_{i<Np−2m} (x_{i+2m} − 2x_{i+m} + x_i)² / (2 m² τ₀² (Np−2m)),
+//!   MVAR(mτ₀)  = Σ_{j<Np−3m+1} (Σ_{i=j}^{j+m−1} x_{i+2m} − 2x_{i+m} + x_i)² / (2 m⁴ τ₀² (Np−3m+1)),
+//!   HVAR(mτ₀)  = Σ_{i<Np−3m} (x_{i+3m} − 3x_{i+2m} + 3x_{i+m} − x_i)² / (6 m² τ₀² (Np−3m)),
+//! with Np phase points. τ₀ cancels for rate data (x in rate·τ₀ units).
+
+use crate::error::{check_finite, check_positive, invalid, Result};
+use crate::noise::nnls::nnls;
+use nalgebra::{DMatrix, DVector};
+
+/// Which variance of the Allan family.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Kind {
+    /// Overlapping Allan variance.
+    Allan,
+    /// Modified Allan variance.
+    Modified,
+    /// Overlapping Hadamard variance.
+    Hadamard,
+}
+
+impl Kind {
+    pub fn by_name(name: &str) -> Result<Kind> {
+        match name {
+            "allan" => Ok(Kind::Allan),
+            "modified" => Ok(Kind::Modified),
+            "hadamard" => Ok(Kind::Hadamard),
+            _ => Err(invalid("kind", format!("unknown {name:?}; choose allan, modified or hadamard"))),
+        }
+    }
+
+    /// Number of terms in the sum at averaging factor m with `np` phase points.
+    pub fn terms(self, np: usize, m: usize) -> usize {
+        match self {
+            Kind::Allan => np.saturating_sub(2 * m),
+            Kind::Modified => (np + 1).saturating_sub(3 * m),
+            Kind::Hadamard => np.saturating_sub(3 * m),
+        }
+    }
+}
+
+/// Whether the input series is a rate (frequency) or its integral (phase, angle).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum DataType {
+    Rate,
+    Phase,
+}
+
+impl DataType {
+    pub fn by_name(name: &str) -> Result<DataType> {
+        match name {
+            "rate" => Ok(DataType::Rate),
+            "phase" => Ok(DataType::Phase),
+            _ => Err(invalid("data_type", format!("unknown {name:?}; choose rate or phase"))),
+        }
+    }
+}
+
+/// Averaging factors m (τ = mτ₀).
+#[derive(Debug, Clone, PartialEq)]
+pub enum TauSet {
+    /// 1, 2, 4, 8, …
+    Octave,
+    /// 1, 2, 4, 10, 20, 40, … (as Stable32 and allantools "decade").
+    Decade,
+    /// Every m.
+    All,
+    /// User-given factors; each must leave at least two terms.
+    List(Vec<usize>),
+}
+
+/// One statistic at each averaging factor.
+#[derive(Debug, Clone, PartialEq)]
+pub struct AllanResult {
+    pub m: Vec<usize>,
+    /// τ = mτ₀ (s).
+    pub tau: Vec<f64>,
+    /// Variance in (rate unit)².
+    pub var: Vec<f64>,
+    /// Number of terms in each sum.
+    pub n: Vec<usize>,
+}
+
+/// Minimum number of terms for a variance to be reported (as allantools).
+pub const MIN_TERMS: usize = 2;
+
+/// Resolve a τ set into the averaging factors that leave at least `MIN_TERMS` terms.
+/// A user list with a factor that is too large is an error naming its index.
+pub fn resolve_m(set: &TauSet, kind: Kind, np: usize) -> Result<Vec<usize>> {
+    let ok = |m: usize| m >= 1 && kind.terms(np, m) >= MIN_TERMS;
+    let gen = |f: &dyn Fn(usize) -> usize| -> Vec<usize> { (0..).map(f).take_while(|&m| ok(m)).collect() };
+    Ok(match set {
+        TauSet::Octave => gen(&|k| 1usize << k),
+        TauSet::All => gen(&|k| k + 1),
+        TauSet::Decade => gen(&|k| [1, 2, 4][k % 3] * 10usize.pow((k / 3) as u32)),
+        TauSet::List(ms) => {
+            for (i, &m) in ms.iter().enumerate() {
+                if m == 0 {
+                    return Err(invalid("m", format!("averaging factor 0 at index {i}; τ must be ≥ τ₀")));
+                }
+                if !ok(m) {
+                    return Err(invalid(
+                        "m",
+                        format!(
+                            "averaging factor {m} at index {i} leaves {} terms (< {MIN_TERMS}) in a record of {np} phase points: τ is too large for the record (larger than about half the record for the Allan variance, a third for modified/Hadamard)",
+                            kind.terms(np, m)
+                        ),
+                    ));
+                }
+            }
+            let mut v = ms.clone();
+            v.sort_unstable();
+            v.dedup();
+            v
+        }
+    })
+}
+
+/// Fixed number of parts that long loops are split into: results are combined in part
+/// order, so they do not depend on how many threads the machine has.
+const PARTS: usize = 8;
+
+/// `f(p)` for p in 0..PARTS, on up to PARTS threads when `work` (element operations)
+/// is large enough to pay for them; results in part order.
+fn par_parts<T: Send>(work: usize, f: impl Fn(usize) -> T + Sync) -> Vec<T> {
+    let threads = if work < 1 << 22 { 1 } else { std::thread::available_parallelism().map_or(1, |n| n.get()).min(PARTS) };
+    if threads == 1 {
+        return (0..PARTS).map(f).collect();
+    }
+    let f = &f;
+    let mut out: Vec<Option<T>> = (0..PARTS).map(|_| None).collect();
+    std::thread::scope(|s| {
+        let handles: Vec<_> = (0..threads).map(|t| s.spawn(move || (t..PARTS).step_by(threads).map(|p| (p, f(p))).collect::<Vec<_>>())).collect();
+        for h in handles {
+            for (p, v) in h.join().expect("worker thread panicked") {
+                out[p] = Some(v);
+            }
+        }
+    });
+    out.into_iter().map(|v| v.expect("every part computed")).collect()
+}
+
+/// Σ f(v) with eight independent accumulators (vectorisable).
+fn lane_sum(v: &[f64], f: impl Fn(f64) -> f64) -> f64 {
+    let mut acc = [0.0f64; 8];
+    let mut chunks = v.chunks_exact(8);
+    for c in &mut chunks {
+        for l in 0..8 {
+            acc[l] += f(c[l]);
+        }
+    }
+    chunks.remainder().iter().map(|&x| f(x)).sum::<f64>() + acc.iter().sum::<f64>()
+}
+
+/// Phase points from rate data: x₀ = 0, x_{i+1} = x_i + (y_i − ȳ) (units rate·τ₀).
+/// Removing the mean does not change any of the three variances and avoids cancellation.
+/// Two passes over PARTS contiguous parts: part sums, then each part's running sum.
+fn rate_to_phase(y: &[f64]) -> Vec<f64> {
+    let n = y.len();
+    let len = n.div_ceil(PARTS);
+    let part = |p: usize| &y[(p * len).min(n)..((p + 1) * len).min(n)];
+    let sums = par_parts(n, |p| lane_sum(part(p), |v| v));
+    let mean = sums.iter().sum::<f64>() / n as f64;
+    let mut x = vec![0.0; n + 1];
+    let mut start = 0.0;
+    let mut starts = Vec::with_capacity(PARTS);
+    for (p, s) in sums.iter().enumerate() {
+        starts.push(start);
+        start += s - part(p).len() as f64 * mean;
+    }
+    let mut outs: Vec<&mut [f64]> = x[1..].chunks_mut(len.max(1)).collect();
+    outs.resize_with(PARTS, || &mut []);
+    let outs: Vec<std::sync::Mutex<&mut [f64]>> = outs.into_iter().map(std::sync::Mutex::new).collect();
+    par_parts(n, |p| {
+        let mut out = outs[p].lock().expect("one part per worker");
+        let mut acc = starts[p];
+        for (o, v) in out.iter_mut().zip(part(p)) {
+            acc += v - mean;
+            *o = acc;
+        }
+    });
+    x
+}
+
+/// Σ_i (Σ_k c_k s_k[i])² over the common length of the K slices, with eight
+/// independent accumulators over fixed-size blocks so the loop vectorises.
+#[inline(always)]
+#[allow(clippy::needless_range_loop)] // index i runs across the K slices
+fn sum_sq_impl<const K: usize>(s: [&[f64]; K], c: [f64; K]) -> f64 {
+    const L: usize = 8;
+    let n = s[0].len();
+    let mut acc = [0.0f64; L];
+    let blocks = n / L;
+    for blk in 0..blocks {
+        let b: [&[f64; L]; K] = std::array::from_fn(|k| s[k][blk * L..blk * L + L].try_into().expect("block of L"));
+        for l in 0..L {
+            let mut v = 0.0;
+            for k in 0..K {
+                v += c[k] * b[k][l];
+            }
+            acc[l] += v * v;
+        }
+    }
+    for i in blocks * L..n {
+        let v: f64 = (0..K).map(|k| c[k] * s[k][i]).sum();
+        acc[0] += v * v;
+    }
+    acc.iter().sum()
+}
+
+/// The same loop compiled for AVX2 (four f64 lanes), chosen at run time.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+unsafe fn sum_sq_avx2<const K: usize>(s: [&[f64]; K], c: [f64; K]) -> f64 {
+    sum_sq_impl(s, c)
+}
+
+fn sum_sq<const K: usize>(s: [&[f64]; K], c: [f64; K]) -> f64 {
+    #[cfg(target_arch = "x86_64")]
+    if std::arch::is_x86_feature_detected!("avx2") {
+        // SAFETY: the CPU supports AVX2 (checked just above).
+        return unsafe { sum_sq_avx2(s, c) };
+    }
+    sum_sq_impl(s, c)
+}
+
+/// Σ_i (Σ_k c_k x_{i+km})² for every m in `ms` (ascending), i < Np − (K−1)m: the Allan
+/// (K = 3) and Hadamard (K = 4) sums. The index range is cut into blocks of `BLOCK`
+/// terms and each block is visited once for all m, so the windows x_{i+km} of
+/// neighbouring octave factors (2m_k = m_{k+1}) are read from cache rather than memory.
+/// The range is split into `PARTS` fixed parts (see [`par_parts`]).
+fn difference_sums<const K: usize>(x: &[f64], ms: &[usize], c: [f64; K]) -> Vec<f64> {
+    const BLOCK: usize = 2048;
+    let terms = |m: usize| x.len() - (K - 1) * m;
+    let total = terms(ms[0]);
+    let part_len = total.div_ceil(PARTS).div_ceil(BLOCK) * BLOCK;
+    let parts = par_parts(total * ms.len(), |p| {
+        let mut sums = vec![0.0; ms.len()];
+        let (start, stop) = ((p * part_len).min(total), ((p + 1) * part_len).min(total));
+        let mut i0 = start;
+        while i0 < stop {
+            for (j, &m) in ms.iter().enumerate() {
+                let end = (i0 + BLOCK).min(stop).min(terms(m));
+                if end > i0 {
+                    sums[j] += sum_sq(std::array::from_fn(|k| &x[i0 + k * m..end + k * m]), c);
+                }
+            }
+            i0 += BLOCK;
+        }
+        sums
+    });
+    (0..ms.len()).map(|j| parts.iter().map(|p| p[j]).sum()).collect()
+}
+
+/// Σ_j v_j², v_j = Σ_{i=j}^{j+m−1} (x_{i+2m} − 2x_{i+m} + x_i), updated by
+/// v_{j+1} = v_j + x_{j+3m} − 3x_{j+2m} + 3x_{j+m} − x_j (NIST SP 1065 Eq. 15).
+fn modified_sum(x: &[f64], m: usize) -> f64 {
+    let mut v: f64 = (0..m).map(|i| x[i + 2 * m] - 2.0 * x[i + m] + x[i]).sum();
+    let mut s = v * v;
+    for j in 0..x.len() + 1 - 3 * m - 1 {
+        v += x[j + 3 * m] - 3.0 * x[j + 2 * m] + 3.0 * x[j + m] - x[j];
+        s += v * v;
+    }
+    s
+}
+
+/// Divisor that turns a sum into the variance: 2m²·n (Allan), 2m⁴·n (modified), 6m²·n (Hadamard).
+fn divisor(kind: Kind, m: usize, n: usize) -> f64 {
+    let (m, n) = (m as f64, n as f64);
+    match kind {
+        Kind::Allan => 2.0 * m * m * n,
+        Kind::Modified => 2.0 * m.powi(4) * n,
+        Kind::Hadamard => 6.0 * m * m * n,
+    }
+}
+
+fn check_series(data: &[f64], data_type: DataType, tau0: f64) -> Result<()> {
+    check_positive("tau0", tau0)?;
+    // v·0 is NaN exactly for NaN/±inf: one vectorised pass, the indexed search only on failure.
+    if lane_sum(data, |v| v * 0.0).is_nan() {
+        check_finite("data", data, 1)?;
+    }
+    let min = if data_type == DataType::Rate { 3 } else { 4 };
+    if data.len() < min {
+        return Err(invalid("data", format!("series of {} samples is too short; at least {min} are needed for one Allan point", data.len())));
+    }
+    // A constant rate (or a phase ramp) has identically zero variance at every τ.
+    let constant = match data_type {
+        DataType::Rate => data.iter().all(|&v| v == data[0]),
+        DataType::Phase => data.windows(3).all(|w| w[2] - 2.0 * w[1] + w[0] == 0.0),
+    };
+    if constant {
+        let what = if data_type == DataType::Rate { "constant series" } else { "phase is a straight line (constant rate)" };
+        return Err(invalid("data", format!("{what}: every Allan-family variance is zero")));
+    }
+    Ok(())
+}
+
+/// Batch Allan-family variance of rate data (any unit) or phase data (angle; the
+/// variance is then in angle/s²) sampled every `tau0` seconds.
+pub fn variance(data: &[f64], tau0: f64, data_type: DataType, kind: Kind, set: &TauSet) -> Result<AllanResult> {
+    check_series(data, data_type, tau0)?;
+    let (x, scale) = match data_type {
+        DataType::Rate => (std::borrow::Cow::Owned(rate_to_phase(data)), 1.0),
+        DataType::Phase => (std::borrow::Cow::Borrowed(data), 1.0 / (tau0 * tau0)),
+    };
+    let ms = resolve_m(set, kind, x.len())?;
+    let sums = match kind {
+        Kind::Allan => difference_sums(&x, &ms, [1.0, -2.0, 1.0]),
+        Kind::Hadamard => difference_sums(&x, &ms, [-1.0, 3.0, -3.0, 1.0]),
+        Kind::Modified => ms.iter().map(|&m| modified_sum(&x, m)).collect(),
+    };
+    let n: Vec<usize> = ms.iter().map(|&m| kind.terms(x.len(), m)).collect();
+    Ok(AllanResult {
+        tau: ms.iter().map(|&m| m as f64 * tau0).collect(),
+        var: (0..ms.len()).map(|j| sums[j] * scale / divisor(kind, ms[j], n[j])).collect(),
+        m: ms,
+        n,
+    })
+}
+
+/// Streaming accumulation of all three variances at fixed averaging factors, for
+/// records that do not fit in memory. Memory is a ring of 3·max(m)+1 phase points.
+/// Rate data are integrated about their first sample instead of their mean (unknown in
+/// advance); the variances do not depend on that offset.
+#[derive(Debug, Clone)]
+pub struct AllanStream {
+    ms: Vec<usize>,
+    tau0: f64,
+    data_type: DataType,
+    ring: Vec<f64>,
+    mask: usize,
+    /// Phase points seen so far.
+    np: usize,
+    /// Running phase (rate data) and the rate offset.
+    phase: f64,
+    offset: Option<f64>,
+    sum_a: Vec<f64>,
+    sum_m: Vec<f64>,
+    sum_h: Vec<f64>,
+    v: Vec<f64>,
+}
+
+impl AllanStream {
+    pub fn new(ms: &[usize], tau0: f64, data_type: DataType) -> Result<AllanStream> {
+        check_positive("tau0", tau0)?;
+        if ms.is_empty() {
+            return Err(invalid("m", "no averaging factors given"));
+        }
+        if let Some(i) = ms.iter().position(|&m| m == 0) {
+            return Err(invalid("m", format!("averaging factor 0 at index {i}")));
+        }
+        let mut ms = ms.to_vec();
+        ms.sort_unstable();
+        ms.dedup();
+        let cap = (3 * ms[ms.len() - 1] + 1).next_power_of_two();
+        let k = ms.len();
+        Ok(AllanStream {
+            ms,
+            tau0,
+            data_type,
+            ring: vec![0.0; cap],
+            mask: cap - 1,
+            np: 0,
+            phase: 0.0,
+            offset: None,
+            sum_a: vec![0.0; k],
+            sum_m: vec![0.0; k],
+            sum_h: vec![0.0; k],
+            v: vec![0.0; k],
+        })
+    }
+
+    fn push_phase(&mut self, x: f64) {
+        let n = self.np;
+        self.ring[n & self.mask] = x;
+        let r = |i: usize| self.ring[i & self.mask];
+        for (j, &m) in self.ms.iter().enumerate() {
+            if n < 2 * m {
+                break;
+            }
+            let s2 = x - 2.0 * r(n - m) + r(n - 2 * m);
+            self.sum_a[j] += s2 * s2;
+            if n >= 3 * m {
+                let h = s2 - (r(n - m) - 2.0 * r(n - 2 * m) + r(n - 3 * m));
+                self.sum_h[j] += h * h;
+                self.v[j] += h;
+                self.sum_m[j] += self.v[j] * self.v[j];
+            } else {
+                self.v[j] += s2;
+                if n == 3 * m - 1 {
+                    self.sum_m[j] += self.v[j] * self.v[j];
+                }
+            }
+        }
+        self.np += 1;
+    }
+
+    /// Feed the next chunk of samples (rate or phase, as constructed).
+    pub fn update(&mut self, chunk: &[f64]) -> Result<()> {
+        check_finite("chunk", chunk, 1)?;
+        for &y in chunk {
+            match self.data_type {
+                DataType::Phase => self.push_phase(y),
+                DataType::Rate => {
+                    let off = *self.offset.get_or_insert(y);
+                    if self.np == 0 {
+                        self.push_phase(0.0);
+                    }
+                    self.phase += y - off;
+                    self.push_phase(self.phase);
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// The variances so far at the factors that already have at least `MIN_TERMS` terms.
+    pub fn result(&self, kind: Kind) -> AllanResult {
+        let scale = if self.data_type == DataType::Phase { 1.0 / (self.tau0 * self.tau0) } else { 1.0 };
+        let sums = match kind {
+            Kind::Allan => &self.sum_a,
+            Kind::Modified => &self.sum_m,
+            Kind::Hadamard => &self.sum_h,
+        };
+        let mut out = AllanResult { m: Vec::new(), tau: Vec::new(), var: Vec::new(), n: Vec::new() };
+        for (j, &m) in self.ms.iter().enumerate() {
+            let n = kind.terms(self.np, m);
+            if n >= MIN_TERMS {
+                out.m.push(m);
+                out.tau.push(m as f64 * self.tau0);
+                out.var.push(sums[j] * scale / divisor(kind, m, n));
+                out.n.push(n);
+            }
+        }
+        out
+    }
+}
+
+/// Power-law noise type for the equivalent degrees of freedom (α of S_y(f) ∝ f^α).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum NoiseType {
+    WhitePm,
+    FlickerPm,
+    WhiteFm,
+    FlickerFm,
+    RandomWalkFm,
+}
+
+impl NoiseType {
+    pub fn by_name(name: &str) -> Result<NoiseType> {
+        match name {
+            "white_pm" => Ok(NoiseType::WhitePm),
+            "flicker_pm" => Ok(NoiseType::FlickerPm),
+            "white_fm" => Ok(NoiseType::WhiteFm),
+            "flicker_fm" => Ok(NoiseType::FlickerFm),
+            "random_walk_fm" => Ok(NoiseType::RandomWalkFm),
+            _ => Err(invalid("noise", format!("unknown {name:?}; choose white_pm, flicker_pm, white_fm, flicker_fm or random_walk_fm"))),
+        }
+    }
+}
+
+/// Equivalent degrees of freedom of the overlapping Allan variance with `np` phase
+/// points at factor m, by Howe's approximations (NIST SP 1065 Table 12; Stable32).
+/// For white FM: (3(Np−1)/(2m) − 2(Np−2)/Np)·4m²/(4m²+5).
+pub fn edf_overlapping_allan(noise: NoiseType, np: usize, m: usize) -> f64 {
+    let (n, m) = (np as f64, m as f64);
+    let edf = match noise {
+        NoiseType::WhitePm => (n + 1.0) * (n - 2.0 * m) / (2.0 * (n - m)),
+        NoiseType::FlickerPm => (((n - 1.0) / (2.0 * m)).ln() * ((2.0 * m + 1.0) * (n - 1.0) / 4.0).ln()).sqrt().exp(),
+        NoiseType::WhiteFm => (3.0 * (n - 1.0) / (2.0 * m) - 2.0 * (n - 2.0) / n) * 4.0 * m * m / (4.0 * m * m + 5.0),
+        NoiseType::FlickerFm => {
+            if m == 1.0 {
+                2.0 * (n - 2.0) / (2.3 * n - 4.9)
+            } else {
+                5.0 * n * n / (4.0 * m * (n + 3.0 * m))
+            }
+        }
+        NoiseType::RandomWalkFm => (n - 2.0) / m * ((n - 1.0).powi(2) - 3.0 * m * (n - 1.0) + 4.0 * m * m) / (n - 3.0).powi(2),
+    };
+    edf.max(1.0)
+}
+
+/// Conservative EDF for the modified Allan and overlapping Hadamard variances: the
+/// number of non-overlapping terms, ⌊(Np−1)/m⌋ − d + 1 (d = 2 or 3 differences), at least 1.
+pub fn edf_non_overlapping(kind: Kind, np: usize, m: usize) -> f64 {
+    let d = if kind == Kind::Allan { 2 } else { 3 };
+    (((np - 1) / m) as f64 - d as f64 + 1.0).max(1.0)
+}
+
+/// Result of the five-term fit σ²(τ) = Σ_{k=−2}^{2} A_k τ^k (seed 002 Eq. 19).
+#[derive(Debug, Clone, PartialEq)]
+pub struct AllanFit {
+    /// A₋₂, A₋₁, A₀, A₁, A₂ in (rate)²·s^k.
+    pub coeffs: [f64; 5],
+    /// Quantisation Q_q = √(A₋₂/3) (rate·s).
+    pub quantization: f64,
+    /// Angle random walk N = √A₋₁ (rate·√s); also the paper's SS (Eq. 20).
+    pub arw: f64,
+    /// Bias instability B = √(π A₀ / (2 ln 2)) (rate); also the paper's LS (Eq. 21).
+    pub bias_instability: f64,
+    /// Rate random walk K = √(3 A₁) (rate/√s).
+    pub rrw: f64,
+    /// Rate ramp R = √(2 A₂) (rate/s).
+    pub ramp: f64,
+    /// Number of Allan points used.
+    pub points: usize,
+}
+
+/// Weighted non-negative least-squares fit of the five-term model to AVAR points (spec D15):
+/// weights 1/σ_j², σ_j = AVAR_j/√max(1, ⌊N/m_j⌋ − 1), columns normalised, Lawson–Hanson.
+/// `terms` selects which of A₋₂…A₂ are free (the others are 0); only points with
+/// `tau_min ≤ τ ≤ tau_max` and positive variance are used. `n_samples` is the record length.
+pub fn fit(res: &AllanResult, n_samples: usize, terms: [bool; 5], tau_min: f64, tau_max: f64) -> Result<AllanFit> {
+    let idx: Vec<usize> = (0..res.tau.len()).filter(|&j| res.tau[j] >= tau_min && res.tau[j] <= tau_max && res.var[j] > 0.0).collect();
+    let cols: Vec<i32> = (-2..=2).filter(|k| terms[(k + 2) as usize]).collect();
+    if cols.is_empty() {
+        return Err(invalid("terms", "no term selected"));
+    }
+    if idx.len() < cols.len() {
+        return Err(invalid(
+            "tau_min/tau_max",
+            format!("{} Allan points with positive variance in [{tau_min}, {tau_max}] s; the fit needs at least {}", idx.len(), cols.len()),
+        ));
+    }
+    let rows = idx.len();
+    let sigma = |j: usize| res.var[j] / (((n_samples / res.m[j]) as f64 - 1.0).max(1.0)).sqrt();
+    let mut a = DMatrix::from_fn(rows, cols.len(), |r, c| res.tau[idx[r]].powi(cols[c]) / sigma(idx[r]));
+    let b = DVector::from_fn(rows, |r, _| res.var[idx[r]] / sigma(idx[r]));
+    let norms: Vec<f64> = (0..cols.len()).map(|c| a.column(c).norm()).collect();
+    for (c, nrm) in norms.iter().enumerate() {
+        a.column_mut(c).unscale_mut(*nrm);
+    }
+    let z = nnls(&a, &b)?;
+    let mut coeffs = [0.0; 5];
+    for (c, &k) in cols.iter().enumerate() {
+        coeffs[(k + 2) as usize] = z[c] / norms[c];
+    }
+    Ok(AllanFit {
+        coeffs,
+        quantization: (coeffs[0] / 3.0).sqrt(),
+        arw: coeffs[1].sqrt(),
+        bias_instability: (coeffs[2] * std::f64::consts::PI / (2.0 * std::f64::consts::LN_2)).sqrt(),
+        rrw: (3.0 * coeffs[3]).sqrt(),
+        ramp: (2.0 * coeffs[4]).sqrt(),
+        points: rows,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn avar(y: &[f64], set: TauSet) -> AllanResult {
+        variance(y, 1.0, DataType::Rate, Kind::Allan, &set).unwrap()
+    }
+
+    #[test]
+    fn ramp_gives_m_squared_over_two() {
+        // spec §4a.7: ω_k = k, N = 32 → σ²(m) = m²/2.
+        let y: Vec<f64> = (0..32).map(|k| k as f64).collect();
+        let r = avar(&y, TauSet::Octave);
+        assert_eq!(r.m, vec![1, 2, 4, 8]);
+        for (m, v) in r.m.iter().zip(&r.var) {
+            assert!((v - (*m as f64).powi(2) / 2.0).abs() < 1e-12, "m={m} v={v}");
+        }
+    }
+
+    #[test]
+    fn alternating_sign() {
+        // spec §4a.7: ±1, N = 16 → 2, 0, 2/9, 0 at m = 1…4.
+        let y: Vec<f64> = (0..16).map(|k| if k % 2 == 0 { 1.0 } else { -1.0 }).collect();
+        let r = avar(&y, TauSet::List(vec![1, 2, 3, 4]));
+        for (v, e) in r.var.iter().zip([2.0, 0.0, 2.0 / 9.0, 0.0]) {
+            assert!((v - e).abs() < 1e-12);
+        }
+    }
+
+    #[test]
+    fn streaming_equals_batch_for_all_kinds() {
+        let y: Vec<f64> = (0..1000).map(|k| ((k * 7919) % 1013) as f64 * 0.01 + (k as f64 * 0.1).sin()).collect();
+        let ms = resolve_m(&TauSet::Octave, Kind::Hadamard, y.len() + 1).unwrap();
+        let mut s = AllanStream::new(&ms, 2.0, DataType::Rate).unwrap();
+        for c in y.chunks(77) {
+            s.update(c).unwrap();
+        }
+        for kind in [Kind::Allan, Kind::Modified, Kind::Hadamard] {
+            let b = variance(&y, 2.0, DataType::Rate, kind, &TauSet::List(ms.clone())).unwrap();
+            let st = s.result(kind);
+            assert_eq!(b.m, st.m);
+            for (u, v) in b.var.iter().zip(&st.var) {
+                assert!((u - v).abs() <= 1e-10 * u.abs(), "{kind:?}: {u} vs {v}");
+            }
+        }
+    }
+
+    #[test]
+    fn tau_too_large_is_rejected() {
+        let y: Vec<f64> = (0..100).map(|k| (k as f64).sin()).collect();
+        let e = variance(&y, 1.0, DataType::Rate, Kind::Allan, &TauSet::List(vec![1, 60])).unwrap_err();
+        assert!(e.to_string().contains("index 1"), "{e}");
+    }
+
+    #[test]
+    fn fit_recovers_exact_power_law() {
+        // A noiseless AVAR curve built from known coefficients is fitted back exactly.
+        let coeffs = [0.0, 2.0, 0.5, 1e-3, 0.0];
+        let m: Vec<usize> = (0..12).map(|k| 1 << k).collect();
+        let tau: Vec<f64> = m.iter().map(|&m| m as f64).collect();
+        let var = tau.iter().map(|t| (0..5).map(|k| coeffs[k] * t.powi(k as i32 - 2)).sum()).collect();
+        let r = AllanResult { m, tau, var, n: vec![10; 12] };
+        let f = fit(&r, 100_000, [true; 5], 0.0, f64::INFINITY).unwrap();
+        for k in 0..5 {
+            assert!((f.coeffs[k] - coeffs[k]).abs() < 1e-9 * (1.0 + coeffs[k]), "{k}: {:?}", f.coeffs);
+        }
+    }
+}

@@ -1,0 +1,499 @@
+//! ARIMA(p,d,q) state-space form and the scalar-measurement Kalman filters of seed 002:
+//! fixed R, the measurement-noise-adaptive R of Eq. 17 (both readings of y_k), and
+//! Sage–Husa (standard form, not from the paper; spec E11, D12). Batch and streaming.
+//!
+//! Sign convention (spec E4, statsmodels): d_k = Σφ_i d_{k−i} + a_k + Σβ_j a_{k−j},
+//! d = (1−L)^D ω. Measurement H = [1 0 … 0]: the filter observes ω_k directly.
+
+use crate::error::{check_finite, check_positive, invalid, NavError, Result};
+use nalgebra::{DMatrix, SMatrix, SVector};
+
+/// How the ARMA innovations enter the state (spec D5).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum NoiseForm {
+    /// Seed 002 Eq. 16: X = [ω_k … ω_{k−n+1}], B first row [1, β₁ … β_q, 0 …], Q = σ²I_n.
+    /// Treats a_{k−j} in W_k as fresh noise (doubles the process noise for β₁ ≈ −1).
+    Paper,
+    /// X = [ω_k … ω_{k−r+1}, a_k … a_{k−q+1}], G = e₀ + e_r, scalar Q = σ² (exact).
+    Exact,
+}
+
+impl NoiseForm {
+    pub fn by_name(name: &str) -> Result<NoiseForm> {
+        match name {
+            "paper" => Ok(NoiseForm::Paper),
+            "exact" => Ok(NoiseForm::Exact),
+            _ => Err(invalid("noise_form", format!("unknown {name:?}; choose paper or exact"))),
+        }
+    }
+}
+
+/// X_k = Φ X_{k−1} + B W_{k−1}, Y_k = H X_k + V_k (seed 002 Eq. 14).
+#[derive(Debug, Clone, PartialEq)]
+pub struct ArimaStateSpace {
+    /// Transition matrix Φ (n×n), companion form of the AR polynomial on ω.
+    pub phi: DMatrix<f64>,
+    /// Noise gain B (n×n for the paper form, n×1 for the exact form).
+    pub b: DMatrix<f64>,
+    /// Noise covariance Q (σ²I_n, or 1×1 σ²).
+    pub q: DMatrix<f64>,
+    /// Process noise covariance B Q Bᵀ (n×n).
+    pub qd: DMatrix<f64>,
+    /// Innovation variance σ_a².
+    pub sigma2: f64,
+}
+
+/// Coefficients c of ω_k = Σ c_i ω_{k−i} + …: (1 − Σφ_i Lⁱ)(1 − L)^d = 1 − Σ c_i Lⁱ.
+/// For (2,1): [1+φ₁, φ₂−φ₁, −φ₂] (seed 002 Eq. 12).
+pub fn integrated_ar(ar: &[f64], d: usize) -> Vec<f64> {
+    // Polynomial in L with constant term first.
+    let mut poly: Vec<f64> = std::iter::once(1.0).chain(ar.iter().map(|a| -a)).collect();
+    for _ in 0..d {
+        let mut next = vec![0.0; poly.len() + 1];
+        for (i, c) in poly.iter().enumerate() {
+            next[i] += c;
+            next[i + 1] -= c;
+        }
+        poly = next;
+    }
+    poly[1..].iter().map(|c| -c).collect()
+}
+
+impl ArimaStateSpace {
+    /// ARIMA(p,d,q) with AR coefficients `ar` (φ), MA coefficients `ma` (β) and
+    /// innovation variance `sigma2`, in the paper's or the exact noise form.
+    pub fn from_arma(ar: &[f64], ma: &[f64], sigma2: f64, d: usize, form: NoiseForm) -> Result<ArimaStateSpace> {
+        check_finite("ar", ar, 1)?;
+        check_finite("ma", ma, 1)?;
+        check_positive("sigma2", sigma2)?;
+        let c = integrated_ar(ar, d);
+        let (r, q) = (c.len(), ma.len());
+        let (n, cols) = match form {
+            NoiseForm::Paper => (r.max(q + 1), r.max(q + 1)),
+            NoiseForm::Exact => (r.max(1) + q, 1),
+        };
+        let mut phi = DMatrix::zeros(n, n);
+        for (i, ci) in c.iter().enumerate() {
+            phi[(0, i)] = *ci;
+        }
+        let mut b = DMatrix::zeros(n, cols);
+        let qm;
+        match form {
+            NoiseForm::Paper => {
+                for i in 1..n {
+                    phi[(i, i - 1)] = 1.0;
+                }
+                b[(0, 0)] = 1.0;
+                for (j, bj) in ma.iter().enumerate() {
+                    b[(0, j + 1)] = *bj;
+                }
+                qm = DMatrix::identity(n, n) * sigma2;
+            }
+            NoiseForm::Exact => {
+                let r1 = r.max(1);
+                for i in 1..r1 {
+                    phi[(i, i - 1)] = 1.0;
+                }
+                for (j, bj) in ma.iter().enumerate() {
+                    phi[(0, r1 + j)] = *bj;
+                }
+                for i in r1 + 1..n {
+                    phi[(i, i - 1)] = 1.0;
+                }
+                b[(0, 0)] = 1.0;
+                if q > 0 {
+                    b[(r1, 0)] = 1.0;
+                }
+                qm = DMatrix::from_element(1, 1, sigma2);
+            }
+        }
+        let qd = &b * &qm * b.transpose();
+        Ok(ArimaStateSpace { phi, b, q: qm, qd, sigma2 })
+    }
+
+    pub fn dim(&self) -> usize {
+        self.phi.nrows()
+    }
+}
+
+/// How R_k is chosen (spec E9–E11, D7, D12).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum RMode {
+    /// R_k ≡ R₀.
+    Fixed,
+    /// Eq. 17 with y = ω: running AVAR(τ₀) of the measurements, from k = 2.
+    Literal,
+    /// Eq. 17 with y = d (the differenced series, the paper's y elsewhere), from k = 3.
+    Differenced,
+    /// Sage–Husa with forgetting factor b; optional Q adaptation and strong-tracking fading.
+    SageHusa { b: f64, adapt_q: bool, fading: bool },
+}
+
+impl RMode {
+    pub fn by_name(name: &str, b: f64, adapt_q: bool, fading: bool) -> Result<RMode> {
+        match name {
+            "fixed" => Ok(RMode::Fixed),
+            "literal" => Ok(RMode::Literal),
+            "differenced" => Ok(RMode::Differenced),
+            "sage_husa" => {
+                if !(b > 0.0 && b < 1.0) {
+                    return Err(invalid("b", format!("forgetting factor must be in (0, 1), got {b}")));
+                }
+                Ok(RMode::SageHusa { b, adapt_q, fading })
+            }
+            _ => Err(invalid("adaptive", format!("unknown {name:?}; choose fixed, literal, differenced or sage_husa"))),
+        }
+    }
+}
+
+/// Running Eq. 17: R̂(k) = (1 − 1/c) R̂(k−1) + (y_k − y_{k−1})²/(2c), c = number of
+/// differences so far; equals Σ(y_i − y_{i−1})²/(2c).
+#[derive(Debug, Clone, Default)]
+pub struct RunningAllanR {
+    prev: Option<f64>,
+    count: usize,
+    r: f64,
+}
+
+impl RunningAllanR {
+    /// Feed y_k; the estimate once at least one difference exists.
+    pub fn update(&mut self, y: f64) -> Option<f64> {
+        let prev = self.prev.replace(y)?;
+        self.count += 1;
+        let c = self.count as f64;
+        let dy = y - prev;
+        // seed 002, Eq. 17 (recursive form)
+        self.r = (1.0 - 1.0 / c) * self.r + dy * dy / (2.0 * c);
+        Some(self.r)
+    }
+}
+
+/// Initial state (spec D6).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum X0 {
+    Zeros,
+    /// All ω-slots start at the first measurement (removes the start-up transient).
+    First,
+}
+
+/// Filter output; the R and gain histories only when requested.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct FilterOutput {
+    /// ω̂_k = H X̂_k.
+    pub xhat: Vec<f64>,
+    /// R_k used at each step.
+    pub r: Vec<f64>,
+    /// K_k, row-major N×n.
+    pub gain: Vec<f64>,
+}
+
+/// Largest state dimension the filter supports (ARMA orders p, q ≤ 3 need at most 7).
+pub const MAX_DIM: usize = 8;
+
+const FADING_RHO: f64 = 0.95;
+
+/// Measurement-variance bookkeeping shared by every state dimension.
+#[derive(Debug, Clone)]
+struct RState {
+    mode: RMode,
+    r: f64,
+    r_floor: f64,
+    k: usize,
+    allan: RunningAllanR,
+    last: Option<f64>,
+    /// Sage–Husa: b^k, and the fading-factor innovation power V_k.
+    bk: f64,
+    v: f64,
+}
+
+impl RState {
+    /// Eq. 17 readings: R_k from the running Allan variance including sample k.
+    fn eq17(&mut self, z: f64) {
+        let y = match self.mode {
+            RMode::Literal => Some(z),
+            RMode::Differenced => self.last.map(|prev| z - prev),
+            _ => None,
+        };
+        self.last = Some(z);
+        if let Some(r) = y.and_then(|y| self.allan.update(y)) {
+            self.r = r;
+        }
+    }
+
+    /// Sage–Husa weight d_k = (1−b)/(1−b^k).
+    fn sage_husa_weight(&self, b: f64) -> f64 {
+        (1.0 - b) / (1.0 - self.bk)
+    }
+}
+
+/// The filter at a fixed state dimension N (fixed-size algebra, no allocation per step).
+#[derive(Debug, Clone)]
+struct Core<const N: usize> {
+    /// Φ = e₀cᵀ + shifts: first row c, row i ≥ 1 copies row i−1 where `shift[i]`.
+    c: SVector<f64, N>,
+    shift: [bool; N],
+    qd: SMatrix<f64, N, N>,
+    x: SVector<f64, N>,
+    p: SMatrix<f64, N, N>,
+    gain: SVector<f64, N>,
+    first: bool,
+}
+
+impl<const N: usize> Core<N> {
+    fn new(model: &ArimaStateSpace, p0: f64, first: bool) -> Core<N> {
+        Core {
+            c: SVector::from_fn(|j, _| model.phi[(0, j)]),
+            shift: std::array::from_fn(|i| i > 0 && model.phi[(i, i - 1)] == 1.0),
+            qd: SMatrix::from_fn(|i, j| model.qd[(i, j)]),
+            x: SVector::zeros(),
+            p: SMatrix::identity() * p0,
+            gain: SVector::zeros(),
+            first,
+        }
+    }
+
+    /// Filter a chunk (the per-step loop is monomorphised for N).
+    fn run(&mut self, z: &[f64], rs: &mut RState, out: &mut FilterOutput, record: bool) -> Result<()> {
+        for &zk in z {
+            out.xhat.push(self.step(zk, rs)?);
+            if record {
+                out.r.push(rs.r);
+                out.gain.extend_from_slice(self.gain.as_slice());
+            }
+        }
+        Ok(())
+    }
+
+    /// One step of seed 002 Eq. 15 with R_k chosen by `rs`.
+    #[inline(always)]
+    fn step(&mut self, z: f64, rs: &mut RState) -> Result<f64> {
+        rs.k += 1;
+        if rs.k == 1 && self.first {
+            self.x.fill(z);
+        }
+        // Predict: X⁻ = Φ X̂, F = Φ P Φᵀ.
+        let xp = SVector::from_fn(|i, _| if i == 0 { self.c.dot(&self.x) } else if self.shift[i] { self.x[i - 1] } else { 0.0 });
+        // Φ P Φᵀ from the structure Φ = e₀cᵀ + shifts and symmetric P, with u = P c:
+        // (0,0) = cᵀu, (i,0) = (0,i) = u_{i−1}, (i,j) = P_{i−1,j−1} on shifted rows.
+        let u = self.p * self.c;
+        let sh = |i: usize| self.shift[i];
+        let fpf = SMatrix::<f64, N, N>::from_fn(|i, j| match (i, j) {
+            (0, 0) => self.c.dot(&u),
+            (0, j) => if sh(j) { u[j - 1] } else { 0.0 },
+            (i, 0) => if sh(i) { u[i - 1] } else { 0.0 },
+            (i, j) => if sh(i) && sh(j) { self.p[(i - 1, j - 1)] } else { 0.0 },
+        });
+        let eps = z - xp[0];
+        let r_prev = rs.r;
+        rs.eq17(z);
+        let mut lambda = 1.0;
+        if let RMode::SageHusa { b, fading, .. } = rs.mode {
+            if fading {
+                // Strong-tracking fading factor (spec E11).
+                rs.v = if rs.k == 1 { eps * eps } else { (FADING_RHO * rs.v + eps * eps) / (1.0 + FADING_RHO) };
+                if fpf[(0, 0)] > 0.0 {
+                    lambda = ((rs.v - self.qd[(0, 0)] - r_prev) / fpf[(0, 0)]).max(1.0);
+                }
+            }
+            let pm00 = lambda * fpf[(0, 0)] + self.qd[(0, 0)];
+            rs.bk *= b;
+            let dk = rs.sage_husa_weight(b);
+            // Sage–Husa: R̂_k = (1−d_k) R̂_{k−1} + d_k (ε² − H P⁻ Hᵀ); drop the subtraction if ≤ 0.
+            let r = (1.0 - dk) * r_prev + dk * (eps * eps - pm00);
+            rs.r = if r > 0.0 { r } else { (1.0 - dk) * r_prev + dk * eps * eps };
+        }
+        // spec D8: R floor.
+        rs.r = rs.r.max(rs.r_floor);
+        let pm = fpf * lambda + self.qd;
+        let s = pm[(0, 0)] + rs.r;
+        if !(s > 0.0 && s.is_finite()) {
+            return Err(NavError::Numerical(format!("innovation variance {s} at step {}", rs.k)));
+        }
+        self.gain = pm.column(0) / s;
+        self.x = xp + self.gain * eps;
+        // P = (I − K H) P⁻, symmetrised (spec D10).
+        let p = pm - self.gain * pm.row(0);
+        self.p = (p + p.transpose()) * 0.5;
+        if let RMode::SageHusa { b, adapt_q: true, .. } = rs.mode {
+            // Sage–Husa Q: Q_k = (1−d_k) Q_{k−1} + d_k (K ε² Kᵀ + P_k − Φ P_{k−1} Φᵀ), kept
+            // only if its diagonal stays non-negative (the standard form can lose
+            // positive semi-definiteness, e.g. right after P₀).
+            let dk = rs.sage_husa_weight(b);
+            let q = self.qd * (1.0 - dk) + (self.gain * self.gain.transpose() * (eps * eps) + self.p - fpf) * dk;
+            if q.diagonal().iter().all(|&d| d >= 0.0) {
+                self.qd = q;
+            }
+        }
+        if !self.x[0].is_finite() {
+            return Err(NavError::Numerical(format!("state diverged at step {}", rs.k)));
+        }
+        Ok(self.x[0])
+    }
+}
+
+/// The filter relies on Φ having the form built by [`ArimaStateSpace::from_arma`]: a
+/// dense first row and, below it, rows that are zero or copy the previous state.
+fn check_companion(phi: &DMatrix<f64>) -> Result<()> {
+    for i in 1..phi.nrows() {
+        for j in 0..phi.ncols() {
+            let v = phi[(i, j)];
+            if v != 0.0 && !(j + 1 == i && v == 1.0) {
+                return Err(invalid("model", format!("Φ row {i} is not a shift row (entry {v} at column {j})")));
+            }
+        }
+    }
+    Ok(())
+}
+
+macro_rules! cores {
+    ($($v:ident = $n:literal),*) => {
+        #[derive(Debug, Clone)]
+        #[allow(clippy::large_enum_variant)] // one per filter; boxing would add an indirection per step
+        enum AnyCore { $($v(Core<$n>)),* }
+
+        impl AnyCore {
+            fn new(model: &ArimaStateSpace, p0: f64, first: bool) -> Result<AnyCore> {
+                check_companion(&model.phi)?;
+                match model.dim() {
+                    $($n => Ok(AnyCore::$v(Core::new(model, p0, first))),)*
+                    n => Err(invalid("model", format!("state dimension {n} exceeds the supported maximum {MAX_DIM}"))),
+                }
+            }
+
+            fn run(&mut self, z: &[f64], rs: &mut RState, out: &mut FilterOutput, record: bool) -> Result<()> {
+                match self { $(AnyCore::$v(c) => c.run(z, rs, out, record),)* }
+            }
+        }
+    };
+}
+
+cores!(D1 = 1, D2 = 2, D3 = 3, D4 = 4, D5 = 5, D6 = 6, D7 = 7, D8 = 8);
+
+/// Stateful Kalman filter on an ARIMA state-space model (seed 002 Eq. 15); feed chunks
+/// with [`Kalman::update`] for streaming, or use [`kalman`] for a whole series.
+#[derive(Debug, Clone)]
+pub struct Kalman {
+    core: AnyCore,
+    rs: RState,
+    record: bool,
+}
+
+impl Kalman {
+    /// `r0`: initial (and fixed) measurement variance; `p0`: P₀ = p0·I.
+    pub fn new(model: &ArimaStateSpace, r0: f64, mode: RMode, x0: X0, p0: f64, record: bool) -> Result<Kalman> {
+        check_positive("r0", r0)?;
+        check_positive("p0", p0)?;
+        let rs = RState { mode, r: r0, r_floor: 1e-12 * model.sigma2, k: 0, allan: RunningAllanR::default(), last: None, bk: 1.0, v: 0.0 };
+        Ok(Kalman { core: AnyCore::new(model, p0, x0 == X0::First)?, rs, record })
+    }
+
+    /// Filter the next chunk of measurements, appending to `out`.
+    pub fn update(&mut self, z: &[f64], out: &mut FilterOutput) -> Result<()> {
+        check_finite("omega", z, 1)?;
+        out.xhat.reserve(z.len());
+        self.core.run(z, &mut self.rs, out, self.record)
+    }
+}
+
+/// Batch filter of a whole series.
+pub fn kalman(omega: &[f64], model: &ArimaStateSpace, r0: f64, mode: RMode, x0: X0, p0: f64, record: bool) -> Result<FilterOutput> {
+    if omega.is_empty() {
+        return Err(invalid("omega", "empty series"));
+    }
+    let mut f = Kalman::new(model, r0, mode, x0, p0, record)?;
+    let mut out = FilterOutput::default();
+    f.update(omega, &mut out)?;
+    Ok(out)
+}
+
+/// Steady state of the fixed filter for measurement variance r: (K∞, P⁻∞, P⁺∞), by
+/// iterating the Riccati recursion to convergence.
+pub fn steady_state(model: &ArimaStateSpace, r: f64) -> Result<(Vec<f64>, DMatrix<f64>, DMatrix<f64>)> {
+    check_positive("r", r)?;
+    let n = model.dim();
+    let phi = &model.phi;
+    let mut pm = phi * phi.transpose() + &model.qd;
+    for _ in 0..1_000_000 {
+        let s = pm[(0, 0)] + r;
+        let k = pm.column(0) / s;
+        let pp = &pm - &k * pm.row(0);
+        let next = phi * &pp * phi.transpose() + &model.qd;
+        let diff = (&next - &pm).abs().max();
+        pm = next;
+        if diff <= 1e-15 * pm.abs().max() {
+            let s = pm[(0, 0)] + r;
+            let k = pm.column(0) / s;
+            let pp = &pm - &k * pm.row(0);
+            return Ok(((0..n).map(|i| k[i]).collect(), pm, pp));
+        }
+    }
+    Err(NavError::Numerical("steady_state: Riccati iteration did not converge (model not detectable?)".into()))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn paper() -> ArimaStateSpace {
+        ArimaStateSpace::from_arma(&[-0.018, 0.029], &[-0.99], 0.035, 1, NoiseForm::Paper).unwrap()
+    }
+
+    #[test]
+    fn eq12_coefficients_and_noise() {
+        let m = paper();
+        let row: Vec<f64> = (0..3).map(|j| m.phi[(0, j)]).collect();
+        for (a, e) in row.iter().zip([0.982, 0.047, -0.029]) {
+            assert!((a - e).abs() < 1e-12);
+        }
+        assert!((m.qd[(0, 0)] - 0.0693035).abs() < 1e-12);
+        assert_eq!(m.qd.iter().filter(|v| **v != 0.0).count(), 1);
+    }
+
+    #[test]
+    fn steady_state_gain_matches_spec() {
+        let (k, pm, pp) = steady_state(&paper(), 0.035).unwrap();
+        for (a, e) in k.iter().zip([0.729723, 0.195707, 0.058209]) {
+            assert!((a - e).abs() < 1e-6, "{k:?}");
+        }
+        assert!((pm[(0, 0)] - 0.094497).abs() < 1e-6 && (pp[(0, 0)] - 0.025540).abs() < 1e-6);
+    }
+
+    #[test]
+    fn eq17_recursion_oracle() {
+        // spec §4a.5: y = [1, 3, 2, 5, 4].
+        let mut r = RunningAllanR::default();
+        let got: Vec<Option<f64>> = [1.0, 3.0, 2.0, 5.0, 4.0].iter().map(|&y| r.update(y)).collect();
+        let want = [None, Some(2.0), Some(1.25), Some(7.0 / 3.0), Some(1.875)];
+        for (g, w) in got.iter().zip(want) {
+            match (g, w) {
+                (None, None) => {}
+                (Some(g), Some(w)) => assert!((g - w).abs() < 1e-14),
+                _ => panic!("{got:?}"),
+            }
+        }
+    }
+
+    #[test]
+    fn exact_form_layout() {
+        let m = ArimaStateSpace::from_arma(&[-0.018, 0.029], &[-0.99], 0.035, 1, NoiseForm::Exact).unwrap();
+        assert_eq!(m.dim(), 4);
+        assert_eq!(m.phi[(0, 3)], -0.99);
+        assert_eq!((m.b[(0, 0)], m.b[(3, 0)]), (1.0, 1.0));
+        assert_eq!(m.phi.row(3).iter().filter(|v| **v != 0.0).count(), 0);
+    }
+
+    #[test]
+    fn streaming_equals_batch() {
+        let m = paper();
+        let w: Vec<f64> = (0..500).map(|k| 0.7 + 0.1 * ((k * 7919 % 101) as f64 / 50.0 - 1.0)).collect();
+        for mode in [RMode::Fixed, RMode::Differenced, RMode::SageHusa { b: 0.98, adapt_q: true, fading: true }] {
+            let batch = kalman(&w, &m, 0.035, mode, X0::Zeros, 1.0, true).unwrap();
+            let mut f = Kalman::new(&m, 0.035, mode, X0::Zeros, 1.0, true).unwrap();
+            let mut out = FilterOutput::default();
+            for c in w.chunks(33) {
+                f.update(c, &mut out).unwrap();
+            }
+            assert_eq!(batch, out);
+        }
+    }
+}
