@@ -6,6 +6,7 @@
 
 pub mod earth;
 pub mod error;
+pub mod filter;
 pub mod imu;
 pub mod math;
 pub mod strapdown;

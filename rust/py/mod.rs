@@ -4,6 +4,7 @@ use pyo3::prelude::*;
 
 mod convert;
 mod earth;
+mod filter;
 mod imu;
 mod rotation;
 mod strapdown;
@@ -41,5 +42,6 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     imu::register(m)?;
     trajectory::register(m)?;
     strapdown::register(m)?;
+    filter::register(m)?;
     Ok(())
 }
