@@ -116,3 +116,18 @@ def test_dare_bad_input_nan():
 def test_riccati_scalar_bad_input():
     with pytest.raises(ValueError, match="r: must be > 0"):
         riccati_scalar(1e-20, 0.0, 1.0)
+
+
+def test_reproduce_section_all_rows_pass(tmp_path):
+    import matplotlib
+
+    matplotlib.use("Agg")
+    from atomnav.reproduce import Report, discover
+
+    _, fn = discover()["riccati_tennstedt2021"]
+    rep = Report(outdir=tmp_path, section="riccati_tennstedt2021", quick=True)
+    fn(rep)
+    verdicts = [r["verdict"] for r in rep.rows]
+    assert len(verdicts) == 9
+    assert all(v == "pass" or v.startswith("ratio 0.99") or v.startswith("ratio 1.00") for v in verdicts), verdicts
+    assert (tmp_path / "riccati_tennstedt2021_recursion.png").exists()

@@ -7,6 +7,8 @@
 
 use super::matrix::{check_covariance, check_square, symmetrize};
 use crate::error::{invalid, NavError, Result};
+use faer::linalg::matmul::matmul;
+use faer::{Accum, Mat, MatMut, MatRef, Par};
 use nalgebra::{DMatrix, DVector};
 
 /// How the filter's estimate reaches the navigation solution (spec gnss-ins-tight §2.11).
@@ -85,7 +87,13 @@ impl Kf {
         if self.mode == LoopMode::Open {
             self.x = phi * &self.x;
         }
-        self.p = phi * &self.p * phi.transpose() + qd;
+        // P ← Φ(PΦᵀ) + Q_d with faer's small-matrix kernels on the column-major buffers.
+        let n = self.size();
+        let phi_f = MatRef::from_column_major_slice(phi.as_slice(), n, n);
+        let mut t = Mat::<f64>::zeros(n, n);
+        matmul(t.as_mut(), Accum::Replace, MatRef::from_column_major_slice(self.p.as_slice(), n, n), phi_f.transpose(), 1.0, Par::Seq);
+        self.p.copy_from(qd);
+        matmul(MatMut::from_column_major_slice_mut(self.p.as_mut_slice(), n, n), Accum::Add, phi_f, t.as_ref(), 1.0, Par::Seq);
         symmetrize(&mut self.p);
         if (0..self.size()).any(|i| !(self.p[(i, i)] > 0.0) || !self.p[(i, i)].is_finite()) {
             return self.check_pd("predict");

@@ -24,7 +24,7 @@ TABLE1 = [
 def reproduce(report) -> None:
     import matplotlib.pyplot as plt
 
-    steps = 300 if report.quick else 3000
+    steps = 5000  # 1×1 recursion: cheap; case C contracts by (1 − K∞H)² ≈ 0.987 per step
     fig, ax = plt.subplots(figsize=(7, 4))
     for label, unit, q, h, paper in TABLE1:
         _, closed = riccati_scalar(q, R_CAI, h)
@@ -32,9 +32,9 @@ def reproduce(report) -> None:
         _, post = kalman_recursion(1.0, q, h, R_CAI, np.array([[1e4 * closed]]), steps)
         p_dare = float(ss.p_post[0, 0])
         report.row(f"P+ {label} closed form (E27) {unit}", paper, closed, f"ratio {closed / paper:.4f}")
-        report.row(f"P+ {label} DARE {unit}", paper, p_dare, abs(p_dare / paper - 1) < 5e-3)
+        report.row(f"P+ {label} DARE {unit}", paper, p_dare, bool(abs(p_dare / paper - 1) < 5e-3))
         report.row(f"P+ {label} Kalman recursion, {steps} steps {unit}", paper, float(post[-1, 0, 0]),
-                   abs(post[-1, 0, 0] / p_dare - 1) < 1e-6)
+                   bool(abs(post[-1, 0, 0] / p_dare - 1) < 1e-6))
         ax.loglog(np.arange(1, steps + 1), post[:, 0, 0] / p_dare, label=label)
     ax.axhline(1.0, color="k", lw=0.8, ls="--")
     ax.set_xlabel("CAI update k")
