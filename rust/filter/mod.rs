@@ -9,3 +9,4 @@ pub mod layout;
 pub mod kf;
 pub mod ins;
 pub mod analysis;
+pub mod aided;

@@ -3,6 +3,7 @@
 use super::convert::{quat_rows, vec3_rows, vector};
 use crate::earth::Ellipsoid;
 use crate::error::{invalid, NavError};
+use crate::filter::aided::{run_position_aided, AidedConfig, PositionFix};
 use crate::filter::analysis::Scenario as CoreScenario;
 use crate::filter::discretize::{discretize, Discretization};
 use crate::filter::ins::{error_dynamics, BiasModel, InsNoise};
@@ -346,6 +347,95 @@ impl Scenario {
     }
 }
 
+/// Position-aided 15-state INS over a whole IMU record (see filter/aided.rs). Returns
+/// (time (N,), lla (N, 3), vel (N, 3), q_nb (N, 4), accel_bias (N, 3), gyro_bias (N, 3),
+/// sigma (N, 15), fix_nis (M,), fix_rejected (M,)) at every prediction epoch.
+#[pyfunction]
+#[pyo3(signature = (t0, lla0, vel0, q0, kind, t, gyro, accel, ba0, bg0, p0, fix_t, fix_lla, fix_cov, accel_psd, gyro_psd, accel_bias, gyro_bias, predict_every, method, mode, sequential=false, gate=None, ellipsoid="WGS84"))]
+#[allow(clippy::too_many_arguments, clippy::type_complexity)]
+fn position_aided<'py>(
+    py: Python<'py>,
+    t0: f64,
+    lla0: PyReadonlyArray1<'py, f64>,
+    vel0: PyReadonlyArray1<'py, f64>,
+    q0: PyReadonlyArray1<'py, f64>,
+    kind: &str,
+    t: PyReadonlyArray1<'py, f64>,
+    gyro: PyReadonlyArray2<'py, f64>,
+    accel: PyReadonlyArray2<'py, f64>,
+    ba0: PyReadonlyArray1<'py, f64>,
+    bg0: PyReadonlyArray1<'py, f64>,
+    p0: PyReadonlyArray2<'py, f64>,
+    fix_t: PyReadonlyArray1<'py, f64>,
+    fix_lla: PyReadonlyArray2<'py, f64>,
+    fix_cov: PyReadonlyArray3<'py, f64>,
+    accel_psd: f64,
+    gyro_psd: f64,
+    accel_bias: (String, f64, f64),
+    gyro_bias: (String, f64, f64),
+    predict_every: usize,
+    method: &str,
+    mode: &str,
+    sequential: bool,
+    gate: Option<f64>,
+    ellipsoid: &str,
+) -> PyResult<Bound<'py, pyo3::types::PyTuple>> {
+    use super::convert::{quat_to_py, vec3, vec3_to_py};
+    let kind = match kind {
+        "rates" => crate::imu::ImuKind::Rates,
+        "increments" => crate::imu::ImuKind::Increments,
+        _ => return Err(invalid("kind", format!("unknown IMU kind {kind:?} (expected \"rates\" or \"increments\")")).into()),
+    };
+    let q = vector(&q0, "q0")?;
+    if q.len() != 4 {
+        return Err(invalid("q0", format!("expected 4 elements, got {}", q.len())).into());
+    }
+    let initial = NavState { t: t0, lla: vec3(&lla0, "lla0")?, vel: vec3(&vel0, "vel0")?, q_nb: crate::math::quat(q[0], q[1], q[2], q[3]) };
+    let (tt, g, a) = (vector(&t, "time")?, vec3_rows(&gyro, "gyro")?, vec3_rows(&accel, "accel")?);
+    let (ft, fl, fc) = (vector(&fix_t, "fix_t")?, vec3_rows(&fix_lla, "fix_lla")?, mats(&fix_cov, "fix_cov")?);
+    if fl.len() != ft.len() || fc.len() != ft.len() {
+        return Err(invalid("fixes", format!("fix_t has {} entries but fix_lla {} and fix_cov {}", ft.len(), fl.len(), fc.len())).into());
+    }
+    if let Some(i) = fc.iter().position(|c| c.nrows() != 3 || c.ncols() != 3) {
+        return Err(invalid("fix_cov", format!("expected (M, 3, 3), entry {i} is {}x{}", fc[i].nrows(), fc[i].ncols())).into());
+    }
+    let fixes: Vec<PositionFix> = (0..ft.len()).map(|i| PositionFix { t: ft[i], lla: fl[i], cov_ned: crate::math::Mat3::from_fn(|r, c| fc[i][(r, c)]) }).collect();
+    let cfg = AidedConfig {
+        noise: InsNoise {
+            accel_psd,
+            gyro_psd,
+            accel_bias: BiasModel::from_parts("accel_bias", &accel_bias.0, accel_bias.1, accel_bias.2)?,
+            gyro_bias: BiasModel::from_parts("gyro_bias", &gyro_bias.0, gyro_bias.1, gyro_bias.2)?,
+        },
+        predict_every,
+        method: Discretization::by_name(method)?,
+        mode: LoopMode::by_name(mode)?,
+        sequential,
+        gate,
+    };
+    let ell = Ellipsoid::by_name(ellipsoid)?;
+    let (ba0, bg0, p0) = (vec3(&ba0, "ba0")?, vec3(&bg0, "bg0")?, mat(&p0, "p0")?);
+    let o = py.detach(|| run_position_aided(initial, kind, ell, &tt, &g, &a, ba0, bg0, p0, &fixes, &cfg))?;
+    let time: Vec<f64> = o.nav.iter().map(|s| s.t).collect();
+    let lla: Vec<_> = o.nav.iter().map(|s| s.lla).collect();
+    let vel: Vec<_> = o.nav.iter().map(|s| s.vel).collect();
+    let qs: Vec<_> = o.nav.iter().map(|s| s.q_nb).collect();
+    let ne = time.len();
+    let sigma = Array2::from_shape_vec((ne, 15), o.sigma).expect("epochs x 15").into_pyarray(py);
+    let items: Vec<Bound<'py, PyAny>> = vec![
+        time.into_pyarray(py).into_any(),
+        vec3_to_py(py, &lla).into_any(),
+        vec3_to_py(py, &vel).into_any(),
+        quat_to_py(py, &qs).into_any(),
+        vec3_to_py(py, &o.accel_bias).into_any(),
+        vec3_to_py(py, &o.gyro_bias).into_any(),
+        sigma.into_any(),
+        o.fix_nis.into_pyarray(py).into_any(),
+        o.fix_rejected.into_pyarray(py).into_any(),
+    ];
+    pyo3::types::PyTuple::new(py, items)
+}
+
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(dare, m)?)?;
     m.add_function(wrap_pyfunction!(riccati_scalar, m)?)?;
@@ -354,6 +444,7 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(discretize_model, m)?)?;
     m.add_function(wrap_pyfunction!(ins_error_dynamics, m)?)?;
     m.add_function(wrap_pyfunction!(rts, m)?)?;
+    m.add_function(wrap_pyfunction!(position_aided, m)?)?;
     m.add_class::<KalmanFilter>()?;
     m.add_class::<Scenario>()?;
     Ok(())
