@@ -87,8 +87,8 @@ mod tests {
     fn van_loan_gauss_markov() {
         let (tau, q, dt) = (10.0, 3e-6, 4.0);
         let (phi, qd) = discretize(&DMatrix::from_element(1, 1, -1.0 / tau), &DMatrix::from_element(1, 1, q), dt, Discretization::VanLoan);
-        assert!((phi[(0, 0)] / (-dt / tau as f64).exp() - 1.0).abs() < 1e-14);
-        let e = q * tau / 2.0 * (1.0 - (-2.0 * dt / tau as f64).exp());
+        assert!((phi[(0, 0)] / (-dt / tau).exp() - 1.0).abs() < 1e-14);
+        let e = q * tau / 2.0 * (1.0 - (-2.0 * dt / tau).exp());
         assert!((qd[(0, 0)] / e - 1.0).abs() < 1e-13);
     }
 }

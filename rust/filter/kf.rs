@@ -30,6 +30,11 @@ impl LoopMode {
     }
 }
 
+/// Finite and strictly positive (false for NaN).
+fn positive(x: f64) -> bool {
+    x.is_finite() && x > 0.0
+}
+
 /// Result of one update.
 #[derive(Debug, Clone, PartialEq)]
 pub struct UpdateReport {
@@ -62,7 +67,7 @@ impl Kf {
     }
 
     fn check_pd(&self, stage: &str) -> Result<()> {
-        let bad_diag = (0..self.size()).find(|&i| !(self.p[(i, i)] > 0.0) || !self.p[(i, i)].is_finite());
+        let bad_diag = (0..self.size()).find(|&i| !positive(self.p[(i, i)]));
         if bad_diag.is_some() || self.p.clone().cholesky().is_none() {
             return Err(NavError::Numerical(format!(
                 "covariance lost positive definiteness at epoch {} ({stage}){}",
@@ -95,7 +100,7 @@ impl Kf {
         self.p.copy_from(qd);
         matmul(MatMut::from_column_major_slice_mut(self.p.as_mut_slice(), n, n), Accum::Add, phi_f, t.as_ref(), 1.0, Par::Seq);
         symmetrize(&mut self.p);
-        if (0..self.size()).any(|i| !(self.p[(i, i)] > 0.0) || !self.p[(i, i)].is_finite()) {
+        if (0..self.size()).any(|i| !positive(self.p[(i, i)])) {
             return self.check_pd("predict");
         }
         Ok(())
@@ -115,7 +120,7 @@ impl Kf {
         }
         check_covariance("r", r, Some(m), true)?;
         if let Some(g) = gate {
-            if !(g > 0.0) {
+            if !positive(g) {
                 return Err(invalid("gate", format!("chi-square threshold must be > 0, got {g}")));
             }
         }

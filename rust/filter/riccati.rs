@@ -139,6 +139,9 @@ pub fn posterior(p_prior: &DMatrix<f64>, h: &DMatrix<f64>, r: &DMatrix<f64>) -> 
     Ok((p_post, gain))
 }
 
+/// A sequence of covariance matrices, one per step.
+pub type Covariances = Vec<DMatrix<f64>>;
+
 /// The Kalman covariance recursion from P⁻₀: returns the a-priori and a-posteriori
 /// covariances of steps 0..steps (spec cai-ekf E24/E25 iterated, no steady-state assumption).
 pub fn recursion(
@@ -148,7 +151,7 @@ pub fn recursion(
     r: &DMatrix<f64>,
     p0: &DMatrix<f64>,
     steps: usize,
-) -> Result<(Vec<DMatrix<f64>>, Vec<DMatrix<f64>>)> {
+) -> Result<(Covariances, Covariances)> {
     check_system(phi, q, h, r)?;
     check_covariance("p0", p0, Some(phi.nrows()), false)?;
     let mut prior = Vec::with_capacity(steps);

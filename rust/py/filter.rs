@@ -121,6 +121,7 @@ fn layout_ranges(blocks: Vec<(String, Option<usize>)>) -> PyResult<Vec<(String, 
 
 /// Van Loan (or first-order) discretisation: (Φ, Q_d).
 #[pyfunction]
+#[allow(clippy::type_complexity)]
 fn discretize_model<'py>(
     py: Python<'py>,
     f: PyReadonlyArray2<'py, f64>,
