@@ -7,6 +7,7 @@
 pub mod cai;
 pub mod earth;
 pub mod error;
+pub mod filter;
 pub mod imu;
 pub mod math;
 pub mod noise;

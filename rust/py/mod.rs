@@ -5,6 +5,7 @@ use pyo3::prelude::*;
 mod cai;
 mod convert;
 mod earth;
+mod filter;
 mod imu;
 mod noise;
 mod rotation;
@@ -45,5 +46,6 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     strapdown::register(m)?;
     cai::register(m)?;
     noise::register(m)?;
+    filter::register(m)?;
     Ok(())
 }

@@ -1,0 +1,159 @@
+"""Error-state Kalman filter engine (Rust core, ``rust/filter``).
+
+Conventions (binding, README "Conventions"): δx = estimate − true; attitude error ψ with
+Ĉ_b^n = (I − [ψ×])C_b^n; sensor bias errors δb = b̂ − b. A measurement is given as
+z = predicted − measured ≈ H δx + v. SI units throughout.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from .. import _core
+from .._validate import rows
+from .riccati import _mat
+
+#: Standard blocks and their sizes; extra blocks (lever arm, clock, ...) give their size.
+STANDARD_BLOCKS = {
+    "position": 3, "velocity": 3, "attitude": 3, "accel_bias": 3, "gyro_bias": 3,
+    "accel_scale": 3, "gyro_scale": 3, "accel_misalignment": 6, "gyro_misalignment": 6,
+}
+#: The 15-state INS layout (spec gnss-ins-tight §2.9, atom-strapdown E22).
+INS15 = ("position", "velocity", "attitude", "accel_bias", "gyro_bias")
+
+
+def _block_spec(blocks) -> list[tuple[str, int | None]]:
+    out = []
+    for b in blocks:
+        if isinstance(b, str):
+            out.append((b, None))
+        else:
+            name, size = b
+            out.append((str(name), int(size)))
+    return out
+
+
+class Layout:
+    """State layout from named blocks, e.g. ``Layout(INS15 + (("clock", 2),))``.
+
+    Indices are derived: ``layout["gyro_bias"]`` is a slice; an unknown name raises
+    ValueError.
+    """
+
+    def __init__(self, blocks=INS15):
+        self._spec = _block_spec(blocks)
+        self._ranges = {n: slice(a, b) for n, a, b in _core.layout_ranges(self._spec)}
+
+    def __getitem__(self, name: str) -> slice:
+        if name not in self._ranges:
+            raise ValueError(f"block: unknown block name {name!r} (layout has: {', '.join(self._ranges)})")
+        return self._ranges[name]
+
+    @property
+    def spec(self) -> list[tuple[str, int | None]]:
+        return list(self._spec)
+
+    @property
+    def size(self) -> int:
+        return max(s.stop for s in self._ranges.values())
+
+    @property
+    def labels(self) -> list[str]:
+        """Name of every state component, e.g. ``velocity[2]``."""
+        return [f"{n}[{i}]" for n, s in self._ranges.items() for i in range(s.stop - s.start)]
+
+
+def discretize(f, qc, dt: float, method: str = "van_loan") -> tuple[np.ndarray, np.ndarray]:
+    """(Φ, Q_d) of ẋ = Fx + w, E[wwᵀ] = Q_c δ(t−s), over dt (s).
+
+    method "van_loan" (exact for constant F) or "first_order" (Φ = I + FΔt, Q_d = Q_cΔt).
+    """
+    return _core.discretize_model(_mat(f, "f"), _mat(qc, "qc"), float(dt), method)
+
+
+@dataclass(frozen=True)
+class BiasModel:
+    """Per-axis bias process: ``random_constant``, ``random_walk`` (psd in units²/s) or
+    ``gauss_markov`` (tau in s, sigma = steady-state σ in the bias unit)."""
+
+    kind: str = "random_constant"
+    psd: float = 0.0
+    tau: float = 0.0
+    sigma: float = 0.0
+
+    def _parts(self) -> tuple[str, float, float]:
+        if self.kind == "gauss_markov":
+            return (self.kind, float(self.tau), float(self.sigma))
+        return (self.kind, float(self.psd), 0.0)
+
+
+def ins_error_model(lla, vel_ned, q_nb, f_b, accel_psd: float, gyro_psd: float,
+                    accel_bias: BiasModel = BiasModel(), gyro_bias: BiasModel = BiasModel(),
+                    layout: Layout | None = None, ellipsoid: str = "WGS84") -> tuple[np.ndarray, np.ndarray]:
+    """Continuous INS error model F, Q_c (spec gnss-ins-tight Eq. 28) along a trajectory.
+
+    lla (N, 3) rad/rad/m, vel_ned (N, 3) m/s, q_nb (N, 4), f_b (N, 3) compensated specific
+    force m/s²; accel_psd ((m/s²)²/Hz = VRW²) and gyro_psd (rad²/s = ARW²) white noise.
+    Returns (F, Q_c) stacks of shape (N, n, n) for ``layout`` (default 15 states).
+    """
+    layout = layout or Layout()
+    return _core.ins_error_dynamics(layout.spec, rows(lla, 3, "lla"), rows(vel_ned, 3, "vel_ned"),
+                                    rows(q_nb, 4, "q_nb"), rows(f_b, 3, "f_b"), float(accel_psd), float(gyro_psd),
+                                    accel_bias._parts(), gyro_bias._parts(), ellipsoid)
+
+
+class KalmanFilter:
+    """Error-state Kalman filter.
+
+    p0: initial covariance (PD); mode "closed" (feedback: :meth:`take_correction` hands δx̂
+    to the caller and resets it) or "open" (δx̂ propagated by Φ and kept). A covariance
+    that loses positive definiteness raises :class:`atomnav.NumericalError` naming the epoch.
+    """
+
+    def __init__(self, p0, mode: str = "closed"):
+        self._core = _core.KalmanFilter(_mat(p0, "p0"), mode)
+
+    def predict(self, phi, qd, steps: int = 1) -> None:
+        """P ← ΦPΦᵀ + Q_d (and δx̂ ← Φδx̂ in open loop), ``steps`` times (multirate: pass
+        Φ(ΔT), Q_d(ΔT) for ΔT = MΔt and steps=1)."""
+        if steps == 1:
+            self._core.predict(_mat(phi, "phi"), _mat(qd, "qd"))
+        else:
+            self._core.predict_many(_mat(phi, "phi"), _mat(qd, "qd"), int(steps))
+
+    def update(self, z, h, r, sequential: bool = False, gate: float | None = None):
+        """Update with z = Hδx + v (z = predicted − measured), R = cov(v).
+
+        sequential: decorrelate with chol(R) and process scalar rows (spec gnss-ins-tight
+        Eq. 40); gate: χ² threshold (per row when sequential, else on the whole NIS).
+        Returns (innovation, nis, rejected_rows).
+        """
+        z = np.atleast_1d(np.asarray(z, dtype=float))
+        return self._core.update(z, _mat(h, "h"), _mat(r, "r"), bool(sequential), None if gate is None else float(gate))
+
+    def take_correction(self) -> np.ndarray:
+        return self._core.take_correction()
+
+    @property
+    def x(self) -> np.ndarray:
+        return self._core.x
+
+    @property
+    def p(self) -> np.ndarray:
+        return self._core.p
+
+    @property
+    def epoch(self) -> int:
+        return self._core.epoch
+
+
+def rts_smooth(phi, x_prior, p_prior, x_post, p_post) -> tuple[np.ndarray, np.ndarray]:
+    """Rauch–Tung–Striebel smoother over a stored open-loop run of N epochs.
+
+    phi (N, n, n): transition into epoch k (phi[0] unused); x_prior/x_post (N, n);
+    p_prior/p_post (N, n, n). Returns smoothed (x (N, n), P (N, n, n)).
+    """
+    a = [np.ascontiguousarray(np.asarray(v, dtype=float)) for v in (phi, x_prior, p_prior, x_post, p_post)]
+    return _core.rts(*a)

@@ -1,0 +1,12 @@
+//! Estimation engine: error-state Kalman filter, discretisation, Riccati analysis,
+//! consistency measures. Dense algebra on nalgebra `DMatrix` (state sizes 1–30),
+//! the DARE on faer.
+
+pub mod matrix;
+pub mod riccati;
+pub mod discretize;
+pub mod layout;
+pub mod kf;
+pub mod ins;
+pub mod analysis;
+pub mod aided;

@@ -1,0 +1,212 @@
+"""Error-state Kalman filter engine: layout, discretisation, updates, smoother, bad input."""
+
+import numpy as np
+import pytest
+
+import atomnav
+from atomnav.filter import INS15, BiasModel, KalmanFilter, Layout, discretize, ins_error_model, rts_smooth
+
+
+def test_layout_derives_indices_and_rejects_unknown_names():
+    lay = Layout(INS15 + (("lever_arm", 3), ("clock", 2)))
+    assert lay["gyro_bias"] == slice(12, 15)
+    assert lay["clock"] == slice(18, 20)
+    assert lay.size == 20
+    assert lay.labels[19] == "clock[1]"
+    with pytest.raises(ValueError, match="unknown block name 'scale'"):
+        lay["scale"]
+    with pytest.raises(ValueError, match='unknown block name "lever" at index 1: a non-standard block needs a size'):
+        Layout(["position", "lever"])
+
+
+def test_van_loan_double_integrator_and_gauss_markov():
+    dt, q = 0.3, 2.5
+    phi, qd = discretize([[0, 1], [0, 0]], [[0, 0], [0, q]], dt)
+    assert np.allclose(phi, [[1, dt], [0, 1]], rtol=0, atol=1e-15)
+    assert np.allclose(qd, q * np.array([[dt**3 / 3, dt**2 / 2], [dt**2 / 2, dt]]), rtol=1e-13, atol=0)
+    tau, sigma = 50.0, 3e-4  # Gauss–Markov: q = 2σ²/τ, Q_d = σ²(1 − e^{−2Δt/τ})
+    phi, qd = discretize([[-1 / tau]], [[2 * sigma**2 / tau]], 7.0)
+    assert abs(phi[0, 0] / np.exp(-7 / tau) - 1) < 1e-14
+    assert abs(qd[0, 0] / (sigma**2 * (1 - np.exp(-14 / tau))) - 1) < 1e-13
+    # first-order option: Φ = I + FΔt, Q_d = Q_cΔt
+    phi1, qd1 = discretize([[-1 / tau]], [[2 * sigma**2 / tau]], 7.0, method="first_order")
+    assert phi1[0, 0] == pytest.approx(1 - 7 / tau, rel=1e-15) and qd1[0, 0] == pytest.approx(14 * sigma**2 / tau, rel=1e-15)
+
+
+def _numpy_update(x, p, z, h, r):
+    s = h @ p @ h.T + r
+    k = p @ h.T @ np.linalg.inv(s)
+    a = np.eye(len(x)) - k @ h
+    return x + k @ (z - h @ x), a @ p @ a.T + k @ r @ k.T
+
+
+def test_stacked_and_sequential_updates_match_textbook_kf():
+    rng = np.random.default_rng(5)
+    n, m = 6, 4
+    g = rng.standard_normal((n, n))
+    p0 = g @ g.T + np.eye(n)
+    phi = np.eye(n) + 0.1 * rng.standard_normal((n, n))
+    qd = np.diag(rng.uniform(0.01, 0.1, n))
+    h = rng.standard_normal((m, n))
+    l = rng.standard_normal((m, m))
+    r = l @ l.T + np.eye(m)  # correlated noise: the sequential path must decorrelate
+    z = rng.standard_normal(m)
+    x_ref = phi @ np.zeros(n)
+    p_ref = phi @ p0 @ phi.T + qd
+    x_ref, p_ref = _numpy_update(x_ref, p_ref, z, h, r)
+    for sequential in (False, True):
+        kf = KalmanFilter(p0, mode="open")
+        kf.predict(phi, qd)
+        innov, nis, rejected = kf.update(z, h, r, sequential=sequential)
+        assert rejected == []
+        assert np.allclose(kf.x, x_ref, rtol=1e-10, atol=1e-12)
+        assert np.allclose(kf.p, p_ref, rtol=1e-10, atol=1e-12)
+        assert np.array_equal(kf.p, kf.p.T)
+    s = h @ (phi @ p0 @ phi.T + qd) @ h.T + r
+    kf = KalmanFilter(p0, mode="open")
+    kf.predict(phi, qd)
+    _, nis, _ = kf.update(z, h, r)
+    assert nis[0] == pytest.approx(z @ np.linalg.solve(s, z), rel=1e-12)
+    # closed loop: correction handed over and reset
+    kf = KalmanFilter(p0, mode="closed")
+    kf.update(z, h, r)
+    dx = kf.take_correction()
+    assert np.allclose(dx, _numpy_update(np.zeros(n), p0, z, h, r)[0], rtol=1e-10, atol=1e-12)
+    assert np.all(kf.x == 0)
+
+
+def test_gate_rejects_outlier_row_and_reports_it():
+    kf = KalmanFilter(np.eye(3), mode="open")
+    h, r = np.eye(3), np.eye(3) * 0.01
+    innov, nis, rejected = kf.update([0.1, 50.0, -0.2], h, r, sequential=True, gate=10.83)
+    assert rejected == [1]
+    assert nis[1] == pytest.approx((50.0 / 0.1) ** 2 / (1 + 1 / 0.01), rel=1e-12)  # z̄² / (h̄Ph̄ᵀ + 1), z̄ = z/σ
+    assert kf.x[1] == 0.0 and kf.p[1, 1] == 1.0
+    assert kf.x[0] == pytest.approx(0.1 / 1.01, rel=1e-12)
+    kf = KalmanFilter(np.eye(3), mode="open")
+    _, nis, rejected = kf.update([0.1, 50.0, -0.2], h, r, gate=16.27)
+    assert rejected == [0, 1, 2] and np.all(kf.x == 0)
+
+
+def test_loss_of_positive_definiteness_names_the_epoch():
+    kf = KalmanFilter(np.eye(2))
+    kf.predict(np.eye(2), np.zeros((2, 2)))
+    kf.predict(np.eye(2), np.zeros((2, 2)))
+    with pytest.raises(atomnav.NumericalError, match="positive definiteness at epoch 3"):
+        kf.predict(np.diag([1.0, 0.0]), np.zeros((2, 2)))
+
+
+def test_rts_matches_batch_conditional_mean():
+    """Oracle: the joint Gaussian of all states and measurements, conditioned densely."""
+    rng = np.random.default_rng(11)
+    n, N = 2, 6
+    phi = np.array([[1.0, 0.5], [0.0, 0.9]])
+    qd = np.array([[0.02, 0.01], [0.01, 0.05]])
+    p0 = np.diag([1.0, 0.5])
+    h = np.array([[1.0, 0.0]])
+    r = np.array([[0.3]])
+    z = rng.standard_normal(N)
+    kf = KalmanFilter(p0, mode="open")
+    store = {k: [] for k in ("phi", "xp", "pp", "xs", "ps")}
+    for k in range(N):
+        if k > 0:
+            kf.predict(phi, qd)
+        store["phi"].append(phi)
+        store["xp"].append(kf.x)
+        store["pp"].append(kf.p)
+        kf.update([z[k]], h, r)
+        store["xs"].append(kf.x)
+        store["ps"].append(kf.p)
+    xs, ps = rts_smooth(store["phi"], store["xp"], store["pp"], store["xs"], store["ps"])
+    # joint prior covariance of (x_0..x_{N-1})
+    big = np.zeros((N * n, N * n))
+    covs = [p0]
+    for k in range(1, N):
+        covs.append(phi @ covs[-1] @ phi.T + qd)
+    for i in range(N):
+        for j in range(i, N):
+            c = np.linalg.matrix_power(phi, j - i) @ covs[i]
+            big[j * n:(j + 1) * n, i * n:(i + 1) * n] = c
+            big[i * n:(i + 1) * n, j * n:(j + 1) * n] = c.T
+    hb = np.kron(np.eye(N), h)
+    s = hb @ big @ hb.T + np.eye(N) * r[0, 0]
+    gain = big @ hb.T @ np.linalg.inv(s)
+    mean = gain @ z
+    cov = big - gain @ hb @ big
+    assert np.allclose(xs.ravel(), mean, rtol=1e-9, atol=1e-12)
+    for k in range(N):
+        assert np.allclose(ps[k], cov[k * n:(k + 1) * n, k * n:(k + 1) * n], rtol=1e-9, atol=1e-12)
+
+
+def test_ins_error_model_schuler_and_bias_coupling_at_rest():
+    lat = 0.8
+    g = 9.80665
+    lla = np.array([[lat, 0.2, 0.0]])
+    f, qc = ins_error_model(lla, np.zeros((1, 3)), np.array([[1.0, 0, 0, 0]]), np.array([[0, 0, -g]]),
+                            accel_psd=4e-8, gyro_psd=3e-13,
+                            accel_bias=BiasModel("gauss_markov", tau=100.0, sigma=1e-3),
+                            gyro_bias=BiasModel("random_walk", psd=1e-16))
+    f, qc = f[0], qc[0]
+    lay = Layout()
+    v, a = lay["velocity"], lay["attitude"]
+    # spec gnss-ins-tight §2.9 check: δv̇_N = γψ_E, ψ̇_E = −δv_N/R_M
+    assert f[v.start, a.start + 1] == pytest.approx(g)
+    a_wgs, e2 = 6378137.0, 6.69437999014e-3
+    rm = a_wgs * (1 - e2) / (1 - e2 * np.sin(lat) ** 2) ** 1.5
+    assert f[a.start + 1, v.start] == pytest.approx(-1 / rm, rel=1e-9)
+    # δb = b̂ − b: F_vba = −C, F_ψbg = +C (level, north-aligned: C = I)
+    assert np.allclose(f[v, lay["accel_bias"]], -np.eye(3)) and np.allclose(f[a, lay["gyro_bias"]], np.eye(3))
+    assert np.allclose(np.diag(f[lay["accel_bias"], lay["accel_bias"]]), -0.01)
+    assert np.allclose(np.diag(qc[lay["accel_bias"], lay["accel_bias"]]), 2e-6 / 100)
+    assert np.allclose(np.diag(qc[lay["gyro_bias"], lay["gyro_bias"]]), 1e-16)
+
+
+# ---- bad input: one test per case -------------------------------------------------
+
+def test_bad_p0_non_square():
+    with pytest.raises(ValueError, match="p0: must be square"):
+        KalmanFilter(np.ones((2, 3)))
+
+
+def test_bad_p0_non_symmetric():
+    with pytest.raises(ValueError, match=r"p0: not symmetric: entry \(1, 0\)"):
+        KalmanFilter([[1.0, 0.2], [0.0, 1.0]])
+
+
+def test_bad_p0_not_positive_definite():
+    with pytest.raises(ValueError, match="p0: not positive definite"):
+        KalmanFilter([[1.0, 2.0], [2.0, 1.0]])
+
+
+def test_bad_h_mismatched_dimensions():
+    kf = KalmanFilter(np.eye(3))
+    with pytest.raises(ValueError, match=r"h: expected 2x3 \(measurements x states\), got 2x4"):
+        kf.update([0.0, 0.0], np.ones((2, 4)), np.eye(2))
+
+
+def test_bad_r_not_positive_definite():
+    kf = KalmanFilter(np.eye(2))
+    with pytest.raises(ValueError, match="r: not positive definite"):
+        kf.update([0.0], np.ones((1, 2)), [[0.0]])
+
+
+def test_bad_nan_measurement():
+    kf = KalmanFilter(np.eye(2))
+    with pytest.raises(ValueError, match="z: non-finite value NaN at index 1"):
+        kf.update([0.0, np.nan], np.eye(2), np.eye(2))
+
+
+def test_bad_phi_dimensions():
+    kf = KalmanFilter(np.eye(2))
+    with pytest.raises(ValueError, match="phi: expected 2x2, got 3x3"):
+        kf.predict(np.eye(3), np.eye(2))
+
+
+def test_bad_mode_name():
+    with pytest.raises(ValueError, match='loop_mode: unknown mode "feedback"'):
+        KalmanFilter(np.eye(2), mode="feedback")
+
+
+def test_bad_bias_model_name():
+    with pytest.raises(ValueError, match='accel_bias: unknown bias model "flicker"'):
+        ins_error_model([[0.5, 0, 0]], [[0, 0, 0]], [[1, 0, 0, 0]], [[0, 0, -9.8]], 0.0, 0.0, accel_bias=BiasModel("flicker"))
