@@ -8,6 +8,7 @@ column names. Conventions (units, frames, signs) are in the README and in
 
 from ._core import NumericalError
 from . import units, rotation, earth, trajectory, strapdown, imu
+from . import astro
 
 __version__ = "0.1.0"
 
