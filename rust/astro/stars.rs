@@ -8,6 +8,10 @@ use crate::math::{Mat3, Vec3};
 use rand::Rng;
 use rand_distr::StandardNormal;
 
+/// Refraction passes after the uncorrected first solution (D13 iterates once; a third
+/// pass takes the noise-free attitude error from ~1e-11 to the rounding level).
+const REFRACTION_PASSES: usize = 3;
+
 /// Largest accepted |‖s‖ − 1| of an input direction vector.
 pub const UNIT_TOLERANCE: f64 = 1e-9;
 
@@ -185,12 +189,18 @@ pub fn star_attitudes(obs: &Observations, n_epochs: usize, cameras: &[Camera], s
     let mut out = StarAttitudes { s: Vec::with_capacity(n_epochs), p: Vec::with_capacity(n_epochs), stars: Vec::with_capacity(n_epochs) };
     for (e, idx) in rows.iter().enumerate() {
         let g: Vec<Vec3> = idx.iter().map(|&r| obs.g[r]).collect();
-        let mut s: Vec<Vec3> = idx.iter().map(|&r| cameras[obs.camera[r]].c_vf_cf * obs.s_cf[r]).collect();
+        let raw: Vec<Vec3> = idx.iter().map(|&r| cameras[obs.camera[r]].c_vf_cf * obs.s_cf[r]).collect();
+        let mut s = raw.clone();
+        let mut att = wahba(&g, &s);
         if let Some((up, n)) = refraction {
-            let u = wahba(&g, &s).transpose() * up[e];
-            s = s.iter().map(|v| refraction_correct(v, &u, n)).collect();
+            // D13: the vertical in VF from the uncorrected solution, then iterated: each pass
+            // shrinks the vertical error by a factor ~(n − 1).
+            for _ in 0..REFRACTION_PASSES {
+                let u = att.transpose() * up[e];
+                s = raw.iter().map(|v| refraction_correct(v, &u, n)).collect();
+                att = wahba(&g, &s);
+            }
         }
-        let att = wahba(&g, &s);
         let mut info = Mat3::zeros();
         let mut a_cam = vec![Mat3::zeros(); cameras.len()];
         for (k, &r) in idx.iter().enumerate() {
