@@ -102,48 +102,55 @@ impl GyroErrorModel {
     }
 }
 
-/// Error state of one interval (E7/E8), started at zero.
+/// Error state of one interval (E7/E8), started at zero; only the selected mode's terms
+/// are propagated.
 #[derive(Debug, Clone, Copy)]
 struct ErrorPropagator {
-    /// E7 recursion with the full E2 per-sample covariance (paper mode).
-    e_paper: Mat3,
-    /// Sensitivity of ε to vec_rowmajor(M_G) and to the rate bias (rad/s) (E8).
+    mode: GyroErrorMode,
+    /// Paper: E7 with the full E2 per-sample covariance. Consistent: E7 with the ARW term
+    /// only (W_n of E8).
+    e: Mat3,
+    /// Consistent: sensitivity of ε to vec_rowmajor(M_G) and to the rate bias (rad/s) (E8).
     j_m: Mat39,
     j_b: Mat3,
-    /// E7 recursion with the ARW term only (E8).
-    w: Mat3,
 }
 
 impl ErrorPropagator {
-    fn zero() -> Self {
-        Self { e_paper: Mat3::zeros(), j_m: Mat39::zeros(), j_b: Mat3::zeros(), w: Mat3::zeros() }
+    fn zero(mode: GyroErrorMode) -> Self {
+        Self { mode, e: Mat3::zeros(), j_m: Mat39::zeros(), j_b: Mat3::zeros() }
     }
 
-    /// One sample: E ← (I − [ρ×]) E (I + [ρ×]) + P_ρ (E7, D12); J_m ← (I − [ρ×])J_m + I₃⊗ρᵀ,
-    /// J_b ← (I − [ρ×])J_b + T I (E8).
+    /// One sample: E ← (I − [ρ×]) E (I + [ρ×]) + P_ρ (E7, D12); in consistent mode also
+    /// J_m ← (I − [ρ×])J_m + I₃⊗ρᵀ and J_b ← (I − [ρ×])J_b + T I (E8).
     fn step(&mut self, rho: &Vec3, model: &GyroErrorModel, period: f64) {
         let a = Mat3::identity() - skew(rho);
-        self.e_paper = a * self.e_paper * a.transpose() + model.sample_cov(rho, period);
-        self.w = a * self.w * a.transpose() + Mat3::identity() * (model.sigma_w * model.sigma_w * period);
-        self.j_m = a * self.j_m;
-        for i in 0..3 {
-            for j in 0..3 {
-                self.j_m[(i, 3 * i + j)] += rho[j];
+        match self.mode {
+            GyroErrorMode::Paper => self.e = a * self.e * a.transpose() + model.sample_cov(rho, period),
+            GyroErrorMode::Consistent => {
+                self.e = a * self.e * a.transpose() + Mat3::identity() * (model.sigma_w * model.sigma_w * period);
+                self.j_m = a * self.j_m;
+                for i in 0..3 {
+                    for j in 0..3 {
+                        self.j_m[(i, 3 * i + j)] += rho[j];
+                    }
+                }
+                self.j_b = a * self.j_b + Mat3::identity() * period;
             }
         }
-        self.j_b = a * self.j_b + Mat3::identity() * period;
     }
 
-    /// E_n of the selected mode: E7 (paper) or J_m P_m J_mᵀ + J_b P_b J_bᵀ + W (consistent).
+    /// E_n: E7 (paper) or J_m P_m J_mᵀ + J_b P_b J_bᵀ + W (consistent).
     fn cov(&self, model: &GyroErrorModel) -> Mat3 {
-        match model.mode {
-            GyroErrorMode::Paper => self.e_paper,
+        match self.mode {
+            GyroErrorMode::Paper => self.e,
             GyroErrorMode::Consistent => {
-                self.j_m * model.p_m() * self.j_m.transpose()
-                    + self.j_b * self.j_b.transpose() * model.sigma_b.powi(2)
-                    + self.w
+                self.j_m * model.p_m() * self.j_m.transpose() + self.j_b * self.j_b.transpose() * model.sigma_b.powi(2) + self.e
             }
         }
+    }
+
+    fn sensitivities(&self) -> Option<(Mat39, Mat3)> {
+        (self.mode == GyroErrorMode::Consistent).then_some((self.j_m, self.j_b))
     }
 }
 
@@ -209,9 +216,8 @@ pub struct Increment {
     pub q: Quat,
     /// E_n^imu (rad²) of the model's mode (E7 or E8).
     pub cov: Mat3,
-    /// ∂ε_n/∂vec_rowmajor(M_G) and ∂ε_n/∂b (b in rad/s) (E8).
-    pub j_m: Mat39,
-    pub j_b: Mat3,
+    /// Consistent mode: ∂ε_n/∂vec_rowmajor(M_G) and ∂ε_n/∂b (b in rad/s) (E8).
+    pub sensitivities: Option<(Mat39, Mat3)>,
 }
 
 impl Increment {
@@ -240,11 +246,11 @@ pub fn integrate_increments(rec: &ImuRecord, epochs: &[f64], model: &GyroErrorMo
                 q = quat_normalize(&(q * r(jb, xb)));
             }
             // E7/E8 over every sample touched by the interval.
-            let mut p = ErrorPropagator::zero();
+            let mut p = ErrorPropagator::zero(model.mode);
             for rho in &rec.rho[ja..=jb] {
                 p.step(rho, model, rec.period);
             }
-            Increment { q, cov: p.cov(model), j_m: p.j_m, j_b: p.j_b }
+            Increment { q, cov: p.cov(model), sensitivities: p.sensitivities() }
         })
         .collect())
 }
@@ -256,7 +262,7 @@ pub fn dead_reckoning_cov(rec: &ImuRecord, epochs: &[f64], model: &GyroErrorMode
     model.validate()?;
     rec.check_epochs(epochs)?;
     let mut out = Vec::with_capacity(epochs.len());
-    let mut p = ErrorPropagator::zero();
+    let mut p = ErrorPropagator::zero(model.mode);
     let mut j = rec.locate(epochs[0]).0;
     for &t in epochs {
         let (jt, x) = rec.locate(t);

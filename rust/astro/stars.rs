@@ -93,7 +93,8 @@ impl Catalog {
 }
 
 fn check_unit(field: &str, v: &[Vec3]) -> Result<()> {
-    match v.iter().position(|s| !((s.norm() - 1.0).abs() <= UNIT_TOLERANCE)) {
+    // NaN norms fail too: `is_nan() ||` keeps them out of the accepted set
+    match v.iter().position(|s| (s.norm() - 1.0).is_nan() || (s.norm() - 1.0).abs() > UNIT_TOLERANCE) {
         None => Ok(()),
         Some(i) => Err(invalid(field, format!("not a unit vector at index {i} (norm {})", v[i].norm()))),
     }

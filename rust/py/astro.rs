@@ -16,6 +16,8 @@ use pyo3::types::PyDict;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 
+type Arr3<'py> = Bound<'py, PyArray3<f64>>;
+
 /// The (R, C) blocks of an (N, R, C) array, checked for shape and NaN/inf.
 fn mats<const R: usize, const C: usize>(a: &PyReadonlyArray3<'_, f64>, field: &str) -> Result<Vec<SMatrix<f64, R, C>>, NavError> {
     let s = a.shape();
@@ -73,12 +75,12 @@ fn astro_euler_from_dcm<'py>(py: Python<'py>, c: PyReadonlyArray3<'py, f64>) -> 
 }
 
 #[pyfunction]
-fn astro_d1_d2<'py>(py: Python<'py>, beta: PyReadonlyArray2<'py, f64>) -> PyResult<(Bound<'py, PyArray3<f64>>, Bound<'py, PyArray3<f64>>)> {
+fn astro_d1_d2<'py>(py: Python<'py>, beta: PyReadonlyArray2<'py, f64>) -> PyResult<(Arr3<'py>, Arr3<'py>)> {
     let b = vec3_rows(&beta, "beta")?;
     Ok((mats_to_py(py, &b.iter().map(d1).collect::<Vec<_>>()), mats_to_py(py, &b.iter().map(d2).collect::<Vec<_>>())))
 }
 
-type IncrementArrays<'py> = (Bound<'py, PyArray2<f64>>, Bound<'py, PyArray3<f64>>, Bound<'py, PyArray3<f64>>, Bound<'py, PyArray3<f64>>);
+type IncrementArrays<'py> = (Bound<'py, PyArray2<f64>>, Bound<'py, PyArray3<f64>>, Option<(Bound<'py, PyArray3<f64>>, Bound<'py, PyArray3<f64>>)>);
 
 #[pyfunction]
 #[allow(clippy::too_many_arguments)]
@@ -99,9 +101,11 @@ fn astro_increments<'py>(
     let inc = py.detach(|| increments::integrate_increments(&ImuRecord { t_start, period, rho: &rho }, &epochs, &model, variant))?;
     let q: Vec<_> = inc.iter().map(|i| i.q).collect();
     let cov: Vec<Mat3> = inc.iter().map(|i| i.cov).collect();
-    let jm: Vec<_> = inc.iter().map(|i| i.j_m).collect();
-    let jb: Vec<Mat3> = inc.iter().map(|i| i.j_b).collect();
-    Ok((quat_to_py(py, &q), mats_to_py(py, &cov), mats_to_py(py, &jm), mats_to_py(py, &jb)))
+    let sens = (model.mode == GyroErrorMode::Consistent).then(|| {
+        let (jm, jb): (Vec<_>, Vec<Mat3>) = inc.iter().filter_map(|i| i.sensitivities).unzip();
+        (mats_to_py(py, &jm), mats_to_py(py, &jb))
+    });
+    Ok((quat_to_py(py, &q), mats_to_py(py, &cov), sens))
 }
 
 #[pyfunction]
@@ -185,6 +189,7 @@ fn diff_form(s: &str) -> Result<DiffForm, NavError> {
 
 #[pyfunction]
 #[pyo3(signature = (ds_imu, ds_avu, init="axes", c0=None, max_iter=50, tol=1e-9, residual_form="full"))]
+#[allow(clippy::too_many_arguments)]
 fn astro_calibrate<'py>(
     py: Python<'py>,
     ds_imu: PyReadonlyArray3<'py, f64>,
@@ -241,7 +246,7 @@ fn astro_star_attitudes<'py>(
     sigma_s: f64,
     up_gcrs: Option<PyReadonlyArray2<'py, f64>>,
     n_refr: f64,
-) -> PyResult<(Bound<'py, PyArray3<f64>>, Bound<'py, PyArray3<f64>>, Bound<'py, PyArray1<i64>>)> {
+) -> PyResult<(Arr3<'py>, Arr3<'py>, Bound<'py, PyArray1<i64>>)> {
     let obs = Observations { epoch: indices(&epoch, "epoch")?, camera: indices(&camera, "camera")?, s_cf: vec3_rows(&s_cf, "star_directions")?, g: vec3_rows(&g, "catalog_directions")? };
     let cams = cameras_arg(&cameras, &p_alpha)?;
     let up = up_gcrs.map(|u| vec3_rows(&u, "up_gcrs")).transpose()?;
@@ -251,7 +256,7 @@ fn astro_star_attitudes<'py>(
 }
 
 #[pyfunction]
-fn astro_astro_increments<'py>(py: Python<'py>, s: PyReadonlyArray3<'py, f64>, p: PyReadonlyArray3<'py, f64>) -> PyResult<(Bound<'py, PyArray3<f64>>, Bound<'py, PyArray3<f64>>)> {
+fn astro_astro_increments<'py>(py: Python<'py>, s: PyReadonlyArray3<'py, f64>, p: PyReadonlyArray3<'py, f64>) -> PyResult<(Arr3<'py>, Arr3<'py>)> {
     let (s, p) = (mats::<3, 3>(&s, "s_vf")?, mats::<3, 3>(&p, "p_avu")?);
     if s.len() != p.len() {
         return Err(invalid("p_avu", format!("expected {} covariances, got {}", s.len(), p.len())).into());
@@ -263,8 +268,10 @@ fn astro_astro_increments<'py>(py: Python<'py>, s: PyReadonlyArray3<'py, f64>, p
     Ok((mats_to_py(py, &ds), mats_to_py(py, &e)))
 }
 
+type CatalogArrays<'py> = (Bound<'py, PyArray2<f64>>, Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<u64>>);
+
 #[pyfunction]
-fn astro_synthetic_catalog<'py>(py: Python<'py>, m_lim: f64, seed: u64) -> PyResult<(Bound<'py, PyArray2<f64>>, Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<u64>>)> {
+fn astro_synthetic_catalog<'py>(py: Python<'py>, m_lim: f64, seed: u64) -> PyResult<CatalogArrays<'py>> {
     let c = Catalog::synthetic(m_lim, seed)?;
     Ok((vec3_to_py(py, &c.dirs), c.mags.into_pyarray(py), c.ids.into_pyarray(py)))
 }

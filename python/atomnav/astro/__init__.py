@@ -93,14 +93,14 @@ class GyroErrorModel:
 @dataclass(frozen=True)
 class Increments:
     """Gyro increments between epochs: q (M, 4) scalar first with R(q) = ΔS^imu (dcm),
-    covariance E^imu (M, 3, 3) rad², sensitivities j_m (M, 3, 9) to vec_rowmajor(M_G) and
-    j_b (M, 3, 3) to the rate bias (rad/s → rad)."""
+    covariance E^imu (M, 3, 3) rad²; in "consistent" mode the sensitivities j_m (M, 3, 9)
+    to vec_rowmajor(M_G) and j_b (M, 3, 3) to the rate bias (rad/s → rad), else None."""
 
     q: np.ndarray
     dcm: np.ndarray
     cov: np.ndarray
-    j_m: np.ndarray
-    j_b: np.ndarray
+    j_m: np.ndarray | None
+    j_b: np.ndarray | None
 
     @property
     def sigma_rad(self) -> np.ndarray:
@@ -117,8 +117,9 @@ def gyro_increments(t_start: float, period: float, rho, epochs, model: GyroError
     ``taylor_variant`` "corrected" (c = 1/8, default) or "paper_literal" (c = 1/4) (D1).
     """
     choice(taylor_variant, {"corrected", "paper_literal"}, "taylor_variant")
-    q, cov, jm, jb = _core.astro_increments(float(t_start), positive(period, "period"), rows(rho, 3, "gyro_increments"),
+    q, cov, sens = _core.astro_increments(float(t_start), positive(period, "period"), rows(rho, 3, "gyro_increments"),
                                             vector(epochs, None, "epochs"), model._sigmas(), model.mode, taylor_variant)
+    jm, jb = sens if sens is not None else (None, None)
     return Increments(q=q, dcm=_core.dcm_from_quat_rows(q) if len(q) else np.zeros((0, 3, 3)), cov=cov, j_m=jm, j_b=jb)
 
 
