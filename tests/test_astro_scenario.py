@@ -45,3 +45,20 @@ def test_single_run_quantities(scn):
     assert r["theta_diff"].shape == (72, 3) and r["p_diff"].shape == (72, 3, 3)
     # the sandwich covariance is a covariance of θ^clb in MF: P^clb = C P_θ Cᵀ
     assert np.allclose(cal.p_clb, cal.c @ cal.p_theta @ cal.c.T, rtol=1e-9, atol=0)
+
+
+def test_consistent_mode_model_prediction_matches_spec():
+    # spec §5.2 row 21: model + systematic prediction (6.53, 3.03, 3.37)″ with constant gyro errors
+    r = astro.Vasilyuk2024(gyro_error_model="consistent").run(3)
+    sd = np.sqrt(np.diag(r["p_beta_model"])) / AS
+    assert np.allclose(sd, [6.53, 3.03, 3.37], rtol=0.1), sd
+    assert np.all(np.diag(r["p_beta_sys"]) < np.diag(r["p_beta_model"]))
+
+
+@pytest.mark.slow
+def test_consistent_mode_predicts_constant_error_spread():
+    df = astro.Vasilyuk2024(gyro_error_model="consistent").monte_carlo(200, seed0=0)
+    err = df[["err_psi_rad", "err_theta_rad", "err_gamma_rad"]].to_numpy()
+    model = df[["sigma_model_psi_rad", "sigma_model_theta_rad", "sigma_model_gamma_rad"]].to_numpy()
+    ratio = err.std(axis=0) / np.sqrt((model ** 2).mean(axis=0))
+    assert np.all(np.abs(ratio - 1) < 0.15), ratio

@@ -5,7 +5,8 @@
 use super::{d1, d2, euler_from_dcm, nearest_rotation, rotation_angle, vee};
 use crate::error::{invalid, NavError, Result};
 use crate::math::{dcm_from_rotvec, rotvec_from_dcm, skew, Mat3, Vec3};
-use nalgebra::SymmetricEigen;
+use super::increments::Mat39;
+use nalgebra::{SMatrix, SymmetricEigen};
 
 /// κ below which a trajectory cannot determine the mount, and below which it is weak (D16).
 pub const KAPPA_REJECT: f64 = 1e-12;
@@ -295,6 +296,57 @@ pub fn calibrate(ds_imu: &[Mat3], ds_avu: &[Mat3], opt: &Options) -> Result<Cali
         singular_values,
         observability: obs,
     })
+}
+
+/// Constant gyro errors of the consistent mode (E8): per-interval sensitivities
+/// (J_m,n, J_b,n), P_m of vec_rowmajor(M_G) and σ_b (rad/s).
+pub struct ConstantGyroErrors<'a> {
+    pub sensitivities: &'a [(Mat39, Mat3)],
+    pub p_m: SMatrix<f64, 9, 9>,
+    pub sigma_b: f64,
+}
+
+/// Model-form covariance of β (spec E18): P_β^model = (HᵀH)⁻¹HᵀΣ_fH(HᵀH)⁻¹ with Σ_f from the
+/// error models — diagonal blocks CᵀE_n^imuC + E_n^avu, the E13 neighbour blocks
+/// cov(ε_n, ε_{n+1}) = −P_n^avu ΔS_{n+1}, and with constant gyro errors the cross blocks
+/// Cᵀ(J_m,n P_m J_m,pᵀ + J_b,n P_b J_b,pᵀ)C — and its systematic part
+/// P_β^sys = G_mP_mG_mᵀ + G_bP_bG_bᵀ, G = −(HᵀH)⁻¹Σ_n H_nᵀCᵀJ_n. Returns (P_β^model, P_β^sys) in rad².
+pub fn model_covariance(cal: &Calibration, ds_imu: &[Mat3], ds_avu: &[Mat3], e_imu: &[Mat3], p_avu: &[Mat3], constant: Option<&ConstantGyroErrors>) -> Result<(Mat3, Mat3)> {
+    let m = ds_imu.len();
+    if e_imu.len() != m || p_avu.len() != m + 1 || constant.is_some_and(|k| k.sensitivities.len() != m) {
+        return Err(invalid("e_imu", format!("expected {m} interval covariances (and sensitivities) and {} epoch covariances", m + 1)));
+    }
+    let c = &cal.c;
+    let h: Vec<Mat3> = ds_imu.iter().zip(ds_avu).map(|(i, a)| jacobian_block(c, i, a)).collect();
+    let a_inv = h.iter().map(|h| h.transpose() * h).sum::<Mat3>().try_inverse().ok_or_else(|| NavError::Numerical("singular HᵀH".into()))?;
+    let (mut g_m, mut g_b) = (SMatrix::<f64, 3, 9>::zeros(), Mat3::zeros());
+    let mut mid = Mat3::zeros();
+    for n in 0..m {
+        let mut e = e_imu[n];
+        if let Some(k) = constant {
+            // the constant part enters through g_m, g_b below (all n, p pairs at once)
+            let (jm, jb) = &k.sensitivities[n];
+            e -= jm * k.p_m * jm.transpose() + jb * jb.transpose() * k.sigma_b.powi(2);
+            g_m += h[n].transpose() * c.transpose() * jm;
+            g_b += h[n].transpose() * c.transpose() * jb;
+        }
+        let e_avu = p_avu[n + 1] + ds_avu[n].transpose() * p_avu[n] * ds_avu[n];
+        mid += h[n].transpose() * (c.transpose() * e * c + e_avu) * h[n];
+        if n + 1 < m {
+            let x = h[n].transpose() * (-p_avu[n + 1] * ds_avu[n + 1]) * h[n + 1];
+            mid += x + x.transpose();
+        }
+    }
+    let d1_inv = d1(&cal.beta).try_inverse().ok_or_else(|| NavError::Numerical("Euler angles at gimbal lock (|ϑ| = 90°)".into()))?;
+    let to_beta = |p: Mat3| d1_inv * p * d1_inv.transpose();
+    let p_sys = match constant {
+        Some(k) => {
+            let (gm, gb) = (a_inv * g_m, a_inv * g_b);
+            gm * k.p_m * gm.transpose() + gb * gb.transpose() * k.sigma_b.powi(2)
+        }
+        None => Mat3::zeros(),
+    };
+    Ok((to_beta(a_inv * mid * a_inv + p_sys), to_beta(p_sys)))
 }
 
 /// P^mfa = C P^avu Cᵀ + P^clb: IMU attitude from stars through the calibrated mount (Eq. 8, E19).

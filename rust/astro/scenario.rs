@@ -5,7 +5,7 @@
 //! obtained with T = [[0,1,0],[1,0,0],[0,0,−1]] (T = Tᵀ = T⁻¹, det T = 1):
 //! C_ENU^MF = T C_nb T, ρ_MF = T ρ_FRD. This gives C_ENU^MF = R_ϑ(τ) R_ψ(ψ_t) as in §5.1.
 
-use super::calibration::{calibrate, dead_reckoning_check, Calibration, DiffForm, Options};
+use super::calibration::{calibrate, dead_reckoning_check, model_covariance, Calibration, ConstantGyroErrors, DiffForm, Options};
 use super::increments::{dead_reckoning_cov, integrate_increments, GyroErrorMode, GyroErrorModel, ImuRecord, TaylorVariant};
 use super::stars::{astro_increments, refractive_index, simulate_observations, star_attitudes, Camera, Catalog, Observations};
 use super::euler_dcm;
@@ -120,6 +120,9 @@ pub struct Run {
     pub ds_avu: Vec<Mat3>,
     pub e_avu: Vec<Mat3>,
     pub calibration: Calibration,
+    /// P_β^model and its systematic part P_β^sys (rad², E18) from the scenario's gyro mode.
+    pub p_beta_model: Mat3,
+    pub p_beta_sys: Mat3,
     /// β̂ − β̆ (rad) and the VF rotation error log(C̆ᵀ Ĉ) (rad).
     pub beta_error: Vec3,
     pub theta_error: Vec3,
@@ -139,6 +142,9 @@ pub fn run(scn: &Scenario, seed: u64, opt: &Options, diff_form: DiffForm) -> Res
     let (ds_imu, e_imu): (Vec<Mat3>, Vec<Mat3>) = inc.iter().map(|i| (i.dcm(), i.cov)).unzip();
     let (ds_avu, e_avu) = astro_increments(&att.s, &att.p);
     let cal = calibrate(&ds_imu, &ds_avu, opt)?;
+    let sens: Vec<_> = inc.iter().filter_map(|i| i.sensitivities).collect();
+    let constant = (scn.gyro.mode == GyroErrorMode::Consistent).then(|| ConstantGyroErrors { sensitivities: &sens, p_m: scn.gyro.p_m(), sigma_b: scn.gyro.sigma_b });
+    let (p_beta_model, p_beta_sys) = model_covariance(&cal, &ds_imu, &ds_avu, &e_imu, &att.p, constant.as_ref())?;
     let p_imu = dead_reckoning_cov(&rec, &scn.epochs, &scn.gyro)?;
     let (theta_diff, p_diff) = dead_reckoning_check(&cal.c, &att.s, &ds_imu, &att.p, &p_imu, &cal.p_clb, diff_form)?;
     let beta_true = super::euler_from_dcm(&scn.c_true);
@@ -154,6 +160,8 @@ pub fn run(scn: &Scenario, seed: u64, opt: &Options, diff_form: DiffForm) -> Res
         ds_avu,
         e_avu,
         calibration: cal,
+        p_beta_model,
+        p_beta_sys,
         theta_diff,
         p_diff,
     })
@@ -163,8 +171,9 @@ pub fn run(scn: &Scenario, seed: u64, opt: &Options, diff_form: DiffForm) -> Res
 #[derive(Debug, Clone, Copy)]
 pub struct RunSummary {
     pub beta_error: Vec3,
-    /// √diag P_β (rad).
+    /// √diag P_β (residual form) and √diag P_β^model (rad).
     pub sigma_beta: Vec3,
+    pub sigma_beta_model: Vec3,
     /// Fraction of θ^diff components inside their ±3σ bands and the mean χ² of θ^diff.
     pub inside_3sigma: f64,
     pub chi2_diff: f64,
@@ -190,10 +199,11 @@ pub fn monte_carlo(scn: &Scenario, runs: usize, seed0: u64, opt: &Options, diff_
                 .map(|(t, p)| p.try_inverse().map_or(f64::INFINITY, |pi| (t.transpose() * pi * t)[0]))
                 .sum::<f64>()
                 / r.theta_diff.len() as f64;
-            let pb = r.calibration.p_beta;
+            let sd = |p: &Mat3| Vec3::new(p[(0, 0)].sqrt(), p[(1, 1)].sqrt(), p[(2, 2)].sqrt());
             Ok(RunSummary {
                 beta_error: r.beta_error,
-                sigma_beta: Vec3::new(pb[(0, 0)].sqrt(), pb[(1, 1)].sqrt(), pb[(2, 2)].sqrt()),
+                sigma_beta: sd(&r.calibration.p_beta),
+                sigma_beta_model: sd(&r.p_beta_model),
                 inside_3sigma: inside as f64 / comps as f64,
                 chi2_diff: chi2,
                 iterations: r.calibration.iterations,

@@ -386,6 +386,8 @@ fn run_dict<'py>(py: Python<'py>, r: &Run) -> PyResult<Bound<'py, PyDict>> {
     d.set_item("ds_avu", mats_to_py(py, &r.ds_avu))?;
     d.set_item("e_avu", mats_to_py(py, &r.e_avu))?;
     d.set_item("calibration", calibration_dict(py, &r.calibration)?)?;
+    d.set_item("p_beta_model", mat_to_py(py, &r.p_beta_model))?;
+    d.set_item("p_beta_sys", mat_to_py(py, &r.p_beta_sys))?;
     d.set_item("beta_error", vec_to_py(py, &r.beta_error))?;
     d.set_item("theta_error", vec_to_py(py, &r.theta_error))?;
     d.set_item("theta_diff", vec3_to_py(py, &r.theta_diff))?;
@@ -415,7 +417,7 @@ impl PyScenario {
         run_dict(py, &r)
     }
 
-    /// Per run: β̂ − β̆ (rad), √diag P_β (rad), fraction of θ^diff components within ±3σ,
+    /// Per run: β̂ − β̆ (rad), √diag P_β and √diag P_β^model (rad), fraction of θ^diff components within ±3σ,
     /// mean χ² of θ^diff, Gauss–Newton iterations.
     #[pyo3(signature = (runs, seed0=0, p_diff="full"))]
     fn monte_carlo<'py>(&self, py: Python<'py>, runs: usize, seed0: u64, p_diff: &str) -> PyResult<Bound<'py, PyDict>> {
@@ -424,6 +426,7 @@ impl PyScenario {
         let d = PyDict::new(py);
         d.set_item("beta_error", vec3_to_py(py, &s.iter().map(|r| r.beta_error).collect::<Vec<_>>()))?;
         d.set_item("sigma_beta", vec3_to_py(py, &s.iter().map(|r| r.sigma_beta).collect::<Vec<_>>()))?;
+        d.set_item("sigma_beta_model", vec3_to_py(py, &s.iter().map(|r| r.sigma_beta_model).collect::<Vec<_>>()))?;
         d.set_item("inside_3sigma", s.iter().map(|r| r.inside_3sigma).collect::<Vec<_>>().into_pyarray(py))?;
         d.set_item("chi2_diff", s.iter().map(|r| r.chi2_diff).collect::<Vec<_>>().into_pyarray(py))?;
         d.set_item("iterations", s.iter().map(|r| r.iterations as i64).collect::<Vec<_>>().into_pyarray(py))?;

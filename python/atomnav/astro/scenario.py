@@ -30,7 +30,7 @@ class Vasilyuk2024:
 
     def run(self, seed: int, init: str = "axes", p_diff: str = "full") -> dict:
         """One full chain with noise seed ``seed``: observations, star attitudes and P^avu,
-        ΔS^imu/E^imu, ΔS^avu/E^avu, the :class:`Calibration`, β̂ − β̆ (rad), the VF rotation
+        ΔS^imu/E^imu, ΔS^avu/E^avu, the :class:`Calibration`, P_β^model and P_β^sys (rad², E18), β̂ − β̆ (rad), the VF rotation
         error (rad), θ^diff (N−1, 3) rad and P^diff (``p_diff`` "full" | "paper", D10)."""
         d = self._core.run(int(seed), choice(init, {"axes", "zero"}, "init"), choice(p_diff, {"full", "paper"}, "p_diff"))
         d["calibration"] = Calibration(**d["calibration"], gyro_error_model=self.gyro_error_model)
@@ -38,13 +38,14 @@ class Vasilyuk2024:
         return d
 
     def monte_carlo(self, runs: int, seed0: int = 0, p_diff: str = "full") -> pd.DataFrame:
-        """One row per run (seeds seed0, seed0+1, …): β̂ − β̆ and √diag P_β (rad) for
-        ψ, ϑ, γ, the fraction of θ^diff components within ±3σ, mean χ² of θ^diff, iterations."""
+        """One row per run (seeds seed0, seed0+1, …): β̂ − β̆, √diag P_β (residual form) and
+        √diag P_β^model (model form incl. constant gyro errors in "consistent" mode) (rad) for ψ, ϑ, γ, the fraction of θ^diff components within ±3σ, mean χ² of θ^diff, iterations."""
         d = self._core.monte_carlo(int(runs), int(seed0), choice(p_diff, {"full", "paper"}, "p_diff"))
         cols = {}
         for i, a in enumerate(("psi", "theta", "gamma")):
             cols[f"err_{a}_rad"] = d["beta_error"][:, i]
             cols[f"sigma_{a}_rad"] = d["sigma_beta"][:, i]
+            cols[f"sigma_model_{a}_rad"] = d["sigma_beta_model"][:, i]
         cols["inside_3sigma"] = d["inside_3sigma"]
         cols["chi2_diff"] = d["chi2_diff"]
         cols["iterations"] = d["iterations"]
