@@ -52,6 +52,12 @@ def astro_vasilyuk2024(report):
                f"{r['stars_per_epoch'].mean() / 108:.2f}×")
     report.row("P_β is precision conditional on the IMU calibration (D17)", "—", "σφG/√2 ≈ 2.1″ floor", "info")
 
+    rc = astro.Vasilyuk2024(gyro_error_model="consistent").run(0)
+    sd = np.sqrt(np.diag(rc["p_beta_model"])) / AS
+    for i, (name, spec) in enumerate([("ψ", 6.53), ("ϑ", 3.03), ("γ", 3.37)]):
+        report.row(f"constant gyro errors: model σβ {name} (″) (paper propagates them as white)",
+                   f"— (spec row 21: {spec})", float(sd[i]), f"{sd[i] / spec:.2f}× spec")
+
     n = np.arange(2, len(r["ds_imu"]) + 2)
     dphi = (_angle(r["ds_avu"]) - _angle(r["ds_imu"])) / AS
     s_ains = np.sqrt(np.trace(r["e_avu"], axis1=1, axis2=2) + np.trace(r["e_imu"], axis1=1, axis2=2)) / AS
