@@ -130,3 +130,13 @@ def test_increment_not_a_rotation_rejected():
     bad[2] *= 1.001
     with pytest.raises(ValueError, match="ds_avu.*not a rotation matrix at index 2"):
         astro.calibrate(ds, bad)
+
+
+def test_paper_euler_solver_agrees_with_so3_from_zero():
+    # spec row 8: the paper's Euler GN (FD Jacobian, β0 = 0) reaches the SO(3) solution; row 7: few iterations
+    r = astro.Vasilyuk2024().run(5)
+    so3 = r["calibration"]
+    euler = astro.calibrate(r["ds_imu"], r["ds_avu"], init="zero", solver="paper_euler")
+    assert Rotation.from_matrix(so3.c.T @ euler.c).magnitude() < 1e-9
+    assert euler.iterations <= 8
+    assert np.allclose(euler.p_beta, so3.p_beta, rtol=1e-6, atol=0)

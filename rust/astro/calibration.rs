@@ -2,7 +2,7 @@
 //! E14–E20): identifiability, closed-form start, Gauss–Newton on SO(3), the sandwich
 //! covariance P_β, P^clb, P^mfa and the dead-reckoning consistency check.
 
-use super::{d1, d2, euler_from_dcm, nearest_rotation, rotation_angle, vee};
+use super::{d1, d2, euler_dcm, euler_from_dcm, nearest_rotation, rotation_angle, vee};
 use crate::error::{invalid, NavError, Result};
 use crate::math::{dcm_from_rotvec, rotvec_from_dcm, skew, Mat3, Vec3};
 use super::increments::Mat39;
@@ -140,18 +140,28 @@ pub enum ResidualForm {
     Diagonal,
 }
 
+/// Gauss–Newton parametrisation (spec E17, D3, D8).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Solver {
+    /// C_j = C_{j−1} exp([Δθ×]) with the analytic Jacobian (default).
+    So3,
+    /// The paper's β_j = β_{j−1} − (HᵀH)⁻¹Hᵀf with a central-difference Jacobian in β.
+    PaperEuler,
+}
+
 #[derive(Debug, Clone, Copy)]
 pub struct Options {
     pub init: Init,
+    pub solver: Solver,
     pub max_iter: usize,
-    /// Stop when ‖Δθ‖ ≤ tol (rad) (paper: 1e-9).
+    /// Stop when ‖Δθ‖ (SO(3)) or ‖Δβ‖ (Euler) ≤ tol (rad) (paper: 1e-9).
     pub tol: f64,
     pub residual_form: ResidualForm,
 }
 
 impl Default for Options {
     fn default() -> Self {
-        Self { init: Init::Axes, max_iter: 50, tol: 1e-9, residual_form: ResidualForm::Full }
+        Self { init: Init::Axes, solver: Solver::So3, max_iter: 50, tol: 1e-9, residual_form: ResidualForm::Full }
     }
 }
 
@@ -201,6 +211,23 @@ fn normal_equations(c: &Mat3, ds_imu: &[Mat3], ds_avu: &[Mat3]) -> (Mat3, Vec3) 
     (a, g)
 }
 
+/// The paper's Euler-angle Jacobian by central differences, step dx = 1e-6 rad (E17, D8):
+/// H_n[:, χ] = [f_n(β + ½dx e_χ) − f_n(β − ½dx e_χ)]/dx; normal equations as above.
+fn normal_equations_euler_fd(beta: &Vec3, ds_imu: &[Mat3], ds_avu: &[Mat3]) -> (Mat3, Vec3) {
+    const DX: f64 = 1e-6;
+    let cs: Vec<(Mat3, Mat3)> = (0..3).map(|i| (euler_dcm(&(beta + Vec3::ith(i, DX / 2.0))), euler_dcm(&(beta - Vec3::ith(i, DX / 2.0))))).collect();
+    let c = euler_dcm(beta);
+    let mut a = Mat3::zeros();
+    let mut g = Vec3::zeros();
+    for (i, s) in ds_imu.iter().zip(ds_avu) {
+        let cols: Vec<Vec3> = cs.iter().map(|(p, m)| (residual(p, i, s) - residual(m, i, s)) / DX).collect();
+        let h = Mat3::from_columns(&cols);
+        a += h.transpose() * h;
+        g += h.transpose() * residual(&c, i, s);
+    }
+    (a, g)
+}
+
 /// Gauss–Newton on SO(3): C_j = C_{j−1} exp([Δθ×]), Δθ = −(HᵀH)⁻¹Hᵀf, stop at ‖Δθ‖ ≤ tol
 /// (seed 001 §3, spec E17), then the sandwich covariance (E18).
 ///
@@ -229,13 +256,23 @@ pub fn calibrate(ds_imu: &[Mat3], ds_avu: &[Mat3], opt: &Options) -> Result<Cali
         Init::Given(c) => c,
     };
     let mut iterations = None;
+    let mut beta = euler_from_dcm(&c);
     for it in 1..=opt.max_iter {
-        let (a, g) = normal_equations(&c, ds_imu, ds_avu);
+        let (a, g) = match opt.solver {
+            Solver::So3 => normal_equations(&c, ds_imu, ds_avu),
+            Solver::PaperEuler => normal_equations_euler_fd(&beta, ds_imu, ds_avu),
+        };
         let dth = match a.cholesky() {
             Some(ch) => -ch.solve(&g),
             None => return Err(NavError::Numerical(format!("Gauss–Newton: singular HᵀH at iteration {it}"))),
         };
-        c *= dcm_from_rotvec(&dth);
+        match opt.solver {
+            Solver::So3 => c *= dcm_from_rotvec(&dth),
+            Solver::PaperEuler => {
+                beta += dth;
+                c = euler_dcm(&beta);
+            }
+        }
         if !dth.norm().is_finite() {
             return Err(NavError::Numerical(format!("Gauss–Newton: non-finite step at iteration {it}")));
         }
@@ -402,7 +439,6 @@ pub fn dead_reckoning_check(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::astro::euler_dcm;
     use rand::{Rng, SeedableRng};
     use rand_chacha::ChaCha8Rng;
 

@@ -1,7 +1,7 @@
 //! Bindings of astro/: gyro increments, star attitudes, mount calibration, scenario runs.
 
 use super::convert::{rows_to_py, vec3_rows, vec3_to_py, vector, quat_to_py};
-use crate::astro::calibration::{self, Calibration, DiffForm, Init, Observability, Options, ResidualForm, Verdict};
+use crate::astro::calibration::{self, Calibration, DiffForm, Init, Observability, Options, ResidualForm, Solver, Verdict};
 use crate::astro::increments::{self, GyroErrorMode, GyroErrorModel, ImuRecord, TaylorVariant};
 use crate::astro::scenario::{self, Run, Scenario};
 use crate::astro::stars::{self, Camera, Catalog, Observations};
@@ -160,7 +160,7 @@ fn calibration_dict<'py>(py: Python<'py>, c: &Calibration) -> PyResult<Bound<'py
     Ok(d)
 }
 
-fn options(init: &str, c0: Option<PyReadonlyArray2<'_, f64>>, max_iter: usize, tol: f64, residual_form: &str) -> Result<Options, NavError> {
+fn options(init: &str, c0: Option<PyReadonlyArray2<'_, f64>>, solver: &str, max_iter: usize, tol: f64, residual_form: &str) -> Result<Options, NavError> {
     let init = match (init, c0) {
         ("axes", None) => Init::Axes,
         ("zero", None) => Init::Zero,
@@ -172,11 +172,16 @@ fn options(init: &str, c0: Option<PyReadonlyArray2<'_, f64>>, max_iter: usize, t
         "diagonal" => ResidualForm::Diagonal,
         _ => return Err(invalid("residual_form", format!("expected 'full' or 'diagonal', got '{residual_form}'"))),
     };
+    let solver = match solver {
+        "so3" => Solver::So3,
+        "paper_euler" => Solver::PaperEuler,
+        _ => return Err(invalid("solver", format!("expected 'so3' or 'paper_euler', got '{solver}'"))),
+    };
     if max_iter == 0 {
         return Err(invalid("max_iter", "must be ≥ 1"));
     }
     crate::error::check_positive("tol", tol)?;
-    Ok(Options { init, max_iter, tol, residual_form })
+    Ok(Options { init, solver, max_iter, tol, residual_form })
 }
 
 fn diff_form(s: &str) -> Result<DiffForm, NavError> {
@@ -188,7 +193,7 @@ fn diff_form(s: &str) -> Result<DiffForm, NavError> {
 }
 
 #[pyfunction]
-#[pyo3(signature = (ds_imu, ds_avu, init="axes", c0=None, max_iter=50, tol=1e-9, residual_form="full"))]
+#[pyo3(signature = (ds_imu, ds_avu, init="axes", c0=None, solver="so3", max_iter=50, tol=1e-9, residual_form="full"))]
 #[allow(clippy::too_many_arguments)]
 fn astro_calibrate<'py>(
     py: Python<'py>,
@@ -196,12 +201,13 @@ fn astro_calibrate<'py>(
     ds_avu: PyReadonlyArray3<'py, f64>,
     init: &str,
     c0: Option<PyReadonlyArray2<'py, f64>>,
+    solver: &str,
     max_iter: usize,
     tol: f64,
     residual_form: &str,
 ) -> PyResult<Bound<'py, PyDict>> {
     let (a, b) = (mats::<3, 3>(&ds_imu, "ds_imu")?, mats::<3, 3>(&ds_avu, "ds_avu")?);
-    let opt = options(init, c0, max_iter, tol, residual_form)?;
+    let opt = options(init, c0, solver, max_iter, tol, residual_form)?;
     let cal = py.detach(|| calibration::calibrate(&a, &b, &opt))?;
     calibration_dict(py, &cal)
 }
@@ -411,7 +417,7 @@ impl PyScenario {
 
     #[pyo3(signature = (seed, init="axes", p_diff="full"))]
     fn run<'py>(&self, py: Python<'py>, seed: u64, init: &str, p_diff: &str) -> PyResult<Bound<'py, PyDict>> {
-        let opt = options(init, None, 50, 1e-9, "full")?;
+        let opt = options(init, None, "so3", 50, 1e-9, "full")?;
         let form = diff_form(p_diff)?;
         let r = py.detach(|| scenario::run(&self.inner, seed, &opt, form))?;
         run_dict(py, &r)

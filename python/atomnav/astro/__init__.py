@@ -187,13 +187,14 @@ class Calibration:
                        gyro_error_model=str(z["gyro_error_model"]), caveat=str(z["caveat"]))
 
 
-def calibrate(ds_imu, ds_avu, init: str = "axes", c0=None, max_iter: int = 50, tol: float = 1e-9,
-              residual_form: str = "full", gyro_error_model: str = "unspecified") -> Calibration:
+def calibrate(ds_imu, ds_avu, init: str = "axes", c0=None, solver: str = "so3", max_iter: int = 50,
+              tol: float = 1e-9, residual_form: str = "full", gyro_error_model: str = "unspecified") -> Calibration:
     """Mount C_MF^VF from increment pairs ΔS^avu = Cᵀ ΔS^imu C (seed 001 §3; spec E16–E18).
 
-    Gauss–Newton on SO(3) with the analytic Jacobian from ``init`` "axes" (closed-form
-    alignment of rotation axes, default), "zero" (paper's β0 = 0) or "given" (``c0``);
-    stops at ‖Δθ‖ ≤ ``tol`` rad, at most ``max_iter`` iterations. P_β is the paper's
+    Gauss–Newton from ``init`` "axes" (closed-form alignment of rotation axes, default),
+    "zero" (paper's β0 = 0) or "given" (``c0``); ``solver`` "so3" (C ← C exp([Δθ×]),
+    analytic Jacobian, default) or "paper_euler" (β ← β + Δβ, central differences with
+    dx = 1e-6); stops at a step ≤ ``tol`` rad, at most ``max_iter`` iterations. P_β is the paper's
     residual sandwich with P_S "full" (default) or "diagonal".
 
     Raises ValueError when the trajectory cannot determine the mount (κ < 1e-12; the
@@ -202,7 +203,8 @@ def calibrate(ds_imu, ds_avu, init: str = "axes", c0=None, max_iter: int = 50, t
     """
     choice(init, {"axes", "zero", "given"}, "init")
     c0 = None if c0 is None else rows(c0, 3, "c0")
-    d = _core.astro_calibrate(_mats(ds_imu, "ds_imu"), _mats(ds_avu, "ds_avu"), init, c0, int(max_iter),
+    choice(solver, {"so3", "paper_euler"}, "solver")
+    d = _core.astro_calibrate(_mats(ds_imu, "ds_imu"), _mats(ds_avu, "ds_avu"), init, c0, solver, int(max_iter),
                               float(tol), choice(residual_form, {"full", "diagonal"}, "residual_form"))
     if d["observability"]["verdict"] == "warn":
         k = d["observability"]["weak_axis_vf"]
