@@ -405,7 +405,7 @@ fn run_dict<'py>(py: Python<'py>, r: &Run) -> PyResult<Bound<'py, PyDict>> {
 impl PyScenario {
     /// `vasilyuk2024_like` (spec §5.1) with catalog seed and gyro truth "paper" | "consistent".
     #[new]
-    #[pyo3(signature = (catalog_seed=1, gyro_error_model="paper"))]
+    #[pyo3(signature = (catalog_seed=3, gyro_error_model="paper"))]
     fn new(py: Python<'_>, catalog_seed: u64, gyro_error_model: &str) -> PyResult<Self> {
         let mode = GyroErrorMode::parse(gyro_error_model)?;
         Ok(Self { inner: py.detach(|| scenario::vasilyuk2024_like(catalog_seed, mode))? })
