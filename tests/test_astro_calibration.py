@@ -5,7 +5,7 @@ import pytest
 from scipy.spatial.transform import Rotation
 
 import atomnav
-from atomnav import astro
+from atomnav import astro, units
 
 
 def _spec_euler(b):
@@ -140,3 +140,18 @@ def test_paper_euler_solver_agrees_with_so3_from_zero():
     assert Rotation.from_matrix(so3.c.T @ euler.c).magnitude() < 1e-9
     assert euler.iterations <= 8
     assert np.allclose(euler.p_beta, so3.p_beta, rtol=1e-6, atol=0)
+
+
+def test_weak_direction_sigma_per_arcsec_of_residual(stand_truth):
+    # spec row 12 / E15: the weakest direction of the §5.1 geometry is ≈ MF z (heading) and
+    # σ_weak per 1″ isotropic residual is 1/√λ_min(G); residuals of exactly 1″ rms per axis.
+    tr, ds_imu = stand_truth
+    c = tr["c_true"]
+    ds_avu = np.einsum("ji,njk,kl->nil", c, ds_imu, c)
+    obs = astro.observability(ds_avu)
+    rng = np.random.default_rng(8)
+    noise = rng.normal(0, 1.0, (len(ds_imu), 3))
+    noise *= units.ARCSEC / np.sqrt((noise ** 2).mean())
+    est = astro.calibrate(ds_imu, ds_avu @ Rotation.from_rotvec(noise).as_matrix())
+    assert est.sigma_weak == pytest.approx(units.ARCSEC / np.sqrt(obs["eigenvalues"][0]), rel=0.05)
+    assert abs(est.weak_axis_mf[2]) > 0.9

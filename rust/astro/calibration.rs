@@ -182,6 +182,10 @@ pub struct Calibration {
     /// Singular values of the stacked Jacobian H at the solution (descending) and their ratio.
     pub singular_values: Vec3,
     pub condition_number: f64,
+    /// The weakest direction of θ^clb in MF (C times the VF one) and σ_weak = σ̂_f/√λ_min(G)
+    /// (rad) with σ̂_f² = tr P_S / 3 (E15).
+    pub weak_axis_mf: Vec3,
+    pub sigma_weak: f64,
     pub observability: Observability,
 }
 
@@ -331,6 +335,8 @@ pub fn calibrate(ds_imu: &[Mat3], ds_avu: &[Mat3], opt: &Options) -> Result<Cali
         p_clb,
         condition_number: singular_values.x / singular_values.z,
         singular_values,
+        weak_axis_mf: c * obs.weak_axis_vf(),
+        sigma_weak: (p_s.trace() / 3.0).sqrt() / obs.eigenvalues.x.max(0.0).sqrt(),
         observability: obs,
     })
 }

@@ -156,6 +156,8 @@ fn calibration_dict<'py>(py: Python<'py>, c: &Calibration) -> PyResult<Bound<'py
     d.set_item("p_clb", mat_to_py(py, &c.p_clb))?;
     d.set_item("singular_values", vec_to_py(py, &c.singular_values))?;
     d.set_item("condition_number", c.condition_number)?;
+    d.set_item("weak_axis_mf", vec_to_py(py, &c.weak_axis_mf))?;
+    d.set_item("sigma_weak", c.sigma_weak)?;
     d.set_item("observability", observability_dict(py, &c.observability)?)?;
     Ok(d)
 }

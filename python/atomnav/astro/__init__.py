@@ -137,14 +137,15 @@ def observability(ds_avu) -> dict:
     return _core.astro_observability(_mats(ds_avu, "ds_avu"))
 
 
-_RESULT_ARRAYS = ("c", "beta", "residuals", "p_s", "p_theta", "p_beta", "p_clb", "singular_values")
+_RESULT_ARRAYS = ("c", "beta", "residuals", "p_s", "p_theta", "p_beta", "p_clb", "singular_values", "weak_axis_mf")
 
 
 @dataclass
 class Calibration:
     """Calibrated mount C = C_MF^VF with β (rad), Gauss–Newton iterations, residuals f_n
     (rad), P_S, P_θ (VF), P_β, P^clb (MF) (rad²), singular values and condition number
-    of the stacked Jacobian, the identifiability report and the gyro-model provenance."""
+    of the stacked Jacobian, the weakest direction in MF with σ_weak = σ̂_f/√λ_min (rad),
+    the identifiability report (E15) and the gyro-model provenance."""
 
     c: np.ndarray
     beta: np.ndarray
@@ -157,6 +158,8 @@ class Calibration:
     p_clb: np.ndarray
     singular_values: np.ndarray
     condition_number: float
+    weak_axis_mf: np.ndarray
+    sigma_weak: float
     observability: dict
     gyro_error_model: str = "unspecified"
     caveat: str = D17_CAVEAT
@@ -174,7 +177,7 @@ class Calibration:
         """Save as .npz (arrays, scalars, observability, provenance, caveat)."""
         obs = {f"obs_{k}": np.asarray(v) for k, v in self.observability.items()}
         np.savez(path, **{k: getattr(self, k) for k in _RESULT_ARRAYS}, iterations=self.iterations,
-                 relative_misfit=self.relative_misfit, condition_number=self.condition_number,
+                 relative_misfit=self.relative_misfit, condition_number=self.condition_number, sigma_weak=self.sigma_weak,
                  gyro_error_model=self.gyro_error_model, caveat=self.caveat, **obs)
 
     @classmethod
@@ -183,7 +186,8 @@ class Calibration:
             kw = {k: z[k] for k in _RESULT_ARRAYS}
             obs = {k[4:]: (z[k].item() if z[k].ndim == 0 else z[k]) for k in z.files if k.startswith("obs_")}
             return cls(**kw, iterations=int(z["iterations"]), relative_misfit=float(z["relative_misfit"]),
-                       condition_number=float(z["condition_number"]), observability=obs,
+                       condition_number=float(z["condition_number"]), sigma_weak=float(z["sigma_weak"]),
+                       observability=obs,
                        gyro_error_model=str(z["gyro_error_model"]), caveat=str(z["caveat"]))
 
 
