@@ -5,7 +5,7 @@
 //! Interval n runs from epoch t_{E,n−1} to t_{E,n}; its increment q_n maps MF at t_{E,n}
 //! into MF at t_{E,n−1}: R(q_n) = ΔS_n^imu = S_{MF,n−1}^{MF,n} (spec E6).
 
-use crate::error::{check_finite, check_increasing, check_positive, invalid, Result};
+use crate::error::{check_increasing, check_positive, invalid, Result};
 use crate::math::{dcm_from_quat, quat, quat_normalize, skew, Mat3, Quat, Vec3};
 use nalgebra::SMatrix;
 
@@ -102,6 +102,14 @@ impl GyroErrorModel {
     }
 }
 
+/// (I − [ρ×]) E (I − [ρ×])ᵀ for symmetric E: with S = [ρ×] and X = E S, this is
+/// E + X + Xᵀ − S X (Sᵀ = −S), one product fewer than the two dense ones.
+fn transport(e: &Mat3, rho: &Vec3) -> Mat3 {
+    let s = skew(rho);
+    let x = e * s;
+    e + x + x.transpose() - s * x
+}
+
 /// Error state of one interval (E7/E8), started at zero; only the selected mode's terms
 /// are propagated.
 #[derive(Debug, Clone, Copy)]
@@ -125,9 +133,9 @@ impl ErrorPropagator {
     fn step(&mut self, rho: &Vec3, model: &GyroErrorModel, period: f64) {
         let a = Mat3::identity() - skew(rho);
         match self.mode {
-            GyroErrorMode::Paper => self.e = a * self.e * a.transpose() + model.sample_cov(rho, period),
+            GyroErrorMode::Paper => self.e = transport(&self.e, rho) + model.sample_cov(rho, period),
             GyroErrorMode::Consistent => {
-                self.e = a * self.e * a.transpose() + Mat3::identity() * (model.sigma_w * model.sigma_w * period);
+                self.e = transport(&self.e, rho) + Mat3::identity() * (model.sigma_w * model.sigma_w * period);
                 self.j_m = a * self.j_m;
                 for i in 0..3 {
                     for j in 0..3 {
@@ -168,8 +176,10 @@ impl ImuRecord<'_> {
         if !self.t_start.is_finite() {
             return Err(invalid("t_start", format!("must be finite, got {}", self.t_start)));
         }
-        let flat: Vec<f64> = self.rho.iter().flat_map(|v| v.iter().copied()).collect();
-        check_finite("gyro_increments", &flat, 3)
+        match self.rho.iter().position(|v| !v.iter().all(|x| x.is_finite())) {
+            None => Ok(()),
+            Some(i) => Err(invalid("gyro_increments", format!("non-finite value at index {i}"))),
+        }
     }
 
     /// Sample index j and fraction x ∈ [0, 1) of an instant inside the record.
@@ -202,11 +212,22 @@ impl ImuRecord<'_> {
 /// r0 = 1 − |ρ|²x²/8 − c(ρ·Δρ)(x³ − x²),
 /// r_v = (ρ/2)(x − |ρ|²x³/24) + (Δρ/4)(x² − x) + (ρ×Δρ)x³/24.
 pub fn intra_sample(rho: &Vec3, drho: &Vec3, x: f64, variant: TaylorVariant) -> Quat {
+    if x == 1.0 {
+        return full_sample(rho, drho);
+    }
     let r2 = rho.norm_squared();
     let (x2, x3) = (x * x, x * x * x);
     let r0 = 1.0 - r2 * x2 / 8.0 - variant.c() * rho.dot(drho) * (x3 - x2);
     let rv = rho * (0.5 * (x - r2 * x3 / 24.0)) + drho * (0.25 * (x2 - x)) + rho.cross(drho) * (x3 / 24.0);
     quat(r0, rv.x, rv.y, rv.z)
+}
+
+/// r(1) of E4 for a whole sample (x³ − x² = x² − x = 0): r0 = 1 − |ρ|²/8,
+/// r_v = (ρ/2)(1 − |ρ|²/24) + ρ×Δρ/24, the same for both Taylor variants.
+fn full_sample(rho: &Vec3, drho: &Vec3) -> Quat {
+    let r2 = rho.norm_squared();
+    let rv = rho * (0.5 - r2 / 48.0) + rho.cross(drho) / 24.0;
+    quat(1.0 - r2 / 8.0, rv.x, rv.y, rv.z)
 }
 
 /// The increment of one interval and its error model.
@@ -232,27 +253,25 @@ pub fn integrate_increments(rec: &ImuRecord, epochs: &[f64], model: &GyroErrorMo
     model.validate()?;
     rec.check_epochs(epochs)?;
     let r = |j: usize, x: f64| intra_sample(&rec.rho[j], &rec.drho(j), x, variant);
-    Ok(epochs
-        .windows(2)
-        .map(|w| {
-            let ((ja, xa), (jb, xb)) = (rec.locate(w[0]), rec.locate(w[1]));
-            // E5: q_1 = N(r(x0)* ∘ r(x_end of first sample)), then whole samples, then r(x_e).
-            let first_end = if ja == jb { xb } else { 1.0 };
-            let mut q = quat_normalize(&(r(ja, xa).conjugate() * r(ja, first_end)));
-            for j in ja + 1..jb {
-                q = quat_normalize(&(q * r(j, 1.0)));
-            }
-            if jb > ja {
-                q = quat_normalize(&(q * r(jb, xb)));
-            }
-            // E7/E8 over every sample touched by the interval.
-            let mut p = ErrorPropagator::zero(model.mode);
-            for rho in &rec.rho[ja..=jb] {
-                p.step(rho, model, rec.period);
-            }
-            Increment { q, cov: p.cov(model), sensitivities: p.sensitivities() }
-        })
-        .collect())
+    let interval = |w: &[f64]| {
+        let ((ja, xa), (jb, xb)) = (rec.locate(w[0]), rec.locate(w[1]));
+        // E5: q_1 = N(r(x0)* ∘ r(x_end of first sample)), then whole samples, then r(x_e).
+        let first_end = if ja == jb { xb } else { 1.0 };
+        let mut q = quat_normalize(&(r(ja, xa).conjugate() * r(ja, first_end)));
+        for j in ja + 1..jb {
+            q = quat_normalize(&(q * r(j, 1.0)));
+        }
+        if jb > ja {
+            q = quat_normalize(&(q * r(jb, xb)));
+        }
+        // E7/E8 over every sample touched by the interval.
+        let mut p = ErrorPropagator::zero(model.mode);
+        for rho in &rec.rho[ja..=jb] {
+            p.step(rho, model, rec.period);
+        }
+        Increment { q, cov: p.cov(model), sensitivities: p.sensitivities() }
+    };
+    Ok(epochs.windows(2).map(interval).collect())
 }
 
 /// Continuous dead-reckoning covariance P_n^imu at every epoch (spec E20): E7/E8 run from
