@@ -4,6 +4,7 @@
 //! Python bindings live in `py/` behind the `python` feature so `cargo test` and
 //! `cargo bench` never link libpython.
 
+pub mod astro;
 pub mod cai;
 pub mod earth;
 pub mod error;

@@ -2,6 +2,7 @@
 
 use pyo3::prelude::*;
 
+mod astro;
 mod cai;
 mod convert;
 mod earth;
@@ -40,6 +41,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("NumericalError", m.py().get_type::<NumericalError>())?;
     m.add_function(wrap_pyfunction!(unit_constants, m)?)?;
     rotation::register(m)?;
+    astro::register(m)?;
     earth::register(m)?;
     imu::register(m)?;
     trajectory::register(m)?;

@@ -1,0 +1,324 @@
+"""Astro-inertial calibration: star-camera (virtual camera VF) to IMU (MF) mount from
+attitude increments (Vasilyuk et al. 2024, seed 001; spec astro-calibration-vasilyuk2024).
+
+Conventions of this module (the paper's, spec §2): ENU navigation frame, body axes
+right-forward-up (MF), ``S_X2^X1`` maps X1 coordinates into X2, small errors are
+right-multiplicative in the body frame, S = S̆ (I + [θ×]). The mount C = C_MF^VF maps VF into
+MF. Euler angles β = (ψ, ϑ, γ) use C(β) = R_ψ R_ϑ R_γ (heading clockwise from North,
+pitch nose-up) and appear only in reports. Project NED/FRD data converts with
+:data:`NED_TO_ENU` (= FRD→right-forward-up, its own inverse): C_ENU^MF = T C_nb T,
+ρ_MF = T ρ_FRD. All angles in rad, times in s.
+
+P_β is the precision of the mount *conditional on the IMU calibration*: a constant
+rotation of the gyro triad is indistinguishable from a mount error, so accuracy against
+the nominal MF cannot beat about σ_φG/√2 per axis (spec D17).
+"""
+
+from __future__ import annotations
+
+import warnings
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from .. import _core
+from .._validate import choice, positive, rows, vector
+
+NED_TO_ENU = np.array([[0.0, 1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, -1.0]])
+"""T: NED→ENU and FRD→right-forward-up (T = Tᵀ = T⁻¹)."""
+
+D17_CAVEAT = ("P_beta is precision conditional on the IMU calibration: a constant rotation of the gyro "
+              "triad is indistinguishable from a mount error (accuracy vs the nominal MF >= ~sigma_phiG/sqrt(2)).")
+
+
+def _mats(x, name: str) -> np.ndarray:
+    a = np.asarray(x, dtype=float)
+    if a.ndim == 2:
+        a = a[None]
+    if a.ndim != 3 or a.shape[1:] != (3, 3):
+        raise ValueError(f"{name}: expected shape (N, 3, 3), got {a.shape}")
+    return np.ascontiguousarray(a)
+
+
+def _single(fn, x):
+    a = np.asarray(x, dtype=float)
+    out = fn(rows(a, 3, "beta"))
+    return out[0] if a.ndim == 1 else out
+
+
+def euler_dcm(beta) -> np.ndarray:
+    """C(ψ, ϑ, γ) = R_ψ(ψ) R_ϑ(ϑ) R_γ(γ) (rad); (3,) → (3, 3), (N, 3) → (N, 3, 3)."""
+    return _single(_core.astro_euler_dcm, beta)
+
+
+def euler_from_dcm(c) -> np.ndarray:
+    """Canonical (ψ ∈ [0, 2π), ϑ, γ) in rad of rotation matrices (spec D3)."""
+    c = np.asarray(c, dtype=float)
+    out = _core.astro_euler_from_dcm(_mats(c, "c"))
+    return out[0] if c.ndim == 2 else out
+
+
+def d1(beta) -> np.ndarray:
+    """D1(β): θ^clb = D1 δβ (seed 001 Eq. 8)."""
+    return _single(lambda b: _core.astro_d1_d2(b)[0], beta)
+
+
+def d2(beta) -> np.ndarray:
+    """D2(β) = C(β) D1(β): θ^mfa = Cθ^avu − D2 δβ (seed 001 Eq. 8)."""
+    return _single(lambda b: _core.astro_d1_d2(b)[1], beta)
+
+
+@dataclass(frozen=True)
+class GyroErrorModel:
+    """Gyro errors of spec E1: misalignment σ_φ (rad), scale factor σ_k (–), angle random
+    walk σ_w (rad/√s), bias σ_b (rad/s); ``mode`` "paper" (white per sample, E2/E7) or
+    "consistent" (constant over the calibration, E8) (spec D2)."""
+
+    sigma_phi_rad: float
+    sigma_k: float
+    sigma_w_rad_sqrt_s: float
+    sigma_b_rad_s: float
+    mode: str = "paper"
+
+    @classmethod
+    def vasilyuk2024(cls, mode: str = "paper") -> "GyroErrorModel":
+        """The paper's budget: 3″, 1e-5, 0.0012 °/√h, 0.007 °/h."""
+        return cls(*_core.astro_vasilyuk2024_gyro_budget(), mode=choice(mode, {"paper", "consistent"}, "mode"))
+
+    def _sigmas(self):
+        return (self.sigma_phi_rad, self.sigma_k, self.sigma_w_rad_sqrt_s, self.sigma_b_rad_s)
+
+
+@dataclass(frozen=True)
+class Increments:
+    """Gyro increments between epochs: q (M, 4) scalar first with R(q) = ΔS^imu (dcm),
+    covariance E^imu (M, 3, 3) rad²; in "consistent" mode the sensitivities j_m (M, 3, 9)
+    to vec_rowmajor(M_G) and j_b (M, 3, 3) to the rate bias (rad/s → rad), else None."""
+
+    q: np.ndarray
+    dcm: np.ndarray
+    cov: np.ndarray
+    j_m: np.ndarray | None
+    j_b: np.ndarray | None
+
+    @property
+    def sigma_rad(self) -> np.ndarray:
+        """σ_ε^imu = √tr E^imu (rad)."""
+        return np.sqrt(np.trace(self.cov, axis1=1, axis2=2))
+
+
+def gyro_increments(t_start: float, period: float, rho, epochs, model: GyroErrorModel,
+                    taylor_variant: str = "corrected") -> Increments:
+    """Third-order asynchronous quaternion integration between camera epochs (spec E3–E8).
+
+    ``rho`` (K, 3) rad: gyro increments in MF, row j over [t_start + jT, t_start + (j+1)T]
+    with T = ``period`` (s); ``epochs`` (N,) s strictly increasing inside the record.
+    ``taylor_variant`` "corrected" (c = 1/8, default) or "paper_literal" (c = 1/4) (D1).
+    """
+    choice(taylor_variant, {"corrected", "paper_literal"}, "taylor_variant")
+    q, cov, sens = _core.astro_increments(float(t_start), positive(period, "period"), rows(rho, 3, "gyro_increments"),
+                                            vector(epochs, None, "epochs"), model._sigmas(), model.mode, taylor_variant)
+    jm, jb = sens if sens is not None else (None, None)
+    return Increments(q=q, dcm=_core.dcm_from_quat_rows(q) if len(q) else np.zeros((0, 3, 3)), cov=cov, j_m=jm, j_b=jb)
+
+
+def dead_reckoning_cov(t_start: float, period: float, rho, epochs, model: GyroErrorModel) -> np.ndarray:
+    """P^imu at every epoch (rad², (N, 3, 3)): E7/E8 run from the first epoch (spec E20)."""
+    return _core.astro_dead_reckoning_cov(float(t_start), positive(period, "period"), rows(rho, 3, "gyro_increments"),
+                                          vector(epochs, None, "epochs"), model._sigmas(), model.mode)
+
+
+def observability(ds_avu) -> dict:
+    """Identifiability of the mount (spec E15, D16): axes_vf, angles (rad), cluster labels
+    (−1 below 0.5°), n_clusters (5° radius), eigenvalues/eigenvectors of
+    G = Σ(I − ΔS)(I − ΔS)ᵀ, kappa = λ_min/λ_max, weak_axis_vf and verdict "ok" | "warn"
+    (κ < 1e-4) | "reject" (κ < 1e-12)."""
+    return _core.astro_observability(_mats(ds_avu, "ds_avu"))
+
+
+_RESULT_ARRAYS = ("c", "beta", "residuals", "p_s", "p_theta", "p_beta", "p_clb", "singular_values", "weak_axis_mf")
+
+
+@dataclass
+class Calibration:
+    """Calibrated mount C = C_MF^VF with β (rad), Gauss–Newton iterations, residuals f_n
+    (rad), P_S, P_θ (VF), P_β, P^clb (MF) (rad²), singular values and condition number
+    of the stacked Jacobian, the weakest direction in MF with σ_weak = σ̂_f/√λ_min (rad),
+    the identifiability report (E15) and the gyro-model provenance."""
+
+    c: np.ndarray
+    beta: np.ndarray
+    iterations: int
+    residuals: np.ndarray
+    relative_misfit: float
+    p_s: np.ndarray
+    p_theta: np.ndarray
+    p_beta: np.ndarray
+    p_clb: np.ndarray
+    singular_values: np.ndarray
+    condition_number: float
+    weak_axis_mf: np.ndarray
+    sigma_weak: float
+    observability: dict
+    gyro_error_model: str = "unspecified"
+    caveat: str = D17_CAVEAT
+
+    @property
+    def sigma_beta_rad(self) -> np.ndarray:
+        return np.sqrt(np.diag(self.p_beta))
+
+    def p_mfa(self, p_avu) -> np.ndarray:
+        """P^mfa = C P^avu Cᵀ + P^clb (rad²) of IMU attitude from a new star fix (Eq. 8)."""
+        p = np.asarray(p_avu, dtype=float)
+        return self.c @ p @ self.c.T + self.p_clb
+
+    def save(self, path) -> None:
+        """Save as .npz (arrays, scalars, observability, provenance, caveat)."""
+        obs = {f"obs_{k}": np.asarray(v) for k, v in self.observability.items()}
+        np.savez(path, **{k: getattr(self, k) for k in _RESULT_ARRAYS}, iterations=self.iterations,
+                 relative_misfit=self.relative_misfit, condition_number=self.condition_number, sigma_weak=self.sigma_weak,
+                 gyro_error_model=self.gyro_error_model, caveat=self.caveat, **obs)
+
+    @classmethod
+    def load(cls, path) -> "Calibration":
+        with np.load(path, allow_pickle=False) as z:
+            kw = {k: z[k] for k in _RESULT_ARRAYS}
+            obs = {k[4:]: (z[k].item() if z[k].ndim == 0 else z[k]) for k in z.files if k.startswith("obs_")}
+            return cls(**kw, iterations=int(z["iterations"]), relative_misfit=float(z["relative_misfit"]),
+                       condition_number=float(z["condition_number"]), sigma_weak=float(z["sigma_weak"]),
+                       observability=obs,
+                       gyro_error_model=str(z["gyro_error_model"]), caveat=str(z["caveat"]))
+
+
+def calibrate(ds_imu, ds_avu, init: str = "axes", c0=None, solver: str = "so3", max_iter: int = 50,
+              tol: float = 1e-9, residual_form: str = "full", gyro_error_model: str = "unspecified") -> Calibration:
+    """Mount C_MF^VF from increment pairs ΔS^avu = Cᵀ ΔS^imu C (seed 001 §3; spec E16–E18).
+
+    Gauss–Newton from ``init`` "axes" (closed-form alignment of rotation axes, default),
+    "zero" (paper's β0 = 0) or "given" (``c0``); ``solver`` "so3" (C ← C exp([Δθ×]),
+    analytic Jacobian, default) or "paper_euler" (β ← β + Δβ, central differences with
+    dx = 1e-6); stops at a step ≤ ``tol`` rad, at most ``max_iter`` iterations. P_β is the paper's
+    residual sandwich with P_S "full" (default) or "diagonal".
+
+    Raises ValueError when the trajectory cannot determine the mount (κ < 1e-12; the
+    message names the null direction) and atomnav.NumericalError when Gauss–Newton does
+    not converge or stops at a wrong stationary point; warns when κ < 1e-4.
+    """
+    choice(init, {"axes", "zero", "given"}, "init")
+    c0 = None if c0 is None else rows(c0, 3, "c0")
+    choice(solver, {"so3", "paper_euler"}, "solver")
+    d = _core.astro_calibrate(_mats(ds_imu, "ds_imu"), _mats(ds_avu, "ds_avu"), init, c0, solver, int(max_iter),
+                              float(tol), choice(residual_form, {"full", "diagonal"}, "residual_form"))
+    if d["observability"]["verdict"] == "warn":
+        k = d["observability"]["weak_axis_vf"]
+        warnings.warn(f"weakly observable mount: kappa = {d['observability']['kappa']:.3e} < 1e-4, "
+                      f"weak direction {np.round(k, 6)} in VF", RuntimeWarning, stacklevel=2)
+    return Calibration(**d, gyro_error_model=gyro_error_model)
+
+
+# --- star camera front end -------------------------------------------------------------
+
+@dataclass(frozen=True)
+class Catalog:
+    """Star catalog: GCRS unit vectors (N, 3) (annual aberration applied), magnitudes, ids."""
+
+    dirs: np.ndarray
+    mags: np.ndarray
+    ids: np.ndarray
+
+
+def synthetic_catalog(m_lim: float = 5.6, seed: int = 1) -> Catalog:
+    """Deterministic uniform sky (spec D4): round(10^(0.985 + 0.455 m_lim)) stars,
+    xoshiro256** seeded through SplitMix64 (identical on every platform)."""
+    return Catalog(*_core.astro_synthetic_catalog(float(m_lim), int(seed)))
+
+
+def load_catalog(path) -> Catalog:
+    """A user catalog from a CSV file with header ``id,ra_deg,dec_deg,mag`` (GCRS right
+    ascension and declination in degrees) or ``id,x,y,z,mag`` (unit vectors)."""
+    data = np.genfromtxt(Path(path), delimiter=",", names=True, dtype=float)
+    names = set(data.dtype.names or ())
+    if {"ra_deg", "dec_deg"} <= names:
+        ra, dec = np.radians(data["ra_deg"]), np.radians(data["dec_deg"])
+        dirs = np.column_stack([np.cos(dec) * np.cos(ra), np.cos(dec) * np.sin(ra), np.sin(dec)])
+    elif {"x", "y", "z"} <= names:
+        dirs = np.column_stack([data["x"], data["y"], data["z"]])
+    else:
+        raise ValueError(f"catalog: expected columns id,ra_deg,dec_deg,mag or id,x,y,z,mag in {path}, got {sorted(names)}")
+    dirs = rows(dirs, 3, "catalog_directions")
+    norm = np.linalg.norm(dirs, axis=1)
+    bad = np.nonzero(np.abs(norm - 1.0) > 1e-9)[0]
+    if bad.size:
+        raise ValueError(f"catalog_directions: not a unit vector at index {bad[0]} (norm {norm[bad[0]]})")
+    return Catalog(dirs=dirs, mags=vector(data["mag"], None, "mag"), ids=np.asarray(data["id"], dtype=np.int64))
+
+
+def refractive_index(height_m: float) -> float:
+    """n(H) = 1 + 2.7783e-4 (1 − 2.25577e-5 H)^4.25588 (spec D13; H in m)."""
+    return _core.astro_refractive_index(float(height_m))
+
+
+def refraction_correct(s, up, n: float) -> np.ndarray:
+    """Remove refraction from observed unit directions about the local vertical ``up``
+    (same frame, (N, 3)) (spec E10)."""
+    return _core.astro_refraction(rows(s, 3, "directions"), rows(up, 3, "up"), float(n), False)
+
+
+def refraction_apply(s, up, n: float) -> np.ndarray:
+    """Apparent directions of true unit directions (inverse of E10, for simulation)."""
+    return _core.astro_refraction(rows(s, 3, "directions"), rows(up, 3, "up"), float(n), True)
+
+
+@dataclass(frozen=True)
+class Observations:
+    """Star observations, one row per star: epoch index, camera index, measured unit
+    direction in the camera frame (N, 3), catalog direction in GCRS (N, 3)."""
+
+    epoch: np.ndarray
+    camera: np.ndarray
+    s_cf: np.ndarray
+    g: np.ndarray
+
+
+def star_attitudes(obs: Observations, n_epochs: int, cameras, sigma_s_rad: float, p_alpha=None,
+                   up_gcrs=None, n_refr: float = 1.0):
+    """Merge the cameras into VF (``cameras`` (I, 3, 3) = C_VF^CFⁱ, camera 0 = identity), remove
+    refraction about ``up_gcrs`` (N, 3) with index ``n_refr``, solve Wahba per epoch and form
+    P^avu = σ_s²K + K(Σ Cᵢ Aᵢ D1(αⁱ) P_aⁱ D1ᵀ Aᵢ Cᵢᵀ)K (spec E9–E12; ``p_alpha`` (I, 3, 3) rad²).
+
+    Returns (S_GCRS^VF (N, 3, 3), P^avu (N, 3, 3) rad², stars per epoch (N,)).
+    """
+    cams = _mats(cameras, "cameras")
+    pa = np.zeros_like(cams) if p_alpha is None else _mats(p_alpha, "p_alpha")
+    up = None if up_gcrs is None else rows(up_gcrs, 3, "up_gcrs")
+    return _core.astro_star_attitudes(np.ascontiguousarray(obs.epoch, dtype=np.int64),
+                                      np.ascontiguousarray(obs.camera, dtype=np.int64),
+                                      rows(obs.s_cf, 3, "star_directions"), rows(obs.g, 3, "catalog_directions"),
+                                      int(n_epochs), cams, pa, float(sigma_s_rad), up, float(n_refr))
+
+
+def astro_increments(s_vf, p_avu):
+    """ΔS_n^avu = S_{n−1}ᵀ S_n and E_n^avu = P_n + ΔS_nᵀ P_{n−1} ΔS_n (spec E13)."""
+    return _core.astro_astro_increments(_mats(s_vf, "s_vf"), _mats(p_avu, "p_avu"))
+
+
+def simulate_observations(catalog: Catalog, s_gcrs_vf, up_gcrs, cameras, fov_half_rad: float, m_lim: float,
+                          sigma_s_rad: float, n_refr: float, seed: int) -> Observations:
+    """Camera simulator: stars brighter than ``m_lim``, above the horizon, within
+    ``fov_half_rad`` of each camera's +z after refraction, with isotropic tangent noise."""
+    d = _core.astro_simulate_observations(rows(catalog.dirs, 3, "catalog_directions"),
+                                          vector(catalog.mags, None, "magnitudes"), _mats(s_gcrs_vf, "s_gcrs_vf"),
+                                          rows(up_gcrs, 3, "up_gcrs"), _mats(cameras, "cameras"), float(fov_half_rad),
+                                          float(m_lim), float(sigma_s_rad), float(n_refr), int(seed))
+    return Observations(**d)
+
+
+from .scenario import Vasilyuk2024  # noqa: E402
+
+__all__ = [
+    "NED_TO_ENU", "D17_CAVEAT", "euler_dcm", "euler_from_dcm", "d1", "d2", "GyroErrorModel", "Increments",
+    "gyro_increments", "dead_reckoning_cov", "observability", "Calibration", "calibrate", "Catalog",
+    "synthetic_catalog", "load_catalog", "refractive_index", "refraction_correct", "refraction_apply",
+    "Observations", "star_attitudes", "astro_increments", "simulate_observations", "Vasilyuk2024",
+]

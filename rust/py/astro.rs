@@ -1,0 +1,462 @@
+//! Bindings of astro/: gyro increments, star attitudes, mount calibration, scenario runs.
+
+use super::convert::{rows_to_py, vec3_rows, vec3_to_py, vector, quat_to_py};
+use crate::astro::calibration::{self, Calibration, DiffForm, Init, Observability, Options, ResidualForm, Solver, Verdict};
+use crate::astro::increments::{self, GyroErrorMode, GyroErrorModel, ImuRecord, TaylorVariant};
+use crate::astro::scenario::{self, Run, Scenario};
+use crate::astro::stars::{self, Camera, Catalog, Observations};
+use crate::astro::{d1, d2, euler_dcm, euler_from_dcm};
+use crate::error::{invalid, NavError};
+use crate::math::{Mat3, Vec3};
+use nalgebra::SMatrix;
+use numpy::ndarray::Array3;
+use numpy::{IntoPyArray, PyArray1, PyArray2, PyArray3, PyReadonlyArray1, PyReadonlyArray2, PyReadonlyArray3, PyUntypedArrayMethods};
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+use rand::SeedableRng;
+use rand_chacha::ChaCha8Rng;
+
+type Arr3<'py> = Bound<'py, PyArray3<f64>>;
+
+/// The (R, C) blocks of an (N, R, C) array, checked for shape and NaN/inf.
+fn mats<const R: usize, const C: usize>(a: &PyReadonlyArray3<'_, f64>, field: &str) -> Result<Vec<SMatrix<f64, R, C>>, NavError> {
+    let s = a.shape();
+    if s[1] != R || s[2] != C {
+        return Err(invalid(field, format!("expected shape (N, {R}, {C}), got ({}, {}, {})", s[0], s[1], s[2])));
+    }
+    let v = a.as_array();
+    (0..s[0])
+        .map(|i| {
+            let m = SMatrix::<f64, R, C>::from_fn(|r, c| v[[i, r, c]]);
+            if m.iter().all(|x| x.is_finite()) { Ok(m) } else { Err(invalid(field, format!("non-finite value at index {i}"))) }
+        })
+        .collect()
+}
+
+fn mats_to_py<'py, const R: usize, const C: usize>(py: Python<'py>, m: &[SMatrix<f64, R, C>]) -> Bound<'py, PyArray3<f64>> {
+    Array3::from_shape_fn((m.len(), R, C), |(i, r, c)| m[i][(r, c)]).into_pyarray(py)
+}
+
+fn mat_to_py<'py>(py: Python<'py>, m: &Mat3) -> Bound<'py, PyArray2<f64>> {
+    rows_to_py(py, 3, 3, (0..9).map(|k| m[(k / 3, k % 3)]))
+}
+
+fn vec_to_py<'py>(py: Python<'py>, v: &Vec3) -> Bound<'py, PyArray1<f64>> {
+    vec![v.x, v.y, v.z].into_pyarray(py)
+}
+
+fn mat3_arg(a: &PyReadonlyArray2<'_, f64>, field: &str) -> Result<Mat3, NavError> {
+    let r = super::convert::rows::<3>(a, field)?;
+    if r.len() != 3 {
+        return Err(invalid(field, format!("expected shape (3, 3), got ({}, 3)", r.len())));
+    }
+    Ok(Mat3::from_fn(|i, j| r[i][j]))
+}
+
+fn gyro_model(sigmas: (f64, f64, f64, f64), mode: &str) -> Result<GyroErrorModel, NavError> {
+    let m = GyroErrorModel { sigma_phi: sigmas.0, sigma_k: sigmas.1, sigma_w: sigmas.2, sigma_b: sigmas.3, mode: GyroErrorMode::parse(mode)? };
+    m.validate()?;
+    Ok(m)
+}
+
+#[pyfunction]
+fn astro_euler_dcm<'py>(py: Python<'py>, beta: PyReadonlyArray2<'py, f64>) -> PyResult<Bound<'py, PyArray3<f64>>> {
+    let b = vec3_rows(&beta, "beta")?;
+    Ok(mats_to_py(py, &b.iter().map(euler_dcm).collect::<Vec<_>>()))
+}
+
+#[pyfunction]
+fn astro_euler_from_dcm<'py>(py: Python<'py>, c: PyReadonlyArray3<'py, f64>) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    let c = mats::<3, 3>(&c, "c")?;
+    for (i, m) in c.iter().enumerate() {
+        crate::astro::check_rotation("c", i, m)?;
+    }
+    Ok(vec3_to_py(py, &c.iter().map(euler_from_dcm).collect::<Vec<_>>()))
+}
+
+#[pyfunction]
+fn astro_d1_d2<'py>(py: Python<'py>, beta: PyReadonlyArray2<'py, f64>) -> PyResult<(Arr3<'py>, Arr3<'py>)> {
+    let b = vec3_rows(&beta, "beta")?;
+    Ok((mats_to_py(py, &b.iter().map(d1).collect::<Vec<_>>()), mats_to_py(py, &b.iter().map(d2).collect::<Vec<_>>())))
+}
+
+type IncrementArrays<'py> = (Bound<'py, PyArray2<f64>>, Bound<'py, PyArray3<f64>>, Option<(Bound<'py, PyArray3<f64>>, Bound<'py, PyArray3<f64>>)>);
+
+#[pyfunction]
+#[allow(clippy::too_many_arguments)]
+fn astro_increments<'py>(
+    py: Python<'py>,
+    t_start: f64,
+    period: f64,
+    rho: PyReadonlyArray2<'py, f64>,
+    epochs: PyReadonlyArray1<'py, f64>,
+    sigmas: (f64, f64, f64, f64),
+    mode: &str,
+    taylor_variant: &str,
+) -> PyResult<IncrementArrays<'py>> {
+    let rho = vec3_rows(&rho, "gyro_increments")?;
+    let epochs = vector(&epochs, "epochs")?;
+    let model = gyro_model(sigmas, mode)?;
+    let variant = TaylorVariant::parse(taylor_variant)?;
+    let inc = py.detach(|| increments::integrate_increments(&ImuRecord { t_start, period, rho: &rho }, &epochs, &model, variant))?;
+    let q: Vec<_> = inc.iter().map(|i| i.q).collect();
+    let cov: Vec<Mat3> = inc.iter().map(|i| i.cov).collect();
+    let sens = (model.mode == GyroErrorMode::Consistent).then(|| {
+        let (jm, jb): (Vec<_>, Vec<Mat3>) = inc.iter().filter_map(|i| i.sensitivities).unzip();
+        (mats_to_py(py, &jm), mats_to_py(py, &jb))
+    });
+    Ok((quat_to_py(py, &q), mats_to_py(py, &cov), sens))
+}
+
+#[pyfunction]
+fn astro_dead_reckoning_cov<'py>(
+    py: Python<'py>,
+    t_start: f64,
+    period: f64,
+    rho: PyReadonlyArray2<'py, f64>,
+    epochs: PyReadonlyArray1<'py, f64>,
+    sigmas: (f64, f64, f64, f64),
+    mode: &str,
+) -> PyResult<Bound<'py, PyArray3<f64>>> {
+    let rho = vec3_rows(&rho, "gyro_increments")?;
+    let epochs = vector(&epochs, "epochs")?;
+    let model = gyro_model(sigmas, mode)?;
+    let p = py.detach(|| increments::dead_reckoning_cov(&ImuRecord { t_start, period, rho: &rho }, &epochs, &model))?;
+    Ok(mats_to_py(py, &p))
+}
+
+fn observability_dict<'py>(py: Python<'py>, o: &Observability) -> PyResult<Bound<'py, PyDict>> {
+    let d = PyDict::new(py);
+    d.set_item("axes_vf", vec3_to_py(py, &o.axes_vf))?;
+    d.set_item("angles", o.angles.clone().into_pyarray(py))?;
+    d.set_item("cluster", o.cluster.clone().into_pyarray(py))?;
+    d.set_item("n_clusters", o.n_clusters)?;
+    d.set_item("eigenvalues", vec_to_py(py, &o.eigenvalues))?;
+    d.set_item("eigenvectors", mat_to_py(py, &o.eigenvectors))?;
+    d.set_item("kappa", o.kappa)?;
+    d.set_item("weak_axis_vf", vec_to_py(py, &o.weak_axis_vf()))?;
+    d.set_item("verdict", match o.verdict {
+        Verdict::Ok => "ok",
+        Verdict::Warn => "warn",
+        Verdict::Reject => "reject",
+    })?;
+    Ok(d)
+}
+
+fn calibration_dict<'py>(py: Python<'py>, c: &Calibration) -> PyResult<Bound<'py, PyDict>> {
+    let d = PyDict::new(py);
+    d.set_item("c", mat_to_py(py, &c.c))?;
+    d.set_item("beta", vec_to_py(py, &c.beta))?;
+    d.set_item("iterations", c.iterations)?;
+    d.set_item("residuals", vec3_to_py(py, &c.residuals))?;
+    d.set_item("relative_misfit", c.relative_misfit)?;
+    d.set_item("p_s", mat_to_py(py, &c.p_s))?;
+    d.set_item("p_theta", mat_to_py(py, &c.p_theta))?;
+    d.set_item("p_beta", mat_to_py(py, &c.p_beta))?;
+    d.set_item("p_clb", mat_to_py(py, &c.p_clb))?;
+    d.set_item("singular_values", vec_to_py(py, &c.singular_values))?;
+    d.set_item("condition_number", c.condition_number)?;
+    d.set_item("weak_axis_mf", vec_to_py(py, &c.weak_axis_mf))?;
+    d.set_item("sigma_weak", c.sigma_weak)?;
+    d.set_item("observability", observability_dict(py, &c.observability)?)?;
+    Ok(d)
+}
+
+fn options(init: &str, c0: Option<PyReadonlyArray2<'_, f64>>, solver: &str, max_iter: usize, tol: f64, residual_form: &str) -> Result<Options, NavError> {
+    let init = match (init, c0) {
+        ("axes", None) => Init::Axes,
+        ("zero", None) => Init::Zero,
+        ("given", Some(c)) => Init::Given(mat3_arg(&c, "c0")?),
+        _ => return Err(invalid("init", format!("expected 'axes', 'zero', or 'given' with c0, got '{init}'"))),
+    };
+    let residual_form = match residual_form {
+        "full" => ResidualForm::Full,
+        "diagonal" => ResidualForm::Diagonal,
+        _ => return Err(invalid("residual_form", format!("expected 'full' or 'diagonal', got '{residual_form}'"))),
+    };
+    let solver = match solver {
+        "so3" => Solver::So3,
+        "paper_euler" => Solver::PaperEuler,
+        _ => return Err(invalid("solver", format!("expected 'so3' or 'paper_euler', got '{solver}'"))),
+    };
+    if max_iter == 0 {
+        return Err(invalid("max_iter", "must be ≥ 1"));
+    }
+    crate::error::check_positive("tol", tol)?;
+    Ok(Options { init, solver, max_iter, tol, residual_form })
+}
+
+fn diff_form(s: &str) -> Result<DiffForm, NavError> {
+    match s {
+        "full" => Ok(DiffForm::Full),
+        "paper" => Ok(DiffForm::Paper),
+        _ => Err(invalid("p_diff", format!("expected 'full' or 'paper', got '{s}'"))),
+    }
+}
+
+#[pyfunction]
+#[pyo3(signature = (ds_imu, ds_avu, init="axes", c0=None, solver="so3", max_iter=50, tol=1e-9, residual_form="full"))]
+#[allow(clippy::too_many_arguments)]
+fn astro_calibrate<'py>(
+    py: Python<'py>,
+    ds_imu: PyReadonlyArray3<'py, f64>,
+    ds_avu: PyReadonlyArray3<'py, f64>,
+    init: &str,
+    c0: Option<PyReadonlyArray2<'py, f64>>,
+    solver: &str,
+    max_iter: usize,
+    tol: f64,
+    residual_form: &str,
+) -> PyResult<Bound<'py, PyDict>> {
+    let (a, b) = (mats::<3, 3>(&ds_imu, "ds_imu")?, mats::<3, 3>(&ds_avu, "ds_avu")?);
+    let opt = options(init, c0, solver, max_iter, tol, residual_form)?;
+    let cal = py.detach(|| calibration::calibrate(&a, &b, &opt))?;
+    calibration_dict(py, &cal)
+}
+
+#[pyfunction]
+fn astro_observability<'py>(py: Python<'py>, ds_avu: PyReadonlyArray3<'py, f64>) -> PyResult<Bound<'py, PyDict>> {
+    let b = mats::<3, 3>(&ds_avu, "ds_avu")?;
+    for (i, m) in b.iter().enumerate() {
+        crate::astro::check_rotation("ds_avu", i, m)?;
+    }
+    observability_dict(py, &calibration::observability(&b))
+}
+
+fn cameras_arg(c: &PyReadonlyArray3<'_, f64>, p: &PyReadonlyArray3<'_, f64>) -> Result<Vec<Camera>, NavError> {
+    let (c, p) = (mats::<3, 3>(c, "cameras")?, mats::<3, 3>(p, "p_alpha")?);
+    if c.len() != p.len() {
+        return Err(invalid("p_alpha", format!("expected {} covariances (one per camera), got {}", c.len(), p.len())));
+    }
+    Ok(c.into_iter().zip(p).map(|(c_vf_cf, p_alpha)| Camera { c_vf_cf, p_alpha }).collect())
+}
+
+fn indices(a: &PyReadonlyArray1<'_, i64>, field: &str) -> Result<Vec<usize>, NavError> {
+    a.as_array()
+        .iter()
+        .enumerate()
+        .map(|(i, &x)| usize::try_from(x).map_err(|_| invalid(field, format!("negative index {x} at index {i}"))))
+        .collect()
+}
+
+#[pyfunction]
+#[pyo3(signature = (epoch, camera, s_cf, g, n_epochs, cameras, p_alpha, sigma_s, up_gcrs=None, n_refr=1.0))]
+#[allow(clippy::too_many_arguments)]
+fn astro_star_attitudes<'py>(
+    py: Python<'py>,
+    epoch: PyReadonlyArray1<'py, i64>,
+    camera: PyReadonlyArray1<'py, i64>,
+    s_cf: PyReadonlyArray2<'py, f64>,
+    g: PyReadonlyArray2<'py, f64>,
+    n_epochs: usize,
+    cameras: PyReadonlyArray3<'py, f64>,
+    p_alpha: PyReadonlyArray3<'py, f64>,
+    sigma_s: f64,
+    up_gcrs: Option<PyReadonlyArray2<'py, f64>>,
+    n_refr: f64,
+) -> PyResult<(Arr3<'py>, Arr3<'py>, Bound<'py, PyArray1<i64>>)> {
+    let obs = Observations { epoch: indices(&epoch, "epoch")?, camera: indices(&camera, "camera")?, s_cf: vec3_rows(&s_cf, "star_directions")?, g: vec3_rows(&g, "catalog_directions")? };
+    let cams = cameras_arg(&cameras, &p_alpha)?;
+    let up = up_gcrs.map(|u| vec3_rows(&u, "up_gcrs")).transpose()?;
+    let att = py.detach(|| stars::star_attitudes(&obs, n_epochs, &cams, sigma_s, up.as_deref().map(|u| (u, n_refr))))?;
+    let counts: Vec<i64> = att.stars.iter().map(|&k| k as i64).collect();
+    Ok((mats_to_py(py, &att.s), mats_to_py(py, &att.p), counts.into_pyarray(py)))
+}
+
+#[pyfunction]
+fn astro_astro_increments<'py>(py: Python<'py>, s: PyReadonlyArray3<'py, f64>, p: PyReadonlyArray3<'py, f64>) -> PyResult<(Arr3<'py>, Arr3<'py>)> {
+    let (s, p) = (mats::<3, 3>(&s, "s_vf")?, mats::<3, 3>(&p, "p_avu")?);
+    if s.len() != p.len() {
+        return Err(invalid("p_avu", format!("expected {} covariances, got {}", s.len(), p.len())).into());
+    }
+    for (i, m) in s.iter().enumerate() {
+        crate::astro::check_rotation("s_vf", i, m)?;
+    }
+    let (ds, e) = stars::astro_increments(&s, &p);
+    Ok((mats_to_py(py, &ds), mats_to_py(py, &e)))
+}
+
+type CatalogArrays<'py> = (Bound<'py, PyArray2<f64>>, Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<u64>>);
+
+#[pyfunction]
+fn astro_synthetic_catalog<'py>(py: Python<'py>, m_lim: f64, seed: u64) -> PyResult<CatalogArrays<'py>> {
+    let c = Catalog::synthetic(m_lim, seed)?;
+    Ok((vec3_to_py(py, &c.dirs), c.mags.into_pyarray(py), c.ids.into_pyarray(py)))
+}
+
+#[pyfunction]
+fn astro_refraction<'py>(py: Python<'py>, s: PyReadonlyArray2<'py, f64>, u: PyReadonlyArray2<'py, f64>, n_refr: f64, apply: bool) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    let (s, u) = (vec3_rows(&s, "directions")?, vec3_rows(&u, "up")?);
+    if s.len() != u.len() {
+        return Err(invalid("up", format!("expected {} rows like directions, got {}", s.len(), u.len())).into());
+    }
+    if !(n_refr.is_finite() && n_refr >= 1.0) {
+        return Err(invalid("n_refr", format!("refractive index must be finite and ≥ 1, got {n_refr}")).into());
+    }
+    let f = if apply { stars::refraction_apply } else { stars::refraction_correct };
+    Ok(vec3_to_py(py, &s.iter().zip(&u).map(|(s, u)| f(s, u, n_refr)).collect::<Vec<_>>()))
+}
+
+#[pyfunction]
+fn astro_refractive_index(height_m: f64) -> f64 {
+    stars::refractive_index(height_m)
+}
+
+#[pyfunction]
+#[allow(clippy::too_many_arguments)]
+fn astro_simulate_observations<'py>(
+    py: Python<'py>,
+    catalog_dirs: PyReadonlyArray2<'py, f64>,
+    catalog_mags: PyReadonlyArray1<'py, f64>,
+    s_gcrs_vf: PyReadonlyArray3<'py, f64>,
+    up_gcrs: PyReadonlyArray2<'py, f64>,
+    cameras: PyReadonlyArray3<'py, f64>,
+    fov_half: f64,
+    m_lim: f64,
+    sigma_s: f64,
+    n_refr: f64,
+    seed: u64,
+) -> PyResult<Bound<'py, PyDict>> {
+    let dirs = vec3_rows(&catalog_dirs, "catalog_directions")?;
+    let mags = vector(&catalog_mags, "magnitudes")?;
+    let ids = (0..dirs.len() as u64).collect();
+    let cat = Catalog::new(dirs, mags, ids)?;
+    let s = mats::<3, 3>(&s_gcrs_vf, "s_gcrs_vf")?;
+    for (i, m) in s.iter().enumerate() {
+        crate::astro::check_rotation("s_gcrs_vf", i, m)?;
+    }
+    let up = vec3_rows(&up_gcrs, "up_gcrs")?;
+    if up.len() != s.len() {
+        return Err(invalid("up_gcrs", format!("expected {} rows, got {}", s.len(), up.len())).into());
+    }
+    let cams: Vec<Camera> = mats::<3, 3>(&cameras, "cameras")?.into_iter().map(|c| Camera { c_vf_cf: c, p_alpha: Mat3::zeros() }).collect();
+    for (i, c) in cams.iter().enumerate() {
+        crate::astro::check_rotation("cameras", i, &c.c_vf_cf)?;
+    }
+    for (name, v) in [("fov_half", fov_half), ("sigma_s", sigma_s)] {
+        if !(v.is_finite() && v >= 0.0) {
+            return Err(invalid(name, format!("must be finite and ≥ 0, got {v}")).into());
+        }
+    }
+    let obs = py.detach(|| stars::simulate_observations(&cat, &s, &up, &cams, fov_half, m_lim, sigma_s, n_refr, &mut ChaCha8Rng::seed_from_u64(seed)));
+    observations_dict(py, &obs)
+}
+
+fn observations_dict<'py>(py: Python<'py>, o: &Observations) -> PyResult<Bound<'py, PyDict>> {
+    let d = PyDict::new(py);
+    d.set_item("epoch", o.epoch.iter().map(|&x| x as i64).collect::<Vec<_>>().into_pyarray(py))?;
+    d.set_item("camera", o.camera.iter().map(|&x| x as i64).collect::<Vec<_>>().into_pyarray(py))?;
+    d.set_item("s_cf", vec3_to_py(py, &o.s_cf))?;
+    d.set_item("g", vec3_to_py(py, &o.g))?;
+    Ok(d)
+}
+
+/// The paper's gyro budget (σ_φ, σ_k, σ_w, σ_b) in SI units.
+#[pyfunction]
+fn astro_vasilyuk2024_gyro_budget() -> (f64, f64, f64, f64) {
+    let m = GyroErrorModel::vasilyuk2024(GyroErrorMode::Paper);
+    (m.sigma_phi, m.sigma_k, m.sigma_w, m.sigma_b)
+}
+
+/// Scenario wrapper kept alive across calls (its truth takes ~1 s to build).
+#[pyclass(module = "atomnav._core", name = "AstroScenario")]
+pub struct PyScenario {
+    inner: Scenario,
+}
+
+fn scenario_dict<'py>(py: Python<'py>, s: &Scenario) -> PyResult<Bound<'py, PyDict>> {
+    let d = PyDict::new(py);
+    d.set_item("epochs", s.epochs.clone().into_pyarray(py))?;
+    d.set_item("t_start", s.t_start)?;
+    d.set_item("period", s.period)?;
+    d.set_item("rho_true", vec3_to_py(py, &s.rho_true))?;
+    d.set_item("s_gcrs_vf", mats_to_py(py, &s.s_gcrs_vf))?;
+    d.set_item("up_gcrs", vec3_to_py(py, &s.up_gcrs))?;
+    d.set_item("c_true", mat_to_py(py, &s.c_true))?;
+    d.set_item("cameras", mats_to_py(py, &s.cameras.iter().map(|c| c.c_vf_cf).collect::<Vec<_>>()))?;
+    d.set_item("catalog_dirs", vec3_to_py(py, &s.catalog.dirs))?;
+    d.set_item("catalog_mags", s.catalog.mags.clone().into_pyarray(py))?;
+    d.set_item("fov_half", s.fov_half)?;
+    d.set_item("m_lim", s.m_lim)?;
+    d.set_item("sigma_s", s.sigma_s)?;
+    d.set_item("n_refr", s.n_refr)?;
+    Ok(d)
+}
+
+fn run_dict<'py>(py: Python<'py>, r: &Run) -> PyResult<Bound<'py, PyDict>> {
+    let d = PyDict::new(py);
+    d.set_item("observations", observations_dict(py, &r.observations)?)?;
+    d.set_item("stars_per_epoch", r.stars_per_epoch.iter().map(|&x| x as i64).collect::<Vec<_>>().into_pyarray(py))?;
+    d.set_item("s_vf", mats_to_py(py, &r.s_vf))?;
+    d.set_item("p_avu", mats_to_py(py, &r.p_avu))?;
+    d.set_item("ds_imu", mats_to_py(py, &r.ds_imu))?;
+    d.set_item("e_imu", mats_to_py(py, &r.e_imu))?;
+    d.set_item("ds_avu", mats_to_py(py, &r.ds_avu))?;
+    d.set_item("e_avu", mats_to_py(py, &r.e_avu))?;
+    d.set_item("calibration", calibration_dict(py, &r.calibration)?)?;
+    d.set_item("p_beta_model", mat_to_py(py, &r.p_beta_model))?;
+    d.set_item("p_beta_sys", mat_to_py(py, &r.p_beta_sys))?;
+    d.set_item("beta_error", vec_to_py(py, &r.beta_error))?;
+    d.set_item("theta_error", vec_to_py(py, &r.theta_error))?;
+    d.set_item("theta_diff", vec3_to_py(py, &r.theta_diff))?;
+    d.set_item("p_diff", mats_to_py(py, &r.p_diff))?;
+    Ok(d)
+}
+
+#[pymethods]
+impl PyScenario {
+    /// `vasilyuk2024_like` (spec §5.1) with catalog seed and gyro truth "paper" | "consistent".
+    #[new]
+    #[pyo3(signature = (catalog_seed=3, gyro_error_model="paper"))]
+    fn new(py: Python<'_>, catalog_seed: u64, gyro_error_model: &str) -> PyResult<Self> {
+        let mode = GyroErrorMode::parse(gyro_error_model)?;
+        Ok(Self { inner: py.detach(|| scenario::vasilyuk2024_like(catalog_seed, mode))? })
+    }
+
+    fn truth<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        scenario_dict(py, &self.inner)
+    }
+
+    #[pyo3(signature = (seed, init="axes", p_diff="full"))]
+    fn run<'py>(&self, py: Python<'py>, seed: u64, init: &str, p_diff: &str) -> PyResult<Bound<'py, PyDict>> {
+        let opt = options(init, None, "so3", 50, 1e-9, "full")?;
+        let form = diff_form(p_diff)?;
+        let r = py.detach(|| scenario::run(&self.inner, seed, &opt, form))?;
+        run_dict(py, &r)
+    }
+
+    /// Per run: β̂ − β̆ (rad), √diag P_β and √diag P_β^model (rad), fraction of θ^diff components within ±3σ,
+    /// mean χ² of θ^diff, Gauss–Newton iterations.
+    #[pyo3(signature = (runs, seed0=0, p_diff="full"))]
+    fn monte_carlo<'py>(&self, py: Python<'py>, runs: usize, seed0: u64, p_diff: &str) -> PyResult<Bound<'py, PyDict>> {
+        let form = diff_form(p_diff)?;
+        let s = py.detach(|| scenario::monte_carlo(&self.inner, runs, seed0, &Options::default(), form))?;
+        let d = PyDict::new(py);
+        d.set_item("beta_error", vec3_to_py(py, &s.iter().map(|r| r.beta_error).collect::<Vec<_>>()))?;
+        d.set_item("sigma_beta", vec3_to_py(py, &s.iter().map(|r| r.sigma_beta).collect::<Vec<_>>()))?;
+        d.set_item("sigma_beta_model", vec3_to_py(py, &s.iter().map(|r| r.sigma_beta_model).collect::<Vec<_>>()))?;
+        d.set_item("inside_3sigma", s.iter().map(|r| r.inside_3sigma).collect::<Vec<_>>().into_pyarray(py))?;
+        d.set_item("chi2_diff", s.iter().map(|r| r.chi2_diff).collect::<Vec<_>>().into_pyarray(py))?;
+        d.set_item("iterations", s.iter().map(|r| r.iterations as i64).collect::<Vec<_>>().into_pyarray(py))?;
+        Ok(d)
+    }
+}
+
+pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_class::<PyScenario>()?;
+    m.add_function(wrap_pyfunction!(astro_euler_dcm, m)?)?;
+    m.add_function(wrap_pyfunction!(astro_euler_from_dcm, m)?)?;
+    m.add_function(wrap_pyfunction!(astro_d1_d2, m)?)?;
+    m.add_function(wrap_pyfunction!(astro_increments, m)?)?;
+    m.add_function(wrap_pyfunction!(astro_dead_reckoning_cov, m)?)?;
+    m.add_function(wrap_pyfunction!(astro_calibrate, m)?)?;
+    m.add_function(wrap_pyfunction!(astro_observability, m)?)?;
+    m.add_function(wrap_pyfunction!(astro_star_attitudes, m)?)?;
+    m.add_function(wrap_pyfunction!(astro_astro_increments, m)?)?;
+    m.add_function(wrap_pyfunction!(astro_synthetic_catalog, m)?)?;
+    m.add_function(wrap_pyfunction!(astro_refraction, m)?)?;
+    m.add_function(wrap_pyfunction!(astro_refractive_index, m)?)?;
+    m.add_function(wrap_pyfunction!(astro_simulate_observations, m)?)?;
+    m.add_function(wrap_pyfunction!(astro_vasilyuk2024_gyro_budget, m)?)?;
+    Ok(())
+}

@@ -1,0 +1,102 @@
+"""Star-camera front end (spec E9–E13, D4, D13): simulator, refraction, Wahba, P^avu."""
+
+import numpy as np
+import pytest
+from scipy.spatial.transform import Rotation
+
+from atomnav import astro, units
+
+AS = units.ARCSEC
+
+
+@pytest.fixture(scope="module")
+def scn():
+    return astro.Vasilyuk2024().truth()
+
+
+def _simulate(tr, sigma, seed, n_refr=None):
+    cat = astro.Catalog(tr["catalog_dirs"], tr["catalog_mags"], np.arange(len(tr["catalog_mags"])))
+    return astro.simulate_observations(cat, tr["s_gcrs_vf"], tr["up_gcrs"], tr["cameras"], tr["fov_half"], tr["m_lim"],
+                                       sigma, tr["n_refr"] if n_refr is None else n_refr, seed)
+
+
+def test_catalog_is_deterministic_with_the_d4_count():
+    a, b = astro.synthetic_catalog(5.6, 3), astro.synthetic_catalog(5.6, 3)
+    assert len(a.mags) == round(10 ** (0.985 + 0.455 * 5.6)) == 3412
+    assert np.array_equal(a.dirs, b.dirs) and a.mags.max() <= 5.6
+    assert np.abs(np.linalg.norm(a.dirs, axis=1) - 1).max() < 1e-15
+
+
+def test_refraction_matches_snell_and_round_trips():
+    n = astro.refractive_index(150.0)
+    assert n - 1 == pytest.approx(2.7385e-4, rel=1e-4)
+    z = np.radians([10.0, 30.0, 45.0, 60.0, 80.0])
+    true = np.column_stack([np.sin(z), np.zeros_like(z), np.cos(z)])
+    up = np.tile([0.0, 0.0, 1.0], (len(z), 1))
+    app = astro.refraction_apply(true, up, n)
+    z_app = np.arctan2(np.hypot(app[:, 0], app[:, 1]), app[:, 2])
+    assert np.abs(z_app - np.arcsin(np.sin(z) / n)).max() / AS < 1e-6  # Snell: sin z = n sin z_obs
+    assert np.abs(astro.refraction_correct(app, up, n) - true).max() < 1e-15
+
+
+def test_noise_free_stars_give_the_true_attitudes(scn):
+    obs = _simulate(scn, 0.0, 1)
+    s, p, count = astro.star_attitudes(obs, len(scn["epochs"]), scn["cameras"], 16 * AS, up_gcrs=scn["up_gcrs"],
+                                       n_refr=scn["n_refr"])
+    err = Rotation.from_matrix(np.einsum("nji,njk->nik", scn["s_gcrs_vf"], s)).magnitude()
+    assert err.max() < 1e-12
+    assert 100 <= count.mean() <= 120 and count.min() >= 3  # spec row 16: 108.7 per epoch
+
+
+def test_attitude_covariance_model_is_consistent(scn):
+    # spec row 17: mean χ² of θ^avu under P^avu = σ_s² K is ≈ 3 (Monte Carlo over noise seeds)
+    chi2 = []
+    for seed in range(6):
+        obs = _simulate(scn, 16 * AS, 100 + seed)
+        s, p, _ = astro.star_attitudes(obs, len(scn["epochs"]), scn["cameras"], 16 * AS, up_gcrs=scn["up_gcrs"],
+                                       n_refr=scn["n_refr"])
+        th = Rotation.from_matrix(np.einsum("nji,njk->nik", scn["s_gcrs_vf"], s)).as_rotvec()
+        chi2.append(np.einsum("ni,nij,nj->n", th, np.linalg.inv(p), th))
+    assert np.mean(chi2) == pytest.approx(3.0, abs=0.25)
+
+
+def test_astro_increments_compose_and_propagate(scn):
+    s = scn["s_gcrs_vf"][:4]
+    p = np.stack([np.diag([1.0, 2.0, 3.0]) * 1e-10] * 4)
+    ds, e = astro.astro_increments(s, p)
+    assert np.abs(s[:-1] @ ds - s[1:]).max() < 1e-15
+    assert np.allclose(e[0], p[1] + ds[0].T @ p[0] @ ds[0], rtol=1e-14, atol=0)
+
+
+def test_user_catalog_from_file(tmp_path):
+    f = tmp_path / "cat.csv"
+    f.write_text("id,ra_deg,dec_deg,mag\n1,0,0,1.5\n2,90,0,2.0\n3,0,90,3.1\n")
+    cat = astro.load_catalog(f)
+    assert np.allclose(cat.dirs, np.eye(3), atol=1e-15) and list(cat.ids) == [1, 2, 3]
+    assert np.allclose(cat.mags, [1.5, 2.0, 3.1])
+
+
+def _three_stars():
+    g = np.eye(3)
+    return astro.Observations(epoch=np.array([0, 0, 0, 1, 1, 1]), camera=np.zeros(6, dtype=np.int64),
+                              s_cf=np.vstack([g, g]), g=np.vstack([g, g]))
+
+
+def test_fewer_than_three_stars_rejected():
+    o = _three_stars()
+    o = astro.Observations(o.epoch[:5], o.camera[:5], o.s_cf[:5], o.g[:5])
+    with pytest.raises(ValueError, match="star_directions.*epoch at index 1 has 2 stars"):
+        astro.star_attitudes(o, 2, np.eye(3)[None], 16 * AS)
+
+
+def test_non_unit_direction_rejected():
+    o = _three_stars()
+    o.s_cf[4] *= 1.01
+    with pytest.raises(ValueError, match="star_directions.*not a unit vector at index 4"):
+        astro.star_attitudes(o, 2, np.eye(3)[None], 16 * AS)
+
+
+def test_camera_not_a_rotation_rejected():
+    cams = np.stack([np.eye(3), np.diag([1.0, 1.0, -1.0])])
+    with pytest.raises(ValueError, match="cameras.*not a rotation matrix at index 1"):
+        astro.star_attitudes(_three_stars(), 2, cams, 16 * AS)
