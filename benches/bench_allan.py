@@ -10,15 +10,9 @@ import numpy as np
 
 from atomnav import _core
 from atomnav.noise import allan, filters
+from timing import best_of
 
 
-def best_of(fn, repeat):
-    times = []
-    for _ in range(repeat):
-        t0 = time.perf_counter()
-        out = fn()
-        times.append(time.perf_counter() - t0)
-    return min(times), out
 
 
 def main(n: int = 10_000_000) -> None:

@@ -22,15 +22,9 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 from atomnav import astro, units
+from timing import best_of
 
 
-def best_of(fn, repeat):
-    best, out = np.inf, None
-    for _ in range(repeat):
-        t0 = time.perf_counter()
-        out = fn()
-        best = min(best, time.perf_counter() - t0)
-    return best, out
 
 
 def inputs(seed=0):

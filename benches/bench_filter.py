@@ -18,15 +18,9 @@ import numpy as np
 import scipy.linalg
 
 from atomnav.filter import KalmanFilter, dare
+from timing import best_of
 
 
-def best_of(fn, repeat):
-    best = np.inf
-    for _ in range(repeat):
-        t0 = time.perf_counter()
-        fn()
-        best = min(best, time.perf_counter() - t0)
-    return best
 
 
 def system(n, m, rng):
@@ -54,15 +48,15 @@ def main():
             fp.predict()
 
     kf = KalmanFilter(np.eye(15), mode="open")
-    t_fp = best_of(run_fp, args.repeat) / args.steps
-    t_an = best_of(lambda: kf.predict(phi, q, steps=args.steps), args.repeat) / args.steps
+    t_fp = best_of(run_fp, args.repeat)[0] / args.steps
+    t_an = best_of(lambda: kf.predict(phi, q, steps=args.steps), args.repeat)[0] / args.steps
     n_call = max(args.steps // 10, 1)
 
     def run_calls():
         for _ in range(n_call):
             kf.predict(phi, q)
 
-    t_call = best_of(run_calls, args.repeat) / n_call
+    t_call = best_of(run_calls, args.repeat)[0] / n_call
     print(f"15-state predict: filterpy {t_fp * 1e6:.2f} us/step, atomnav {t_an * 1e6:.2f} us/step "
           f"-> ratio {t_fp / t_an:.1f}x  (atomnav one Python call per step: {t_call * 1e6:.2f} us, ratio {t_fp / t_call:.1f}x)")
 
@@ -70,8 +64,8 @@ def main():
     ref = scipy.linalg.solve_discrete_are(phi.T, h.T, q, r)
     got = dare(phi, q, h, r).p_prior
     reps = 50
-    t_sp = best_of(lambda: [scipy.linalg.solve_discrete_are(phi.T, h.T, q, r) for _ in range(reps)], args.repeat) / reps
-    t_da = best_of(lambda: [dare(phi, q, h, r) for _ in range(reps)], args.repeat) / reps
+    t_sp = best_of(lambda: [scipy.linalg.solve_discrete_are(phi.T, h.T, q, r) for _ in range(reps)], args.repeat)[0] / reps
+    t_da = best_of(lambda: [dare(phi, q, h, r) for _ in range(reps)], args.repeat)[0] / reps
     print(f"21-state DARE: scipy {t_sp * 1e6:.1f} us, atomnav {t_da * 1e6:.1f} us -> ratio {t_sp / t_da:.1f}x "
           f"(max rel. difference {np.max(np.abs(got - ref)) / np.max(np.abs(ref)):.1e})")
 

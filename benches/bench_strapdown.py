@@ -17,15 +17,9 @@ import numpy as np
 import pandas as pd
 
 import atomnav as an
+from timing import best_of
 
 
-def best_of(fn, repeat):
-    best, out = np.inf, None
-    for _ in range(repeat):
-        t0 = time.perf_counter()
-        out = fn()
-        best = min(best, time.perf_counter() - t0)
-    return best, out
 
 
 def main():
