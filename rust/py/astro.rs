@@ -80,6 +80,16 @@ fn astro_d1_d2<'py>(py: Python<'py>, beta: PyReadonlyArray2<'py, f64>) -> PyResu
     Ok((mats_to_py(py, &b.iter().map(d1).collect::<Vec<_>>()), mats_to_py(py, &b.iter().map(d2).collect::<Vec<_>>())))
 }
 
+/// The gyro increments, camera epochs and gyro error model shared by the increment calls.
+fn gyro_record(
+    rho: &PyReadonlyArray2<'_, f64>,
+    epochs: &PyReadonlyArray1<'_, f64>,
+    sigmas: (f64, f64, f64, f64),
+    mode: &str,
+) -> PyResult<(Vec<Vec3>, Vec<f64>, GyroErrorModel)> {
+    Ok((vec3_rows(rho, "gyro_increments")?, vector(epochs, "epochs")?, gyro_model(sigmas, mode)?))
+}
+
 type IncrementArrays<'py> = (Bound<'py, PyArray2<f64>>, Bound<'py, PyArray3<f64>>, Option<(Bound<'py, PyArray3<f64>>, Bound<'py, PyArray3<f64>>)>);
 
 #[pyfunction]
@@ -94,9 +104,7 @@ fn astro_increments<'py>(
     mode: &str,
     taylor_variant: &str,
 ) -> PyResult<IncrementArrays<'py>> {
-    let rho = vec3_rows(&rho, "gyro_increments")?;
-    let epochs = vector(&epochs, "epochs")?;
-    let model = gyro_model(sigmas, mode)?;
+    let (rho, epochs, model) = gyro_record(&rho, &epochs, sigmas, mode)?;
     let variant = TaylorVariant::parse(taylor_variant)?;
     let inc = py.detach(|| increments::integrate_increments(&ImuRecord { t_start, period, rho: &rho }, &epochs, &model, variant))?;
     let q: Vec<_> = inc.iter().map(|i| i.q).collect();
@@ -118,9 +126,7 @@ fn astro_dead_reckoning_cov<'py>(
     sigmas: (f64, f64, f64, f64),
     mode: &str,
 ) -> PyResult<Bound<'py, PyArray3<f64>>> {
-    let rho = vec3_rows(&rho, "gyro_increments")?;
-    let epochs = vector(&epochs, "epochs")?;
-    let model = gyro_model(sigmas, mode)?;
+    let (rho, epochs, model) = gyro_record(&rho, &epochs, sigmas, mode)?;
     let p = py.detach(|| increments::dead_reckoning_cov(&ImuRecord { t_start, period, rho: &rho }, &epochs, &model))?;
     Ok(mats_to_py(py, &p))
 }
