@@ -2,7 +2,7 @@
 //! white + random-walk preset (navigation) and one with flicker noise (tactical).
 
 use atomnav::imu::errors::ImuSimulator;
-use atomnav::imu::noise::ImuKind;
+use atomnav::imu::ImuKind;
 use atomnav::imu::presets::preset;
 use atomnav::math::Vec3;
 use criterion::{criterion_group, criterion_main, Criterion};
