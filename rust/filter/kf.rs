@@ -5,10 +5,8 @@
 //! project's δx = estimate − true, spec cai-ekf §2.0); the estimated error δx̂ is removed
 //! from the navigation solution by the caller (closed loop) or kept (open loop).
 
-use super::matrix::{check_covariance, check_square, symmetrize};
+use super::matrix::{check_covariance, check_square, propagate_covariance, symmetrize};
 use crate::error::{invalid, NavError, Result};
-use faer::linalg::matmul::matmul;
-use faer::{Accum, Mat, MatMut, MatRef, Par};
 use nalgebra::{DMatrix, DVector};
 
 /// How the filter's estimate reaches the navigation solution (spec gnss-ins-tight §2.11).
@@ -54,12 +52,14 @@ pub struct Kf {
     pub mode: LoopMode,
     /// Number of predictions done (the "epoch" named by numerical errors).
     pub epoch: usize,
+    /// Work buffer of the covariance propagation (kept to avoid an allocation per step).
+    scratch: Vec<f64>,
 }
 
 impl Kf {
     pub fn new(p0: DMatrix<f64>, mode: LoopMode) -> Result<Kf> {
         check_covariance("p0", &p0, None, true)?;
-        Ok(Kf { x: DVector::zeros(p0.nrows()), p: p0, mode, epoch: 0 })
+        Ok(Kf { x: DVector::zeros(p0.nrows()), p: p0, mode, epoch: 0, scratch: Vec::new() })
     }
 
     pub fn size(&self) -> usize {
@@ -89,17 +89,9 @@ impl Kf {
     /// `predict` without shape checks, for the inner loops whose matrices are built here.
     pub(crate) fn predict_unchecked(&mut self, phi: &DMatrix<f64>, qd: &DMatrix<f64>) -> Result<()> {
         self.epoch += 1;
-        if self.mode == LoopMode::Open {
-            self.x = phi * &self.x;
-        }
-        // P ← Φ(PΦᵀ) + Q_d with faer's small-matrix kernels on the column-major buffers.
         let n = self.size();
-        let phi_f = MatRef::from_column_major_slice(phi.as_slice(), n, n);
-        let mut t = Mat::<f64>::zeros(n, n);
-        matmul(t.as_mut(), Accum::Replace, MatRef::from_column_major_slice(self.p.as_slice(), n, n), phi_f.transpose(), 1.0, Par::Seq);
-        self.p.copy_from(qd);
-        matmul(MatMut::from_column_major_slice_mut(self.p.as_mut_slice(), n, n), Accum::Add, phi_f, t.as_ref(), 1.0, Par::Seq);
-        symmetrize(&mut self.p);
+        let x = (self.mode == LoopMode::Open).then_some(self.x.as_mut_slice());
+        propagate_covariance(self.p.as_mut_slice(), x, phi.as_slice(), qd.as_slice(), n, &mut self.scratch);
         if (0..self.size()).any(|i| !positive(self.p[(i, i)])) {
             return self.check_pd("predict");
         }
