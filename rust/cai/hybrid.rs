@@ -74,7 +74,7 @@ pub struct HybridRun {
     /// Bias estimates (accel m/s², gyro rad/s) and the truth they estimate.
     pub bias: Vec<[f64; 6]>,
     pub bias_true: Vec<[f64; 6]>,
-    /// Accelerometer error (measured − ideal, m/s²) of the sample at each epoch.
+    /// Accelerometer error (measured − ideal, m/s²) of every IMU sample.
     pub accel_error: Vec<[f64; 3]>,
     /// σ of every filter state (epochs × n, row-major), n = state size.
     pub sigma: Vec<f64>,
@@ -99,10 +99,10 @@ impl HybridScenario {
         Ok((t, truth, f, w))
     }
 
-    /// True phases of a perfect CAI (see [`PhaseSource::Ideal`]).
-    pub fn ideal_phases(motion: &Motion, ell: &Ellipsoid, rate_hz: f64, cai: &CaiConfig) -> Result<Vec<f64>> {
-        let (t, truth, f, w) = Self::imu_truth(motion, ell, rate_hz)?;
-        let (_, _, wd) = ideal_rates(motion, ell, &truth);
+    /// True phases of a perfect CAI (see [`PhaseSource::Ideal`]) from the ideal IMU at the
+    /// truth samples `t`, `truth`, `f`, `w` of `motion` (ω̇ exact).
+    pub fn ideal_phases(motion: &Motion, ell: &Ellipsoid, t: &[f64], truth: &[TruthState], f: &[Vec3], w: &[Vec3], cai: &CaiConfig) -> Result<Vec<f64>> {
+        let (_, _, wd) = ideal_rates(motion, ell, truth);
         let cfg = PredictorConfig {
             t_sep: cai.t_sep,
             substeps: 1,
@@ -112,7 +112,7 @@ impl HybridScenario {
             omega_dot: OmegaDot::Given(wd),
             interpolation: Interpolation::Cubic,
         };
-        Ok(predict(Imu { t: &t, f: &f, w: &w }, &cai.shots, &cai.channels, &cfg)?.iter().map(|r| r[0]).collect())
+        Ok(predict(Imu { t, f, w }, &cai.shots, &cai.channels, &cfg)?.iter().map(|r| r[0]).collect())
     }
 
     /// Run `run` of the Monte Carlo seeded by `master_seed`.
@@ -174,6 +174,7 @@ impl HybridScenario {
         let mut free_nav = Vec::with_capacity(self.t.len());
         Strapdown::new(initial, ImuKind::Rates, self.ell, Vertical::Free)?.run(&self.t, &imu.gyro, &imu.accel, None, &mut free_nav)?;
         let mut res = HybridRun { sigma: out.sigma, phase_error: ins.aiding().log.phase_error.clone(), ..Default::default() };
+        res.accel_error = imu.accel.iter().zip(&self.f).map(|(m, f)| [m.x - f.x, m.y - f.y, m.z - f.z]).collect();
         for (e, &te) in out.time.iter().enumerate() {
             let k = ((te - t0) / dt).round() as usize;
             if k >= self.t.len() || (self.t[k] - te).abs() > 1e-9 {
@@ -192,8 +193,6 @@ impl HybridScenario {
                 tg -= rg[k];
             }
             res.bias_true.push([ta.x, ta.y, ta.z, tg.x, tg.y, tg.z]);
-            let ea = imu.accel[k] - self.f[k];
-            res.accel_error.push([ea.x, ea.y, ea.z]);
             // NEES of the 15 INS states: δx = (navigation errors, b̂ − b)
             let dx = DVector::from_iterator(15, err.iter().copied().chain((0..3).map(|i| ba[i] - ta[i])).chain((0..3).map(|i| bg[i] - tg[i])));
             let p = &nees[e].1;

@@ -489,7 +489,11 @@ impl CaiHybrid {
             let (t, truth, f, w) = HybridScenario::imu_truth(m, &ell, rate_hz)?;
             let phase = match (reference, truth_rate_hz) {
                 (Some(model), _) => PhaseSource::Reference(model),
-                (None, Some(r)) => PhaseSource::Ideal(HybridScenario::ideal_phases(m, &ell, r, &cai)?),
+                (None, Some(r)) if r == rate_hz => PhaseSource::Ideal(HybridScenario::ideal_phases(m, &ell, &t, &truth, &f, &w, &cai)?),
+                (None, Some(r)) => {
+                    let (tt, tr, tf, tw) = HybridScenario::imu_truth(m, &ell, r)?;
+                    PhaseSource::Ideal(HybridScenario::ideal_phases(m, &ell, &tt, &tr, &tf, &tw, &cai)?)
+                }
                 (None, None) => return Err(invalid("truth_rate_hz", "required without a reference IMU")),
             };
             let rw = |psd: f64| BiasModel::RandomWalk { psd };
@@ -507,7 +511,8 @@ impl CaiHybrid {
     }
 
     /// Runs `runs` under `seed`: dict of arrays, each (runs, epochs, ...) except
-    /// `phase_error` (runs, shots, channels) and `time` (epochs).
+    /// `phase_error` (runs, shots, channels), `accel_error` (runs, samples, 3), `time`
+    /// (epochs) and `imu_time` (samples).
     fn monte_carlo<'py>(&self, py: Python<'py>, seed: u64, runs: Vec<u64>) -> PyResult<Bound<'py, PyDict>> {
         let res = py.detach(|| self.0.monte_carlo(seed, &runs))?;
         let d = PyDict::new(py);
@@ -525,7 +530,10 @@ impl CaiHybrid {
         d.set_item("free", cube(9, &|r| r.free.iter().flatten().copied().collect())?)?;
         d.set_item("bias", cube(6, &|r| r.bias.iter().flatten().copied().collect())?)?;
         d.set_item("bias_true", cube(6, &|r| r.bias_true.iter().flatten().copied().collect())?)?;
-        d.set_item("accel_error", cube(3, &|r| r.accel_error.iter().flatten().copied().collect())?)?;
+        let ns = self.0.t.len();
+        let flat: Vec<f64> = res.iter().flat_map(|r| r.accel_error.iter().flatten().copied()).collect();
+        d.set_item("accel_error", numpy::PyArray1::from_vec(py, flat).reshape([nr, ns, 3])?)?;
+        d.set_item("imu_time", vec_to_py(py, self.0.t.clone()))?;
         let n = if ne > 0 { res[0].sigma.len() / ne } else { 0 };
         d.set_item("sigma", cube(n, &|r| r.sigma.clone())?)?;
         if res.iter().all(|r| r.nees.len() == ne) {

@@ -105,8 +105,8 @@ class HybridResult:
     """Monte-Carlo result of one scenario. Arrays: ``time`` (E,) s; ``hybrid`` and ``free``
     (R, E, 9) errors (:data:`ERROR_COLUMNS`) of the CAI-aided and the IMU-only solutions;
     ``bias`` / ``bias_true`` (R, E, 6) estimated and true biases (:data:`BIAS_COLUMNS`);
-    ``sigma`` (R, E, n) filter σ of every state; ``accel_error`` (R, E, 3) IMU accelerometer
-    error at the epoch's sample; ``phase_error`` (R, S, C) true − predicted phase (rad) per
+    ``sigma`` (R, E, n) filter σ of every state; ``accel_error`` (R, N, 3) accelerometer error
+    (measured − ideal, m/s²) of every IMU sample at ``imu_time`` (N,); ``phase_error`` (R, S, C) true − predicted phase (rad) per
     shot and channel; ``shots`` (S,) shot start times; ``nees`` (R, E) NEES of the 15 INS
     states (navigation errors and b̂ − b) under the filter's P."""
 
@@ -122,6 +122,7 @@ class HybridResult:
     phase_error: np.ndarray
     shots: np.ndarray
     nees: np.ndarray
+    imu_time: np.ndarray
     channel_names: list = field(default_factory=list)
 
     @property
@@ -227,10 +228,10 @@ def _simulate(name: str, motion, *, ellipsoid: str, rate_hz: float, truth_rate_h
             ids = list(range(lo, min(lo + chunk, int(runs))))
             parts.append(core.monte_carlo(int(seed), ids))
             bar.update(len(ids))
-    cat = {k: np.concatenate([p[k] for p in parts]) for k in parts[0] if k != "time"}
+    cat = {k: np.concatenate([p[k] for p in parts]) for k in parts[0] if k not in ("time", "imu_time")}
     return HybridResult(name, dict(params or {}), parts[0]["time"], cat["hybrid"], cat["free"], cat["bias"], cat["bias_true"],
                         cat["sigma"], cat["accel_error"], cat["phase_error"], np.asarray(core.shots), cat["nees"][:, :, 0],
-                        list(sensor.channels.names))
+                        parts[0]["imu_time"], list(sensor.channels.names))
 
 
 def seed003_sensor(lever=(0.0, 0.0, 0.1), v0: float = 2.8, T: float = 0.025, inflation=(1.25e-11, 1.0576e-12),
@@ -292,12 +293,12 @@ def satellite(days: float = 4.0, seed: int = 2021, *, drift: bool = True, progre
     q_rw = 1e-21 m²/s⁵), one CAI shot every 10 s with T0 = 10 s (T = 5 s), |A| = 0.15
     (C = 0.3), R = 1.024e-3; the filter's bias model is the random walk q_rw
     (Q = 1e-20 (m/s²)² per shot, Table 1 case A). Kinematic frame (drag-free, no
-    gravity); one run; output every IMU sample."""
+    gravity); one run; output at every shot."""
     motion = _core.Motion.stationary(vector(HANNOVER, 3, "origin"), positive(days, "days") * 86400.0, np.zeros(3))
     ch = Channels(np.array([[K_RB87, 0.0, 0.0]]), np.zeros(3), np.eye(3), np.zeros(3), ["x"])
     sensor = CaiSensor(ch, 5.0, contrast=0.3, sigma_p=0.032, inflation=(1e-20, 0.0), omega_dot="zero")
     imu = ImuErrors.preset("electrostatic_space_drift" if drift else "electrostatic_space")
-    setup = FilterSetup(1e-20, 1e-30, 1e-21, 0.0, 1, sigma0=(1e-6, 1e-9, 1e-9, 1e-9, 1e-12))
+    setup = FilterSetup(1e-20, 1e-30, 1e-21, 0.0, 10, sigma0=(1e-6, 1e-9, 1e-9, 1e-9, 1e-12))
     return _simulate("satellite", motion, ellipsoid="kinematic", rate_hz=1.0, truth_rate_hz=1.0, imu=imu, reference=None,
                      sensor=sensor, setup=setup, runs=1, seed=seed, progress=progress,
                      params={"days": days, "drift": drift, "T": sensor.T, "shot_period_s": 2 * sensor.T, "contrast": sensor.contrast,
@@ -400,9 +401,12 @@ def satellite_psd(res: HybridResult, nperseg: int = 2**15) -> pd.DataFrame:
     from scipy.signal import welch
 
     p = res.params
-    fs = 1.0 / float(np.median(np.diff(res.time)))
+    t = res.imu_time
+    fs = 1.0 / float(np.median(np.diff(t)))
     e = res.accel_error[0, :, 0]
-    filt = e - res.bias[0, :, 0]
+    # b̂ held from each output epoch until the next (the estimate the IMU output is corrected with)
+    k = np.clip(np.searchsorted(res.time, t, side="right") - 1, 0, len(res.time) - 1)
+    filt = e - np.where(t >= res.time[0], res.bias[0, k, 0], 0.0)
     f, p_imu = welch(e, fs=fs, nperseg=min(nperseg, len(e)))
     _, p_filt = welch(filt, fs=fs, nperseg=min(nperseg, len(e)))
     df = pd.DataFrame({"frequency_hz": f[1:], "imu_asd": np.sqrt(p_imu[1:]), "filtered_asd": np.sqrt(p_filt[1:])})
