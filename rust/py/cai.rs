@@ -450,7 +450,7 @@ impl CaiHybrid {
     #[allow(clippy::too_many_arguments)]
     #[pyo3(signature = (motion, ellipsoid, rate_hz, truth_rate_hz, imu_accel, imu_gyro, reference, channels, t_sep, shots, readout,
         inflation, omega_dot, savgol_half_width, interpolation, substeps, jacobian_euler, misalignment, lever_arm, force,
-        noise, predict_every, p0, aiding))]
+        noise, predict_every, p0, aiding, draw_initial))]
     fn new(
         py: Python<'_>,
         motion: &Motion,
@@ -477,6 +477,7 @@ impl CaiHybrid {
         predict_every: usize,
         p0: PyReadonlyArray2<'_, f64>,
         aiding: bool,
+        draw_initial: bool,
     ) -> PyResult<Self> {
         let ell = Ellipsoid::by_name(ellipsoid)?;
         let cai = cai_config(channels, t_sep, vector(&shots, "shots")?, readout, inflation, omega_dot, savgol_half_width, interpolation, substeps,
@@ -505,7 +506,7 @@ impl CaiHybrid {
                 sequential: false,
                 gate: None,
             };
-            Ok(HybridScenario { ell, t, truth, f, w, imu_model, cai, phase, filter, p0, aiding })
+            Ok(HybridScenario { ell, t, truth, f, w, imu_model, cai, phase, filter, p0, aiding, draw_initial })
         })?;
         Ok(CaiHybrid(scenario))
     }
