@@ -6,15 +6,24 @@ import pytest
 from atomnav.cai import hybrid
 
 
-@pytest.mark.parametrize("runs", [pytest.param(1, id="1-run"), pytest.param(20, id="20-runs", marks=pytest.mark.slow)])
-def test_all_six_biases_within_3_sigma_of_injected_values_after_60s(runs):
-    res = hybrid.hexapod(runs, progress=False)
-    for t in (60.0, 170.0):
-        k = res.epoch(t)
-        err = res.bias[:, k] - res.bias_true[:, k]
-        assert np.all(np.abs(err) <= 3 * res.sigma[:, k, 9:15]), (t, err / res.sigma[:, k, 9:15])
-    # spec §4: |b̂_a − Δb_a| < 1e-4 m/s², |b̂_g − Δb_g| < 5e-6 rad/s at 170 s
-    err = np.abs(res.bias[:, -1] - res.bias_true[:, -1])
-    assert np.mean(np.all(err[:, :3] < 1e-4, axis=1) & np.all(err[:, 3:] < 5e-6, axis=1)) >= 0.95
+def _inside(res, t):
+    """Per run: are all six bias errors within the filter's 3σ at time t?"""
+    k = res.epoch(t)
+    return np.all(np.abs(res.bias[:, k] - res.bias_true[:, k]) <= 3 * res.sigma[:, k, 9:15], axis=1)
+
+
+def test_one_run_all_six_biases_within_3_sigma_after_60s():
+    res = hybrid.hexapod(1, progress=False)
+    assert _inside(res, 60.0).all() and _inside(res, 170.0).all()
     # the injected MEMS biases are large compared with the filter's final σ
     assert np.all(np.abs(res.bias_true[:, -1]) > 3 * res.sigma[:, -1, 9:15])
+
+
+@pytest.mark.slow
+def test_monte_carlo_biases_within_3_sigma_and_spec_thresholds():
+    res = hybrid.hexapod(20, progress=False)
+    # six components inside 3σ jointly has probability 0.997⁶ = 0.984 for a consistent filter
+    assert _inside(res, 60.0).mean() >= 0.95 and _inside(res, 170.0).mean() >= 0.95
+    # spec §4: |b̂_a − Δb_a| < 1e-4 m/s², |b̂_g − Δb_g| < 5e-6 rad/s per axis at 170 s in ≥ 95 % of runs
+    err = np.abs(res.bias[:, -1] - res.bias_true[:, -1])
+    assert np.mean(np.all(err[:, :3] < 1e-4, axis=1) & np.all(err[:, 3:] < 5e-6, axis=1)) >= 0.95
