@@ -117,7 +117,8 @@ pub struct CaiAiding {
     pub log: ShotLog,
 }
 
-/// Samples kept before a shot start (interpolation and Savitzky–Golay stencils).
+/// Samples kept before a shot start for the interpolation stencils (the Savitzky–Golay
+/// window may need more, see `CaiAiding::pad`).
 const PAD: usize = 3;
 
 /// Shot start times t0, t0 + period, ... with the last shot ending (t_s + 2T) no later
@@ -259,10 +260,19 @@ impl CaiAiding {
         DMatrix::from_fn(m, m, |a, b| 2.0 * t.powi(3) / 3.0 * (qa * kb[a].dot(&kb[b]) + 4.0 * qg * vb[a].dot(&vb[b])))
     }
 
+    /// Samples to keep before a shot start: the interpolation stencil, or a whole
+    /// Savitzky–Golay window (2m + 1 samples) so that ω̇ near the shot start is centred.
+    fn pad(&self) -> usize {
+        match self.cfg.omega_dot {
+            OmegaDot::Savgol { half_width } => PAD.max(2 * half_width + 1),
+            _ => PAD,
+        }
+    }
+
     /// Drop the samples no later shot needs.
     fn prune(&mut self, next_shot: Option<f64>) {
         let keep_from = match next_shot {
-            Some(ts) => self.buf_t.partition_point(|&t| t < ts).saturating_sub(PAD),
+            Some(ts) => self.buf_t.partition_point(|&t| t < ts).saturating_sub(self.pad()),
             None => self.buf_t.len(),
         };
         self.buf_t.drain(..keep_from);

@@ -48,7 +48,8 @@ class CaiSensor:
     CAI misalignment γ / lever-arm correction l as extra random-walk states (21-state filter
     of seed 000) with this PSD; force: None = estimate biases (seed 000 option b), or
     (τ s, σ m/s²) = correct the specific force directly through a Gauss–Markov force-error
-    block (option a)."""
+    block (option a); first_shot: start of the first shot (s) in a simulated scenario (a
+    Savitzky–Golay ω̇ window needs 2m + 1 samples before the first shot ends)."""
 
     channels: Channels
     T: float
@@ -65,6 +66,7 @@ class CaiSensor:
     misalignment_psd: float | None = None
     lever_arm_psd: float | None = None
     force: tuple | None = None
+    first_shot: float = 0.0
 
     def shots(self, t0: float, t_end: float) -> np.ndarray:
         """Shot start times (s) from t0, one per ``shot_period``, the last ending by t_end."""
@@ -210,7 +212,7 @@ def _simulate(name: str, motion, *, ellipsoid: str, rate_hz: float, truth_rate_h
     start makes the filter conservative by construction)."""
     if int(runs) < 1:
         raise ValueError(f"runs: must be >= 1, got {runs}")
-    shots = sensor.shots(0.0, motion.duration)
+    shots = sensor.shots(sensor.first_shot, motion.duration)
     n_extra = sensor.n_extra()
     core = _core.CaiHybrid(
         motion, ellipsoid, positive(rate_hz, "rate_hz"), truth_rate_hz, *imu._to_core(),
