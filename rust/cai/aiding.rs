@@ -197,7 +197,9 @@ impl CaiAiding {
         let z = [Vec3::zeros(); 2];
         let probe = PredictorConfig { omega_dot: OmegaDot::Zero, ..Self::predictor_config(&cfg) };
         predict(Imu { t: &probe_t, f: &z, w: &z }, &[0.0], &cfg.channels, &probe)?;
-        let times = cfg.shots.iter().map(|s| s + 2.0 * cfg.t_sep).collect();
+        // last pulse t_s + 2T, less a rounding margin so that a shot ending on an IMU sample
+        // is applied at that sample (0.05·i + 0.05 may exceed the grid value by 1 ulp)
+        let times = cfg.shots.iter().map(|s| s + 2.0 * cfg.t_sep - 1e-9 * cfg.t_sep).collect();
         Ok(CaiAiding { cfg, data, times, buf_t: Vec::new(), buf_f: Vec::new(), buf_w: Vec::new(), c_nb: Mat3::identity(), log: ShotLog::default() })
     }
 

@@ -44,7 +44,8 @@ class CaiSensor:
     p = o − (C/2) cos(φ + φ0) + n, n ~ N(0, σ_p²); inflation: white-noise PSDs
     (q_a m²/s³, q_g rad²/s) of the IMU(s) for the in-shot R inflation (seed 000 decision 14)
     or None; omega_dot, savgol_half_width, interpolation, substeps: predictor options;
-    jacobian_euler: keep the Euler terms in H; misalignment_psd, lever_arm_psd: estimate the
+    jacobian_euler: keep the Euler terms in H (needed when the lever arm is estimated: its
+    main signature is the Euler term ω̇ × l); misalignment_psd, lever_arm_psd: estimate the
     CAI misalignment γ / lever-arm correction l as extra random-walk states (21-state filter
     of seed 000) with this PSD; force: None = estimate biases (seed 000 option b), or
     (τ s, σ m/s²) = correct the specific force directly through a Gauss–Markov force-error
@@ -252,6 +253,14 @@ def seed003_sensor(lever=(0.0, 0.0, 0.1), v0: float = 2.8, T: float = 0.025, inf
     return CaiSensor(Channels.cyclic(K_RB87, v0, lever=lever), T, inflation=inflation, interpolation=interpolation, omega_dot=omega_dot)
 
 
+def accelerometer_sensor(lever=(0.0, 0.0, 0.1), T: float = 0.025, inflation=(1.25e-11, 1.0576e-12)) -> CaiSensor:
+    """Accelerometer-only CAI: one channel per body axis with atoms at rest in s (v0 = 0), so
+    the readout carries no Coriolis phase and observes the accelerometer biases only (the
+    gyro biases enter only through the small mixed term 2T³k·(ω×f))."""
+    ch = Channels(np.eye(3) * K_RB87, lever, np.eye(3), np.zeros(3), ["x", "y", "z"])
+    return CaiSensor(ch, T, inflation=inflation, interpolation="cubic", omega_dot="pwl")
+
+
 def seed003_filter(attitude_sigma0: float = 1e-7) -> FilterSetup:
     """The seed-003 15-state filter: the navigation IMU's noise (spec (E36)), prediction every
     2T (10 steps at 200 Hz), start at the truth with P0 of spec decision 15 for the biases
@@ -285,15 +294,18 @@ def car_mc(runs: int = 100, seed: int = 2023, *, gravity: str = "kinematic", lev
 
 
 def slalom(runs: int = 100, seed: int = 2024, *, gravity: str = "kinematic", duration: float = 60.0, lever=(0.0, 0.0, 0.1),
-           aiding: bool = True, progress: bool = True) -> HybridResult:
+           aiding: bool = True, sensor: CaiSensor | None = None, setup: FilterSetup | None = None,
+           progress: bool = True) -> HybridResult:
     """Seed 003 smooth slalom (spec §2.8 ``slalom``): north = 5t m, east = 2 sin(2πt/10) m,
     level, heading along the path, 60 s; otherwise as :func:`car_mc`. ``aiding=False`` runs
-    the same filter without CAI updates."""
+    the same filter without CAI updates; ``sensor`` / ``setup`` replace the seed-003 CAI and
+    filter (e.g. :func:`accelerometer_sensor`, the 21-state filter with misalignment and
+    lever-arm states, or option a)."""
     choice(gravity, ("kinematic", "earth"), "gravity")
     motion = _core.Motion.slalom(vector(HANNOVER, 3, "origin"), 5.0, 2.0, 10.0, positive(duration, "duration"))
     return _simulate("slalom", motion, ellipsoid="kinematic" if gravity == "kinematic" else "WGS84", rate_hz=200.0,
-                     truth_rate_hz=2000.0, imu=ImuErrors.preset("navigation"), reference=None, sensor=seed003_sensor(lever),
-                     setup=seed003_filter(), runs=runs, seed=seed, progress=progress, aiding=aiding,
+                     truth_rate_hz=2000.0, imu=ImuErrors.preset("navigation"), reference=None, sensor=sensor or seed003_sensor(lever),
+                     setup=setup or seed003_filter(), runs=runs, seed=seed, progress=progress, aiding=aiding,
                      params={"gravity": gravity, "lever_m": tuple(lever), "duration_s": duration})
 
 
