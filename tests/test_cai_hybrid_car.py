@@ -16,15 +16,26 @@ def test_velocity_gain_at_25s_is_at_least_30(car):
     assert r >= 30, r
 
 
-def test_error_jumps_inside_the_spike_windows(car):
-    # spec §4: velocity-error and gyro-bias spread increase within [25.5, 27] s and [32.5, 35.5] s
+def _jump(car, a, b):
+    """Hybrid velocity-error RMS and gyro-bias-error RMS over runs: value at the window start
+    and maximum inside [a, b] s (spec §4: both increase within the spike windows)."""
     rms = car.rms("hybrid")["vel_norm_mps"].to_numpy()
     gb = np.sqrt(np.mean((car.bias[:, :, 3:] - car.bias_true[:, :, 3:]) ** 2, axis=(0, 2)))
-    t = car.time
-    for (a, b) in ((25.5, 27.0), (32.5, 35.5)):
-        before = car.epoch(a)
-        inside = (t >= a) & (t <= b)
-        assert rms[inside].max() > rms[before] and gb[inside].max() > gb[before], (a, rms[before], rms[inside].max())
+    k, inside = car.epoch(a), (car.time > a) & (car.time <= b)
+    return (rms[k], rms[inside].max()), (gb[k], gb[inside].max())
+
+
+def test_error_jumps_at_the_26s_shock(car):
+    (v0, v1), (g0, g1) = _jump(car, 25.5, 27.0)
+    assert v1 > 1.1 * v0 and g1 > g0, (v0, v1, g0, g1)
+
+
+def test_error_rises_in_the_33_35s_vibration_window(car):
+    # the ×2 vibration of 33-35 s is a weak effect: resolved with 100 runs only
+    if car.runs < 100:
+        pytest.skip("needs the full 100-run Monte Carlo (-m slow)")
+    (v0, v1), (g0, g1) = _jump(car, 32.5, 35.5)
+    assert v1 > v0 and g1 > g0, (v0, v1, g0, g1)
 
 
 def test_accelerometer_bias_tracks_the_random_walk_inside_3_sigma(car):
