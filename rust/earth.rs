@@ -34,6 +34,11 @@ pub const WGS84: Ellipsoid = Ellipsoid {
     gamma_p: 9.8321849378,
 };
 
+/// Kinematic mode (spec atom-strapdown decision 11): WGS-84 geometry without Earth
+/// rotation and with zero normal gravity, so a tilt error does not project gravity into
+/// the velocity and the IMU senses the kinematic acceleration.
+pub const KINEMATIC: Ellipsoid = Ellipsoid { name: "kinematic", omega: 0.0, gamma_e: 0.0, gamma_p: 0.0, ..WGS84 };
+
 /// PZ-90.11 (GLONASS ICD 2016, spec gnss-ins-tight §3).
 pub const PZ90_11: Ellipsoid = Ellipsoid {
     name: "PZ90.11",
@@ -53,7 +58,8 @@ impl Ellipsoid {
         match key.as_str() {
             "wgs84" => Ok(WGS84),
             "pz9011" | "pz90" => Ok(PZ90_11),
-            _ => Err(invalid("ellipsoid", format!("unknown ellipsoid '{name}' (known: WGS84, PZ90.11)"))),
+            "kinematic" => Ok(KINEMATIC),
+            _ => Err(invalid("ellipsoid", format!("unknown ellipsoid '{name}' (known: WGS84, PZ90.11, kinematic)"))),
         }
     }
 
@@ -86,6 +92,15 @@ impl Ellipsoid {
         (ge, gp)
     }
 
+    /// Somigliana's k = bγ_p/(aγ_e) − 1 (0 for the gravity-free kinematic model).
+    fn somigliana_k(&self) -> f64 {
+        if self.gamma_e == 0.0 {
+            0.0
+        } else {
+            self.b() * self.gamma_p / (self.a * self.gamma_e) - 1.0
+        }
+    }
+
     /// Meridian (M) and prime-vertical (N) radii of curvature (m) at latitude `lat`.
     pub fn radii(&self, lat: f64) -> (f64, f64) {
         let e2 = self.e2();
@@ -98,21 +113,21 @@ impl Ellipsoid {
     /// Normal gravity magnitude γ (m/s², positive down): Somigliana with the second-order
     /// height correction, spec gnss-ins-tight §2.1 Eq. 4.
     pub fn gravity(&self, lat: f64, h: f64) -> f64 {
-        let (ge, gp) = (self.gamma_e, self.gamma_p);
-        let (a, b, f, m) = (self.a, self.b(), self.f, self.m());
+        let ge = self.gamma_e;
+        let (a, f, m) = (self.a, self.f, self.m());
         let s2 = lat.sin().powi(2);
-        let k = b * gp / (a * ge) - 1.0;
+        let k = self.somigliana_k();
         let g0 = ge * (1.0 + k * s2) / (1.0 - self.e2() * s2).sqrt();
         g0 * (1.0 - 2.0 / a * (1.0 + f + m - 2.0 * f * s2) * h + 3.0 * h * h / (a * a))
     }
 
     /// ∂γ/∂φ at height h (m/s²/rad), by the analytic derivative of `gravity`.
     pub fn gravity_dlat(&self, lat: f64, h: f64) -> f64 {
-        let (ge, gp) = (self.gamma_e, self.gamma_p);
-        let (a, b, f, m, e2) = (self.a, self.b(), self.f, self.m(), self.e2());
+        let ge = self.gamma_e;
+        let (a, f, m, e2) = (self.a, self.f, self.m(), self.e2());
         let s2 = lat.sin().powi(2);
         let ds2 = (2.0 * lat).sin(); // d(sin²φ)/dφ
-        let k = b * gp / (a * ge) - 1.0;
+        let k = self.somigliana_k();
         let w = (1.0 - e2 * s2).sqrt();
         let g0 = ge * (1.0 + k * s2) / w;
         let dg0 = ge * (k * ds2 / w + (1.0 + k * s2) * 0.5 * e2 * ds2 / (w * w * w));
@@ -238,7 +253,7 @@ impl Ellipsoid {
         let w = w2.sqrt();
         let (m, n) = (self.a * (1.0 - e2) / (w2 * w), self.a / w);
         let (a, f, mm, s2) = (self.a, self.f, self.m(), sin * sin);
-        let k = self.b() * self.gamma_p / (a * self.gamma_e) - 1.0;
+        let k = self.somigliana_k();
         let g0 = self.gamma_e * (1.0 + k * s2) / w;
         let gravity = g0 * (1.0 - 2.0 / a * (1.0 + f + mm - 2.0 * f * s2) * h + 3.0 * h * h / (a * a));
         Local { sin, cos, rm: m + h, rp: n + h, gravity, omega: self.omega }
@@ -259,6 +274,19 @@ impl Ellipsoid {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Kinematic mode: no gravity, no gradient, no Earth rate; WGS-84 geometry.
+    #[test]
+    fn kinematic_model_has_no_gravity_and_no_rotation() {
+        let k = Ellipsoid::by_name("kinematic").unwrap();
+        for (lat, h) in [(0.0, 0.0), (0.9, 300.0), (-1.2, -50.0)] {
+            assert_eq!(k.gravity(lat, h), 0.0);
+            assert_eq!(k.gravity_dlat(lat, h), 0.0);
+            assert_eq!(k.local(lat, h).gravity, 0.0);
+            assert_eq!(k.earth_rate_ned(lat), Vec3::zeros());
+            assert_eq!(k.radii(lat), WGS84.radii(lat));
+        }
+    }
 
     #[test]
     fn wgs84_normal_gravity_matches_published_constants() {

@@ -7,7 +7,9 @@
 //! (origin at the release point); atom motion driven by the SPECIFIC FORCE (E5);
 //! measured = true + bias, the estimated bias is subtracted.
 
+pub mod aiding;
 pub mod closed_form;
+pub mod hybrid;
 pub mod noise_id;
 pub mod oracle;
 pub mod predictor;

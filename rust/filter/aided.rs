@@ -232,6 +232,11 @@ impl<A: Aiding> AidedIns<A> {
         &self.aiding
     }
 
+    /// Current error-state covariance P (n × n), e.g. for NEES.
+    pub fn covariance(&self) -> &DMatrix<f64> {
+        &self.kf.p
+    }
+
     /// Measurements not applied yet (their time is after the last processed sample).
     pub fn pending(&self) -> usize {
         self.aiding.times().len() - self.next_meas

@@ -2,6 +2,19 @@
 //! sensitivity function, fringe tracking and ML noise identification.
 
 use super::convert::{rows, to_py_rows, vec3, vec3_rows, vec3_to_py, vec_to_py, vector};
+use super::imu::triad_from_dict;
+use super::trajectory::Motion;
+use super::filter::{ins_noise, PyAidedIns};
+use crate::cai::aiding::{CaiAiding, CaiConfig, CaiData, ForceMode};
+use nalgebra::DVector;
+use crate::cai::hybrid::{HybridRun, HybridScenario, PhaseSource};
+use crate::earth::Ellipsoid;
+use crate::filter::aided::AidedConfig;
+use crate::filter::discretize::Discretization;
+use crate::filter::ins::{BiasModel, InsNoise};
+use crate::filter::kf::LoopMode;
+use crate::imu::errors::ImuErrorModel;
+use crate::imu::ImuKind;
 use crate::cai::closed_form::{phase_constant, phase_seed000, phase_series};
 use crate::cai::noise_id::{fringe_track, ml_windows, FringeEkf, Method, MlConfig};
 use crate::cai::oracle::{imu_from_motion, oracle_phase, BodyMotion, Gravity, SineMotion, Signal, YawDrive};
@@ -9,7 +22,7 @@ use crate::cai::predictor::{jacobian, jacobian_fd, predict, Channel, Imu, Interp
 use crate::cai::sensitivity::{convolution_phase, ideal_transfer, Pulses};
 use crate::error::invalid;
 use crate::math::{Mat3, Vec3};
-use numpy::{PyArray1, PyArray2, PyReadonlyArray1, PyReadonlyArray2, PyReadonlyArray3, PyUntypedArrayMethods};
+use numpy::{PyArray1, PyArray2, PyArrayMethods, PyReadonlyArray1, PyReadonlyArray2, PyReadonlyArray3, PyUntypedArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
@@ -354,6 +367,8 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<CaiSetup>()?;
     m.add_class::<CaiGravity>()?;
     m.add_class::<CaiMotion>()?;
+    m.add_class::<CaiHybrid>()?;
+    m.add_function(wrap_pyfunction!(cai_aided_ins, m)?)?;
     m.add_function(wrap_pyfunction!(cai_phase_closed_form, m)?)?;
     m.add_function(wrap_pyfunction!(cai_sensitivity, m)?)?;
     m.add_function(wrap_pyfunction!(cai_convolution_phase, m)?)?;
@@ -362,4 +377,251 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(cai_fringe_track, m)?)?;
     m.add_function(wrap_pyfunction!(cai_ml_identify, m)?)?;
     Ok(())
+}
+
+/// The triad of an IMU error model from its two dicts (as `atomnav.imu.ImuErrors._to_core`).
+fn error_model(accel: &Bound<'_, PyDict>, gyro: &Bound<'_, PyDict>, name: &str) -> PyResult<ImuErrorModel> {
+    let m = ImuErrorModel { accel: triad_from_dict(accel, &format!("{name}.accel"))?, gyro: triad_from_dict(gyro, &format!("{name}.gyro"))? };
+    m.validate()?;
+    Ok(m)
+}
+
+fn omega_dot_mode(name: &str, half_width: usize) -> PyResult<OmegaDot> {
+    match name {
+        "zero" => Ok(OmegaDot::Zero),
+        "pwl" => Ok(OmegaDot::Pwl),
+        "savgol" => Ok(OmegaDot::Savgol { half_width }),
+        other => Err(invalid("omega_dot", format!("unknown option {other:?}; choose zero, pwl, savgol")).into()),
+    }
+}
+
+fn interpolation_mode(name: &str) -> PyResult<Interpolation> {
+    match name {
+        "linear" => Ok(Interpolation::Linear),
+        "cubic" => Ok(Interpolation::Cubic),
+        other => Err(invalid("interpolation", format!("unknown option {other:?}; choose linear, cubic")).into()),
+    }
+}
+
+/// CAI aiding configuration from the Python keyword set (see `atomnav.hybrid.CaiSensor`).
+#[allow(clippy::too_many_arguments)]
+fn cai_config(
+    channels: &CaiChannels,
+    t_sep: f64,
+    shots: Vec<f64>,
+    readout: (f64, f64, f64),
+    inflation: Option<(f64, f64)>,
+    omega_dot: &str,
+    savgol_half_width: usize,
+    interpolation: &str,
+    substeps: usize,
+    jacobian_euler: bool,
+    misalignment: Option<f64>,
+    lever_arm: Option<f64>,
+    force: Option<(f64, f64)>,
+) -> PyResult<CaiConfig> {
+    Ok(CaiConfig {
+        channels: channels.0.clone(),
+        t_sep,
+        shots,
+        offset: readout.0,
+        contrast: readout.1,
+        sigma_p: readout.2,
+        inflation,
+        omega_dot: omega_dot_mode(omega_dot, savgol_half_width)?,
+        interpolation: interpolation_mode(interpolation)?,
+        substeps,
+        jacobian_euler,
+        misalignment,
+        lever_arm,
+        force: force.map_or(ForceMode::Bias, |(tau, sigma)| ForceMode::Direct { tau, sigma }),
+        kind: ImuKind::Rates,
+    })
+}
+
+/// A CAI-aided INS scenario (truth, IMU errors, CAI, filter), built once; `monte_carlo`
+/// runs seeded runs in parallel with the GIL released.
+#[pyclass(module = "atomnav._core", frozen)]
+struct CaiHybrid(HybridScenario);
+
+#[pymethods]
+impl CaiHybrid {
+    #[new]
+    #[allow(clippy::too_many_arguments)]
+    #[pyo3(signature = (motion, ellipsoid, rate_hz, truth_rate_hz, imu_accel, imu_gyro, reference, channels, t_sep, shots, readout,
+        inflation, omega_dot, savgol_half_width, interpolation, substeps, jacobian_euler, misalignment, lever_arm, force,
+        noise, predict_every, p0, aiding, draw_initial))]
+    fn new(
+        py: Python<'_>,
+        motion: &Motion,
+        ellipsoid: &str,
+        rate_hz: f64,
+        truth_rate_hz: Option<f64>,
+        imu_accel: &Bound<'_, PyDict>,
+        imu_gyro: &Bound<'_, PyDict>,
+        reference: Option<(Bound<'_, PyDict>, Bound<'_, PyDict>)>,
+        channels: &CaiChannels,
+        t_sep: f64,
+        shots: PyReadonlyArray1<'_, f64>,
+        readout: (f64, f64, f64),
+        inflation: Option<(f64, f64)>,
+        omega_dot: &str,
+        savgol_half_width: usize,
+        interpolation: &str,
+        substeps: usize,
+        jacobian_euler: bool,
+        misalignment: Option<f64>,
+        lever_arm: Option<f64>,
+        force: Option<(f64, f64)>,
+        noise: (f64, f64, f64, f64),
+        predict_every: usize,
+        p0: PyReadonlyArray2<'_, f64>,
+        aiding: bool,
+        draw_initial: bool,
+    ) -> PyResult<Self> {
+        let ell = Ellipsoid::by_name(ellipsoid)?;
+        let cai = cai_config(channels, t_sep, vector(&shots, "shots")?, readout, inflation, omega_dot, savgol_half_width, interpolation, substeps,
+            jacobian_euler, misalignment, lever_arm, force)?;
+        let imu_model = error_model(imu_accel, imu_gyro, "imu")?;
+        let reference = reference.map(|(a, g)| error_model(&a, &g, "reference")).transpose()?;
+        let p0 = super::filter::mat(&p0, "p0")?;
+        let m = &motion.inner;
+        let scenario = py.detach(|| -> crate::Result<HybridScenario> {
+            let (t, truth, f, w) = HybridScenario::imu_truth(m, &ell, rate_hz)?;
+            let phase = match (reference, truth_rate_hz) {
+                (Some(model), _) => PhaseSource::Reference(model),
+                (None, Some(r)) if r == rate_hz => PhaseSource::Ideal(HybridScenario::ideal_phases(m, &ell, &t, &truth, &f, &w, &cai)?),
+                (None, Some(r)) => {
+                    let (tt, tr, tf, tw) = HybridScenario::imu_truth(m, &ell, r)?;
+                    PhaseSource::Ideal(HybridScenario::ideal_phases(m, &ell, &tt, &tr, &tf, &tw, &cai)?)
+                }
+                (None, None) => return Err(invalid("truth_rate_hz", "required without a reference IMU")),
+            };
+            let rw = |psd: f64| BiasModel::RandomWalk { psd };
+            let filter = AidedConfig {
+                noise: InsNoise { accel_psd: noise.0, gyro_psd: noise.1, accel_bias: rw(noise.2), gyro_bias: rw(noise.3) },
+                predict_every,
+                method: Discretization::VanLoan,
+                mode: LoopMode::Closed,
+                sequential: false,
+                gate: None,
+            };
+            Ok(HybridScenario { ell, t, truth, f, w, imu_model, cai, phase, filter, p0, aiding, draw_initial })
+        })?;
+        Ok(CaiHybrid(scenario))
+    }
+
+    /// Runs `runs` under `seed`: dict of arrays, each (runs, epochs, ...) except
+    /// `phase_error` (runs, shots, channels), `accel_error` (runs, samples, 3), `time`
+    /// (epochs) and `imu_time` (samples).
+    fn monte_carlo<'py>(&self, py: Python<'py>, seed: u64, runs: Vec<u64>) -> PyResult<Bound<'py, PyDict>> {
+        let res = py.detach(|| self.0.monte_carlo(seed, &runs))?;
+        let d = PyDict::new(py);
+        let nr = res.len();
+        let ne = res.first().map_or(0, |r| r.time.len());
+        if res.iter().any(|r| r.time.len() != ne) {
+            return Err(crate::NavError::Numerical("runs produced different numbers of epochs".into()).into());
+        }
+        let cube = |w: usize, get: &dyn Fn(&HybridRun) -> Vec<f64>| -> PyResult<Bound<'py, numpy::PyArray3<f64>>> {
+            let flat: Vec<f64> = res.iter().flat_map(get).collect();
+            Ok(numpy::PyArray1::from_vec(py, flat).reshape([nr, ne, w])?)
+        };
+        d.set_item("time", vec_to_py(py, res.first().map_or_else(Vec::new, |r| r.time.clone())))?;
+        d.set_item("hybrid", cube(9, &|r| r.hybrid.iter().flatten().copied().collect())?)?;
+        d.set_item("free", cube(9, &|r| r.free.iter().flatten().copied().collect())?)?;
+        d.set_item("bias", cube(6, &|r| r.bias.iter().flatten().copied().collect())?)?;
+        d.set_item("bias_true", cube(6, &|r| r.bias_true.iter().flatten().copied().collect())?)?;
+        let ns = self.0.t.len();
+        let flat: Vec<f64> = res.iter().flat_map(|r| r.accel_error.iter().flatten().copied()).collect();
+        d.set_item("accel_error", numpy::PyArray1::from_vec(py, flat).reshape([nr, ns, 3])?)?;
+        d.set_item("imu_time", vec_to_py(py, self.0.t.clone()))?;
+        let n = if ne > 0 { res[0].sigma.len() / ne } else { 0 };
+        d.set_item("sigma", cube(n, &|r| r.sigma.clone())?)?;
+        if res.iter().all(|r| r.nees.len() == ne) {
+            d.set_item("nees", cube(1, &|r| r.nees.clone())?)?;
+        }
+        let nch = self.0.cai.channels.len();
+        let nshots = res.first().map_or(0, |r| r.phase_error.len() / nch);
+        let flat: Vec<f64> = res.iter().flat_map(|r| r.phase_error.iter().copied()).collect();
+        d.set_item("phase_error", numpy::PyArray1::from_vec(py, flat).reshape([nr, nshots, nch])?)?;
+        Ok(d)
+    }
+
+    /// Shot start times (s).
+    #[getter]
+    fn shots<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        vec_to_py(py, self.0.cai.shots.clone())
+    }
+
+    /// Ideal specific force (N, 3) m/s² and angular rate (N, 3) rad/s at the IMU times, and the times.
+    fn ideal_imu<'py>(&self, py: Python<'py>) -> (Arr1<'py>, Arr2<'py>, Arr2<'py>) {
+        (vec_to_py(py, self.0.t.clone()), vec3_to_py(py, &self.0.f), vec3_to_py(py, &self.0.w))
+    }
+}
+
+/// CAI-aided INS on the generic engine (`atomnav.filter.AidedIns`): the shots' data are
+/// either emulated (`phase` true phases + `noise` population noise, shots × channels, the
+/// laser phase steered inside the loop) or recorded (`population` + `laser_phase`).
+#[pyfunction]
+#[pyo3(signature = (t0, lla0, vel0, q0, kind, ba0, bg0, extra0, p0, accel_psd, gyro_psd, accel_bias, gyro_bias, predict_every, method, mode,
+    sequential, gate, ellipsoid, channels, t_sep, shots, readout, inflation, omega_dot, savgol_half_width, interpolation, substeps,
+    jacobian_euler, misalignment, lever_arm, force, data_kind, data_a, data_b))]
+#[allow(clippy::too_many_arguments)]
+fn cai_aided_ins(
+    t0: f64,
+    lla0: PyReadonlyArray1<'_, f64>,
+    vel0: PyReadonlyArray1<'_, f64>,
+    q0: PyReadonlyArray1<'_, f64>,
+    kind: &str,
+    ba0: PyReadonlyArray1<'_, f64>,
+    bg0: PyReadonlyArray1<'_, f64>,
+    extra0: PyReadonlyArray1<'_, f64>,
+    p0: PyReadonlyArray2<'_, f64>,
+    accel_psd: f64,
+    gyro_psd: f64,
+    accel_bias: (String, f64, f64),
+    gyro_bias: (String, f64, f64),
+    predict_every: usize,
+    method: &str,
+    mode: &str,
+    sequential: bool,
+    gate: Option<f64>,
+    ellipsoid: &str,
+    channels: &CaiChannels,
+    t_sep: f64,
+    shots: PyReadonlyArray1<'_, f64>,
+    readout: (f64, f64, f64),
+    inflation: Option<(f64, f64)>,
+    omega_dot: &str,
+    savgol_half_width: usize,
+    interpolation: &str,
+    substeps: usize,
+    jacobian_euler: bool,
+    misalignment: Option<f64>,
+    lever_arm: Option<f64>,
+    force: Option<(f64, f64)>,
+    data_kind: &str,
+    data_a: PyReadonlyArray2<'_, f64>,
+    data_b: PyReadonlyArray2<'_, f64>,
+) -> PyResult<PyAidedIns> {
+    let mut cfg = cai_config(channels, t_sep, vector(&shots, "shots")?, readout, inflation, omega_dot, savgol_half_width, interpolation, substeps,
+        jacobian_euler, misalignment, lever_arm, force)?;
+    cfg.kind = ImuKind::parse(kind)?;
+    // (shots, channels) tables, read row-major; the aiding checks their sizes
+    let flat = |a: &PyReadonlyArray2<'_, f64>| a.as_array().iter().copied().collect::<Vec<f64>>();
+    let (a, b) = (flat(&data_a), flat(&data_b));
+    let data = match data_kind {
+        "emulated" => CaiData::Emulated { phase: a, noise: b },
+        "recorded" => CaiData::Recorded { population: a, laser_phase: b },
+        other => return Err(invalid("data", format!("unknown kind {other:?}; choose emulated, recorded")).into()),
+    };
+    let (sa, sb) = (data_a.shape()[1], data_b.shape()[1]);
+    for (name, w) in [(if data_kind == "emulated" { "phase" } else { "population" }, sa), (if data_kind == "emulated" { "noise" } else { "laser_phase" }, sb)] {
+        if w != cfg.channels.len() {
+            return Err(invalid(name, format!("has {w} interferometers per shot, but the configuration has {}", cfg.channels.len())).into());
+        }
+    }
+    let aiding = CaiAiding::new(cfg, data)?;
+    PyAidedIns::from_aiding(t0, &lla0, &vel0, &q0, kind, &ba0, &bg0, DVector::from_vec(vector(&extra0, "extra0")?), &p0,
+        ins_noise(accel_psd, gyro_psd, &accel_bias, &gyro_bias)?, predict_every, method, mode, sequential, gate, ellipsoid, Box::new(aiding))
 }

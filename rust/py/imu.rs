@@ -22,7 +22,7 @@ fn floats(v: &Bound<'_, PyAny>, field: &str, len: usize) -> PyResult<Vec<f64>> {
     Ok(x)
 }
 
-fn triad_from_dict(d: &Bound<'_, PyDict>, name: &str) -> PyResult<TriadErrors> {
+pub(super) fn triad_from_dict(d: &Bound<'_, PyDict>, name: &str) -> PyResult<TriadErrors> {
     let mut t = TriadErrors::default();
     for (k, v) in d.iter() {
         let key: String = k.extract()?;

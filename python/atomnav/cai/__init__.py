@@ -12,4 +12,6 @@ from .readout import capture_region, fringes_crossed, invert_readout, readout, s
 from .sensitivity import convolution_phase, ideal_transfer, response_area, sensitivity
 from .noise_id import fringe_track, identify_noise, readout_variance, residuals, simulate_fringe
 
+from . import hybrid
+
 __all__ = [name for name in dir() if not name.startswith("_")]

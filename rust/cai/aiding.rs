@@ -1,0 +1,565 @@
+//! CAI aiding of the generic aided INS (`filter::aided`): the measurement of one shot is
+//! the raw population readout of every interferometer channel, stacked into one vector
+//! (spec cai-ekf-tennstedt2021 decision 6, atom-strapdown decision 7: 3 axes × A/B = 6
+//! rows). The predicted readout comes from the atom-strapdown predictor (`predictor.rs`)
+//! driven by the bias-compensated IMU stream the engine hands to `observe`.
+//!
+//! Per shot j with pulses at t_s, t_s + T, t_s + 2T (measurement at t_s + 2T):
+//! - φ̂_j = predictor(compensated IMU over the shot)            (atom-strapdown E5–E7)
+//! - laser phase steered by the filter's own best prediction:
+//!   φ0_j = π/2 − (φ̂_j − J_j δx̂) mod 2π  (δx̂ = 0 in closed loop)   (atom-strapdown E27)
+//! - instrument: p_j = o − (C/2) cos(φ_j + φ0_j) + n_j  (emulated from the true phase, or
+//!   recorded together with the laser phase it used)                 (cai-ekf E3)
+//! - z_j = h_j − p_j with h_j = o − (C/2) cos(φ̂_j + φ0_j), no linearisation  (cai-ekf E5)
+//! - H_j = (C/2) sin(φ̂_j + φ0_j) J_j, J_j = ∂φ̂_j/∂(δb_a, δb_g, δl, δγ) from the
+//!   tangent-linear predictor                                         (cai-ekf E33)
+//! - R = σ_p² I + (C/2)² sin² · Σ_shot (in-shot IMU white noise, full 6 × 6 with the A/B
+//!   correlation, decision 14): Σ = (2T³/3)[q_a K Kᵀ + 4 q_g V Vᵀ], K_j = C_sbᵀ k_j,
+//!   V_j = C_sbᵀ (v0_j × k_j)                                          (atom-strapdown E38)
+//!
+//! Signs: the compensated force is f̃ − b̂ = f − δb (δb = b̂ − b), so φ̂ − φ = J δx with J
+//! the predictor's derivative with respect to the subtracted bias; the extra blocks follow
+//! the same convention (δl = l̂ − l, δγ = γ̂ − γ, C_sb = exp(−[γ×]) C_sb,0).
+
+use super::predictor::{jacobian, predict, Channel, Imu, Interpolation, OmegaDot, PredictorConfig};
+use crate::error::{check_finite, check_positive, invalid, Result};
+use crate::filter::aided::{Aiding, AidingContext, Measurement};
+use crate::filter::layout::Layout;
+use crate::imu::ImuKind;
+use crate::math::{dcm_from_quat, dcm_from_rotvec, Mat3, Vec3};
+use crate::strapdown::NavState;
+use nalgebra::{DMatrix, DVector};
+use std::f64::consts::{FRAC_PI_2, TAU};
+
+/// Names of the optional extra state blocks (after the 15 INS states).
+pub const MISALIGNMENT_BLOCK: &str = "cai_misalignment";
+pub const LEVER_BLOCK: &str = "cai_lever_arm";
+pub const FORCE_BLOCK: &str = "cai_force";
+
+/// Where the populations come from.
+#[derive(Clone, Debug)]
+pub enum CaiData {
+    /// Emulated instrument: the true phase (rad) and the population noise of every shot and
+    /// channel (row-major, shots × channels); the population is formed inside the loop with
+    /// the laser phase the filter steers, p = o − (C/2) cos(φ + φ0) + n.
+    Emulated { phase: Vec<f64>, noise: Vec<f64> },
+    /// Recorded populations and the laser phases (rad) the instrument applied (shots × channels).
+    Recorded { population: Vec<f64>, laser_phase: Vec<f64> },
+}
+
+/// How the CAI corrects the IMU (seed 000 (E11)).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum ForceMode {
+    /// Option b (default): the readout observes the accelerometer (and gyro) bias states.
+    Bias,
+    /// Option a: the readout corrects the specific force of the shot directly. The force
+    /// error is an extra Gauss–Markov block (correlation time `tau` s, σ `sigma` m/s²)
+    /// entering the velocity like a bias (δv̇ = −Ĉ_b^n δf); the accelerometer-bias columns
+    /// of H are zero, so nothing is fed back into the bias estimate.
+    Direct { tau: f64, sigma: f64 },
+}
+
+/// Configuration of the CAI aiding.
+#[derive(Clone, Debug)]
+pub struct CaiConfig {
+    /// Interferometer channels (nominal lever arm and C_sb).
+    pub channels: Vec<Channel>,
+    /// Pulse separation T (s).
+    pub t_sep: f64,
+    /// Shot start (first pulse) times (s), strictly increasing, non-overlapping.
+    pub shots: Vec<f64>,
+    /// Readout offset o and contrast C.
+    pub offset: f64,
+    pub contrast: f64,
+    /// Population noise σ_p per channel.
+    pub sigma_p: f64,
+    /// White-noise PSDs (q_a m²/s³, q_g rad²/s) of the IMU for the in-shot R inflation
+    /// (decision 14); None = no inflation.
+    pub inflation: Option<(f64, f64)>,
+    pub omega_dot: OmegaDot,
+    pub interpolation: Interpolation,
+    pub substeps: usize,
+    /// Keep the Euler terms in the Jacobian (atom-strapdown decision 9; default false).
+    pub jacobian_euler: bool,
+    /// Estimate the CAI misalignment γ (3 states, random walk of this PSD rad²/s).
+    pub misalignment: Option<f64>,
+    /// Estimate the lever-arm correction l (3 states, random walk of this PSD m²/s).
+    pub lever_arm: Option<f64>,
+    pub force: ForceMode,
+    /// Kind of the IMU record the engine runs on (increments become interval-mean rates).
+    pub kind: ImuKind,
+}
+
+/// Per shot and channel, what the instrument and the filter saw.
+#[derive(Clone, Debug, Default)]
+pub struct ShotLog {
+    /// Predicted phase at the filter's best estimate (rad).
+    pub predicted: Vec<f64>,
+    /// True minus predicted phase (rad); NaN for recorded data.
+    pub phase_error: Vec<f64>,
+    /// Laser phase φ0 (rad) and population p.
+    pub laser_phase: Vec<f64>,
+    pub population: Vec<f64>,
+}
+
+/// The CAI as an `Aiding` of the engine.
+pub struct CaiAiding {
+    cfg: CaiConfig,
+    data: CaiData,
+    /// Measurement epochs t_s + 2T.
+    times: Vec<f64>,
+    /// Compensated IMU samples (t, f m/s², ω rad/s) kept for the current shot.
+    buf_t: Vec<f64>,
+    buf_f: Vec<Vec3>,
+    buf_w: Vec<Vec3>,
+    /// Ĉ_b^n of the latest solution (for the force block's velocity coupling).
+    c_nb: Mat3,
+    pub log: ShotLog,
+}
+
+/// Samples kept before a shot start for the interpolation stencils (the Savitzky–Golay
+/// window may need more, see `CaiAiding::pad`).
+const PAD: usize = 3;
+
+/// Shot start times t0, t0 + period, ... with the last shot ending (t_s + 2T) no later
+/// than `t_end`; period = 2T + dead time.
+pub fn shot_times(t0: f64, t_end: f64, t_sep: f64, dead_time: f64) -> Result<Vec<f64>> {
+    check_positive("T", t_sep)?;
+    if !(dead_time.is_finite() && dead_time >= 0.0) {
+        return Err(invalid("dead_time", format!("must be finite and >= 0, got {dead_time}")));
+    }
+    check_finite("t0", &[t0, t_end], 1)?;
+    let period = 2.0 * t_sep + dead_time;
+    let n = ((t_end - t0 - 2.0 * t_sep) / period + 1e-9).floor();
+    Ok((0..(n.max(-1.0) + 1.0) as usize).map(|i| t0 + i as f64 * period).collect())
+}
+
+impl CaiAiding {
+    pub fn new(cfg: CaiConfig, data: CaiData) -> Result<Self> {
+        check_positive("T", cfg.t_sep)?;
+        if cfg.channels.is_empty() {
+            return Err(invalid("channels", "at least one interferometer channel is required"));
+        }
+        if cfg.substeps == 0 {
+            return Err(invalid("substeps", "must be >= 1"));
+        }
+        check_positive("sigma_p", cfg.sigma_p)?;
+        check_positive("contrast", cfg.contrast)?;
+        check_finite("offset", &[cfg.offset], 1)?;
+        check_finite("shots", &cfg.shots, 1)?;
+        for i in 1..cfg.shots.len() {
+            let end = cfg.shots[i - 1] + 2.0 * cfg.t_sep;
+            if cfg.shots[i] < end - 1e-9 * cfg.t_sep {
+                return Err(invalid("shots", format!("shot {i} starts at {} s, before shot {} ends at {end} s (shots must not overlap)", cfg.shots[i], i - 1)));
+            }
+        }
+        if let Some((qa, qg)) = cfg.inflation {
+            for (name, q) in [("inflation q_accel", qa), ("inflation q_gyro", qg)] {
+                if !(q.is_finite() && q >= 0.0) {
+                    return Err(invalid(name, format!("must be finite and >= 0, got {q}")));
+                }
+            }
+        }
+        for (name, q) in [("misalignment psd", cfg.misalignment), ("lever_arm psd", cfg.lever_arm)] {
+            if let Some(q) = q {
+                if !(q.is_finite() && q >= 0.0) {
+                    return Err(invalid(name, format!("must be finite and >= 0, got {q}")));
+                }
+            }
+        }
+        if let ForceMode::Direct { tau, sigma } = cfg.force {
+            check_positive("force tau", tau)?;
+            check_positive("force sigma", sigma)?;
+        }
+        let expected = cfg.shots.len() * cfg.channels.len();
+        let (a, b, na, nb) = match &data {
+            CaiData::Emulated { phase, noise } => (phase, noise, "phase", "noise"),
+            CaiData::Recorded { population, laser_phase } => (population, laser_phase, "population", "laser_phase"),
+        };
+        for (v, name) in [(a, na), (b, nb)] {
+            if v.len() != expected {
+                return Err(invalid(
+                    name,
+                    format!(
+                        "expected {} shots × {} interferometers = {expected} values, got {} ({} per shot would be {})",
+                        cfg.shots.len(),
+                        cfg.channels.len(),
+                        v.len(),
+                        name,
+                        v.len() as f64 / cfg.shots.len().max(1) as f64
+                    ),
+                ));
+            }
+            check_finite(name, v, cfg.channels.len())?;
+        }
+        // the predictor validates the channels on its first call; do it now instead
+        let probe_t = [0.0, 2.0 * cfg.t_sep];
+        let z = [Vec3::zeros(); 2];
+        let probe = PredictorConfig { omega_dot: OmegaDot::Zero, ..Self::predictor_config(&cfg) };
+        predict(Imu { t: &probe_t, f: &z, w: &z }, &[0.0], &cfg.channels, &probe)?;
+        // last pulse t_s + 2T, less a rounding margin so that a shot ending on an IMU sample
+        // is applied at that sample (0.05·i + 0.05 may exceed the grid value by 1 ulp)
+        let times = cfg.shots.iter().map(|s| s + 2.0 * cfg.t_sep - 1e-9 * cfg.t_sep).collect();
+        Ok(CaiAiding { cfg, data, times, buf_t: Vec::new(), buf_f: Vec::new(), buf_w: Vec::new(), c_nb: Mat3::identity(), log: ShotLog::default() })
+    }
+
+    pub fn config(&self) -> &CaiConfig {
+        &self.cfg
+    }
+
+    fn predictor_config(cfg: &CaiConfig) -> PredictorConfig {
+        PredictorConfig {
+            t_sep: cfg.t_sep,
+            substeps: cfg.substeps,
+            gradient: None,
+            bias_a: Vec3::zeros(),
+            bias_g: Vec3::zeros(),
+            omega_dot: cfg.omega_dot.clone(),
+            interpolation: cfg.interpolation,
+        }
+    }
+
+    /// Channels with the current lever-arm and misalignment estimates applied.
+    fn current_channels(&self, layout: &Layout, extra: &DVector<f64>) -> Vec<Channel> {
+        let n_ins = 15;
+        let get = |name: &str| layout.get(name).map(|r| Vec3::new(extra[r.start - n_ins], extra[r.start + 1 - n_ins], extra[r.start + 2 - n_ins]));
+        let dl = get(LEVER_BLOCK).unwrap_or_else(Vec3::zeros);
+        let rot = get(MISALIGNMENT_BLOCK).map_or_else(Mat3::identity, |g| dcm_from_rotvec(&-g));
+        self.cfg.channels.iter().map(|c| Channel { lever: c.lever + dl, c_sb: rot * c.c_sb, ..c.clone() }).collect()
+    }
+
+    /// Phase Jacobian rows (channels × n) w.r.t. the full error state.
+    fn phase_jacobian(&self, rows: &[[f64; 12]], layout: &Layout) -> Result<DMatrix<f64>> {
+        let n = layout.size();
+        let mut j = DMatrix::<f64>::zeros(rows.len(), n);
+        let ba = layout.range("accel_bias")?.start;
+        let bg = layout.range("gyro_bias")?.start;
+        for (r, row) in rows.iter().enumerate() {
+            for c in 0..3 {
+                match self.cfg.force {
+                    ForceMode::Bias => j[(r, ba + c)] = row[c],
+                    ForceMode::Direct { .. } => j[(r, layout.range(FORCE_BLOCK)?.start + c)] = row[c],
+                }
+                j[(r, bg + c)] = row[3 + c];
+                if let Some(l) = layout.get(LEVER_BLOCK) {
+                    j[(r, l.start + c)] = row[6 + c];
+                }
+                if let Some(g) = layout.get(MISALIGNMENT_BLOCK) {
+                    j[(r, g.start + c)] = row[9 + c];
+                }
+            }
+        }
+        Ok(j)
+    }
+
+    /// In-shot IMU-noise phase covariance Σ (rad²) of the channels (decision 14).
+    fn in_shot_covariance(&self, channels: &[Channel]) -> DMatrix<f64> {
+        let m = channels.len();
+        let Some((qa, qg)) = self.cfg.inflation else { return DMatrix::zeros(m, m) };
+        let kb: Vec<Vec3> = channels.iter().map(|c| c.c_sb.transpose() * c.k).collect();
+        let vb: Vec<Vec3> = channels.iter().map(|c| c.c_sb.transpose() * c.v0.cross(&c.k)).collect();
+        let t = self.cfg.t_sep;
+        DMatrix::from_fn(m, m, |a, b| 2.0 * t.powi(3) / 3.0 * (qa * kb[a].dot(&kb[b]) + 4.0 * qg * vb[a].dot(&vb[b])))
+    }
+
+    /// Samples to keep before a shot start: the interpolation stencil, or a whole
+    /// Savitzky–Golay window (2m + 1 samples) so that ω̇ near the shot start is centred.
+    fn pad(&self) -> usize {
+        match self.cfg.omega_dot {
+            OmegaDot::Savgol { half_width } => PAD.max(2 * half_width + 1),
+            _ => PAD,
+        }
+    }
+
+    /// Drop the samples no later shot needs.
+    fn prune(&mut self, next_shot: Option<f64>) {
+        let keep_from = match next_shot {
+            Some(ts) => self.buf_t.partition_point(|&t| t < ts).saturating_sub(self.pad()),
+            None => self.buf_t.len(),
+        };
+        self.buf_t.drain(..keep_from);
+        self.buf_f.drain(..keep_from);
+        self.buf_w.drain(..keep_from);
+    }
+
+    /// The measurement of shot j given the filter's state (the engine's `measure`).
+    fn shot_measurement(&mut self, j: usize, x: &DVector<f64>, extra: &DVector<f64>, layout: &Layout) -> Result<Measurement> {
+        let ts = self.cfg.shots[j];
+        let first = self.buf_t.iter().position(|&t| t >= ts - 1e-9 * self.cfg.t_sep);
+        match (self.buf_t.first(), first) {
+            (Some(&t0), Some(_)) if t0 <= ts + 1e-9 * self.cfg.t_sep => {}
+            _ => {
+                return Err(invalid(
+                    "shots",
+                    format!("shot {j} starts at {ts} s, before the first IMU sample available to it ({:?} s)", self.buf_t.first()),
+                ))
+            }
+        }
+        let channels = self.current_channels(layout, extra);
+        let imu = Imu { t: &self.buf_t, f: &self.buf_f, w: &self.buf_w };
+        let pcfg = Self::predictor_config(&self.cfg);
+        let phi_nom: Vec<f64> = predict(imu, &[ts], &channels, &pcfg)?.iter().map(|r| r[0]).collect();
+        let jac = self.phase_jacobian(&jacobian(imu, &[ts], &channels, &pcfg, self.cfg.jacobian_euler)?, layout)?;
+        let best = DVector::from_vec(phi_nom.clone()) - &jac * x;
+        let m = channels.len();
+        let (o, half_c) = (self.cfg.offset, 0.5 * self.cfg.contrast);
+        let mut z = Vec::with_capacity(m);
+        let mut gain = Vec::with_capacity(m);
+        for c in 0..m {
+            let idx = j * m + c;
+            let (phi0, p, err) = match &self.data {
+                CaiData::Emulated { phase, noise } => {
+                    let phi0 = (FRAC_PI_2 - best[c]).rem_euclid(TAU);
+                    (phi0, o - half_c * (phase[idx] + phi0).cos() + noise[idx], phase[idx] - best[c])
+                }
+                CaiData::Recorded { population, laser_phase } => (laser_phase[idx], population[idx], f64::NAN),
+            };
+            let arg = phi_nom[c] + phi0;
+            z.push(o - half_c * arg.cos() - p);
+            gain.push(half_c * arg.sin());
+            self.log.predicted.push(best[c]);
+            self.log.phase_error.push(err);
+            self.log.laser_phase.push(phi0);
+            self.log.population.push(p);
+        }
+        let g = DMatrix::from_diagonal(&DVector::from_vec(gain));
+        let h = &g * jac;
+        let r = DMatrix::identity(m, m) * self.cfg.sigma_p.powi(2) + &g * self.in_shot_covariance(&channels) * &g;
+        self.prune(self.cfg.shots.get(j + 1).copied());
+        Ok(Measurement { z, h, r })
+    }
+}
+
+impl Aiding for CaiAiding {
+    fn name(&self) -> &str {
+        "cai"
+    }
+
+    fn extra_blocks(&self) -> Vec<(String, usize)> {
+        let mut b = Vec::new();
+        if self.cfg.misalignment.is_some() {
+            b.push((MISALIGNMENT_BLOCK.to_string(), 3));
+        }
+        if self.cfg.lever_arm.is_some() {
+            b.push((LEVER_BLOCK.to_string(), 3));
+        }
+        if let ForceMode::Direct { .. } = self.cfg.force {
+            b.push((FORCE_BLOCK.to_string(), 3));
+        }
+        b
+    }
+
+    fn times(&self) -> &[f64] {
+        &self.times
+    }
+
+    fn observe(&mut self, t: f64, dt: f64, gyro: &Vec3, accel: &Vec3, nav: &NavState) {
+        self.c_nb = dcm_from_quat(&nav.q_nb);
+        // the engine passes samples of the record's kind; increments become interval rates
+        // stamped at the interval midpoint
+        let (t, f, w) = match self.cfg.kind {
+            ImuKind::Increments if dt > 0.0 => (t - 0.5 * dt, accel / dt, gyro / dt),
+            _ => (t, *accel, *gyro),
+        };
+        if self.buf_t.last().is_some_and(|&l| t <= l) {
+            return;
+        }
+        self.buf_t.push(t);
+        self.buf_f.push(f);
+        self.buf_w.push(w);
+    }
+
+    fn measure(&mut self, j: usize, ctx: &AidingContext) -> Result<Option<Measurement>> {
+        self.shot_measurement(j, ctx.x, ctx.extra, ctx.layout).map(Some)
+    }
+
+    fn extra_dynamics(&self, layout: &Layout, f: &mut DMatrix<f64>, qc: &mut DMatrix<f64>) {
+        for (name, psd) in [(MISALIGNMENT_BLOCK, self.cfg.misalignment), (LEVER_BLOCK, self.cfg.lever_arm)] {
+            if let (Some(r), Some(q)) = (layout.get(name), psd) {
+                for i in r {
+                    qc[(i, i)] = q;
+                }
+            }
+        }
+        if let (ForceMode::Direct { tau, sigma }, Some(r)) = (self.cfg.force, layout.get(FORCE_BLOCK)) {
+            let iv = layout.get("velocity").map_or(3, |v| v.start);
+            for a in 0..3 {
+                f[(r.start + a, r.start + a)] = -1.0 / tau;
+                qc[(r.start + a, r.start + a)] = 2.0 * sigma * sigma / tau;
+                // δv̇ = −Ĉ_b^n δf, like the accelerometer bias (ins.rs F_vba)
+                for b in 0..3 {
+                    f[(iv + b, r.start + a)] = -self.c_nb[(b, a)];
+                }
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::cai::closed_form::phase_constant;
+    use crate::math::{dcm_from_euler, quat};
+
+    const K: f64 = 1.610576e7;
+
+    /// Seed-003 six-channel geometry (cyclic ±v0), lever arm and C_sb as given.
+    fn cyclic(lever: Vec3, c_sb: Mat3) -> Vec<Channel> {
+        (0..6).map(|c| Channel { k: Vec3::ith(c / 2, K), lever, c_sb, v0: Vec3::ith((c / 2 + 1) % 3, if c % 2 == 0 { 2.8 } else { -2.8 }) }).collect()
+    }
+
+    fn config(channels: Vec<Channel>, shots: Vec<f64>) -> CaiConfig {
+        CaiConfig {
+            channels,
+            t_sep: 0.025,
+            shots,
+            offset: 0.5,
+            contrast: 0.9,
+            sigma_p: 1e-3f64.sqrt(),
+            inflation: None,
+            omega_dot: OmegaDot::Zero,
+            interpolation: Interpolation::Linear,
+            substeps: 2,
+            jacobian_euler: false,
+            misalignment: Some(1e-12),
+            lever_arm: Some(1e-12),
+            force: ForceMode::Bias,
+            kind: ImuKind::Rates,
+        }
+    }
+
+    fn layout(a: &CaiAiding) -> Layout {
+        let mut spec: Vec<(String, Option<usize>)> = crate::filter::layout::INS15.iter().map(|s| (s.to_string(), None)).collect();
+        spec.extend(a.extra_blocks().into_iter().map(|(n, s)| (n, Some(s))));
+        Layout::new(&spec).unwrap()
+    }
+
+    fn nav() -> NavState {
+        NavState { t: 0.0, lla: Vec3::new(0.9, 0.2, 50.0), vel: Vec3::zeros(), q_nb: quat(1.0, 0.0, 0.0, 0.0) }
+    }
+
+    /// Feed a 200 Hz stream (f, ω at t), shifted by the bias perturbation −(δb_a, δb_g).
+    fn feed(a: &mut CaiAiding, f: &dyn Fn(f64) -> Vec3, w: &dyn Fn(f64) -> Vec3, dba: Vec3, dbg: Vec3) {
+        for i in 0..=12 {
+            let t = i as f64 * 0.005;
+            a.observe(t, 0.005, &(w(t) - dbg), &(f(t) - dba), &nav());
+        }
+    }
+
+    /// H (readout Jacobian, bias and extra columns) equals central differences of the
+    /// predicted readout h(x̂) = o − (C/2)cos(φ̂(x̂) + φ0) at fixed recorded φ0 and p.
+    #[test]
+    fn h_matches_finite_differences_of_the_readout() {
+        let c_sb = dcm_from_euler(0.01, -0.02, 0.03);
+        let chs = cyclic(Vec3::new(0.05, -0.02, 0.1), c_sb);
+        let f = |t: f64| Vec3::new(0.3 + 0.5 * (7.0 * t).sin(), -0.2 + t, 0.1);
+        let w = |t: f64| Vec3::new(0.05 + 0.3 * t, -0.03, 0.2 * (5.0 * t).cos());
+        let shots = vec![0.005];
+        // laser phases away from mid-fringe so that sin(φ̂ + φ0) ≠ 1 is exercised
+        let data = CaiData::Recorded { population: vec![0.4; 6], laser_phase: vec![0.3, 1.1, -0.7, 2.0, 0.4, -1.3] };
+        let base = CaiAiding::new(config(chs, shots), data).unwrap();
+        let lay = layout(&base);
+        let n = lay.size();
+        let z_at = |dx: &DVector<f64>| -> (Vec<f64>, DMatrix<f64>) {
+            let mut a = CaiAiding::new(base.cfg.clone(), base.data.clone()).unwrap();
+            let (ba, bg) = (lay.range("accel_bias").unwrap().start, lay.range("gyro_bias").unwrap().start);
+            feed(&mut a, &f, &w, Vec3::new(dx[ba], dx[ba + 1], dx[ba + 2]), Vec3::new(dx[bg], dx[bg + 1], dx[bg + 2]));
+            let extra = DVector::from_iterator(n - 15, dx.iter().skip(15).copied());
+            let m = a.shot_measurement(0, &DVector::zeros(n), &extra, &lay).unwrap();
+            (m.z, m.h)
+        };
+        let (_, h) = z_at(&DVector::zeros(n));
+        // accel bias, gyro bias, misalignment, lever arm (layout order); small enough that the
+        // readout curvature (Δφ²/6) stays below the tolerance
+        let steps = [1e-6, 1e-7, 1e-7, 1e-5];
+        for col in 9..n {
+            let step = steps[(col - 9) / 3];
+            let mut dx = DVector::zeros(n);
+            dx[col] = step;
+            let (zp, _) = z_at(&dx);
+            dx[col] = -step;
+            let (zm, _) = z_at(&dx);
+            for r in 0..6 {
+                let fd = (zp[r] - zm[r]) / (2.0 * step);
+                let scale = h.row(r).abs().max() * steps[(col - 9) / 3];
+                assert!((fd - h[(r, col)]).abs() * steps[(col - 9) / 3] < 1e-4 * scale.max(1e-12), "row {r} col {col}: fd {fd} vs H {}", h[(r, col)]);
+            }
+        }
+        // navigation columns are zero: the phase does not depend on position, velocity, attitude
+        assert!(h.columns(0, 9).iter().all(|x| *x == 0.0));
+    }
+
+    /// Constant inputs: the innovation of a steered emulated shot is exactly
+    /// z = (C/2) sin(φ̂ − φ) − n with φ̂ from the closed form (E10) (no linearisation), and
+    /// H = (C/2) J at mid-fringe.
+    #[test]
+    fn steered_innovation_is_nonlinear_closed_form() {
+        let chs = cyclic(Vec3::zeros(), Mat3::identity());
+        let (f0, w0) = (Vec3::new(0.4, -0.3, 0.2), Vec3::new(0.02, -0.05, 0.1));
+        let truth = [0.3, -2.5, 1.0, 4.0, -0.2, 0.0]; // true − predicted up to ±4 rad
+        let phat: Vec<f64> = chs.iter().map(|c| phase_constant(&c.k, &w0, &f0, &c.v0, 0.025)).collect();
+        let phase: Vec<f64> = phat.iter().zip(truth).map(|(p, d)| p + d).collect();
+        let noise = vec![1e-3, -2e-3, 0.0, 5e-3, 0.0, -1e-3];
+        let mut cfg = config(chs, vec![0.005]);
+        cfg.omega_dot = OmegaDot::Zero;
+        let mut a = CaiAiding::new(cfg, CaiData::Emulated { phase, noise: noise.clone() }).unwrap();
+        let lay = layout(&a);
+        feed(&mut a, &|_| f0, &|_| w0, Vec3::zeros(), Vec3::zeros());
+        let m = a.shot_measurement(0, &DVector::zeros(lay.size()), &DVector::zeros(lay.size() - 15), &lay).unwrap();
+        for c in 0..6 {
+            let expect = 0.45 * (-truth[c]).sin() - noise[c];
+            assert!((m.z[c] - expect).abs() < 1e-7, "channel {c}: {} vs {expect}", m.z[c]);
+            assert!((a.log.phase_error[c] - truth[c]).abs() < 2e-7);
+            assert!((a.log.predicted[c] - phat[c]).abs() < 2e-7);
+        }
+        // accelerometer-bias column of channel x: (C/2) T² k (constant-input closed form)
+        let ba = lay.range("accel_bias").unwrap().start;
+        let expect = 0.45 * 0.025f64.powi(2) * K;
+        assert!((m.h[(0, ba)] / expect - 1.0).abs() < 0.05, "{} vs {expect}", m.h[(0, ba)]);
+    }
+
+    /// R inflation (decision 14) at mid-fringe reproduces the spec's in-shot phase noise
+    /// (atom-strapdown §4: 0.1838 rad accelerometer, 0.2994 rad gyro at T = 25 ms) and the
+    /// A/B correlation (common accelerometer, opposite Coriolis part).
+    #[test]
+    fn inflated_r_matches_in_shot_noise_values() {
+        let mut cfg = config(cyclic(Vec3::zeros(), Mat3::identity()), vec![0.005]);
+        cfg.inflation = Some((1.25e-11, 1.0576e-12));
+        cfg.contrast = 1.0;
+        let mut a = CaiAiding::new(cfg, CaiData::Emulated { phase: vec![0.0; 6], noise: vec![0.0; 6] }).unwrap();
+        let lay = layout(&a);
+        feed(&mut a, &|_| Vec3::zeros(), &|_| Vec3::zeros(), Vec3::zeros(), Vec3::zeros());
+        let m = a.shot_measurement(0, &DVector::zeros(lay.size()), &DVector::zeros(lay.size() - 15), &lay).unwrap();
+        let (sa, sg) = (0.1838f64, 0.2994f64);
+        let diag = 1e-3 + 0.25 * (sa * sa + sg * sg);
+        let cross = 0.25 * (sa * sa - sg * sg);
+        assert!((m.r[(0, 0)] / diag - 1.0).abs() < 1e-3, "{} vs {diag}", m.r[(0, 0)]);
+        assert!((m.r[(0, 1)] / cross - 1.0).abs() < 2e-3, "{} vs {cross}", m.r[(0, 1)]);
+        assert!(m.r[(0, 2)].abs() < 1e-12);
+    }
+
+    #[test]
+    fn bad_input_is_rejected_with_the_field() {
+        let chs = cyclic(Vec3::zeros(), Mat3::identity());
+        let ok = CaiData::Emulated { phase: vec![0.0; 12], noise: vec![0.0; 12] };
+        let e = CaiAiding::new(config(chs.clone(), vec![0.0, 0.04]), ok.clone()).err().unwrap().to_string();
+        assert!(e.starts_with("shots:") && e.contains("shot 1") && e.contains("overlap"), "{e}");
+        let e = CaiAiding::new(config(chs[..5].to_vec(), vec![0.0, 0.05]), ok).err().unwrap().to_string();
+        assert!(e.starts_with("phase:") && e.contains("5 interferometers"), "{e}");
+        let mut a = CaiAiding::new(config(chs, vec![0.0]), CaiData::Emulated { phase: vec![0.0; 6], noise: vec![0.0; 6] }).unwrap();
+        let lay = layout(&a);
+        for i in 1..=12 {
+            a.observe(i as f64 * 0.005, 0.005, &Vec3::zeros(), &Vec3::zeros(), &nav());
+        }
+        let e = a.shot_measurement(0, &DVector::zeros(lay.size()), &DVector::zeros(lay.size() - 15), &lay).err().unwrap().to_string();
+        assert!(e.starts_with("shots:") && e.contains("shot 0"), "{e}");
+    }
+
+    #[test]
+    fn shot_times_respect_rate_and_dead_time() {
+        let s = shot_times(0.0, 1.0, 0.025, 0.05).unwrap();
+        assert_eq!(s.len(), 10);
+        assert!((s[9] - 0.9).abs() < 1e-12);
+        assert!(shot_times(0.0, 1.0, 0.025, -1.0).is_err());
+    }
+}

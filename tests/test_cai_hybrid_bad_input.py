@@ -1,0 +1,81 @@
+"""Issue 5, bad input of the CAI-aided INS: clear ValueErrors naming the field."""
+
+import numpy as np
+import pytest
+
+import atomnav as an
+from atomnav.cai import hybrid
+
+T = 0.025
+
+
+@pytest.fixture(scope="module")
+def record():
+    traj = an.trajectory.slalom(rate_hz=200.0, duration=2.0, ellipsoid="kinematic")
+    imu = traj.ideal_imu("rates")
+    s = traj.df.iloc[0]
+    init = (float(s.time_s), s[["lat_rad", "lon_rad", "h_m"]].to_numpy(float), s[["vn_mps", "ve_mps", "vd_mps"]].to_numpy(float),
+            s[["qw", "qx", "qy", "qz"]].to_numpy(float))
+    return init, imu
+
+
+def _ins(record, shots, n_channels=6, **kw):
+    init, _ = record
+    sensor = hybrid.seed003_sensor()
+    data = np.zeros((len(shots), n_channels))
+    return hybrid.cai_aided_ins(*init, sensor, shots, phase=data, noise=data, ellipsoid="kinematic", **kw)
+
+
+def _run(ins, record):
+    _, imu = record
+    return ins.run(imu.time_s, imu[["gyro_x_rad_s", "gyro_y_rad_s", "gyro_z_rad_s"]], imu[["accel_x_mps2", "accel_y_mps2", "accel_z_mps2"]],
+                   progress=False)
+
+
+def test_valid_record_runs(record):
+    res = _run(_ins(record, 0.1 + 2 * T * np.arange(10)), record)
+    assert len(res.measurements) == 10
+
+
+def test_shot_ending_after_the_record(record):
+    with pytest.raises(ValueError, match=r"outside the IMU span"):
+        _run(_ins(record, [0.5, 1.97]), record)
+
+
+def test_shot_starting_before_the_record(record):
+    with pytest.raises(ValueError, match=r"shots: shot 0 starts at -0.01"):
+        _run(_ins(record, [-0.01, 0.5]), record)
+
+
+def test_overlapping_shots(record):
+    with pytest.raises(ValueError, match=r"shots: shot 2 starts at 0.23 s, before shot 1 ends"):
+        _ins(record, [0.1, 0.2, 0.23])
+
+
+def test_mismatched_number_of_interferometers(record):
+    with pytest.raises(ValueError, match=r"phase: has 5 interferometers per shot, but the configuration has 6"):
+        _ins(record, [0.1, 0.2], n_channels=5)
+
+
+def test_mismatched_number_of_shots(record):
+    init, _ = record
+    with pytest.raises(ValueError, match=r"noise: expected 2 shots"):
+        hybrid.cai_aided_ins(*init, hybrid.seed003_sensor(), [0.1, 0.2], phase=np.zeros((2, 6)), noise=np.zeros((3, 6)))
+
+
+def test_recorded_and_emulated_data_are_exclusive(record):
+    init, _ = record
+    with pytest.raises(ValueError, match=r"data: give either"):
+        hybrid.cai_aided_ins(*init, hybrid.seed003_sensor(), [0.1], phase=np.zeros((1, 6)), noise=np.zeros((1, 6)), population=np.zeros((1, 6)))
+
+
+def test_shot_period_shorter_than_the_shot():
+    s = hybrid.seed003_sensor()
+    s.shot_period = 0.04
+    with pytest.raises(ValueError, match=r"shot_period: must be >= 2T"):
+        s.shots(0.0, 10.0)
+
+
+def test_zero_runs():
+    with pytest.raises(ValueError, match=r"runs: must be >= 1"):
+        hybrid.slalom(0, progress=False)
