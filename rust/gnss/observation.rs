@@ -129,3 +129,30 @@ pub fn simulate(eph: &Ephemerides, t: &[f64], lla: &[Vec3], vel_ned: &[Vec3], cf
     }
     Ok(out)
 }
+
+/// Group a flat observation table (one row per satellite and epoch, time non-decreasing)
+/// into epochs; rejects decreasing time, non-finite code and duplicated satellites.
+pub fn group_epochs(time: &[f64], obs: &[Observation]) -> Result<Vec<(f64, Vec<Observation>)>> {
+    if time.len() != obs.len() {
+        return Err(invalid("time", format!("{} time stamps for {} observations", time.len(), obs.len())));
+    }
+    let mut out: Vec<(f64, Vec<Observation>)> = Vec::new();
+    for (i, (&t, o)) in time.iter().zip(obs).enumerate() {
+        if !t.is_finite() || !o.code.is_finite() {
+            return Err(invalid("obs", format!("non-finite time or pseudorange at index {i}")));
+        }
+        match out.last_mut() {
+            Some((t0, v)) if *t0 == t => {
+                if v.iter().any(|x| x.sat == o.sat) {
+                    return Err(invalid("obs", format!("duplicated satellite {} at index {i}", o.sat.name())));
+                }
+                v.push(*o);
+            }
+            Some((t0, _)) if *t0 > t => {
+                return Err(invalid("time", format!("observation time decreasing at index {i} ({t} after {t0})")));
+            }
+            _ => out.push((t, vec![*o])),
+        }
+    }
+    Ok(out)
+}
