@@ -84,21 +84,29 @@ impl Strapdown {
         for k in 0..t.len() {
             let href = h_ref.map(|h| h[k]);
             self.step(t[k], &gyro[k], &accel[k], href);
-            let s = &self.state;
-            // a sum is finite iff every term is (NaN and ±inf propagate)
-            let finite = (s.lla.sum() + s.vel.sum() + s.q_nb.coords.sum()).is_finite();
-            if !finite || s.lla.x.abs() > std::f64::consts::FRAC_PI_2 {
-                return Err(crate::error::NavError::Numerical(format!(
-                    "navigation solution diverged at sample {k} (t = {} s): latitude {} rad, velocity {:?}",
-                    t[k], self.state.lla.x, self.state.vel
-                )));
-            }
+            self.check_diverged(k)?;
             out.push(self.state);
         }
         Ok(())
     }
 
-    fn validate(&self, t: &[f64], gyro: &[Vec3], accel: &[Vec3], h_ref: Option<&[f64]>) -> Result<()> {
+    /// Numerical error if the solution after sample `k` is non-finite or off the globe.
+    pub(crate) fn check_diverged(&self, k: usize) -> Result<()> {
+        let s = &self.state;
+        // a sum is finite iff every term is (NaN and ±inf propagate)
+        let finite = (s.lla.sum() + s.vel.sum() + s.q_nb.coords.sum()).is_finite();
+        if !finite || s.lla.x.abs() > std::f64::consts::FRAC_PI_2 {
+            return Err(crate::error::NavError::Numerical(format!(
+                "navigation solution diverged at sample {k} (t = {} s): latitude {} rad, velocity {:?}",
+                s.t, s.lla.x, s.vel
+            )));
+        }
+        Ok(())
+    }
+
+    /// Checks of a chunk before it is run (shapes, time order from the current state,
+    /// finite samples, reference altitude).
+    pub(crate) fn validate(&self, t: &[f64], gyro: &[Vec3], accel: &[Vec3], h_ref: Option<&[f64]>) -> Result<()> {
         let n = t.len();
         if gyro.len() != n || accel.len() != n {
             return Err(invalid("imu", format!("time has {n} samples but gyro {} and accel {}", gyro.len(), accel.len())));

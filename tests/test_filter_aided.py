@@ -10,7 +10,7 @@ LAT, LON, H = 0.8, 0.2, 100.0
 OMEGA = 7.292115e-5
 
 
-def static_case(duration=200.0, rate=100.0, seed=4, mode="closed"):
+def static_case(duration=200.0, rate=100.0, seed=4, mode="closed", chunk_s=60.0):
     """Level, north-facing, at rest: exact rates are ω_ie^n and −gⁿ; IMU biases added."""
     n = int(duration * rate) + 1
     t = np.arange(n) / rate
@@ -26,10 +26,11 @@ def static_case(duration=200.0, rate=100.0, seed=4, mode="closed"):
     rm, rp = m_rad + H, n_rad + H
     fix_lla = np.c_[LAT + ned[:, 0] / rm, LON + ned[:, 1] / (rp * np.cos(LAT)), H - ned[:, 2]]
     p0 = np.diag(np.r_[[1.0] * 3, [0.01] * 3, [1e-8] * 3, [(3e-3) ** 2] * 3, [(1e-7) ** 2] * 3])
-    table, fixes = position_aided_ins(0.0, [LAT, LON, H], [0, 0, 0], [1, 0, 0, 0], "rates", t, gyro + bg_true,
-                                      accel + ba_true, fix_t, fix_lla, np.tile(np.eye(3) * sig**2, (m, 1, 1)), p0,
-                                      accel_psd=1e-10, gyro_psd=1e-16, predict_every=10, mode=mode)
-    return table, fixes, ba_true
+    ins = position_aided_ins(0.0, [LAT, LON, H], [0, 0, 0], [1, 0, 0, 0], "rates", fix_t, fix_lla,
+                             np.tile(np.eye(3) * sig**2, (m, 1, 1)), p0, accel_psd=1e-10, gyro_psd=1e-16,
+                             predict_every=10, mode=mode)
+    res = ins.run(t, gyro + bg_true, accel + ba_true, chunk_s=chunk_s, progress=False)
+    return res.nav, res.measurements, ba_true
 
 
 def test_closed_loop_estimates_vertical_accel_bias_and_is_consistent():
@@ -41,7 +42,7 @@ def test_closed_loop_estimates_vertical_accel_bias_and_is_consistent():
     assert abs(last["h_m"] - H) < 3.0
     lo, hi = chi2_band(3, len(fixes))
     assert lo <= fixes["nis"].mean() <= hi
-    assert not fixes["rejected"].any()
+    assert not fixes["rejected_rows"].any()
 
 
 def test_open_and_closed_loop_agree_on_bias_estimate():
@@ -56,35 +57,86 @@ def _args():
     t = np.arange(11) * 0.1
     g = np.zeros((11, 3))
     a = np.tile([0, 0, -9.8], (11, 1))
-    return dict(t0=0.0, lla0=[LAT, LON, H], vel0=[0, 0, 0], q0=[1, 0, 0, 0], kind="rates", time=t, gyro=g, accel=a,
-                fix_time=[0.5], fix_lla=[[LAT, LON, H]], fix_cov=np.eye(3)[None], p0=np.eye(15),
-                accel_psd=1e-8, gyro_psd=1e-12)
+    build = dict(t0=0.0, lla0=[LAT, LON, H], vel0=[0, 0, 0], q0=[1, 0, 0, 0], kind="rates", fix_time=[0.5],
+                 fix_lla=[[LAT, LON, H]], fix_cov=np.eye(3)[None], p0=np.eye(15), accel_psd=1e-8, gyro_psd=1e-12)
+    return build, (t, g, a)
 
 
 def test_bad_fix_time_outside_imu_span():
-    kw = _args()
+    kw, imu = _args()
     kw["fix_time"] = [1.5]
-    with pytest.raises(ValueError, match=r"fixes: time 1.5 s at index 0 is outside the IMU span \[0, 1\] s"):
-        position_aided_ins(**kw)
+    with pytest.raises(ValueError, match=r"measurements: time 1.5 s at index 0 is outside the IMU span \[0, 1\] s"):
+        position_aided_ins(**kw).run(*imu, progress=False)
+
+
+def test_bad_fix_before_streamed_record():
+    kw, (t, g, a) = _args()
+    kw.update(fix_time=[0.05], t0=0.1)
+    with pytest.raises(ValueError, match=r"fixes: time 0.05 s at index 0 is before the IMU record start 0.1 s"):
+        position_aided_ins(**kw).process(t[1:], g[1:], a[1:])
 
 
 def test_bad_nan_fix():
-    kw = _args()
+    kw, _ = _args()
     kw["fix_lla"] = [[LAT, np.nan, H]]
     with pytest.raises(ValueError, match="fix_lla: non-finite value nan at index 0"):
         position_aided_ins(**kw)
 
 
 def test_bad_p0_size():
-    kw = _args()
+    kw, _ = _args()
     kw["p0"] = np.eye(9)
     with pytest.raises(ValueError, match="p0: expected 15x15, got 9x9"):
         position_aided_ins(**kw)
 
 
 def test_bad_fix_covariance():
-    kw = _args()
+    kw, _ = _args()
     kw["fix_cov"] = -np.eye(3)[None]
     with pytest.raises(ValueError, match=r"fixes\[0\] covariance: not positive definite"):
         position_aided_ins(**kw)
 
+
+def test_bad_unsorted_fixes():
+    kw, _ = _args()
+    kw.update(fix_time=[0.5, 0.4], fix_lla=[[LAT, LON, H]] * 2, fix_cov=np.tile(np.eye(3), (2, 1, 1)))
+    with pytest.raises(ValueError, match="fixes: time not strictly increasing at index 1"):
+        position_aided_ins(**kw)
+
+
+def test_divergence_keeps_partial_result():
+    from atomnav import NumericalError
+
+    kw, (t, g, a) = _args()
+    kw["predict_every"] = 2
+    a[7] = [1e12, 0, 0]  # flings the INS off the globe at sample 7 (t = 0.7 s)
+    ins = position_aided_ins(**kw)
+    with pytest.raises(NumericalError, match=r"navigation solution diverged at sample 7 \(t = 0.70") as err:
+        ins.run(t, g, a, chunk_s=0.35, progress=False)
+    # every epoch before the failing sample is kept: every 2 steps (0.2, 0.4 s) and at the fix (0.5 s)
+    assert list(err.value.partial.nav["time_s"]) == pytest.approx([0.2, 0.4, 0.5])
+
+
+def test_chunked_run_equals_one_call():
+    one, fixes_one, _ = static_case(duration=30.0, chunk_s=1e9)
+    many, fixes_many, _ = static_case(duration=30.0, chunk_s=0.73)
+    assert one.equals(many)
+    assert fixes_one.equals(fixes_many)
+
+
+def test_without_measurements_equals_free_strapdown():
+    """No hidden aiding: with no fix the aided INS is the strapdown on the same data."""
+    from atomnav.strapdown import Strapdown
+
+    kw, _ = _args()
+    kw.update(fix_time=np.zeros(0), fix_lla=np.zeros((0, 3)), fix_cov=np.zeros((0, 3, 3)), predict_every=1)
+    rng = np.random.default_rng(1)
+    n = 2001
+    t = np.arange(n) * 0.01
+    g = rng.normal(0, 1e-3, (n, 3))
+    a = np.tile([0.1, 0.0, -9.8], (n, 1)) + rng.normal(0, 1e-2, (n, 3))
+    res = position_aided_ins(**kw).run(t, g, a, progress=False)
+    sd = Strapdown(0.0, [LAT, LON, H], [0, 0, 0], [1, 0, 0, 0], kind="rates")
+    free = sd.run(np.column_stack([t, g, a]))
+    cols = ["lat_rad", "lon_rad", "h_m", "vn_mps", "ve_mps", "vd_mps", "qw", "qx", "qy", "qz"]
+    np.testing.assert_allclose(res.nav[cols].to_numpy(), free.iloc[1:][cols].to_numpy(), rtol=0, atol=1e-9)

@@ -4,6 +4,7 @@ on a linearised 15-state INS with 1 Hz position aiding."""
 import numpy as np
 import pytest
 
+from atomnav.trajectory import sinusoidal
 from atomnav.filter import (BiasModel, Layout, Scenario, chi2_band, covariance_analysis, dare, discretize,
                             ins_error_model, monte_carlo)
 
@@ -11,13 +12,20 @@ G = 9.80665
 DT = 0.2  # filter step (s)
 
 
-def ins_scenario(duration=120.0, method="van_loan", sequential=False, sigma_pos=1.0):
-    """Static navigation-grade INS at 46° N, position fixes at 1 Hz."""
+def ins_scenario(duration=120.0, method="van_loan", sequential=False, sigma_pos=1.0, moving=False):
+    """Navigation-grade INS at 46° N with position fixes at 1 Hz: static, or (``moving``)
+    on a horizontal sinusoidal path (±200 m N, ±150 m E), whose accelerations make yaw and
+    the gyro biases observable."""
     steps = int(round(duration / DT))
     lay = Layout()
-    one = lambda row: np.repeat(np.asarray([row], float), steps, axis=0)
-    f, qc = ins_error_model(one([0.8, 0.2, 100.0]), one([0, 0, 0]), one([1, 0, 0, 0]), one([0, 0, -G]),
-                            accel_psd=(5e-5) ** 2, gyro_psd=(1e-6) ** 2,
+    if moving:
+        truth = sinusoidal(duration, rate_hz=1 / DT, origin=(0.8, 0.2, 100.0), amp_ned=(200.0, 150.0, 2.0))
+        lla, vel, q = truth.lla[1:], truth.vel_ned[1:], truth.q_nb[1:]
+        f_b = truth.ideal_imu("rates")[["accel_x_mps2", "accel_y_mps2", "accel_z_mps2"]].to_numpy()[1:]
+    else:
+        one = lambda row: np.repeat(np.asarray([row], float), steps, axis=0)
+        lla, vel, q, f_b = one([0.8, 0.2, 100.0]), one([0, 0, 0]), one([1, 0, 0, 0]), one([0, 0, -G])
+    f, qc = ins_error_model(lla, vel, q, f_b, accel_psd=(5e-5) ** 2, gyro_psd=(1e-6) ** 2,
                             accel_bias=BiasModel("random_walk", psd=1e-10),
                             gyro_bias=BiasModel("gauss_markov", tau=300.0, sigma=1e-6), layout=lay)
     p0 = np.diag(np.r_[[4.0] * 3, [0.01] * 3, [1e-6] * 3, [(1e-3) ** 2] * 3, [(1e-6) ** 2] * 3])
@@ -60,21 +68,15 @@ def test_covariance_steady_state_equals_dare():
     assert last["x[1]"] ** 2 == pytest.approx(ss.p_post[1, 1], rel=1e-9)
 
 
-def _nees_fraction(runs, method, seeds, duration=120.0):
-    """Fraction of (master seed, epoch) pairs whose run-averaged NEES lies in the 95 % χ²
-    band, pooled over independent master seeds. One master seed alone is a poor sample:
-    unobservable states (yaw, vertical gyro bias) keep each run's initial draw, so the
-    epochs of one campaign are strongly correlated and a consistent filter fails the
-    "≥ 90 % of epochs" criterion for about a third of single seeds (measured 4 of 12
-    with 100 runs); pooled over seeds the expected fraction is 0.95."""
-    scn = ins_scenario(method=method, duration=duration)
-    fr = [monte_carlo(scn, runs=runs, seed=s).nees_inside(dof=15) for s in seeds]
-    return float(np.mean(fr)), fr
+def _nees_fraction(method, seed, runs=100):
+    """Fraction of epochs whose NEES averaged over ``runs`` runs lies in the 95 % χ² band
+    (15 states), 10 min on the moving path."""
+    return monte_carlo(ins_scenario(duration=600.0, method=method, moving=True), runs=runs, seed=seed).nees_inside(dof=15)
 
 
-def test_nees_inside_chi2_band_reduced():
-    frac, fr = _nees_fraction(30, "van_loan", range(8), duration=60.0)
-    assert frac >= 0.90, fr
+def test_nees_inside_chi2_band_100_runs():
+    """Issue 3 acceptance: 100 runs, ≥ 90 % of epochs in the band (master seed 0: 0.976)."""
+    assert _nees_fraction("van_loan", seed=0) >= 0.90
 
 
 def test_monte_carlo_table_layout():
@@ -85,16 +87,20 @@ def test_monte_carlo_table_layout():
 
 
 @pytest.mark.slow
-def test_nees_inside_chi2_band_100_runs():
-    frac, fr = _nees_fraction(100, "van_loan", range(10))
-    assert frac >= 0.90, fr
+def test_nees_first_order_discretisation_100_runs():
+    """First-order Φ, Q_d at Δt = 0.2 s: as consistent as Van Loan (seed 0: 0.975 vs 0.976)."""
+    assert _nees_fraction("first_order", seed=0) >= 0.90
 
 
 @pytest.mark.slow
-def test_nees_first_order_discretisation_100_runs():
-    # Documented result (report): at Δt = 0.2 s the first-order Φ, Q_d keep the NEES in the band.
-    frac, fr = _nees_fraction(100, "first_order", range(10))
-    assert frac >= 0.90, fr
+def test_nees_over_master_seeds():
+    """The criterion over 12 independent master seeds. It is a statistic of correlated
+    epochs — the slowly observable states (yaw, gyro biases) keep each run's draw for
+    minutes, shifting a whole campaign's average NEES together — so a consistent filter
+    fails it for some seeds (measured: 1 of 12, seed 11 at 0.854, with every state's
+    mean normalised squared error within 0.8–1.1). Pooled, the fraction is ≈ 0.97."""
+    fr = [_nees_fraction("van_loan", seed=s) for s in range(12)]
+    assert np.mean(fr) >= 0.90 and sum(f >= 0.90 for f in fr) >= 10, fr
 
 
 def test_nis_average_inside_band():

@@ -1,27 +1,96 @@
-//! Position-aided strapdown INS with the 15-state error-state filter (batch over a whole
-//! IMU record): the strapdown of `strapdown.rs` runs on bias-compensated IMU output, the
-//! filter predicts every `predict_every` IMU steps with F from the current solution
-//! (spec gnss-ins-tight Eq. 28, `ins::error_dynamics`), position fixes update it, and in
-//! closed loop the estimate is fed back (X ← X ⊖ δx̂, b̂ ← b̂ − δb̂, δx̂ ← 0); in open loop
-//! the INS runs free and the output is X ⊖ δx̂ (spec gnss-ins-tight §2.11).
+//! The aided strapdown INS: one engine for every aiding sensor (position fixes, CAI, GNSS,
+//! star camera). The strapdown of `strapdown.rs` runs on bias-compensated IMU output; the
+//! error-state filter predicts every `predict_every` IMU steps and at each measurement
+//! epoch with F from the current solution (spec gnss-ins-tight Eq. 28,
+//! `ins::error_dynamics`, plus the sensor's extra blocks); an [`Aiding`] model supplies
+//! z = predicted − measured, H and R. In closed loop the estimate is fed back
+//! (X ← X ⊖ δx̂, b̂ ← b̂ − δb̂, extra ← extra − δx̂_extra, δx̂ ← 0); in open loop the INS
+//! runs free and the output is X ⊖ δx̂ (spec gnss-ins-tight §2.11).
+//!
+//! [`AidedIns::process`] takes the IMU record chunk by chunk (streaming); feeding the
+//! whole record in one call, or in any chunks followed by [`AidedIns::finish`], gives the
+//! same result.
 
 use super::discretize::{discretize, Discretization};
 use super::ins::{error_dynamics, InsNoise};
 use super::kf::{Kf, LoopMode};
-use super::layout::Layout;
+use super::layout::{Layout, INS15};
 use crate::earth::Ellipsoid;
-use crate::error::{invalid, Result};
+use crate::error::{invalid, NavError, Result};
 use crate::imu::ImuKind;
 use crate::math::{quat_from_rotvec, quat_normalize, Mat3, Vec3};
 use crate::strapdown::{NavState, Strapdown, Vertical};
 use nalgebra::{DMatrix, DVector};
 
-/// A position fix: time (s), (lat rad, lon rad, h m) and its NED covariance (m²).
-#[derive(Debug, Clone, Copy)]
-pub struct PositionFix {
+/// What an aiding sensor reports at one epoch.
+#[derive(Debug, Clone)]
+pub struct Measurement {
+    /// z = predicted − measured (m rows; δx = estimate − true).
+    pub z: Vec<f64>,
+    /// H (m × n) with respect to the whole layout's δx.
+    pub h: DMatrix<f64>,
+    /// Measurement-noise covariance (m × m); sequential mode decorrelates it.
+    pub r: DMatrix<f64>,
+}
+
+/// What the engine knows when it asks for a measurement.
+pub struct AidingContext<'a> {
+    /// IMU epoch at which the measurement is applied (first epoch ≥ its time), s.
     pub t: f64,
-    pub lla: Vec3,
-    pub cov_ned: Mat3,
+    /// Current strapdown solution (open loop: the free, uncorrected INS).
+    pub nav: &'a NavState,
+    /// Bias estimates currently removed from the IMU output (m/s², rad/s).
+    pub accel_bias: Vec3,
+    pub gyro_bias: Vec3,
+    /// δx̂ (all zeros in closed loop).
+    pub x: &'a DVector<f64>,
+    /// Estimate of the extra blocks currently in use (layout order after the 15 INS states).
+    pub extra: &'a DVector<f64>,
+    pub layout: &'a Layout,
+    pub ell: &'a Ellipsoid,
+}
+
+/// An aiding sensor's measurement model.
+pub trait Aiding: Send {
+    /// Field name used in error messages about the measurements (e.g. "fixes").
+    fn name(&self) -> &str {
+        "measurements"
+    }
+    /// Extra state blocks after the 15 INS states: (name, size).
+    fn extra_blocks(&self) -> Vec<(String, usize)> {
+        Vec::new()
+    }
+    /// Measurement times (s), strictly increasing.
+    fn times(&self) -> &[f64];
+    /// After every strapdown step: the bias-compensated IMU sample (rates or increments as
+    /// the record), its interval `dt` (s; 0 for a rate sample at the initial time, which
+    /// only primes the integrator) and the new navigation solution.
+    fn observe(&mut self, _t: f64, _dt: f64, _gyro: &Vec3, _accel: &Vec3, _nav: &NavState) {}
+    /// Measurement `j` at `ctx.t`; `Ok(None)` skips it.
+    fn measure(&mut self, j: usize, ctx: &AidingContext) -> Result<Option<Measurement>>;
+    /// Continuous F and Q_c rows/columns of the extra blocks (INS blocks already filled).
+    fn extra_dynamics(&self, _layout: &Layout, _f: &mut DMatrix<f64>, _qc: &mut DMatrix<f64>) {}
+}
+
+impl Aiding for Box<dyn Aiding> {
+    fn name(&self) -> &str {
+        (**self).name()
+    }
+    fn extra_blocks(&self) -> Vec<(String, usize)> {
+        (**self).extra_blocks()
+    }
+    fn times(&self) -> &[f64] {
+        (**self).times()
+    }
+    fn observe(&mut self, t: f64, dt: f64, gyro: &Vec3, accel: &Vec3, nav: &NavState) {
+        (**self).observe(t, dt, gyro, accel, nav)
+    }
+    fn measure(&mut self, j: usize, ctx: &AidingContext) -> Result<Option<Measurement>> {
+        (**self).measure(j, ctx)
+    }
+    fn extra_dynamics(&self, layout: &Layout, f: &mut DMatrix<f64>, qc: &mut DMatrix<f64>) {
+        (**self).extra_dynamics(layout, f, qc)
+    }
 }
 
 #[derive(Debug, Clone, Copy)]
@@ -34,20 +103,29 @@ pub struct AidedConfig {
     pub gate: Option<f64>,
 }
 
-/// Output at every prediction epoch, and per fix the innovation statistics.
+/// Output per prediction epoch and per applied measurement (appended by `process`).
 #[derive(Debug, Clone, Default)]
 pub struct AidedOutput {
+    pub time: Vec<f64>,
+    /// Navigation estimate (open loop: X ⊖ δx̂).
     pub nav: Vec<NavState>,
     pub accel_bias: Vec<Vec3>,
     pub gyro_bias: Vec<Vec3>,
-    /// σ of the 15 states, row-major (epochs × 15).
+    /// Estimate of the extra blocks, epochs × n_extra.
+    pub extra: Vec<f64>,
+    /// σ of every state, epochs × n.
     pub sigma: Vec<f64>,
-    pub fix_nis: Vec<f64>,
-    pub fix_rejected: Vec<bool>,
+    /// Per measurement: its time, number of rows, innovations (concatenated), NIS (summed
+    /// over rows) and the number of rows the χ² gate rejected.
+    pub meas_time: Vec<f64>,
+    pub meas_rows: Vec<usize>,
+    pub innovation: Vec<f64>,
+    pub nis: Vec<f64>,
+    pub rejected: Vec<usize>,
 }
 
 /// NED position difference (m) of `a` relative to `b` (small-difference form).
-fn ned_diff(ell: &Ellipsoid, a: &Vec3, b: &Vec3) -> Vec3 {
+pub fn ned_diff(ell: &Ellipsoid, a: &Vec3, b: &Vec3) -> Vec3 {
     let loc = ell.local(b.x, b.z);
     Vec3::new((a.x - b.x) * loc.rm, (a.y - b.y) * loc.rp * loc.cos, -(a.z - b.z))
 }
@@ -62,106 +140,340 @@ fn remove_error(ell: &Ellipsoid, s: &NavState, dx: &DVector<f64>) -> NavState {
     NavState { t: s.t, lla, vel, q_nb }
 }
 
-/// Run the aided INS over the record. `t`, `gyro`, `accel` as for `Strapdown::run`
-/// (free vertical channel); `p0` 15 × 15; biases start at `ba0`, `bg0`.
-#[allow(clippy::too_many_arguments)]
-pub fn run_position_aided(
-    initial: NavState,
-    kind: ImuKind,
+fn block(x: &DVector<f64>, start: usize) -> Vec3 {
+    Vec3::new(x[start], x[start + 1], x[start + 2])
+}
+
+pub struct AidedIns<A: Aiding> {
+    sd: Strapdown,
+    kf: Kf,
+    layout: Layout,
     ell: Ellipsoid,
-    t: &[f64],
-    gyro: &[Vec3],
-    accel: &[Vec3],
-    ba0: Vec3,
-    bg0: Vec3,
-    p0: DMatrix<f64>,
-    fixes: &[PositionFix],
-    cfg: &AidedConfig,
-) -> Result<AidedOutput> {
-    let n = t.len();
-    if n < 2 || gyro.len() != n || accel.len() != n {
-        return Err(invalid("imu", format!("need >= 2 samples with equal lengths, got time {n}, gyro {}, accel {}", gyro.len(), accel.len())));
-    }
-    crate::error::check_increasing("time", t)?;
-    if cfg.predict_every == 0 {
-        return Err(invalid("predict_every", "must be >= 1"));
-    }
-    for (i, f) in fixes.iter().enumerate() {
-        if !(f.t >= t[0] && f.t <= t[n - 1]) {
-            return Err(invalid("fixes", format!("time {} s at index {i} is outside the IMU span [{}, {}] s", f.t, t[0], t[n - 1])));
+    cfg: AidedConfig,
+    aiding: A,
+    accel_bias: Vec3,
+    gyro_bias: Vec3,
+    extra: DVector<f64>,
+    next_meas: usize,
+    t_last_predict: f64,
+    /// Time and compensated specific force (m/s²) of the last sample, for F.
+    last_sample: Option<(f64, Vec3)>,
+    steps_since: usize,
+    /// Samples processed so far (numerical errors name the sample of the whole record).
+    samples: usize,
+}
+
+impl<A: Aiding> AidedIns<A> {
+    /// `p0`: n × n for the whole layout (15 INS states then the aiding's extra blocks);
+    /// `extra0`: initial estimate of the extra blocks.
+    #[allow(clippy::too_many_arguments)]
+    pub fn new(
+        initial: NavState,
+        kind: ImuKind,
+        ell: Ellipsoid,
+        accel_bias0: Vec3,
+        gyro_bias0: Vec3,
+        extra0: DVector<f64>,
+        p0: DMatrix<f64>,
+        cfg: AidedConfig,
+        aiding: A,
+    ) -> Result<Self> {
+        if cfg.predict_every == 0 {
+            return Err(invalid("predict_every", "must be >= 1"));
         }
-        if i > 0 && f.t <= fixes[i - 1].t {
-            return Err(invalid("fixes", format!("time not strictly increasing at index {i}")));
+        let mut spec: Vec<(String, Option<usize>)> = INS15.iter().map(|s| (s.to_string(), None)).collect();
+        spec.extend(aiding.extra_blocks().into_iter().map(|(b, k)| (b, Some(k))));
+        let layout = Layout::new(&spec)?;
+        let n = layout.size();
+        if p0.nrows() != n || p0.ncols() != n {
+            return Err(invalid("p0", format!("expected {n}x{n}, got {}x{}", p0.nrows(), p0.ncols())));
         }
-        if !f.lla.iter().all(|x| x.is_finite()) {
-            return Err(invalid("fixes", format!("non-finite position at index {i}")));
+        if extra0.len() != n - 15 {
+            return Err(invalid("extra0", format!("expected {} values for the extra blocks, got {}", n - 15, extra0.len())));
         }
-        super::matrix::check_covariance(&format!("fixes[{i}] covariance"), &DMatrix::from_fn(3, 3, |a, b| f.cov_ned[(a, b)]), Some(3), true)?;
+        crate::error::check_finite("extra0", extra0.as_slice(), 1)?;
+        for (field, v) in [("accel_bias0", &accel_bias0), ("gyro_bias0", &gyro_bias0)] {
+            crate::error::check_finite(field, v.as_slice(), 1)?;
+        }
+        let times = aiding.times();
+        for (i, &tm) in times.iter().enumerate() {
+            if !tm.is_finite() {
+                return Err(invalid(aiding.name(), format!("non-finite time {tm} at index {i}")));
+            }
+            if i > 0 && tm <= times[i - 1] {
+                return Err(invalid(aiding.name(), format!("time not strictly increasing at index {i}")));
+            }
+        }
+        let kf = Kf::new(p0, cfg.mode)?;
+        let sd = Strapdown::new(initial, kind, ell, Vertical::Free)?;
+        Ok(AidedIns {
+            sd,
+            kf,
+            layout,
+            ell,
+            cfg,
+            aiding,
+            accel_bias: accel_bias0,
+            gyro_bias: gyro_bias0,
+            extra: extra0,
+            next_meas: 0,
+            t_last_predict: initial.t,
+            last_sample: None,
+            steps_since: 0,
+            samples: 0,
+        })
     }
-    let layout = Layout::ins15();
-    let mut kf = Kf::new(p0, cfg.mode)?;
-    if kf.size() != 15 {
-        return Err(invalid("p0", format!("expected 15x15, got {0}x{0}", kf.size())));
+
+    pub fn layout(&self) -> &Layout {
+        &self.layout
     }
-    let mut sd = Strapdown::new(initial, kind, ell, Vertical::Free)?;
-    let (mut ba, mut bg) = (ba0, bg0);
-    let mut h = DMatrix::<f64>::zeros(3, 15);
-    h.view_mut((0, 0), (3, 3)).fill_with_identity();
-    let mut out = AidedOutput::default();
-    let mut next_fix = 0;
-    let mut t_last_predict = initial.t;
-    let mut steps_since = 0;
-    let record = |out: &mut AidedOutput, sd: &Strapdown, kf: &Kf, ba: &Vec3, bg: &Vec3| {
-        let (nav, dba, dbg) = match cfg.mode {
-            LoopMode::Closed => (sd.state, Vec3::zeros(), Vec3::zeros()),
-            LoopMode::Open => (remove_error(&ell, &sd.state, &kf.x), Vec3::new(kf.x[9], kf.x[10], kf.x[11]), Vec3::new(kf.x[12], kf.x[13], kf.x[14])),
-        };
-        out.nav.push(nav);
-        out.accel_bias.push(ba - dba);
-        out.gyro_bias.push(bg - dbg);
-        out.sigma.extend((0..15).map(|i| kf.p[(i, i)].sqrt()));
-    };
-    for k in 0..n {
-        let dt = if k > 0 { t[k] - t[k - 1] } else { t[0] - initial.t };
-        let (g, a) = match kind {
-            ImuKind::Rates => (gyro[k] - bg, accel[k] - ba),
-            ImuKind::Increments => (gyro[k] - bg * dt, accel[k] - ba * dt),
-        };
-        sd.step(t[k], &g, &a, None);
-        let s = sd.state;
-        if !s.lla.iter().chain(s.vel.iter()).all(|x| x.is_finite()) {
-            return Err(crate::error::NavError::Numerical(format!("navigation solution diverged at sample {k} (t = {} s)", t[k])));
+
+    pub fn aiding(&self) -> &A {
+        &self.aiding
+    }
+
+    /// Measurements not applied yet (their time is after the last processed sample).
+    pub fn pending(&self) -> usize {
+        self.aiding.times().len() - self.next_meas
+    }
+
+    /// Feed one chunk of the IMU record (`t`, `gyro`, `accel` as for `Strapdown::run`);
+    /// appends to `out`. On error `out` keeps every epoch computed before it.
+    pub fn process(&mut self, t: &[f64], gyro: &[Vec3], accel: &[Vec3], out: &mut AidedOutput) -> Result<()> {
+        let n = t.len();
+        if gyro.len() != n || accel.len() != n {
+            return Err(invalid("imu", format!("time has {n} samples but gyro {} and accel {}", gyro.len(), accel.len())));
         }
-        steps_since += 1;
-        let fix_due = next_fix < fixes.len() && fixes[next_fix].t <= t[k];
-        if (steps_since >= cfg.predict_every || fix_due || k == n - 1) && t[k] > t_last_predict {
-            let f_b = match kind {
+        if n == 0 {
+            return Ok(());
+        }
+        self.sd.validate(t, gyro, accel, None)?;
+        // A measurement before the first sample of the record can never be applied.
+        if self.last_sample.is_none() {
+            if let Some(&tm) = self.aiding.times().first().filter(|&&tm| tm < t[0]) {
+                return Err(invalid(self.aiding.name(), format!("time {tm} s at index 0 is before the IMU record start {} s", t[0])));
+            }
+        }
+        for k in 0..n {
+            let dt = t[k] - self.sd.state.t;
+            let (g, a) = match self.sd.kind {
+                ImuKind::Rates => (gyro[k] - self.gyro_bias, accel[k] - self.accel_bias),
+                ImuKind::Increments => (gyro[k] - self.gyro_bias * dt, accel[k] - self.accel_bias * dt),
+            };
+            self.sd.step(t[k], &g, &a, None);
+            self.sd.check_diverged(self.samples)?;
+            self.samples += 1;
+            self.aiding.observe(t[k], dt, &g, &a, &self.sd.state);
+            let f_b = match self.sd.kind {
                 ImuKind::Rates => a,
                 ImuKind::Increments => a / dt,
             };
-            let (f, qc) = error_dynamics(&layout, &ell, &sd.state, &f_b, &cfg.noise)?;
-            let (phi, qd) = discretize(&f, &qc, t[k] - t_last_predict, cfg.method);
-            kf.predict_unchecked(&phi, &qd)?;
-            t_last_predict = t[k];
-            steps_since = 0;
-            // Fixes are applied at the first IMU epoch at or after their time.
-            while next_fix < fixes.len() && fixes[next_fix].t <= t[k] {
-                let fx = &fixes[next_fix];
-                let z = ned_diff(&ell, &sd.state.lla, &fx.lla);
-                let r = DMatrix::from_fn(3, 3, |i, j| fx.cov_ned[(i, j)]);
-                let rep = kf.update(z.as_slice(), &h, &r, cfg.sequential, cfg.gate)?;
-                out.fix_nis.push(rep.nis.iter().sum());
-                out.fix_rejected.push(!rep.rejected.is_empty());
-                next_fix += 1;
+            self.last_sample = Some((t[k], f_b));
+            // A rate sample at the initial time only primes the integrator: not a step.
+            if dt > 0.0 {
+                self.steps_since += 1;
             }
-            if cfg.mode == LoopMode::Closed {
-                let dx = kf.take_correction();
-                sd.state = remove_error(&ell, &sd.state, &dx);
-                ba -= Vec3::new(dx[9], dx[10], dx[11]);
-                bg -= Vec3::new(dx[12], dx[13], dx[14]);
+            let due = self.next_meas < self.aiding.times().len() && self.aiding.times()[self.next_meas] <= t[k];
+            if self.steps_since >= self.cfg.predict_every || due {
+                self.epoch(out)?;
             }
-            record(&mut out, &sd, &kf, &ba, &bg);
+        }
+        Ok(())
+    }
+
+    /// End of the record: predict to the last sample if steps are left since the last
+    /// epoch (so the output ends at the last sample).
+    pub fn finish(&mut self, out: &mut AidedOutput) -> Result<()> {
+        if self.steps_since > 0 {
+            self.epoch(out)?;
+        }
+        Ok(())
+    }
+
+    /// Predict to the last sample, apply the measurements due, feed back, record.
+    fn epoch(&mut self, out: &mut AidedOutput) -> Result<()> {
+        let (tk, f_b) = self.last_sample.expect("epoch after a sample");
+        self.steps_since = 0;
+        if tk <= self.t_last_predict {
+            return Ok(());
+        }
+        let (mut f, mut qc) = error_dynamics(&self.layout, &self.ell, &self.sd.state, &f_b, &self.cfg.noise)?;
+        self.aiding.extra_dynamics(&self.layout, &mut f, &mut qc);
+        let (phi, qd) = discretize(&f, &qc, tk - self.t_last_predict, self.cfg.method);
+        self.kf.predict_unchecked(&phi, &qd)?;
+        self.t_last_predict = tk;
+        while self.next_meas < self.aiding.times().len() && self.aiding.times()[self.next_meas] <= tk {
+            let j = self.next_meas;
+            self.next_meas += 1;
+            let ctx = AidingContext {
+                t: tk,
+                nav: &self.sd.state,
+                accel_bias: self.accel_bias,
+                gyro_bias: self.gyro_bias,
+                x: &self.kf.x,
+                extra: &self.extra,
+                layout: &self.layout,
+                ell: &self.ell,
+            };
+            let Some(m) = self.aiding.measure(j, &ctx)? else { continue };
+            let rep = self.kf.update(&m.z, &m.h, &m.r, self.cfg.sequential, self.cfg.gate).map_err(|e| at_measurement(e, self.aiding.name(), j))?;
+            out.meas_time.push(self.aiding.times()[j]);
+            out.meas_rows.push(m.z.len());
+            out.innovation.extend_from_slice(&rep.innovation);
+            out.nis.push(rep.nis.iter().sum());
+            out.rejected.push(rep.rejected.len());
+        }
+        if self.cfg.mode == LoopMode::Closed {
+            let dx = self.kf.take_correction();
+            self.sd.state = remove_error(&self.ell, &self.sd.state, &dx);
+            self.accel_bias -= block(&dx, 9);
+            self.gyro_bias -= block(&dx, 12);
+            self.extra -= dx.rows(15, dx.len() - 15);
+        }
+        self.record(out);
+        Ok(())
+    }
+
+    fn record(&self, out: &mut AidedOutput) {
+        let x = &self.kf.x;
+        let (nav, ba, bg, extra) = match self.cfg.mode {
+            LoopMode::Closed => (self.sd.state, self.accel_bias, self.gyro_bias, self.extra.clone()),
+            LoopMode::Open => (
+                remove_error(&self.ell, &self.sd.state, x),
+                self.accel_bias - block(x, 9),
+                self.gyro_bias - block(x, 12),
+                &self.extra - x.rows(15, x.len() - 15),
+            ),
+        };
+        out.time.push(nav.t);
+        out.nav.push(nav);
+        out.accel_bias.push(ba);
+        out.gyro_bias.push(bg);
+        out.extra.extend(extra.iter());
+        out.sigma.extend((0..self.kf.size()).map(|i| self.kf.p[(i, i)].sqrt()));
+    }
+}
+
+/// Name the measurement in an invalid-input error of the update (NaN z, bad R, ...).
+fn at_measurement(e: NavError, name: &str, j: usize) -> NavError {
+    match e {
+        NavError::InvalidInput { field, reason } => NavError::InvalidInput { field: format!("{name}[{j}] {field}"), reason },
+        other => other,
+    }
+}
+
+/// Run over a whole record: every measurement must lie inside the IMU span.
+pub fn run_aided<A: Aiding>(mut ins: AidedIns<A>, t: &[f64], gyro: &[Vec3], accel: &[Vec3]) -> Result<(AidedOutput, AidedIns<A>)> {
+    if t.len() < 2 {
+        return Err(invalid("imu", format!("need >= 2 samples, got {}", t.len())));
+    }
+    let (t0, t1) = (t[0], t[t.len() - 1]);
+    if let Some((i, tm)) = ins.aiding.times().iter().enumerate().find(|(_, &tm)| !(tm >= t0 && tm <= t1)) {
+        return Err(invalid(ins.aiding.name(), format!("time {tm} s at index {i} is outside the IMU span [{t0}, {t1}] s")));
+    }
+    let mut out = AidedOutput::default();
+    ins.process(t, gyro, accel, &mut out)?;
+    ins.finish(&mut out)?;
+    Ok((out, ins))
+}
+
+/// A position fix: time (s), (lat rad, lon rad, h m) and its NED covariance (m²).
+#[derive(Debug, Clone, Copy)]
+pub struct PositionFix {
+    pub t: f64,
+    pub lla: Vec3,
+    pub cov_ned: Mat3,
+}
+
+/// Position fixes as an aiding sensor: z = NED(INS − fix), H = [I 0 ...].
+pub struct PositionAiding {
+    times: Vec<f64>,
+    fixes: Vec<PositionFix>,
+}
+
+impl PositionAiding {
+    pub fn new(fixes: Vec<PositionFix>) -> Result<Self> {
+        for (i, f) in fixes.iter().enumerate() {
+            if !f.lla.iter().all(|x| x.is_finite()) {
+                return Err(invalid("fixes", format!("non-finite position at index {i}")));
+            }
+            super::matrix::check_covariance(&format!("fixes[{i}] covariance"), &DMatrix::from_fn(3, 3, |a, b| f.cov_ned[(a, b)]), Some(3), true)?;
+        }
+        Ok(PositionAiding { times: fixes.iter().map(|f| f.t).collect(), fixes })
+    }
+}
+
+impl Aiding for PositionAiding {
+    fn name(&self) -> &str {
+        "fixes"
+    }
+    fn times(&self) -> &[f64] {
+        &self.times
+    }
+    fn measure(&mut self, j: usize, ctx: &AidingContext) -> Result<Option<Measurement>> {
+        let fx = &self.fixes[j];
+        let z = ned_diff(ctx.ell, &ctx.nav.lla, &fx.lla);
+        let mut h = DMatrix::<f64>::zeros(3, ctx.layout.size());
+        h.view_mut((0, ctx.layout.range("position")?.start), (3, 3)).fill_with_identity();
+        Ok(Some(Measurement { z: z.as_slice().to_vec(), h, r: DMatrix::from_fn(3, 3, |a, b| fx.cov_ned[(a, b)]) }))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::filter::ins::BiasModel;
+
+    fn config(mode: LoopMode) -> AidedConfig {
+        let noise = InsNoise { accel_psd: 1e-8, gyro_psd: 1e-14, accel_bias: BiasModel::RandomConstant, gyro_bias: BiasModel::RandomConstant };
+        AidedConfig { noise, predict_every: 7, method: Discretization::VanLoan, mode, sequential: false, gate: None }
+    }
+
+    /// A stationary record with an accelerometer bias, fixes every 0.5 s.
+    fn record() -> (NavState, Vec<f64>, Vec<Vec3>, Vec<Vec3>, Vec<PositionFix>) {
+        let ell = Ellipsoid::by_name("WGS84").unwrap();
+        let lla = Vec3::new(0.8, 0.2, 100.0);
+        let loc = ell.local(lla.x, lla.z);
+        let t: Vec<f64> = (0..=500).map(|k| k as f64 * 0.01).collect();
+        let gyro = vec![loc.earth_rate(); t.len()];
+        let accel = vec![Vec3::new(1e-3, 0.0, -loc.gravity); t.len()];
+        let fixes = (1..10).map(|i| PositionFix { t: i as f64 * 0.5, lla, cov_ned: Mat3::identity() }).collect();
+        (NavState { t: 0.0, lla, vel: Vec3::zeros(), q_nb: crate::math::quat(1.0, 0.0, 0.0, 0.0) }, t, gyro, accel, fixes)
+    }
+
+    fn engine(mode: LoopMode) -> AidedIns<PositionAiding> {
+        let (s0, _, _, _, fixes) = record();
+        let p0 = DMatrix::from_diagonal(&DVector::from_vec([1.0, 1.0, 1.0, 0.01, 0.01, 0.01, 1e-6, 1e-6, 1e-6, 1e-4, 1e-4, 1e-4, 1e-10, 1e-10, 1e-10].to_vec()));
+        let ell = Ellipsoid::by_name("WGS84").unwrap();
+        AidedIns::new(s0, ImuKind::Rates, ell, Vec3::zeros(), Vec3::zeros(), DVector::zeros(0), p0, config(mode), PositionAiding::new(fixes).unwrap()).unwrap()
+    }
+
+    /// Streaming in uneven chunks equals one batch call, to the last bit.
+    #[test]
+    fn chunks_equal_batch() {
+        let (_, t, g, a, _) = record();
+        for mode in [LoopMode::Closed, LoopMode::Open] {
+            let (batch, _) = run_aided(engine(mode), &t, &g, &a).unwrap();
+            let mut ins = engine(mode);
+            let mut out = AidedOutput::default();
+            for (lo, hi) in [(0, 3), (3, 140), (140, 141), (141, 501)] {
+                ins.process(&t[lo..hi], &g[lo..hi], &a[lo..hi], &mut out).unwrap();
+            }
+            ins.finish(&mut out).unwrap();
+            assert_eq!(batch.nav, out.nav);
+            assert_eq!(batch.sigma, out.sigma);
+            assert_eq!(batch.nis, out.nis);
+            assert_eq!(batch.meas_time.len(), 9);
         }
     }
-    Ok(out)
+
+    #[test]
+    fn chunk_time_must_keep_increasing() {
+        let (_, t, g, a, _) = record();
+        let mut ins = engine(LoopMode::Closed);
+        let mut out = AidedOutput::default();
+        ins.process(&t[..10], &g[..10], &a[..10], &mut out).unwrap();
+        let err = ins.process(&t[5..10], &g[5..10], &a[5..10], &mut out).unwrap_err();
+        assert!(err.to_string().contains("time not strictly increasing: decreasing stamp 0.05 at index 0"), "{err}");
+    }
 }

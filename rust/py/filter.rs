@@ -3,7 +3,7 @@
 use super::convert::{quat_rows, vec3_rows, vector};
 use crate::earth::Ellipsoid;
 use crate::error::{invalid, NavError};
-use crate::filter::aided::{run_position_aided, AidedConfig, PositionFix};
+use crate::filter::aided::{AidedConfig, AidedIns, AidedOutput, Aiding, PositionAiding, PositionFix};
 use crate::filter::analysis::Scenario as CoreScenario;
 use crate::filter::discretize::{discretize, Discretization};
 use crate::filter::ins::{error_dynamics, BiasModel, InsNoise};
@@ -348,22 +348,158 @@ impl Scenario {
     }
 }
 
-/// Position-aided 15-state INS over a whole IMU record (see filter/aided.rs). Returns
-/// (time (N,), lla (N, 3), vel (N, 3), q_nb (N, 4), accel_bias (N, 3), gyro_bias (N, 3),
-/// sigma (N, 15), fix_nis (M,), fix_rejected (M,)) at every prediction epoch.
+/// The aided INS (filter/aided.rs) with any aiding sensor, fed chunk by chunk. Built by
+/// a sensor's factory function (`position_aided_ins`, ...). `process` and `finish` return
+/// (nav (14, E) column table, accel_bias (E, 3), gyro_bias (E, 3), extra (E, n_extra),
+/// sigma (E, n), meas_time (M,), meas_rows (M,), innovation (ΣM rows,), nis (M,),
+/// rejected (M,)) for the epochs and measurements of that call.
+#[pyclass(name = "AidedIns", module = "atomnav._core")]
+pub struct PyAidedIns {
+    inner: std::sync::Mutex<AidedIns<Box<dyn Aiding>>>,
+}
+
+type OutputTuple<'py> = Bound<'py, pyo3::types::PyTuple>;
+
+impl PyAidedIns {
+    /// Build from the shared arguments of every factory and the sensor's model.
+    #[allow(clippy::too_many_arguments)]
+    pub(crate) fn from_aiding(
+        t0: f64,
+        lla0: &PyReadonlyArray1<'_, f64>,
+        vel0: &PyReadonlyArray1<'_, f64>,
+        q0: &PyReadonlyArray1<'_, f64>,
+        kind: &str,
+        ba0: &PyReadonlyArray1<'_, f64>,
+        bg0: &PyReadonlyArray1<'_, f64>,
+        extra0: DVector<f64>,
+        p0: &PyReadonlyArray2<'_, f64>,
+        noise: InsNoise,
+        predict_every: usize,
+        method: &str,
+        mode: &str,
+        sequential: bool,
+        gate: Option<f64>,
+        ellipsoid: &str,
+        aiding: Box<dyn Aiding>,
+    ) -> PyResult<Self> {
+        use super::convert::vec3;
+        let q = vector(q0, "q0")?;
+        if q.len() != 4 {
+            return Err(invalid("q0", format!("expected 4 elements, got {}", q.len())).into());
+        }
+        let initial = NavState { t: t0, lla: vec3(lla0, "lla0")?, vel: vec3(vel0, "vel0")?, q_nb: crate::math::quat(q[0], q[1], q[2], q[3]) };
+        let cfg = AidedConfig { noise, predict_every, method: Discretization::by_name(method)?, mode: LoopMode::by_name(mode)?, sequential, gate };
+        let ins = AidedIns::new(
+            initial,
+            crate::imu::ImuKind::parse(kind)?,
+            Ellipsoid::by_name(ellipsoid)?,
+            vec3(ba0, "ba0")?,
+            vec3(bg0, "bg0")?,
+            extra0,
+            mat(p0, "p0")?,
+            cfg,
+            aiding,
+        )?;
+        Ok(PyAidedIns { inner: std::sync::Mutex::new(ins) })
+    }
+
+    fn output<'py>(py: Python<'py>, o: AidedOutput, n: usize) -> PyResult<OutputTuple<'py>> {
+        use super::convert::{flat_to_py, vec3_to_py};
+        let ne = o.time.len();
+        let items: Vec<Bound<'py, PyAny>> = vec![
+            super::strapdown::states_to_columns(py, &o.nav).into_any(),
+            vec3_to_py(py, &o.accel_bias).into_any(),
+            vec3_to_py(py, &o.gyro_bias).into_any(),
+            flat_to_py(py, ne, n - 15, o.extra).into_any(),
+            flat_to_py(py, ne, n, o.sigma).into_any(),
+            o.meas_time.into_pyarray(py).into_any(),
+            o.meas_rows.into_pyarray(py).into_any(),
+            o.innovation.into_pyarray(py).into_any(),
+            o.nis.into_pyarray(py).into_any(),
+            o.rejected.into_pyarray(py).into_any(),
+        ];
+        pyo3::types::PyTuple::new(py, items)
+    }
+
+    /// Run `f` on the engine with the GIL released. When it stops on an error, the epochs
+    /// computed before it are not lost: the raised exception carries them as `partial`.
+    fn call<'py>(&self, py: Python<'py>, f: impl FnOnce(&mut AidedIns<Box<dyn Aiding>>, &mut AidedOutput) -> crate::error::Result<()> + Send) -> PyResult<OutputTuple<'py>> {
+        let mut guard = self.inner.lock().map_err(|_| pyo3::exceptions::PyRuntimeError::new_err("AidedIns: a previous call panicked"))?;
+        let n = guard.layout().size();
+        let mut out = AidedOutput::default();
+        let ins: &mut AidedIns<Box<dyn Aiding>> = &mut guard;
+        let res = py.detach(|| f(ins, &mut out));
+        drop(guard);
+        let table = Self::output(py, out, n)?;
+        match res {
+            Ok(()) => Ok(table),
+            Err(e) => {
+                let err = PyErr::from(e);
+                err.value(py).setattr("partial", table)?;
+                Err(err)
+            }
+        }
+    }
+}
+
+#[pymethods]
+impl PyAidedIns {
+    /// Feed one chunk: time (N,) s, gyro and accel (N, 3) as rates or increments.
+    fn process<'py>(&self, py: Python<'py>, t: PyReadonlyArray1<'py, f64>, gyro: PyReadonlyArray2<'py, f64>, accel: PyReadonlyArray2<'py, f64>) -> PyResult<OutputTuple<'py>> {
+        let (tt, g, a) = (vector(&t, "time")?, vec3_rows(&gyro, "gyro")?, vec3_rows(&accel, "accel")?);
+        self.call(py, move |ins, out| ins.process(&tt, &g, &a, out))
+    }
+
+    /// End of the record: one last epoch at the last sample.
+    fn finish<'py>(&self, py: Python<'py>) -> PyResult<OutputTuple<'py>> {
+        self.call(py, |ins, out| ins.finish(out))
+    }
+
+    /// Labels of the state components, e.g. "velocity[2]".
+    #[getter]
+    fn labels(&self) -> Vec<String> {
+        self.inner.lock().map(|g| g.layout().labels()).unwrap_or_default()
+    }
+
+    /// Measurement times (s) of the sensor.
+    #[getter]
+    fn measurement_times(&self) -> Vec<f64> {
+        self.inner.lock().map(|g| g.aiding().times().to_vec()).unwrap_or_default()
+    }
+
+    /// Number of measurements not applied yet.
+    #[getter]
+    fn pending(&self) -> usize {
+        self.inner.lock().map(|g| g.pending()).unwrap_or(0)
+    }
+}
+
+/// INS noise model from the Python arguments.
+pub(crate) fn ins_noise(accel_psd: f64, gyro_psd: f64, accel_bias: &(String, f64, f64), gyro_bias: &(String, f64, f64)) -> PyResult<InsNoise> {
+    for (field, x) in [("accel_psd", accel_psd), ("gyro_psd", gyro_psd)] {
+        if !(x.is_finite() && x >= 0.0) {
+            return Err(invalid(field, format!("must be finite and >= 0, got {x}")).into());
+        }
+    }
+    Ok(InsNoise {
+        accel_psd,
+        gyro_psd,
+        accel_bias: BiasModel::from_parts("accel_bias", &accel_bias.0, accel_bias.1, accel_bias.2)?,
+        gyro_bias: BiasModel::from_parts("gyro_bias", &gyro_bias.0, gyro_bias.1, gyro_bias.2)?,
+    })
+}
+
+/// Position-aided INS: fixes at `fix_t` (M,) with (lat, lon, h) `fix_lla` (M, 3) and NED
+/// covariance `fix_cov` (M, 3, 3) m².
 #[pyfunction]
-#[pyo3(signature = (t0, lla0, vel0, q0, kind, t, gyro, accel, ba0, bg0, p0, fix_t, fix_lla, fix_cov, accel_psd, gyro_psd, accel_bias, gyro_bias, predict_every, method, mode, sequential=false, gate=None, ellipsoid="WGS84"))]
-#[allow(clippy::too_many_arguments, clippy::type_complexity)]
-fn position_aided<'py>(
-    py: Python<'py>,
+#[pyo3(signature = (t0, lla0, vel0, q0, kind, ba0, bg0, p0, fix_t, fix_lla, fix_cov, accel_psd, gyro_psd, accel_bias, gyro_bias, predict_every, method, mode, sequential=false, gate=None, ellipsoid="WGS84"))]
+#[allow(clippy::too_many_arguments)]
+fn position_aided_ins<'py>(
     t0: f64,
     lla0: PyReadonlyArray1<'py, f64>,
     vel0: PyReadonlyArray1<'py, f64>,
     q0: PyReadonlyArray1<'py, f64>,
     kind: &str,
-    t: PyReadonlyArray1<'py, f64>,
-    gyro: PyReadonlyArray2<'py, f64>,
-    accel: PyReadonlyArray2<'py, f64>,
     ba0: PyReadonlyArray1<'py, f64>,
     bg0: PyReadonlyArray1<'py, f64>,
     p0: PyReadonlyArray2<'py, f64>,
@@ -380,19 +516,7 @@ fn position_aided<'py>(
     sequential: bool,
     gate: Option<f64>,
     ellipsoid: &str,
-) -> PyResult<Bound<'py, pyo3::types::PyTuple>> {
-    use super::convert::{quat_to_py, vec3, vec3_to_py};
-    let kind = match kind {
-        "rates" => crate::imu::ImuKind::Rates,
-        "increments" => crate::imu::ImuKind::Increments,
-        _ => return Err(invalid("kind", format!("unknown IMU kind {kind:?} (expected \"rates\" or \"increments\")")).into()),
-    };
-    let q = vector(&q0, "q0")?;
-    if q.len() != 4 {
-        return Err(invalid("q0", format!("expected 4 elements, got {}", q.len())).into());
-    }
-    let initial = NavState { t: t0, lla: vec3(&lla0, "lla0")?, vel: vec3(&vel0, "vel0")?, q_nb: crate::math::quat(q[0], q[1], q[2], q[3]) };
-    let (tt, g, a) = (vector(&t, "time")?, vec3_rows(&gyro, "gyro")?, vec3_rows(&accel, "accel")?);
+) -> PyResult<PyAidedIns> {
     let (ft, fl, fc) = (vector(&fix_t, "fix_t")?, vec3_rows(&fix_lla, "fix_lla")?, mats(&fix_cov, "fix_cov")?);
     if fl.len() != ft.len() || fc.len() != ft.len() {
         return Err(invalid("fixes", format!("fix_t has {} entries but fix_lla {} and fix_cov {}", ft.len(), fl.len(), fc.len())).into());
@@ -401,40 +525,25 @@ fn position_aided<'py>(
         return Err(invalid("fix_cov", format!("expected (M, 3, 3), entry {i} is {}x{}", fc[i].nrows(), fc[i].ncols())).into());
     }
     let fixes: Vec<PositionFix> = (0..ft.len()).map(|i| PositionFix { t: ft[i], lla: fl[i], cov_ned: crate::math::Mat3::from_fn(|r, c| fc[i][(r, c)]) }).collect();
-    let cfg = AidedConfig {
-        noise: InsNoise {
-            accel_psd,
-            gyro_psd,
-            accel_bias: BiasModel::from_parts("accel_bias", &accel_bias.0, accel_bias.1, accel_bias.2)?,
-            gyro_bias: BiasModel::from_parts("gyro_bias", &gyro_bias.0, gyro_bias.1, gyro_bias.2)?,
-        },
+    PyAidedIns::from_aiding(
+        t0,
+        &lla0,
+        &vel0,
+        &q0,
+        kind,
+        &ba0,
+        &bg0,
+        DVector::zeros(0),
+        &p0,
+        ins_noise(accel_psd, gyro_psd, &accel_bias, &gyro_bias)?,
         predict_every,
-        method: Discretization::by_name(method)?,
-        mode: LoopMode::by_name(mode)?,
+        method,
+        mode,
         sequential,
         gate,
-    };
-    let ell = Ellipsoid::by_name(ellipsoid)?;
-    let (ba0, bg0, p0) = (vec3(&ba0, "ba0")?, vec3(&bg0, "bg0")?, mat(&p0, "p0")?);
-    let o = py.detach(|| run_position_aided(initial, kind, ell, &tt, &g, &a, ba0, bg0, p0, &fixes, &cfg))?;
-    let time: Vec<f64> = o.nav.iter().map(|s| s.t).collect();
-    let lla: Vec<_> = o.nav.iter().map(|s| s.lla).collect();
-    let vel: Vec<_> = o.nav.iter().map(|s| s.vel).collect();
-    let qs: Vec<_> = o.nav.iter().map(|s| s.q_nb).collect();
-    let ne = time.len();
-    let sigma = Array2::from_shape_vec((ne, 15), o.sigma).expect("epochs x 15").into_pyarray(py);
-    let items: Vec<Bound<'py, PyAny>> = vec![
-        time.into_pyarray(py).into_any(),
-        vec3_to_py(py, &lla).into_any(),
-        vec3_to_py(py, &vel).into_any(),
-        quat_to_py(py, &qs).into_any(),
-        vec3_to_py(py, &o.accel_bias).into_any(),
-        vec3_to_py(py, &o.gyro_bias).into_any(),
-        sigma.into_any(),
-        o.fix_nis.into_pyarray(py).into_any(),
-        o.fix_rejected.into_pyarray(py).into_any(),
-    ];
-    pyo3::types::PyTuple::new(py, items)
+        ellipsoid,
+        Box::new(PositionAiding::new(fixes)?),
+    )
 }
 
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
@@ -445,7 +554,8 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(discretize_model, m)?)?;
     m.add_function(wrap_pyfunction!(ins_error_dynamics, m)?)?;
     m.add_function(wrap_pyfunction!(rts, m)?)?;
-    m.add_function(wrap_pyfunction!(position_aided, m)?)?;
+    m.add_function(wrap_pyfunction!(position_aided_ins, m)?)?;
+    m.add_class::<PyAidedIns>()?;
     m.add_class::<KalmanFilter>()?;
     m.add_class::<Scenario>()?;
     Ok(())

@@ -17,7 +17,7 @@ pub struct Strapdown {
 /// Navigation states as a (14, N) array — one row per column of
 /// `atomnav.trajectory.COLUMNS` (time, lat, lon, h, v_N, v_E, v_D, q_nb (4), roll, pitch,
 /// yaw) — so that pandas can wrap its transpose without copying.
-fn states_to_columns<'py>(py: Python<'py>, s: &[NavState]) -> Bound<'py, PyArray2<f64>> {
+pub(crate) fn states_to_columns<'py>(py: Python<'py>, s: &[NavState]) -> Bound<'py, PyArray2<f64>> {
     let n = s.len();
     let mut buf = vec![0.0; 14 * n];
     for (i, x) in s.iter().enumerate() {

@@ -1,49 +1,167 @@
-"""Position-aided strapdown INS with the 15-state error-state filter (Rust core,
-``rust/filter/aided.rs``): batch over a whole IMU record, closed or open loop."""
+"""The aided strapdown INS (Rust core, ``rust/filter/aided.rs``): one engine for every
+aiding sensor. A sensor's factory (:func:`position_aided_ins`, and the CAI and GNSS
+factories of their packages) builds an :class:`AidedIns`; :meth:`AidedIns.run` feeds a
+whole IMU record in chunks with a progress bar, :meth:`AidedIns.process` /
+:meth:`AidedIns.finish` stream it yourself. Closed loop (feedback) or open loop
+(estimation) is chosen at construction."""
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 import pandas as pd
+from tqdm.auto import tqdm
 
 from .. import _core
-from .._validate import rows, vector
-from .engine import BiasModel, Layout
+from .._validate import choice, increasing, positive, rows, vector
+from ..strapdown import _table
+from .engine import BiasModel
 from .riccati import _mat
 
+_AXES = "xyz"
 
-def position_aided_ins(t0: float, lla0, vel0, q0, kind: str, time, gyro, accel, fix_time, fix_lla, fix_cov,
-                       p0, accel_psd: float, gyro_psd: float, accel_bias: BiasModel = BiasModel(),
-                       gyro_bias: BiasModel = BiasModel(), ba0=(0, 0, 0), bg0=(0, 0, 0), predict_every: int = 1,
-                       method: str = "van_loan", mode: str = "closed", sequential: bool = False,
-                       gate: float | None = None, ellipsoid: str = "WGS84"):
-    """Run the aided INS.
 
-    Initial state t0 (s), lla0 (rad, rad, m), vel0 NED (m/s), q0 = q_nb; IMU ``time`` (N,),
-    ``gyro``/``accel`` (N, 3) as rates (rad/s, m/s²) or increments (rad, m/s) per ``kind``;
-    fixes at ``fix_time`` (M,) with ``fix_lla`` (M, 3) and NED covariance ``fix_cov``
-    (M, 3, 3) m² (applied at the first IMU epoch at or after their time; a fix outside
-    the IMU span is a ValueError); p0 (15, 15) in the order of :data:`INS15`; white-noise
-    PSDs accel_psd ((m/s²)²/Hz), gyro_psd (rad²/s). Predicts every ``predict_every`` IMU
-    steps. Returns (table, fixes): the solution, bias estimates and σ of the 15 states at
-    every prediction epoch, and per fix its NIS and whether the gate rejected it.
+@dataclass
+class AidedResult:
+    """Output of the aided INS.
+
+    ``nav``: one row per prediction epoch — the navigation estimate in the columns of
+    :data:`atomnav.trajectory.COLUMNS` (so ``Trajectory.errors(result.nav)`` works), the
+    IMU bias estimates (``accel_bias_*_mps2``, ``gyro_bias_*_rad_s``), the extra blocks'
+    estimates (``extra_<label>``) and σ of every state (``sigma_<label>``, SI units of the
+    state). ``measurements``: one row per applied measurement — its time, row count, NIS
+    (summed over rows) and the number of rows the χ² gate rejected. ``innovation``: the
+    innovations of all measurements, concatenated in order (``measurements.rows`` each).
     """
-    out = _core.position_aided(
-        float(t0), vector(lla0, 3, "lla0"), vector(vel0, 3, "vel0"), vector(q0, 4, "q0"), kind,
-        np.ascontiguousarray(np.asarray(time, float)), rows(gyro, 3, "gyro"), rows(accel, 3, "accel"),
-        vector(ba0, 3, "ba0"), vector(bg0, 3, "bg0"), _mat(p0, "p0"),
-        np.ascontiguousarray(np.asarray(fix_time, float).ravel()), rows(fix_lla, 3, "fix_lla"),
-        np.ascontiguousarray(np.asarray(fix_cov, float).reshape(-1, 3, 3)),
-        float(accel_psd), float(gyro_psd), accel_bias._parts(), gyro_bias._parts(), int(predict_every),
-        method, mode, bool(sequential), None if gate is None else float(gate), ellipsoid)
-    t, lla, vel, q, ba, bg, sigma, nis, rejected = out
-    cols = {"time_s": t, "lat_rad": lla[:, 0], "lon_rad": lla[:, 1], "h_m": lla[:, 2],
-            "v_n_mps": vel[:, 0], "v_e_mps": vel[:, 1], "v_d_mps": vel[:, 2],
-            "q_w": q[:, 0], "q_x": q[:, 1], "q_y": q[:, 2], "q_z": q[:, 3]}
-    for i, a in enumerate("xyz"):
-        cols[f"accel_bias_{a}_mps2"] = ba[:, i]
-    for i, a in enumerate("xyz"):
-        cols[f"gyro_bias_{a}_rad_s"] = bg[:, i]
-    for i, lab in enumerate(Layout().labels):
-        cols[f"sigma_{lab}"] = sigma[:, i]
-    return pd.DataFrame(cols), pd.DataFrame({"fix_time_s": np.asarray(fix_time, float).ravel(), "nis": nis, "rejected": rejected})
+
+    nav: pd.DataFrame
+    measurements: pd.DataFrame
+    innovation: np.ndarray
+
+
+class AidedIns:
+    """A running aided INS; build it with a sensor's factory function."""
+
+    def __init__(self, core: _core.AidedIns, kind: str):
+        self._core = core
+        self.kind = kind
+        #: Labels of the state components in filter order, e.g. ``velocity[2]``.
+        self.labels: list[str] = list(core.labels)
+
+    @property
+    def pending(self) -> int:
+        """Measurements not yet applied (their time is after the last processed sample)."""
+        return self._core.pending
+
+    def _result(self, out) -> AidedResult:
+        nav, ba, bg, extra, sigma, mt, mrows, innov, nis, rejected = out
+        table = _table(nav).copy()
+        for name, block, unit in (("accel_bias", ba, "mps2"), ("gyro_bias", bg, "rad_s")):
+            for i, a in enumerate(_AXES):
+                table[f"{name}_{a}_{unit}"] = block[:, i]
+        for i, lab in enumerate(self.labels[15:]):
+            table[f"extra_{lab}"] = extra[:, i]
+        for i, lab in enumerate(self.labels):
+            table[f"sigma_{lab}"] = sigma[:, i]
+        meas = pd.DataFrame({"time_s": mt, "rows": mrows, "nis": nis, "rejected_rows": rejected})
+        return AidedResult(table, meas, innov)
+
+    def process(self, time, gyro, accel) -> AidedResult:
+        """Feed one chunk of the IMU record: ``time`` (N,) s, ``gyro``/``accel`` (N, 3) as
+        rates (rad/s, m/s²) or increments (rad, m/s) per the ``kind`` given at
+        construction; time must keep increasing across chunks. Returns the epochs and
+        measurements of this chunk. If it stops on an error (bad sample, divergence, loss
+        of positive definiteness), the exception's ``partial`` attribute is the
+        :class:`AidedResult` of the epochs computed before it."""
+        t = vector(time, None, "time")
+        return self._call(self._core.process, t, rows(gyro, 3, "gyro"), rows(accel, 3, "accel"))
+
+    def _call(self, fn, *args) -> AidedResult:
+        try:
+            return self._result(fn(*args))
+        except (ValueError, _core.NumericalError) as e:
+            if isinstance(getattr(e, "partial", None), tuple):
+                e.partial = self._result(e.partial)
+            raise
+
+    def finish(self) -> AidedResult:
+        """End of the record: a last epoch at the last sample if steps are left over."""
+        return self._call(self._core.finish)
+
+    def run(self, time, gyro, accel, chunk_s: float = 60.0, progress: bool = True) -> AidedResult:
+        """Run a whole IMU record (see :meth:`process`) in chunks of ``chunk_s`` seconds
+        with a progress bar. Every measurement must lie inside the record. The result is
+        the same for any chunk length. On an error the exception's ``partial`` attribute
+        holds every epoch computed before it."""
+        t = vector(time, None, "time")
+        g, a = rows(gyro, 3, "gyro"), rows(accel, 3, "accel")
+        positive(chunk_s, "chunk_s")
+        increasing(t, "time")
+        if len(t) < 2:
+            raise ValueError(f"time: need >= 2 samples, got {len(t)}")
+        mt = np.asarray(self._core.measurement_times)
+        outside = np.nonzero((mt < t[0]) | (mt > t[-1]))[0]
+        if outside.size:
+            i = outside[0]
+            raise ValueError(f"measurements: time {mt[i]:g} s at index {i} is outside the IMU span [{t[0]:g}, {t[-1]:g}] s")
+        edges = np.searchsorted(t, np.arange(t[0], t[-1], chunk_s)[1:], side="left")
+        bounds = np.r_[0, edges, len(t)]
+        parts = []
+        try:
+            for lo, hi in tqdm(list(zip(bounds[:-1], bounds[1:])), desc="aided INS", unit="chunk",
+                               disable=not progress or len(bounds) <= 2):
+                if hi > lo:
+                    parts.append(self.process(t[lo:hi], g[lo:hi], a[lo:hi]))
+            parts.append(self.finish())
+        except (ValueError, _core.NumericalError) as e:
+            if isinstance(getattr(e, "partial", None), AidedResult):
+                e.partial = _concat(parts + [e.partial])
+            raise
+        return _concat(parts)
+
+
+def _concat(parts: list[AidedResult]) -> AidedResult:
+    return AidedResult(pd.concat([p.nav for p in parts], ignore_index=True),
+                       pd.concat([p.measurements for p in parts], ignore_index=True),
+                       np.concatenate([p.innovation for p in parts]))
+
+
+def ins_arguments(t0, lla0, vel0, q0, kind, p0, accel_psd, gyro_psd, accel_bias: BiasModel, gyro_bias: BiasModel,
+                  ba0, bg0, predict_every, method, mode, sequential, gate, ellipsoid) -> dict:
+    """The checked arguments every sensor factory passes to the core (see
+    :func:`position_aided_ins` for their meaning)."""
+    choice(kind, ("rates", "increments"), "kind")
+    return dict(t0=float(t0), lla0=vector(lla0, 3, "lla0"), vel0=vector(vel0, 3, "vel0"), q0=vector(q0, 4, "q0"),
+                kind=kind, ba0=vector(ba0, 3, "ba0"), bg0=vector(bg0, 3, "bg0"), p0=_mat(p0, "p0"),
+                accel_psd=float(accel_psd), gyro_psd=float(gyro_psd), accel_bias=accel_bias._parts(),
+                gyro_bias=gyro_bias._parts(), predict_every=int(predict_every), method=method, mode=mode,
+                sequential=bool(sequential), gate=None if gate is None else float(gate), ellipsoid=ellipsoid)
+
+
+def position_aided_ins(t0: float, lla0, vel0, q0, kind: str, fix_time, fix_lla, fix_cov, p0, accel_psd: float,
+                       gyro_psd: float, accel_bias: BiasModel = BiasModel(), gyro_bias: BiasModel = BiasModel(),
+                       ba0=(0, 0, 0), bg0=(0, 0, 0), predict_every: int = 1, method: str = "van_loan",
+                       mode: str = "closed", sequential: bool = False, gate: float | None = None,
+                       ellipsoid: str = "WGS84") -> AidedIns:
+    """A position-aided 15-state INS.
+
+    Initial state t0 (s), lla0 (rad, rad, m), vel0 NED (m/s), q0 = q_nb; IMU output
+    ``kind`` "rates" or "increments"; fixes at ``fix_time`` (M,) s with ``fix_lla``
+    (M, 3) and NED covariance ``fix_cov`` (M, 3, 3) m², applied at the first IMU epoch at
+    or after their time; p0 (15, 15) in the order of :data:`INS15`; white-noise PSDs
+    accel_psd ((m/s²)²/Hz) and gyro_psd (rad²/s); bias processes; initial bias estimates
+    ba0 (m/s²), bg0 (rad/s); the filter predicts every ``predict_every`` IMU steps and at
+    every fix; ``method`` "van_loan" or "first_order"; ``mode`` "closed" or "open";
+    ``sequential`` scalar updates; ``gate`` χ² threshold.
+
+    >>> ins = position_aided_ins(...)              # doctest: +SKIP
+    >>> result = ins.run(time, gyro, accel)        # doctest: +SKIP
+    >>> truth.errors(result.nav)                   # doctest: +SKIP
+    """
+    args = ins_arguments(t0, lla0, vel0, q0, kind, p0, accel_psd, gyro_psd, accel_bias, gyro_bias, ba0, bg0,
+                         predict_every, method, mode, sequential, gate, ellipsoid)
+    core = _core.position_aided_ins(
+        fix_t=np.ascontiguousarray(np.asarray(fix_time, float).ravel()), fix_lla=rows(fix_lla, 3, "fix_lla"),
+        fix_cov=np.ascontiguousarray(np.asarray(fix_cov, float).reshape(-1, 3, 3)), **args)
+    return AidedIns(core, kind)
