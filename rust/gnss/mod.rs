@@ -15,6 +15,7 @@ pub mod glonass_orbit;
 pub mod gps_orbit;
 pub mod observation;
 pub mod spp;
+pub mod tight;
 
 use crate::error::{invalid, Result};
 

@@ -96,9 +96,10 @@ pub fn receiver_ecef(lla: &Vec3, vel_ned: &Vec3) -> (Vec3, Vec3) {
     (WGS84.lla_to_ecef(lla), dcm_ned_to_ecef(lla.x, lla.y) * vel_ned)
 }
 
-/// Observations at GPS times `t` of a receiver at `lla` moving with `vel_ned`. Satellites
-/// are those with ephemerides, in the order of `Ephemerides::satellites`.
-pub fn simulate(eph: &Ephemerides, t: &[f64], lla: &[Vec3], vel_ned: &[Vec3], cfg: &SimConfig, vis: &Visibility) -> Result<Vec<Vec<Observation>>> {
+/// Observations at GPS times `t` of a receiver at `lla` moving with `vel_ned`, each with its
+/// true elevation (rad). Satellites are those with ephemerides, in the order of
+/// `Ephemerides::satellites`.
+pub fn simulate(eph: &Ephemerides, t: &[f64], lla: &[Vec3], vel_ned: &[Vec3], cfg: &SimConfig, vis: &Visibility) -> Result<Vec<Vec<(Observation, f64)>>> {
     if lla.len() != t.len() || vel_ned.len() != t.len() {
         return Err(invalid("lla", format!("{} positions and {} velocities for {} epochs", lla.len(), vel_ned.len(), t.len())));
     }
@@ -123,7 +124,7 @@ pub fn simulate(eph: &Ephemerides, t: &[f64], lla: &[Vec3], vel_ned: &[Vec3], cf
             };
             let code = g.range + C_LIGHT * (dtr - g.sat.clock + tau) + cfg.atm.delay(sat, channel, &lla[k], &g, t[k]) + sigma * n1;
             let rate = g.rate + C_LIGHT * (dtr_dot - g.sat.clock_rate) + cfg.sigma_rate * n2;
-            epoch.push(Observation { sat, channel, code, rate });
+            epoch.push((Observation { sat, channel, code, rate }, g.elevation));
         }
         out.push(epoch);
     }

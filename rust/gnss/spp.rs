@@ -221,7 +221,7 @@ mod tests {
             atm: Atmosphere { iono: Some(Default::default()), tropo: true }, seed: 1,
         };
         let vis = Visibility { mask: 10f64.to_radians(), ..Default::default() };
-        let obs = simulate(&eph, &[600.0], &[lla], &[Vec3::new(3.0, -2.0, 0.5)], &sim, &vis).unwrap().remove(0);
+        let obs = simulate(&eph, &[600.0], &[lla], &[Vec3::new(3.0, -2.0, 0.5)], &sim, &vis).unwrap().remove(0).into_iter().map(|x| x.0).collect();
         (eph, lla, obs, sim)
     }
 

@@ -12,6 +12,8 @@ use crate::gnss::glonass_orbit::{propagate, GloEphemeris};
 use crate::gnss::gps_orbit::GpsEphemeris;
 use crate::gnss::observation::{group_epochs, receiver_ecef, simulate, Atmosphere, Observation, SimConfig, Visibility};
 use crate::gnss::spp::{solve_position, solve_velocity, SppConfig};
+use crate::gnss::tight::{Formulation, TightAiding, TightConfig};
+use super::filter::PyAidedIns;
 use crate::gnss::{check_channel, SatId, System, TimeScales};
 use crate::math::Vec3;
 use numpy::{PyArray1, PyArray2, PyReadonlyArray1, PyReadonlyArray2};
@@ -144,7 +146,8 @@ fn atmosphere(iono: bool, tropo: bool) -> Atmosphere {
     Atmosphere { iono: if iono { Some(Klobuchar::default()) } else { None }, tropo }
 }
 
-/// Simulated observation table: dict of sat (list of str), channel, time_s, code_m, rate_mps.
+/// Simulated observation table: dict of sat (list of str), channel, time_s, code_m, rate_mps,
+/// elevation_rad (truth).
 #[pyfunction]
 #[pyo3(signature = (eph, t, lla, vel_ned, sigma_code_gps, sigma_code_glo, sigma_rate, tau_gps, clock_bias, clock_drift, iono, tropo, mask, only, outages, sat_outages, seed))]
 #[allow(clippy::too_many_arguments)]
@@ -167,9 +170,10 @@ fn gnss_simulate<'py>(
     let cfg = SimConfig { sigma_code_gps, sigma_code_glo, sigma_rate, tau_gps, clock_bias, clock_drift, atm: atmosphere(iono, tropo), seed };
     let e = &eph.inner;
     let epochs = py.detach(|| simulate(e, &t, &lla, &vel, &cfg, &vis))?;
-    let (mut sat, mut ch, mut tt, mut code, mut rate) = (vec![], vec![], vec![], vec![], vec![]);
+    let (mut sat, mut ch, mut tt, mut code, mut rate, mut el) = (vec![], vec![], vec![], vec![], vec![], vec![]);
     for (k, ep) in epochs.iter().enumerate() {
-        for o in ep {
+        for (o, e) in ep {
+            el.push(*e);
             sat.push(o.sat.name());
             ch.push(o.channel as i64);
             tt.push(t[k]);
@@ -183,6 +187,7 @@ fn gnss_simulate<'py>(
     d.set_item("time_s", PyArray1::from_vec(py, tt))?;
     d.set_item("code_m", PyArray1::from_vec(py, code))?;
     d.set_item("rate_mps", PyArray1::from_vec(py, rate))?;
+    d.set_item("elevation_rad", PyArray1::from_vec(py, el))?;
     Ok(d)
 }
 
@@ -225,7 +230,49 @@ fn gnss_spp<'py>(
     Ok(rows_to_py(py, out.len() / 22, 22, out.into_iter()))
 }
 
+/// Tightly coupled GNSS/INS on the aided-INS engine (see `gnss/tight.rs`). Observation
+/// table as for `gnss_spp`; `extra0` initial (c·τ_GPS m[, c·δt_r m, c·δṫ_r m/s]); `p0` for
+/// the whole layout (15 INS states, then the extra blocks).
+#[pyfunction]
+#[pyo3(signature = (eph, time, sat, channel, code, rate, formulation, lever_arm, sigma_code_gps, sigma_code_glo, sigma_rate, use_rate, iono, tropo, tau_psd, clock_h0, clock_hm2, t0, lla0, vel0, q0, kind, ba0, bg0, extra0, p0, accel_psd, gyro_psd, accel_bias, gyro_bias, predict_every, method, mode, sequential, gate, ellipsoid="WGS84"))]
+#[allow(clippy::too_many_arguments)]
+fn gnss_tight_ins<'py>(
+    eph: &PyEphemerides, time: PyReadonlyArray1<'py, f64>, sat: Vec<String>, channel: PyReadonlyArray1<'py, i64>,
+    code: PyReadonlyArray1<'py, f64>, rate: PyReadonlyArray1<'py, f64>, formulation: &str, lever_arm: PyReadonlyArray1<'py, f64>,
+    sigma_code_gps: f64, sigma_code_glo: f64, sigma_rate: f64, use_rate: bool, iono: bool, tropo: bool, tau_psd: f64, clock_h0: f64,
+    clock_hm2: f64, t0: f64, lla0: PyReadonlyArray1<'py, f64>, vel0: PyReadonlyArray1<'py, f64>, q0: PyReadonlyArray1<'py, f64>, kind: &str,
+    ba0: PyReadonlyArray1<'py, f64>, bg0: PyReadonlyArray1<'py, f64>, extra0: PyReadonlyArray1<'py, f64>, p0: PyReadonlyArray2<'py, f64>,
+    accel_psd: f64, gyro_psd: f64, accel_bias: (String, f64, f64), gyro_bias: (String, f64, f64), predict_every: usize, method: &str,
+    mode: &str, sequential: bool, gate: Option<f64>, ellipsoid: &str,
+) -> PyResult<PyAidedIns> {
+    let obs = parse_obs(&sat, &channel, &code, &rate)?;
+    let epochs = group_epochs(time.as_array().as_slice().ok_or_else(|| invalid("time", "must be contiguous"))?, &obs)?;
+    for (field, x) in [("tau_psd", tau_psd), ("clock_h0", clock_h0), ("clock_hm2", clock_hm2)] {
+        if !(x.is_finite() && x >= 0.0) {
+            return Err(invalid(field, format!("must be finite and >= 0, got {x}")).into());
+        }
+    }
+    let cfg = TightConfig {
+        formulation: Formulation::by_name(formulation)?,
+        lever_arm: super::convert::vec3(&lever_arm, "lever_arm")?,
+        sigma_code_gps,
+        sigma_code_glo,
+        sigma_rate,
+        use_rate,
+        atm: atmosphere(iono, tropo),
+        tau_psd,
+        clock_h0,
+        clock_hm2,
+        kind: crate::imu::ImuKind::parse(kind)?,
+    };
+    let aiding = TightAiding::new(eph.inner.clone(), epochs, cfg)?;
+    let noise = super::filter::ins_noise(accel_psd, gyro_psd, &accel_bias, &gyro_bias)?;
+    let x0 = nalgebra::DVector::from_vec(vector(&extra0, "extra0")?);
+    PyAidedIns::from_aiding(t0, &lla0, &vel0, &q0, kind, &ba0, &bg0, x0, &p0, noise, predict_every, method, mode, sequential, gate, ellipsoid, Box::new(aiding))
+}
+
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_function(wrap_pyfunction!(gnss_tight_ins, m)?)?;
     m.add_class::<PyEphemerides>()?;
     m.add_function(wrap_pyfunction!(glonass_propagate, m)?)?;
     m.add_function(wrap_pyfunction!(gnss_simulate, m)?)?;

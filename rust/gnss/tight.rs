@@ -1,0 +1,283 @@
+//! Tightly coupled GNSS aiding of the generic aided-INS engine (spec gnss-ins-tight §2.12,
+//! Eqs. 37–42). Default: between-satellite first differences of code and pseudorange rate
+//! against the highest GPS satellite (no receiver-clock states; the correlated FD noise
+//! R = σ₀²11ᵀ + diag(σᵢ²) is decorrelated by the engine in sequential mode) with c·τ_GPS
+//! as an extra state. Option: undifferenced rows with the receiver clock states (c·δt_r,
+//! c·δṫ_r) of Eq. 41. Lever arm l^b from the IMU to the antenna.
+//!
+//! Signs: z = predicted − measured; δx = estimate − true. The H rows have no IMU-bias
+//! columns, so the spec's raw-bias sign convention (opposite to the engine's
+//! δb = b̂ − b, see filter/ins.rs) never enters here.
+
+use super::ephemeris::Ephemerides;
+use super::geometry::geometry;
+use super::observation::{Atmosphere, Observation};
+use super::{SatId, System, C_LIGHT};
+use crate::earth::dcm_ned_to_ecef;
+use crate::error::{invalid, Result};
+use crate::filter::aided::{Aiding, AidingContext, Measurement};
+use crate::filter::layout::Layout;
+use crate::imu::ImuKind;
+use crate::math::{dcm_from_quat, skew, Vec3};
+use crate::strapdown::NavState;
+use nalgebra::{DMatrix, RowDVector};
+
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Formulation {
+    /// Between-satellite first differences (no clock states).
+    FirstDifference,
+    /// Undifferenced rows with the receiver clock bias and drift states (m, m/s).
+    ClockStates,
+}
+
+impl Formulation {
+    pub fn by_name(name: &str) -> Result<Formulation> {
+        match name {
+            "first_difference" => Ok(Formulation::FirstDifference),
+            "clock_states" => Ok(Formulation::ClockStates),
+            _ => Err(invalid("formulation", format!("unknown '{name}' (known: first_difference, clock_states)"))),
+        }
+    }
+}
+
+#[derive(Debug, Clone, Copy)]
+pub struct TightConfig {
+    pub formulation: Formulation,
+    /// IMU → antenna lever arm in the body frame (m).
+    pub lever_arm: Vec3,
+    pub sigma_code_gps: f64,
+    pub sigma_code_glo: f64,
+    pub sigma_rate: f64,
+    pub use_rate: bool,
+    pub atm: Atmosphere,
+    /// c·τ_GPS random-walk PSD (m²/s); spec Eq. 42: (0.1 ns)²/h.
+    pub tau_psd: f64,
+    /// Receiver oscillator h₀ (s) and h₋₂ (1/s) of Eq. 41 (TCXO 2e-19, 2e-20).
+    pub clock_h0: f64,
+    pub clock_hm2: f64,
+    /// IMU record kind: the gyro sample gives the body rate for the lever-arm velocity.
+    pub kind: ImuKind,
+}
+
+pub struct TightAiding {
+    eph: Ephemerides,
+    times: Vec<f64>,
+    epochs: Vec<Vec<Observation>>,
+    cfg: TightConfig,
+    reference: Option<SatId>,
+    /// Last compensated body rate (rad/s).
+    omega_b: Vec3,
+}
+
+/// One satellite's undifferenced innovation and rows for code and rate.
+struct Row {
+    sat: SatId,
+    elevation: f64,
+    z_code: f64,
+    h_code: RowDVector<f64>,
+    s_code: f64,
+    z_rate: f64,
+    h_rate: RowDVector<f64>,
+}
+
+impl TightAiding {
+    /// `epochs`: (GPS time, observations) with strictly increasing time.
+    pub fn new(eph: Ephemerides, epochs: Vec<(f64, Vec<Observation>)>, cfg: TightConfig) -> Result<TightAiding> {
+        for (field, s) in [("sigma_code_gps", cfg.sigma_code_gps), ("sigma_code_glo", cfg.sigma_code_glo), ("sigma_rate", cfg.sigma_rate)] {
+            crate::error::check_positive(field, s)?;
+        }
+        for (i, (_, obs)) in epochs.iter().enumerate() {
+            for o in obs {
+                if o.sat.system == System::Glonass && eph.channel(o.sat)? != o.channel {
+                    return Err(invalid("obs", format!("epoch {i}: {} on channel {} but the ephemeris says {}", o.sat.name(), o.channel, eph.channel(o.sat)?)));
+                }
+            }
+        }
+        let times = epochs.iter().map(|e| e.0).collect();
+        Ok(TightAiding { eph, times, epochs: epochs.into_iter().map(|e| e.1).collect(), cfg, reference: None, omega_b: Vec3::zeros() })
+    }
+
+    /// The FD reference satellite at the last measurement (None before the first).
+    pub fn reference(&self) -> Option<SatId> {
+        self.reference
+    }
+
+    fn rows(&self, j: usize, ctx: &AidingContext) -> Result<Vec<Row>> {
+        let t = self.times[j];
+        let nav = ctx.nav;
+        let n = ctx.layout.size();
+        let cne = dcm_ned_to_ecef(nav.lla.x, nav.lla.y);
+        let cnb = dcm_from_quat(&nav.q_nb);
+        let lever_n = cnb * self.cfg.lever_arm;
+        // antenna: r̂_a = r̂ + Ĉl^b, v̂_a = v̂ + Ĉ(ω × l^b) (Eq. 37)
+        let r_a = ctx.ell.lla_to_ecef(&nav.lla) + cne * lever_n;
+        let v_a = cne * (nav.vel + cnb * self.omega_b.cross(&self.cfg.lever_arm));
+        let lla_a = ctx.ell.ecef_to_lla(&r_a);
+        let (ip, iv, ipsi) = (ctx.layout.range("position")?.start, ctx.layout.range("velocity")?.start, ctx.layout.range("attitude")?.start);
+        let extra = |name: &str| ctx.layout.get(name).map(|r| (r.start, ctx.extra[r.start - 15]));
+        let tau = extra("c_tau_gps");
+        let clock = extra("clock");
+        let lever_skew = skew(&lever_n);
+        let mut rows = Vec::new();
+        for o in &self.epochs[j] {
+            let glo = o.sat.system == System::Glonass;
+            let g = geometry(&self.eph, o.sat, t, &r_a, &v_a, lla_a.x, lla_a.y, tau.map_or(0.0, |x| x.1 / C_LIGHT))?;
+            if g.elevation <= 0.0 {
+                continue;
+            }
+            let u_n = cne.transpose() * g.los * g.kappa;
+            let mut pred = g.range;
+            let mut h_code = RowDVector::zeros(n);
+            let mut h_rate = RowDVector::zeros(n);
+            for k in 0..3 {
+                h_code[ip + k] = -u_n[k];
+            }
+            let hp = -u_n.transpose() * lever_skew;
+            for k in 0..3 {
+                h_code[ipsi + k] = hp[k];
+            }
+            // g_iᵀ = −(v_s − v̂)ᵀ(I − uuᵀ)C_n^e/ρ̂ (Eq. 37; required in open loop, decision 9)
+            let dv = g.sat.vel - v_a;
+            let gi = -(dv - g.los * g.los.dot(&dv)).transpose() * cne / g.range;
+            for k in 0..3 {
+                h_rate[ip + k] = gi[k];
+                h_rate[iv + k] = -u_n[k];
+            }
+            let mut pred_rate = g.rate;
+            if let Some((i, ct)) = tau {
+                if glo {
+                    pred += ct;
+                    h_code[i] = 1.0 - g.kappa * g.los.dot(&g.sat.vel) / C_LIGHT;
+                }
+            }
+            if let Some((i, cb)) = clock {
+                pred += cb;
+                pred_rate += ctx.extra[i - 15 + 1];
+                h_code[i] = 1.0;
+                h_rate[i + 1] = 1.0;
+            }
+            let measured = o.code + C_LIGHT * g.sat.clock - self.cfg.atm.delay(o.sat, o.channel, &lla_a, &g, t);
+            let measured_rate = o.rate + C_LIGHT * g.sat.clock_rate;
+            rows.push(Row {
+                sat: o.sat,
+                elevation: g.elevation,
+                z_code: pred - measured,
+                h_code,
+                s_code: if glo { self.cfg.sigma_code_glo } else { self.cfg.sigma_code_gps },
+                z_rate: if self.cfg.use_rate && o.rate.is_finite() { pred_rate - measured_rate } else { f64::NAN },
+                h_rate,
+            });
+        }
+        Ok(rows)
+    }
+
+    /// Keep the reference while it is seen; otherwise the highest GPS satellite (the
+    /// highest GLONASS one when no GPS satellite is seen). Returns its index in `rows`.
+    fn pick_reference(&mut self, rows: &[Row]) -> usize {
+        if let Some(i) = self.reference.and_then(|r| rows.iter().position(|x| x.sat == r)) {
+            return i;
+        }
+        let best = |sys: System| {
+            rows.iter().enumerate().filter(|(_, r)| r.sat.system == sys).max_by(|a, b| a.1.elevation.total_cmp(&b.1.elevation)).map(|(i, _)| i)
+        };
+        let i = best(System::Gps).or_else(|| best(System::Glonass)).expect("at least one row");
+        self.reference = Some(rows[i].sat);
+        i
+    }
+}
+
+/// Stack (z, H, R) of a set of rows; FD against row `r0` when given, with
+/// R = σ₀²11ᵀ + diag(σᵢ²) (Eq. 39).
+fn stack(z: &[f64], h: &[&RowDVector<f64>], s: &[f64], r0: Option<usize>, n: usize) -> (Vec<f64>, DMatrix<f64>, DMatrix<f64>) {
+    let idx: Vec<usize> = (0..z.len()).filter(|&i| Some(i) != r0).collect();
+    let m = idx.len();
+    let mut hm = DMatrix::zeros(m, n);
+    let mut r = DMatrix::zeros(m, m);
+    let mut zz = Vec::with_capacity(m);
+    for (a, &i) in idx.iter().enumerate() {
+        match r0 {
+            Some(k) => {
+                zz.push(z[i] - z[k]);
+                hm.set_row(a, &(h[i] - h[k]));
+                for b in 0..m {
+                    r[(a, b)] = s[k] * s[k];
+                }
+            }
+            None => {
+                zz.push(z[i]);
+                hm.set_row(a, h[i]);
+            }
+        }
+        r[(a, a)] += s[i] * s[i];
+    }
+    (zz, hm, r)
+}
+
+impl Aiding for TightAiding {
+    fn name(&self) -> &str {
+        "gnss"
+    }
+
+    fn extra_blocks(&self) -> Vec<(String, usize)> {
+        let mut b = vec![("c_tau_gps".to_string(), 1)];
+        if self.cfg.formulation == Formulation::ClockStates {
+            b.push(("clock".to_string(), 2));
+        }
+        b
+    }
+
+    fn times(&self) -> &[f64] {
+        &self.times
+    }
+
+    fn observe(&mut self, _t: f64, dt: f64, gyro: &Vec3, _accel: &Vec3, _nav: &NavState) {
+        self.omega_b = match self.cfg.kind {
+            ImuKind::Rates => *gyro,
+            ImuKind::Increments if dt > 0.0 => gyro / dt,
+            ImuKind::Increments => self.omega_b,
+        };
+    }
+
+    fn measure(&mut self, j: usize, ctx: &AidingContext) -> Result<Option<Measurement>> {
+        let rows = self.rows(j, ctx)?;
+        let fd = self.cfg.formulation == Formulation::FirstDifference;
+        if rows.is_empty() || (fd && rows.len() < 2) {
+            return Ok(None);
+        }
+        let n = ctx.layout.size();
+        let r0 = if fd { Some(self.pick_reference(&rows)) } else { None };
+        let zc: Vec<f64> = rows.iter().map(|r| r.z_code).collect();
+        let hc: Vec<&RowDVector<f64>> = rows.iter().map(|r| &r.h_code).collect();
+        let sc: Vec<f64> = rows.iter().map(|r| r.s_code).collect();
+        let (mut z, mut h, mut r) = stack(&zc, &hc, &sc, r0, n);
+        // rate rows: only satellites with a rate, differenced against the same reference
+        let with_rate: Vec<usize> = (0..rows.len()).filter(|&i| rows[i].z_rate.is_finite()).collect();
+        let rate_ref = r0.and_then(|k| with_rate.iter().position(|&i| i == k));
+        if with_rate.len() > usize::from(fd) && (!fd || rate_ref.is_some()) {
+            let zr: Vec<f64> = with_rate.iter().map(|&i| rows[i].z_rate).collect();
+            let hr: Vec<&RowDVector<f64>> = with_rate.iter().map(|&i| &rows[i].h_rate).collect();
+            let sr = vec![self.cfg.sigma_rate; with_rate.len()];
+            let (z2, h2, r2) = stack(&zr, &hr, &sr, rate_ref, n);
+            let (m1, m2) = (z.len(), z2.len());
+            z.extend(z2);
+            h = h.resize_vertically(m1 + m2, 0.0);
+            h.rows_mut(m1, m2).copy_from(&h2);
+            r = r.resize(m1 + m2, m1 + m2, 0.0);
+            r.view_mut((m1, m1), (m2, m2)).copy_from(&r2);
+        }
+        Ok(Some(Measurement { z, h, r }))
+    }
+
+    fn extra_dynamics(&self, layout: &Layout, f: &mut DMatrix<f64>, qc: &mut DMatrix<f64>) {
+        if let Some(r) = layout.get("c_tau_gps") {
+            qc[(r.start, r.start)] = self.cfg.tau_psd;
+        }
+        if let Some(r) = layout.get("clock") {
+            // ẋ_c = [[0, 1], [0, 0]]x_c + w, Q_c = c²·diag(h₀/2, 2π²h₋₂) (Eq. 41)
+            let i = r.start;
+            f[(i, i + 1)] = 1.0;
+            qc[(i, i)] = C_LIGHT * C_LIGHT * self.cfg.clock_h0 / 2.0;
+            qc[(i + 1, i + 1)] = C_LIGHT * C_LIGHT * 2.0 * std::f64::consts::PI.powi(2) * self.cfg.clock_hm2;
+        }
+    }
+}
