@@ -57,12 +57,16 @@ pub struct TightConfig {
     pub clock_hm2: f64,
     /// IMU record kind: the gyro sample gives the body rate for the lever-arm velocity.
     pub kind: ImuKind,
+    /// σ of the barometric altitude rows (m); spec §3: 1 m.
+    pub sigma_baro: f64,
 }
 
 pub struct TightAiding {
     eph: Ephemerides,
     times: Vec<f64>,
     epochs: Vec<Vec<Observation>>,
+    /// Barometric altitude (m) at each epoch, NaN when none.
+    baro: Vec<f64>,
     cfg: TightConfig,
     reference: Option<SatId>,
     /// Last compensated body rate (rad/s).
@@ -81,9 +85,11 @@ struct Row {
 }
 
 impl TightAiding {
-    /// `epochs`: (GPS time, observations) with strictly increasing time.
-    pub fn new(eph: Ephemerides, epochs: Vec<(f64, Vec<Observation>)>, cfg: TightConfig) -> Result<TightAiding> {
-        for (field, s) in [("sigma_code_gps", cfg.sigma_code_gps), ("sigma_code_glo", cfg.sigma_code_glo), ("sigma_rate", cfg.sigma_rate)] {
+    /// `epochs`: (GPS time, observations) with strictly increasing time; `baro`: (time,
+    /// altitude m) readings of the barometric altimeter that damps the vertical channel
+    /// (spec decision 13, σ `cfg.sigma_baro`), merged with the GNSS epochs.
+    pub fn new(eph: Ephemerides, epochs: Vec<(f64, Vec<Observation>)>, baro: &[(f64, f64)], cfg: TightConfig) -> Result<TightAiding> {
+        for (field, s) in [("sigma_code_gps", cfg.sigma_code_gps), ("sigma_code_glo", cfg.sigma_code_glo), ("sigma_rate", cfg.sigma_rate), ("sigma_baro", cfg.sigma_baro)] {
             crate::error::check_positive(field, s)?;
         }
         for (i, (_, obs)) in epochs.iter().enumerate() {
@@ -93,8 +99,27 @@ impl TightAiding {
                 }
             }
         }
-        let times = epochs.iter().map(|e| e.0).collect();
-        Ok(TightAiding { eph, times, epochs: epochs.into_iter().map(|e| e.1).collect(), cfg, reference: None, omega_b: Vec3::zeros() })
+        for (i, w) in baro.windows(2).enumerate() {
+            if !(w[1].0 > w[0].0) {
+                return Err(invalid("baro_time", format!("not strictly increasing at index {}", i + 1)));
+            }
+        }
+        if let Some(i) = baro.iter().position(|b| !(b.0.is_finite() && b.1.is_finite())) {
+            return Err(invalid("baro", format!("non-finite time or altitude at index {i}")));
+        }
+        // merge the two sorted streams into one list of epochs
+        let (mut times, mut obs, mut alt) = (Vec::new(), Vec::new(), Vec::new());
+        let mut k = 0;
+        let mut epochs = epochs.into_iter().peekable();
+        while epochs.peek().is_some() || k < baro.len() {
+            let tg = epochs.peek().map_or(f64::INFINITY, |e| e.0);
+            let tb = baro.get(k).map_or(f64::INFINITY, |b| b.0);
+            let t = tg.min(tb);
+            times.push(t);
+            obs.push(if tg == t { epochs.next().expect("peeked").1 } else { Vec::new() });
+            alt.push(if tb == t { k += 1; baro[k - 1].1 } else { f64::NAN });
+        }
+        Ok(TightAiding { eph, times, epochs: obs, baro: alt, cfg, reference: None, omega_b: Vec3::zeros() })
     }
 
     /// The FD reference satellite at the last measurement (None before the first).
@@ -186,6 +211,25 @@ impl TightAiding {
     }
 }
 
+impl TightAiding {
+    /// Append the barometric row z = ĥ − h_baro, H = −1 on δr_D (δr_D = −δh), when there
+    /// is a reading at epoch j; None when nothing is left to apply.
+    fn baro_row(&self, j: usize, ctx: &AidingContext, (mut z, h, r): (Vec<f64>, DMatrix<f64>, DMatrix<f64>)) -> Option<Measurement> {
+        let hb = self.baro[j];
+        let m = z.len();
+        if !hb.is_finite() {
+            return (m > 0).then_some(Measurement { z, h, r });
+        }
+        let ip = ctx.layout.get("position").expect("INS15 layout").start;
+        z.push(ctx.nav.lla.z - hb);
+        let mut h = h.resize_vertically(m + 1, 0.0);
+        h[(m, ip + 2)] = -1.0;
+        let mut r = r.resize(m + 1, m + 1, 0.0);
+        r[(m, m)] = self.cfg.sigma_baro * self.cfg.sigma_baro;
+        Some(Measurement { z, h, r })
+    }
+}
+
 /// Stack (z, H, R) of a set of rows; FD against row `r0` when given, with
 /// R = σ₀²11ᵀ + diag(σᵢ²) (Eq. 39).
 fn stack(z: &[f64], h: &[&RowDVector<f64>], s: &[f64], r0: Option<usize>, n: usize) -> (Vec<f64>, DMatrix<f64>, DMatrix<f64>) {
@@ -241,10 +285,10 @@ impl Aiding for TightAiding {
     fn measure(&mut self, j: usize, ctx: &AidingContext) -> Result<Option<Measurement>> {
         let rows = self.rows(j, ctx)?;
         let fd = self.cfg.formulation == Formulation::FirstDifference;
-        if rows.is_empty() || (fd && rows.len() < 2) {
-            return Ok(None);
-        }
         let n = ctx.layout.size();
+        if rows.is_empty() || (fd && rows.len() < 2) {
+            return Ok(self.baro_row(j, ctx, (Vec::new(), DMatrix::zeros(0, n), DMatrix::zeros(0, 0))));
+        }
         let r0 = if fd { Some(self.pick_reference(&rows)) } else { None };
         let zc: Vec<f64> = rows.iter().map(|r| r.z_code).collect();
         let hc: Vec<&RowDVector<f64>> = rows.iter().map(|r| &r.h_code).collect();
@@ -265,7 +309,7 @@ impl Aiding for TightAiding {
             r = r.resize(m1 + m2, m1 + m2, 0.0);
             r.view_mut((m1, m1), (m2, m2)).copy_from(&r2);
         }
-        Ok(Some(Measurement { z, h, r }))
+        Ok(self.baro_row(j, ctx, (z, h, r)))
     }
 
     fn extra_dynamics(&self, layout: &Layout, f: &mut DMatrix<f64>, qc: &mut DMatrix<f64>) {

@@ -22,7 +22,7 @@ def tight_ins(eph: Ephemerides, obs: pd.DataFrame, t0: float, lla0, vel0, q0, ki
               sigma_code_glonass: float | None = None, sigma_rate: float = 0.05, use_rate: bool = True,
               iono: bool = True, tropo: bool = True, tau0: float = 0.0, sigma_tau0: float = 1e-6,
               tau_psd: float = (0.1e-9) ** 2 / 3600.0, clock0=(0.0, 0.0), sigma_clock0=(3e5, 300.0),
-              clock_h0: float = 2e-19, clock_hm2: float = 2e-20, ba0=(0, 0, 0), bg0=(0, 0, 0), predict_every: int = 1,
+              clock_h0: float = 2e-19, clock_hm2: float = 2e-20, baro_time=(), baro_h=(), sigma_baro: float = 1.0, ba0=(0, 0, 0), bg0=(0, 0, 0), predict_every: int = 1,
               method: str = "van_loan", mode: str = "closed", sequential: bool = True, gate: float | None = 10.83,
               ellipsoid: str = "WGS84") -> AidedIns:
     """A tightly coupled aided INS.
@@ -35,7 +35,8 @@ def tight_ins(eph: Ephemerides, obs: pd.DataFrame, t0: float, lla0, vel0, q0, ki
     ``lever_arm`` IMU → antenna in body axes (m); code σ (m), rate σ (m/s);
     Klobuchar/Saastamoinen corrections; τ_GPS initial value ``tau0`` ± ``sigma_tau0`` (s)
     and random-walk PSD ``tau_psd`` (s²/s; spec Eq. 42: (0.1 ns)²/h); clock states (m, m/s)
-    with oscillator h₀ (s), h₋₂ (1/s). Extra states are carried in metres:
+    with oscillator h₀ (s), h₋₂ (1/s). Barometric altitudes ``baro_h`` (m, σ ``sigma_baro``)
+    at ``baro_time`` (s) damp the vertical channel (spec decision 13). Extra states are carried in metres:
     ``c_tau_gps`` = c·τ_GPS and ``clock`` = (c·δt_r, c·δṫ_r). The default gate 10.83 is χ²₁
     at 0.999 per decorrelated row (spec Eq. 40)."""
     choice(formulation, ("first_difference", "clock_states"), "formulation")
@@ -58,5 +59,7 @@ def tight_ins(eph: Ephemerides, obs: pd.DataFrame, t0: float, lla0, vel0, q0, ki
         sigma_code_gps=float(sigma_code), sigma_code_glo=float(sigma_code if sigma_code_glonass is None else sigma_code_glonass),
         sigma_rate=float(sigma_rate), use_rate=bool(use_rate), iono=bool(iono), tropo=bool(tropo),
         tau_psd=C_LIGHT ** 2 * float(tau_psd), clock_h0=float(clock_h0), clock_hm2=float(clock_hm2),
+        baro_time=vector(np.asarray(baro_time, float), None, "baro_time"), baro_h=vector(np.asarray(baro_h, float), None, "baro_h"),
+        sigma_baro=float(sigma_baro),
         extra0=np.array(extra), **args)
     return AidedIns(core, kind)
