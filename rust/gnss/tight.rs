@@ -71,6 +71,11 @@ pub struct TightAiding {
     reference: Option<SatId>,
     /// Last compensated body rate (rad/s).
     omega_b: Vec3,
+    /// Clock-state option: the engine propagates only the error state, not the nominal
+    /// value of an extra block, so the nominal clock bias ∫ĉδṫ dt accumulated since the
+    /// start is kept here (m) and added to the `clock[0]` estimate in the prediction;
+    /// (time, value) of the last measurement.
+    clock_shift: (f64, f64),
 }
 
 /// One satellite's undifferenced innovation and rows for code and rate.
@@ -119,7 +124,7 @@ impl TightAiding {
             obs.push(if tg == t { epochs.next().expect("peeked").1 } else { Vec::new() });
             alt.push(if tb == t { k += 1; baro[k - 1].1 } else { f64::NAN });
         }
-        Ok(TightAiding { eph, times, epochs: obs, baro: alt, cfg, reference: None, omega_b: Vec3::zeros() })
+        Ok(TightAiding { eph, times, epochs: obs, baro: alt, cfg, reference: None, omega_b: Vec3::zeros(), clock_shift: (f64::NAN, 0.0) })
     }
 
     /// The FD reference satellite at the last measurement (None before the first).
@@ -127,7 +132,12 @@ impl TightAiding {
         self.reference
     }
 
-    fn rows(&self, j: usize, ctx: &AidingContext) -> Result<Vec<Row>> {
+    /// Nominal clock bias accumulated from the drift estimate up to the current epoch (m).
+    pub fn clock_shift(&self) -> f64 {
+        self.clock_shift.1
+    }
+
+    fn rows(&mut self, j: usize, ctx: &AidingContext) -> Result<Vec<Row>> {
         let t = self.times[j];
         let nav = ctx.nav;
         let n = ctx.layout.size();
@@ -142,6 +152,12 @@ impl TightAiding {
         let extra = |name: &str| ctx.layout.get(name).map(|r| (r.start, ctx.extra[r.start - 15]));
         let tau = extra("c_tau_gps");
         let clock = extra("clock");
+        if let Some((i, _)) = clock {
+            let (t_prev, shift) = self.clock_shift;
+            let dt = if t_prev.is_finite() { t - t_prev } else { 0.0 };
+            self.clock_shift = (t, shift + ctx.extra[i - 15 + 1] * dt);
+        }
+        let shift = self.clock_shift.1;
         let lever_skew = skew(&lever_n);
         let mut rows = Vec::new();
         for o in &self.epochs[j] {
@@ -176,7 +192,7 @@ impl TightAiding {
                 }
             }
             if let Some((i, cb)) = clock {
-                pred += cb;
+                pred += cb + shift;
                 pred_rate += ctx.extra[i - 15 + 1];
                 h_code[i] = 1.0;
                 h_rate[i + 1] = 1.0;
