@@ -68,6 +68,16 @@ impl Ephemerides {
         Ok(Ephemerides { gps: g, glo: r, time, datum, glo_step: DEFAULT_STEP })
     }
 
+    /// Every GPS set, by satellite then reference time.
+    pub fn gps_sets(&self) -> impl Iterator<Item = &GpsEphemeris> {
+        self.gps.values().flatten()
+    }
+
+    /// Every GLONASS set, by slot then reference time.
+    pub fn glonass_sets(&self) -> impl Iterator<Item = &GloEphemeris> {
+        self.glo.values().flatten()
+    }
+
     /// All satellites with at least one set, GPS first.
     pub fn satellites(&self) -> Vec<SatId> {
         self.gps.keys().map(|&p| SatId::gps(p)).chain(self.glo.keys().map(|&s| SatId::glonass(s))).collect()

@@ -96,6 +96,26 @@ impl PyEphemerides {
         Ok(PyEphemerides { inner: nominal(&cfg)? })
     }
 
+    /// The GPS sets as (N, 22) rows in the constructor's column order.
+    fn gps_table<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
+        let r: Vec<[f64; 22]> = self
+            .inner
+            .gps_sets()
+            .map(|e| [e.prn as f64, e.toe, e.sqrt_a, e.e, e.m0, e.delta_n, e.omega0, e.i0, e.omega, e.omega_dot, e.idot, e.cuc, e.cus, e.crc, e.crs, e.cic, e.cis, e.toc, e.af0, e.af1, e.af2, e.tgd])
+            .collect();
+        super::convert::to_py_rows(py, &r)
+    }
+
+    /// The GLONASS sets as (M, 14) rows in the constructor's column order.
+    fn glonass_table<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
+        let r: Vec<[f64; 14]> = self
+            .inner
+            .glonass_sets()
+            .map(|e| [e.slot as f64, e.channel as f64, e.tb, e.pos.x, e.pos.y, e.pos.z, e.vel.x, e.vel.y, e.vel.z, e.acc.x, e.acc.y, e.acc.z, e.tau_n, e.gamma_n])
+            .collect();
+        super::convert::to_py_rows(py, &r)
+    }
+
     fn satellites(&self) -> Vec<String> {
         self.inner.satellites().iter().map(|s| s.name()).collect()
     }

@@ -52,6 +52,11 @@ class Ephemerides:
         return cls(_core_obj=_core.GnssEphemerides.nominal(float(t_start), float(t_end), gps, glonass, float(tau_gps),
                                                            float(n_leap), clocks, int(seed)))
 
+    def tables(self) -> tuple[pd.DataFrame, pd.DataFrame]:
+        """The GPS and GLONASS sets as DataFrames (:data:`GPS_COLUMNS`, :data:`GLONASS_COLUMNS`)."""
+        return (pd.DataFrame(self._core.gps_table(), columns=GPS_COLUMNS),
+                pd.DataFrame(self._core.glonass_table(), columns=GLONASS_COLUMNS))
+
     @property
     def satellites(self) -> list[str]:
         """Satellite names, GPS first ("G01", ..., "R24")."""
