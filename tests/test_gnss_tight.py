@@ -52,10 +52,6 @@ def test_clock_state_formulation_tracks_the_receiver_clock():
     assert abs(nav["extra_clock[1]"].iloc[-1] - C * 1e-8) < 0.1
 
 
-def _after(e, t0=60.0):
-    return e[e.time_s > t0]
-
-
 def _check_precise_closed(e):
     d3 = np.sqrt(e.dpos_n_m ** 2 + e.dpos_e_m ** 2 + e.dpos_d_m ** 2)
     assert d3[e.time_s > 60.0].max() < 2.0
@@ -89,13 +85,8 @@ def test_medium_open_loop_leaves_the_nees_band_closed_loop_stays_1h():
     _check_medium(S.run("medium_closed_1h")["errors"], S.run("medium_open_1h")["errors"], 3600.0)
 
 
-def _last_rms(e, window=600.0):
-    x = e[e.time_s > e.time_s.max() - window]
-    return np.sqrt((x.horizontal_m ** 2).mean())
-
-
 def _check_constellation(duration):
-    res = {n: _last_rms(S.run(f"sats_{n}", duration_s=duration)["errors"]) for n in ("all", 3, 2, 0)}
+    res = {n: S.last_rms(S.run(f"sats_{n}", duration_s=duration)["errors"]) for n in ("all", 3, 2, 0)}
     assert res[3] <= 3 * res["all"], res
     assert res[2] > 10 * res["all"], res        # two satellites: reported, much larger
     return res
@@ -111,11 +102,7 @@ def test_three_satellites_close_to_full_constellation_40min():
 
 
 def _outage(cls, minutes):
-    e = S.run(f"outage_{cls}_{minutes}min")["errors"]
-    a, b = 900.0, 900.0 + 60 * minutes
-    rms = lambda x: float(np.sqrt((x.horizontal_m ** 2).mean()))
-    return dict(pre=rms(e[(e.time_s > a - 300) & (e.time_s < a)]), end=float(e[e.time_s < b].horizontal_m.iloc[-1]),
-                post=rms(e[(e.time_s > b + 60) & (e.time_s < b + 600)]), at5=rms(e[(e.time_s > b + 240) & (e.time_s <= b + 300)]))
+    return S.outage_summary(S.run(f"outage_{cls}_{minutes}min")["errors"], 900.0, 60.0 * minutes)
 
 
 def test_precise_ins_is_insensitive_to_outage_length():

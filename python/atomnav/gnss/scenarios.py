@@ -139,3 +139,23 @@ def run(sc: Scenario | str, progress: bool = False, clock=(0.0, 0.0), **override
     res = ins.run(m["time_s"].to_numpy(), m[["dtheta_x_rad", "dtheta_y_rad", "dtheta_z_rad"]].to_numpy(),
                   m[["dv_x_mps", "dv_y_mps", "dv_z_mps"]].to_numpy(), chunk_s=300.0, progress=progress)
     return dict(setup=setup, result=res, errors=errors_and_nees(setup, res))
+
+
+def _rms(x) -> float:
+    return float(np.sqrt(np.mean(np.square(x)))) if len(x) else float("nan")
+
+
+def outage_summary(err: pd.DataFrame, start: float, length: float) -> dict:
+    """Horizontal error around an outage [start, start + length) s: RMS over the 5 min
+    before (``pre``), the error at its end (``end``), RMS 60–600 s after reacquisition
+    (``post``) and RMS over 240–300 s after it (``at5``, the 5-minute recovery check)."""
+    t, e = err["time_s"].to_numpy(), err["horizontal_m"].to_numpy()
+    b = start + length
+    return dict(pre=_rms(e[(t > start - 300) & (t < start)]), end=float(e[t < b][-1]),
+                post=_rms(e[(t > b + 60) & (t < b + 600)]), at5=_rms(e[(t > b + 240) & (t <= b + 300)]))
+
+
+def last_rms(err: pd.DataFrame, window: float = 600.0) -> float:
+    """Horizontal RMS error over the last ``window`` seconds."""
+    t = err["time_s"].to_numpy()
+    return _rms(err["horizontal_m"].to_numpy()[t > t.max() - window])
