@@ -123,7 +123,7 @@ def test_coarse_ins_reconverges_after_a_5_minute_outage():
 
 
 def test_schuler_period_of_the_stationary_ins():
-    periods = an.diagnostics.schuler_test(np.radians(55.75), v0=200.0, hours=4.5, h=200.0)["periods_min"][:3]
+    periods = an.diagnostics.schuler_test(np.radians(55.75), v0=200.0, hours=3.0, h=200.0)["periods_min"][:3]
     assert abs(np.mean(periods) / 84.4 - 1) < 0.005, periods
 
 
