@@ -61,8 +61,11 @@ def _check_medium(cl, ol, duration):
     lo, hi = 4.60, 32.80                      # χ²₁₅ two-sided 99 % band
     inside = ((cl.nees > lo) & (cl.nees < hi)).mean()
     assert inside >= 0.90, inside
-    out = ol[(ol.nees > hi)]
-    assert len(out) and out.time_s.iloc[0] < duration
+    # open loop leaves the band for good: some 5-min window's mean NEES is above it, and
+    # every later window too (a single epoch outside the band happens to any run)
+    w = ol.groupby((ol.time_s // 300).astype(int)).nees.mean().to_numpy()
+    above = np.nonzero(w > hi)[0]
+    assert above.size and np.all(w[above[0]:] > hi) and (above[0] + 1) * 300 <= duration, w
 
 
 def test_precise_closed_loop_reduced():
