@@ -271,6 +271,48 @@ impl Ellipsoid {
     }
 }
 
+/// A seven-parameter Helmert transformation r_WGS = T + (1 + s)·Rot·r_PZ with the
+/// coordinate-frame rotation Rot = [[1, r_z, −r_y], [−r_z, 1, r_x], [r_y, −r_x, 1]]
+/// (spec gnss-ins-tight §2.1 Eq. 6). Rotations in rad, scale dimensionless.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Helmert {
+    pub translation: Vec3,
+    pub rotation: Vec3,
+    pub scale: f64,
+}
+
+impl Helmert {
+    /// `identity` (default: PZ-90.11 ≈ WGS-84 to a few cm) or `pz90_02_to_wgs84`
+    /// (T = (−0.36, +0.08, +0.18) m, for pre-2014 GLONASS ephemerides), spec Eq. 6.
+    pub fn by_name(name: &str) -> Result<Helmert> {
+        match name {
+            "identity" => Ok(Helmert { translation: Vec3::zeros(), rotation: Vec3::zeros(), scale: 0.0 }),
+            "pz90_02_to_wgs84" => Ok(Helmert { translation: Vec3::new(-0.36, 0.08, 0.18), rotation: Vec3::zeros(), scale: 0.0 }),
+            _ => Err(invalid("datum", format!("unknown datum transformation '{name}' (known: identity, pz90_02_to_wgs84)"))),
+        }
+    }
+
+    fn rot(&self) -> Mat3 {
+        let r = self.rotation;
+        Mat3::new(1.0, r.z, -r.y, -r.z, 1.0, r.x, r.y, -r.x, 1.0)
+    }
+
+    /// PZ-90 → WGS-84 position (m).
+    pub fn forward(&self, r: &Vec3) -> Vec3 {
+        self.translation + self.rot() * r * (1.0 + self.scale)
+    }
+
+    /// PZ-90 → WGS-84 velocity (m/s): the translation drops out.
+    pub fn forward_velocity(&self, v: &Vec3) -> Vec3 {
+        self.rot() * v * (1.0 + self.scale)
+    }
+
+    /// WGS-84 → PZ-90 position (m), the exact inverse of `forward`.
+    pub fn inverse(&self, r: &Vec3) -> Vec3 {
+        self.rot().try_inverse().expect("Rot is I + small skew, always invertible") * (r - self.translation) / (1.0 + self.scale)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -327,5 +369,15 @@ mod tests {
         let (lat, h, d) = (0.7, 300.0, 1e-6);
         let fd = (WGS84.gravity(lat + d, h) - WGS84.gravity(lat - d, h)) / (2.0 * d);
         assert!((WGS84.gravity_dlat(lat, h) - fd).abs() < 1e-8);
+    }
+    #[test]
+    fn helmert_round_trip_and_pz90_02_offset() {
+        let h = Helmert { translation: Vec3::new(-0.36, 0.08, 0.18), rotation: Vec3::new(1e-8, -2e-8, 3e-9), scale: 2e-9 };
+        let r = Vec3::new(2.1e7, -1.3e7, 9.0e6);
+        assert!((h.inverse(&h.forward(&r)) - r).norm() < 1e-7);
+        let p = Helmert::by_name("pz90_02_to_wgs84").unwrap();
+        assert!(((p.forward(&r) - r) - Vec3::new(-0.36, 0.08, 0.18)).norm() < 1e-9);
+        assert_eq!(Helmert::by_name("identity").unwrap().forward(&r), r);
+        assert!(Helmert::by_name("itrf").is_err());
     }
 }

@@ -9,6 +9,7 @@ pub mod cai;
 pub mod earth;
 pub mod error;
 pub mod filter;
+pub mod gnss;
 pub mod imu;
 pub mod math;
 pub mod noise;

@@ -7,8 +7,8 @@ column names. Conventions (units, frames, signs) are in the README and in
 """
 
 from ._core import NumericalError
-from . import units, rotation, earth, trajectory, strapdown, imu, diagnostics, cai, noise, filter, astro
+from . import units, rotation, earth, trajectory, strapdown, imu, diagnostics, cai, noise, filter, astro, gnss
 
 __version__ = "0.1.0"
 
-__all__ = ["NumericalError", "units", "rotation", "earth", "trajectory", "strapdown", "imu", "diagnostics", "cai", "noise", "filter", "astro", "__version__"]
+__all__ = ["NumericalError", "units", "rotation", "earth", "trajectory", "strapdown", "imu", "diagnostics", "cai", "noise", "filter", "astro", "gnss", "__version__"]

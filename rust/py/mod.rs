@@ -7,6 +7,7 @@ mod cai;
 mod convert;
 mod earth;
 mod filter;
+mod gnss;
 mod imu;
 mod noise;
 mod rotation;
@@ -49,5 +50,6 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     cai::register(m)?;
     noise::register(m)?;
     filter::register(m)?;
+    gnss::register(m)?;
     Ok(())
 }

@@ -1,0 +1,11 @@
+"""GNSS for tight GPS + GLONASS / INS integration (spec gnss-ins-tight-demidov2009):
+broadcast orbits, nominal constellations, observation simulation, single-point
+positioning with the system-time offset τ_GPS, and the tightly coupled aided INS."""
+
+from .ephemeris import GLONASS_COLUMNS, GPS_COLUMNS, Ephemerides, glonass_propagate
+from .observations import OBS_COLUMNS, doppler_to_rate, simulate
+from .spp import SPP_COLUMNS, solve
+from .tight import tight_ins
+
+__all__ = ["Ephemerides", "GPS_COLUMNS", "GLONASS_COLUMNS", "glonass_propagate", "OBS_COLUMNS", "simulate",
+           "doppler_to_rate", "SPP_COLUMNS", "solve", "tight_ins"]

@@ -1,0 +1,94 @@
+"""Broadcast ephemerides of GPS (Keplerian elements, IS-GPS-200) and GLONASS (state
+vectors, GLONASS ICD) and the nominal constellations of spec gnss-ins-tight §2.5.
+
+Times are GPS system time in seconds (t = 0 at the start of a GPS week); GLONASS sets are
+referenced to GLONASS time, T_GPS − T_GLO = ΔT_leap + τ_GPS with ΔT_leap = n_leap − 10800 s.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+
+from .. import _core
+from .._validate import rows, vector
+
+#: Columns of a GPS ephemeris table (angles rad, times GPS s, clock s, s/s, s/s²).
+GPS_COLUMNS = ["prn", "toe", "sqrt_a", "e", "m0", "delta_n", "omega0", "i0", "omega", "omega_dot", "idot",
+               "cuc", "cus", "crc", "crs", "cic", "cis", "toc", "af0", "af1", "af2", "tgd"]
+#: Columns of a GLONASS ephemeris table (tb GLONASS s; PZ-90 m, m/s, m/s²; tau_n s).
+GLONASS_COLUMNS = ["slot", "channel", "tb", "x", "y", "z", "vx", "vy", "vz", "ax", "ay", "az", "tau_n", "gamma_n"]
+
+
+def _table(df, columns, name) -> np.ndarray:
+    if df is None:
+        return np.zeros((0, len(columns)))
+    if isinstance(df, pd.DataFrame):
+        missing = [c for c in columns if c not in df.columns]
+        if missing:
+            raise ValueError(f"{name}: missing columns {missing}")
+        df = df[columns].to_numpy(float)
+    return rows(df, len(columns), name) if len(df) else np.zeros((0, len(columns)))
+
+
+class Ephemerides:
+    """Broadcast ephemerides of both systems (Rust ``gnss/ephemeris.rs``)."""
+
+    def __init__(self, gps: pd.DataFrame | None = None, glonass: pd.DataFrame | None = None,
+                 n_leap: float = 18.0, datum: str = "identity", *, _core_obj=None):
+        """``gps``/``glonass``: tables with :data:`GPS_COLUMNS` / :data:`GLONASS_COLUMNS`;
+        ``n_leap`` GPS−UTC leap seconds (15 in 2009, 18 since 2017); ``datum`` PZ-90 → WGS-84
+        transformation ``"identity"`` or ``"pz90_02_to_wgs84"``."""
+        self._core = _core_obj if _core_obj is not None else _core.GnssEphemerides(
+            _table(gps, GPS_COLUMNS, "gps"), _table(glonass, GLONASS_COLUMNS, "glonass"), float(n_leap), datum)
+
+    @classmethod
+    def nominal(cls, t_start: float, t_end: float, gps: bool = True, glonass: bool = True, tau_gps: float = 0.0,
+                n_leap: float = 18.0, clocks: bool = True, seed: int = 0) -> "Ephemerides":
+        """Nominal 24-satellite GPS (6 planes) and GLONASS (3 planes, FDMA channels)
+        constellations covering GPS times [t_start, t_end] s; ``tau_gps`` (s) is the true
+        GPS−GLONASS offset used to reference the GLONASS sets; ``clocks``: random satellite
+        clocks (b ~ U(±0.5 ms), drift ~ N(0, 1e-11²)) from ``seed``."""
+        return cls(_core_obj=_core.GnssEphemerides.nominal(float(t_start), float(t_end), gps, glonass, float(tau_gps),
+                                                           float(n_leap), clocks, int(seed)))
+
+    def tables(self) -> tuple[pd.DataFrame, pd.DataFrame]:
+        """The GPS and GLONASS sets as DataFrames (:data:`GPS_COLUMNS`, :data:`GLONASS_COLUMNS`)."""
+        return (pd.DataFrame(self._core.gps_table(), columns=GPS_COLUMNS),
+                pd.DataFrame(self._core.glonass_table(), columns=GLONASS_COLUMNS))
+
+    @property
+    def satellites(self) -> list[str]:
+        """Satellite names, GPS first ("G01", ..., "R24")."""
+        return list(self._core.satellites())
+
+    def channel(self, sat: str) -> int:
+        """FDMA channel k of a GLONASS satellite (0 for GPS)."""
+        return self._core.channel(sat)
+
+    def state(self, sat: str, t, tau_gps: float = 0.0) -> pd.DataFrame:
+        """Satellite position ``x_m, y_m, z_m`` and velocity (WGS-84 ECEF) and clock
+        ``clock_s``, ``clock_rate`` at GPS times ``t`` (GLONASS at t − ΔT_leap − tau_gps)."""
+        t = np.atleast_1d(np.asarray(t, float))
+        s = self._core.state(sat, vector(t, None, "t"), float(tau_gps))
+        return pd.DataFrame(s, columns=["x_m", "y_m", "z_m", "vx_mps", "vy_mps", "vz_mps", "clock_s", "clock_rate"])
+
+    def look_angles(self, sat: str, t, lla) -> pd.DataFrame:
+        """Elevation and azimuth (rad) of ``sat`` from geodetic ``lla`` at GPS times ``t``."""
+        t = np.atleast_1d(np.asarray(t, float))
+        a = self._core.look_angles(sat, vector(t, None, "t"), vector(lla, 3, "lla"))
+        return pd.DataFrame(a, columns=["elevation_rad", "azimuth_rad"])
+
+    def top(self, n: int, t: float, lla, mask_deg: float = 10.0) -> list[str]:
+        """The ``n`` highest satellites above the mask at time ``t`` (fixed subsets, spec §4 row 13)."""
+        el = {s: self.look_angles(s, [t], lla)["elevation_rad"].iloc[0] for s in self.satellites}
+        up = sorted((s for s in el if el[s] >= np.radians(mask_deg)), key=lambda s: -el[s])
+        return up[:n]
+
+
+def glonass_propagate(pos, vel, acc, dt: float, step: float = 30.0, j2: float = 1082625.75e-9) -> np.ndarray:
+    """RK4 propagation of a GLONASS PZ-90 state (m, m/s) with constant luni-solar
+    acceleration ``acc`` (m/s²) over ``dt`` s in steps ≤ ``step`` s (spec Eq. 10).
+    Returns [x, y, z, vx, vy, vz]."""
+    return _core.glonass_propagate(vector(pos, 3, "pos"), vector(vel, 3, "vel"), vector(acc, 3, "acc"),
+                                   float(dt), float(step), float(j2))

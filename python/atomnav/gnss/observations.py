@@ -1,0 +1,59 @@
+"""Simulated code and pseudorange-rate observations (spec gnss-ins-tight §2.6) as a table
+with one row per satellite and epoch: ``time_s, sat, channel, code_m, rate_mps``.
+GLONASS code is delivered with c·ΔT_leap removed (Eq. 15)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+
+from .. import _core
+from .._validate import rows, vector
+from .ephemeris import Ephemerides
+
+C_LIGHT = 299792458.0
+OBS_COLUMNS = ["time_s", "sat", "channel", "code_m", "rate_mps"]
+
+
+def simulate(eph: Ephemerides, time, lla, vel_ned, sigma_code: float = 3.0, sigma_code_glonass: float | None = None,
+             sigma_rate: float = 0.05, tau_gps: float = 0.0, clock_bias: float = 0.0, clock_drift: float = 0.0,
+             iono: bool = True, tropo: bool = True, mask_deg: float = 10.0, only: list[str] | None = None,
+             outages=(), sat_outages=(), seed: int = 0) -> pd.DataFrame:
+    """Observations of a receiver at ``lla`` (N, 3) rad/rad/m with NED velocity ``vel_ned``
+    (N, 3) m/s at GPS times ``time`` (N,) s.
+
+    Code σ ``sigma_code`` m (GLONASS ``sigma_code_glonass``, default the same), rate σ
+    ``sigma_rate`` m/s, true ``tau_gps`` (s) on GLONASS code, receiver clock
+    δt_r = clock_bias + clock_drift·t (s), Klobuchar ``iono`` and Saastamoinen ``tropo``,
+    elevation mask ``mask_deg``; visibility: ``only`` a fixed satellite subset, ``outages``
+    [(start, end)] s of all satellites, ``sat_outages`` [(sat, start, end)]. Seeded. The table also carries the true ``elevation_rad``."""
+    t = vector(time, None, "time")
+    out = np.asarray(outages, float).reshape(-1, 2)
+    d = _core.gnss_simulate(eph._core, t, rows(lla, 3, "lla"), rows(vel_ned, 3, "vel_ned"), float(sigma_code),
+                            float(sigma_code if sigma_code_glonass is None else sigma_code_glonass), float(sigma_rate),
+                            float(tau_gps), float(clock_bias), float(clock_drift), bool(iono), bool(tropo),
+                            np.radians(mask_deg), only, np.ascontiguousarray(out),
+                            [(str(s), float(a), float(b)) for s, a, b in sat_outages], int(seed))
+    return pd.DataFrame({c: d[c] for c in OBS_COLUMNS + ["elevation_rad"]})
+
+
+def doppler_to_rate(doppler_hz, sat, channel) -> np.ndarray:
+    """Pseudorange rate (m/s) = −λ·D with the per-channel GLONASS wavelength (spec Eq. 16)."""
+    d = np.asarray(doppler_hz, float)
+    sys = np.array([str(s)[0] for s in np.atleast_1d(sat)])
+    k = np.asarray(channel, float)
+    if np.any((sys == "R") & ((k < -7) | (k > 6))):
+        i = int(np.nonzero((sys == "R") & ((k < -7) | (k > 6)))[0][0])
+        raise ValueError(f"channel: unknown GLONASS frequency channel {k[i]:g} at index {i} (valid: -7..6)")
+    f = np.where(sys == "R", (1602.0 + 0.5625 * k) * 1e6, 1575.42e6)
+    return -C_LIGHT / f * d
+
+
+def obs_arrays(obs: pd.DataFrame) -> tuple:
+    """The observation table as the arrays the core takes."""
+    missing = [c for c in OBS_COLUMNS if c not in obs.columns]
+    if missing:
+        raise ValueError(f"obs: missing columns {missing}")
+    return (np.ascontiguousarray(obs["time_s"].to_numpy(float)), [str(s) for s in obs["sat"]],
+            np.ascontiguousarray(obs["channel"].to_numpy(np.int64)), np.ascontiguousarray(obs["code_m"].to_numpy(float)),
+            np.ascontiguousarray(obs["rate_mps"].to_numpy(float)))

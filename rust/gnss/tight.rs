@@ -1,0 +1,415 @@
+//! Tightly coupled GNSS aiding of the generic aided-INS engine (spec gnss-ins-tight §2.12,
+//! Eqs. 37–42). Default: between-satellite first differences of code and pseudorange rate
+//! against the highest GPS satellite (no receiver-clock states; the correlated FD noise
+//! R = σ₀²11ᵀ + diag(σᵢ²) is decorrelated by the engine in sequential mode) with c·τ_GPS
+//! as an extra state. Option: undifferenced rows with the receiver clock states (c·δt_r,
+//! c·δṫ_r) of Eq. 41. Lever arm l^b from the IMU to the antenna.
+//!
+//! Signs: z = predicted − measured; δx = estimate − true. The H rows have no IMU-bias
+//! columns, so the spec's raw-bias sign convention (opposite to the engine's
+//! δb = b̂ − b, see filter/ins.rs) never enters here.
+
+use super::ephemeris::Ephemerides;
+use super::geometry::geometry;
+use super::observation::{Atmosphere, Observation};
+use super::{SatId, System, C_LIGHT};
+use crate::earth::dcm_ned_to_ecef;
+use crate::error::{invalid, Result};
+use crate::filter::aided::{Aiding, AidingContext, Measurement};
+use crate::filter::layout::Layout;
+use crate::imu::ImuKind;
+use crate::math::{dcm_from_quat, skew, Mat3, Vec3};
+use crate::strapdown::NavState;
+use nalgebra::{DMatrix, RowDVector};
+
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Formulation {
+    /// Between-satellite first differences (no clock states).
+    FirstDifference,
+    /// Undifferenced rows with the receiver clock bias and drift states (m, m/s).
+    ClockStates,
+}
+
+impl Formulation {
+    pub fn by_name(name: &str) -> Result<Formulation> {
+        match name {
+            "first_difference" => Ok(Formulation::FirstDifference),
+            "clock_states" => Ok(Formulation::ClockStates),
+            _ => Err(invalid("formulation", format!("unknown '{name}' (known: first_difference, clock_states)"))),
+        }
+    }
+}
+
+#[derive(Debug, Clone, Copy)]
+pub struct TightConfig {
+    pub formulation: Formulation,
+    /// IMU → antenna lever arm in the body frame (m).
+    pub lever_arm: Vec3,
+    pub sigma_code_gps: f64,
+    pub sigma_code_glo: f64,
+    pub sigma_rate: f64,
+    pub use_rate: bool,
+    pub atm: Atmosphere,
+    /// c·τ_GPS random-walk PSD (m²/s); spec Eq. 42: (0.1 ns)²/h.
+    pub tau_psd: f64,
+    /// Receiver oscillator h₀ (s) and h₋₂ (1/s) of Eq. 41 (TCXO 2e-19, 2e-20).
+    pub clock_h0: f64,
+    pub clock_hm2: f64,
+    /// IMU record kind: the gyro sample gives the body rate for the lever-arm velocity.
+    pub kind: ImuKind,
+    /// σ of the barometric altitude rows (m); spec §3: 1 m.
+    pub sigma_baro: f64,
+}
+
+pub struct TightAiding {
+    eph: Ephemerides,
+    times: Vec<f64>,
+    epochs: Vec<Vec<Observation>>,
+    /// Barometric altitude (m) at each epoch, NaN when none.
+    baro: Vec<f64>,
+    cfg: TightConfig,
+    reference: Option<SatId>,
+    /// Last compensated body rate (rad/s).
+    omega_b: Vec3,
+    /// Clock-state option: the engine propagates only the error state, not the nominal
+    /// value of an extra block, so the nominal clock bias ∫ĉδṫ dt accumulated since the
+    /// start is kept here (m) and added to the `clock[0]` estimate in the prediction;
+    /// (time, value) of the last measurement.
+    clock_shift: (f64, f64),
+}
+
+/// One satellite's undifferenced innovation and rows for code and rate.
+struct Row {
+    sat: SatId,
+    elevation: f64,
+    z_code: f64,
+    h_code: RowDVector<f64>,
+    s_code: f64,
+    z_rate: f64,
+    h_rate: RowDVector<f64>,
+}
+
+impl TightAiding {
+    /// `epochs`: (GPS time, observations) with strictly increasing time; `baro`: (time,
+    /// altitude m) readings of the barometric altimeter that damps the vertical channel
+    /// (spec decision 13, σ `cfg.sigma_baro`), merged with the GNSS epochs.
+    pub fn new(eph: Ephemerides, epochs: Vec<(f64, Vec<Observation>)>, baro: &[(f64, f64)], cfg: TightConfig) -> Result<TightAiding> {
+        for (field, s) in [("sigma_code_gps", cfg.sigma_code_gps), ("sigma_code_glo", cfg.sigma_code_glo), ("sigma_rate", cfg.sigma_rate), ("sigma_baro", cfg.sigma_baro)] {
+            crate::error::check_positive(field, s)?;
+        }
+        for (i, (_, obs)) in epochs.iter().enumerate() {
+            for o in obs {
+                if o.sat.system == System::Glonass && eph.channel(o.sat)? != o.channel {
+                    return Err(invalid("obs", format!("epoch {i}: {} on channel {} but the ephemeris says {}", o.sat.name(), o.channel, eph.channel(o.sat)?)));
+                }
+            }
+        }
+        for (i, w) in baro.windows(2).enumerate() {
+            if !(w[1].0 > w[0].0) {
+                return Err(invalid("baro_time", format!("not strictly increasing at index {}", i + 1)));
+            }
+        }
+        if let Some(i) = baro.iter().position(|b| !(b.0.is_finite() && b.1.is_finite())) {
+            return Err(invalid("baro", format!("non-finite time or altitude at index {i}")));
+        }
+        // merge the two sorted streams into one list of epochs
+        let (mut times, mut obs, mut alt) = (Vec::new(), Vec::new(), Vec::new());
+        let mut k = 0;
+        let mut epochs = epochs.into_iter().peekable();
+        while epochs.peek().is_some() || k < baro.len() {
+            let tg = epochs.peek().map_or(f64::INFINITY, |e| e.0);
+            let tb = baro.get(k).map_or(f64::INFINITY, |b| b.0);
+            let t = tg.min(tb);
+            times.push(t);
+            obs.push(if tg == t { epochs.next().expect("peeked").1 } else { Vec::new() });
+            alt.push(if tb == t { k += 1; baro[k - 1].1 } else { f64::NAN });
+        }
+        Ok(TightAiding { eph, times, epochs: obs, baro: alt, cfg, reference: None, omega_b: Vec3::zeros(), clock_shift: (f64::NAN, 0.0) })
+    }
+
+    /// The FD reference satellite at the last measurement (None before the first).
+    pub fn reference(&self) -> Option<SatId> {
+        self.reference
+    }
+
+    /// Nominal clock bias accumulated from the drift estimate up to the current epoch (m).
+    pub fn clock_shift(&self) -> f64 {
+        self.clock_shift.1
+    }
+
+    fn rows(&mut self, j: usize, ctx: &AidingContext) -> Result<Vec<Row>> {
+        let t = self.times[j];
+        let nav = ctx.nav;
+        let n = ctx.layout.size();
+        let cne = dcm_ned_to_ecef(nav.lla.x, nav.lla.y);
+        let cnb = dcm_from_quat(&nav.q_nb);
+        let lever_n = cnb * self.cfg.lever_arm;
+        // antenna: r̂_a = r̂ + Ĉl^b, v̂_a = v̂ + Ĉ(ω × l^b) (Eq. 37)
+        let r_a = ctx.ell.lla_to_ecef(&nav.lla) + cne * lever_n;
+        let v_a = cne * (nav.vel + cnb * self.omega_b.cross(&self.cfg.lever_arm));
+        let lla_a = ctx.ell.ecef_to_lla(&r_a);
+        let (ip, iv, ipsi) = (ctx.layout.range("position")?.start, ctx.layout.range("velocity")?.start, ctx.layout.range("attitude")?.start);
+        let extra = |name: &str| ctx.layout.get(name).map(|r| (r.start, ctx.extra[r.start - 15]));
+        let tau = extra("c_tau_gps");
+        let clock = extra("clock");
+        if let Some((i, _)) = clock {
+            let (t_prev, shift) = self.clock_shift;
+            let dt = if t_prev.is_finite() { t - t_prev } else { 0.0 };
+            self.clock_shift = (t, shift + ctx.extra[i - 15 + 1] * dt);
+        }
+        let shift = self.clock_shift.1;
+        let lever_skew = skew(&lever_n);
+        // v̂^e = C_n^e(r̂)v̂ⁿ: a position error δr turns the computed frame by δθ = A_ev·δr
+        // (C(r̂) = C(r)(I + [δθ×])), so δv^e = C(δv − [vⁿ×]A_ev δr); the Doppler rows carry
+        // this term besides g_i (|v||δr|/R: 0.016 m/s at 100 m/s and 1 km, open loop).
+        let loc = ctx.ell.local(nav.lla.x, nav.lla.z);
+        let a_ev = Mat3::new(0.0, 1.0 / loc.rp, 0.0, -1.0 / loc.rm, 0.0, 0.0, 0.0, -loc.sin / (loc.cos * loc.rp), 0.0);
+        let frame_term = skew(&(cne.transpose() * v_a)) * a_ev;
+        let mut rows = Vec::new();
+        for o in &self.epochs[j] {
+            let glo = o.sat.system == System::Glonass;
+            let g = geometry(&self.eph, o.sat, t, &r_a, &v_a, lla_a.x, lla_a.y, tau.map_or(0.0, |x| x.1 / C_LIGHT))?;
+            if g.elevation <= 0.0 {
+                continue;
+            }
+            let u_n = cne.transpose() * g.los * g.kappa;
+            let mut pred = g.range;
+            let mut h_code = RowDVector::zeros(n);
+            let mut h_rate = RowDVector::zeros(n);
+            for k in 0..3 {
+                h_code[ip + k] = -u_n[k];
+            }
+            let hp = -u_n.transpose() * lever_skew;
+            for k in 0..3 {
+                h_code[ipsi + k] = hp[k];
+            }
+            // g_iᵀ = −(v_s − v̂)ᵀ(I − uuᵀ)C_n^e/ρ̂ (Eq. 37; required in open loop, decision 9)
+            let dv = g.sat.vel - v_a;
+            let gi = -(dv - g.los * g.los.dot(&dv)).transpose() * cne / g.range;
+            let gf = gi + u_n.transpose() * frame_term;
+            // the lever arm moves the antenna by [(Ĉl)×]ψ, which turns the line of sight
+            let gpsi = gi * lever_skew;
+            for k in 0..3 {
+                h_rate[ip + k] = gf[k];
+                h_rate[iv + k] = -u_n[k];
+                h_rate[ipsi + k] = gpsi[k];
+            }
+            let mut pred_rate = g.rate;
+            if let Some((i, ct)) = tau {
+                if glo {
+                    pred += ct;
+                    h_code[i] = 1.0 - g.kappa * g.los.dot(&g.sat.vel) / C_LIGHT;
+                }
+            }
+            if let Some((i, cb)) = clock {
+                pred += cb + shift;
+                pred_rate += ctx.extra[i - 15 + 1];
+                h_code[i] = 1.0;
+                h_rate[i + 1] = 1.0;
+            }
+            let measured = o.code + C_LIGHT * g.sat.clock - self.cfg.atm.delay(o.sat, o.channel, &lla_a, &g, t);
+            let measured_rate = o.rate + C_LIGHT * g.sat.clock_rate;
+            rows.push(Row {
+                sat: o.sat,
+                elevation: g.elevation,
+                z_code: pred - measured,
+                h_code,
+                s_code: if glo { self.cfg.sigma_code_glo } else { self.cfg.sigma_code_gps },
+                z_rate: if self.cfg.use_rate && o.rate.is_finite() { pred_rate - measured_rate } else { f64::NAN },
+                h_rate,
+            });
+        }
+        Ok(rows)
+    }
+
+    /// Keep the reference while it is seen; otherwise the highest GPS satellite (the
+    /// highest GLONASS one when no GPS satellite is seen). Returns its index in `rows`.
+    fn pick_reference(&mut self, rows: &[Row]) -> usize {
+        if let Some(i) = self.reference.and_then(|r| rows.iter().position(|x| x.sat == r)) {
+            return i;
+        }
+        let best = |sys: System| {
+            rows.iter().enumerate().filter(|(_, r)| r.sat.system == sys).max_by(|a, b| a.1.elevation.total_cmp(&b.1.elevation)).map(|(i, _)| i)
+        };
+        let i = best(System::Gps).or_else(|| best(System::Glonass)).expect("at least one row");
+        self.reference = Some(rows[i].sat);
+        i
+    }
+}
+
+impl TightAiding {
+    /// Append the barometric row z = ĥ − h_baro, H = −1 on δr_D (δr_D = −δh), when there
+    /// is a reading at epoch j; None when nothing is left to apply.
+    fn baro_row(&self, j: usize, ctx: &AidingContext, (mut z, h, r): (Vec<f64>, DMatrix<f64>, DMatrix<f64>)) -> Option<Measurement> {
+        let hb = self.baro[j];
+        let m = z.len();
+        if !hb.is_finite() {
+            return (m > 0).then_some(Measurement { z, h, r });
+        }
+        let ip = ctx.layout.get("position").expect("INS15 layout").start;
+        z.push(ctx.nav.lla.z - hb);
+        let mut h = h.resize_vertically(m + 1, 0.0);
+        h[(m, ip + 2)] = -1.0;
+        let mut r = r.resize(m + 1, m + 1, 0.0);
+        r[(m, m)] = self.cfg.sigma_baro * self.cfg.sigma_baro;
+        Some(Measurement { z, h, r })
+    }
+}
+
+/// Stack (z, H, R) of a set of rows; FD against row `r0` when given, with
+/// R = σ₀²11ᵀ + diag(σᵢ²) (Eq. 39).
+fn stack(z: &[f64], h: &[&RowDVector<f64>], s: &[f64], r0: Option<usize>, n: usize) -> (Vec<f64>, DMatrix<f64>, DMatrix<f64>) {
+    let idx: Vec<usize> = (0..z.len()).filter(|&i| Some(i) != r0).collect();
+    let m = idx.len();
+    let mut hm = DMatrix::zeros(m, n);
+    let mut r = DMatrix::zeros(m, m);
+    let mut zz = Vec::with_capacity(m);
+    for (a, &i) in idx.iter().enumerate() {
+        match r0 {
+            Some(k) => {
+                zz.push(z[i] - z[k]);
+                hm.set_row(a, &(h[i] - h[k]));
+                for b in 0..m {
+                    r[(a, b)] = s[k] * s[k];
+                }
+            }
+            None => {
+                zz.push(z[i]);
+                hm.set_row(a, h[i]);
+            }
+        }
+        r[(a, a)] += s[i] * s[i];
+    }
+    (zz, hm, r)
+}
+
+impl Aiding for TightAiding {
+    fn name(&self) -> &str {
+        "gnss"
+    }
+
+    fn extra_blocks(&self) -> Vec<(String, usize)> {
+        let mut b = vec![("c_tau_gps".to_string(), 1)];
+        if self.cfg.formulation == Formulation::ClockStates {
+            b.push(("clock".to_string(), 2));
+        }
+        b
+    }
+
+    fn times(&self) -> &[f64] {
+        &self.times
+    }
+
+    fn observe(&mut self, _t: f64, dt: f64, gyro: &Vec3, _accel: &Vec3, _nav: &NavState) {
+        self.omega_b = match self.cfg.kind {
+            ImuKind::Rates => *gyro,
+            ImuKind::Increments if dt > 0.0 => gyro / dt,
+            ImuKind::Increments => self.omega_b,
+        };
+    }
+
+    fn measure(&mut self, j: usize, ctx: &AidingContext) -> Result<Option<Measurement>> {
+        let rows = self.rows(j, ctx)?;
+        let fd = self.cfg.formulation == Formulation::FirstDifference;
+        let n = ctx.layout.size();
+        if rows.is_empty() || (fd && rows.len() < 2) {
+            return Ok(self.baro_row(j, ctx, (Vec::new(), DMatrix::zeros(0, n), DMatrix::zeros(0, 0))));
+        }
+        let r0 = if fd { Some(self.pick_reference(&rows)) } else { None };
+        let zc: Vec<f64> = rows.iter().map(|r| r.z_code).collect();
+        let hc: Vec<&RowDVector<f64>> = rows.iter().map(|r| &r.h_code).collect();
+        let sc: Vec<f64> = rows.iter().map(|r| r.s_code).collect();
+        let (mut z, mut h, mut r) = stack(&zc, &hc, &sc, r0, n);
+        // rate rows: only satellites with a rate, differenced against the same reference
+        let with_rate: Vec<usize> = (0..rows.len()).filter(|&i| rows[i].z_rate.is_finite()).collect();
+        let rate_ref = r0.and_then(|k| with_rate.iter().position(|&i| i == k));
+        if with_rate.len() > usize::from(fd) && (!fd || rate_ref.is_some()) {
+            let zr: Vec<f64> = with_rate.iter().map(|&i| rows[i].z_rate).collect();
+            let hr: Vec<&RowDVector<f64>> = with_rate.iter().map(|&i| &rows[i].h_rate).collect();
+            let sr = vec![self.cfg.sigma_rate; with_rate.len()];
+            let (z2, h2, r2) = stack(&zr, &hr, &sr, rate_ref, n);
+            let (m1, m2) = (z.len(), z2.len());
+            z.extend(z2);
+            h = h.resize_vertically(m1 + m2, 0.0);
+            h.rows_mut(m1, m2).copy_from(&h2);
+            r = r.resize(m1 + m2, m1 + m2, 0.0);
+            r.view_mut((m1, m1), (m2, m2)).copy_from(&r2);
+        }
+        Ok(self.baro_row(j, ctx, (z, h, r)))
+    }
+
+    fn extra_dynamics(&self, layout: &Layout, f: &mut DMatrix<f64>, qc: &mut DMatrix<f64>) {
+        if let Some(r) = layout.get("c_tau_gps") {
+            qc[(r.start, r.start)] = self.cfg.tau_psd;
+        }
+        if let Some(r) = layout.get("clock") {
+            // ẋ_c = [[0, 1], [0, 0]]x_c + w, Q_c = c²·diag(h₀/2, 2π²h₋₂) (Eq. 41)
+            let i = r.start;
+            f[(i, i + 1)] = 1.0;
+            qc[(i, i)] = C_LIGHT * C_LIGHT * self.cfg.clock_h0 / 2.0;
+            qc[(i + 1, i + 1)] = C_LIGHT * C_LIGHT * 2.0 * std::f64::consts::PI.powi(2) * self.cfg.clock_hm2;
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::constellation::{nominal, ConstellationConfig};
+    use super::super::observation::{simulate, SimConfig, Visibility};
+    use super::super::TimeScales;
+    use super::*;
+    use crate::earth::WGS84;
+    use crate::filter::layout::INS15;
+    use crate::math::{quat_from_euler, quat_from_rotvec};
+    use nalgebra::DVector;
+
+    /// H rows (code and rate, clock-state form) = finite differences of the innovation
+    /// with respect to position (NED m), velocity and ψ of the INS solution.
+    #[test]
+    fn h_rows_match_finite_differences_of_the_prediction() {
+        let lla = Vec3::new(0.97, 0.66, 300.0);
+        let vel = Vec3::new(80.0, -60.0, 2.0);
+        let cfg = ConstellationConfig { gps: true, glonass: true, t_start: 0.0, t_end: 600.0, tau_gps: 0.0, time: TimeScales::default(), clocks: true, seed: 4 };
+        let eph = nominal(&cfg).unwrap();
+        let atm = Atmosphere { iono: None, tropo: false };
+        let sim = SimConfig { sigma_code_gps: 0.0, sigma_code_glo: 0.0, sigma_rate: 0.0, tau_gps: 0.0, clock_bias: 0.0, clock_drift: 0.0, atm, seed: 1 };
+        let obs: Vec<Observation> = simulate(&eph, &[100.0], &[lla], &[vel], &sim, &Visibility::default()).unwrap().remove(0).into_iter().map(|x| x.0).collect();
+        let tc = TightConfig {
+            formulation: Formulation::ClockStates, lever_arm: Vec3::new(1.0, -0.5, -2.0), sigma_code_gps: 3.0, sigma_code_glo: 3.0, sigma_rate: 0.05,
+            use_rate: true, atm, tau_psd: 0.0, clock_h0: 0.0, clock_hm2: 0.0, kind: ImuKind::Rates, sigma_baro: 1.0,
+        };
+        let mut aiding = TightAiding::new(eph, vec![(100.0, obs)], &[], tc).unwrap();
+        let mut spec: Vec<(String, Option<usize>)> = INS15.iter().map(|s| (s.to_string(), None)).collect();
+        spec.extend(aiding.extra_blocks().into_iter().map(|(b, k)| (b, Some(k))));
+        let layout = Layout::new(&spec).unwrap();
+        let (x, extra) = (DVector::zeros(layout.size()), DVector::zeros(3));
+        let q = quat_from_euler(0.1, -0.05, 1.2);
+        let z_of = |a: &mut TightAiding, nav: &NavState| {
+            let ctx = AidingContext { t: 100.0, nav, accel_bias: Vec3::zeros(), gyro_bias: Vec3::zeros(), x: &x, extra: &extra, layout: &layout, ell: &WGS84 };
+            a.measure(0, &ctx).unwrap().unwrap()
+        };
+        let nav0 = NavState { t: 100.0, lla, vel, q_nb: q };
+        let m0 = z_of(&mut aiding, &nav0);
+        let loc = WGS84.local(lla.x, lla.z);
+        for k in 0..9 {
+            let d = [10.0, 10.0, 10.0, 0.1, 0.1, 0.1, 1e-3, 1e-3, 1e-3][k];
+            let shifted = |s: f64| {
+                let mut e = Vec3::zeros();
+                e[k % 3] = s * d;
+                match k / 3 {
+                    0 => NavState { lla: lla + Vec3::new(e.x / loc.rm, e.y / (loc.rp * loc.cos), -e.z), ..nav0 },
+                    1 => NavState { vel: vel + e, ..nav0 },
+                    // Ĉ = (I − [ψ×])C ⇒ q̂ = q(−ψ) ⊗ q
+                    _ => NavState { q_nb: quat_from_rotvec(&(-e)) * q, ..nav0 },
+                }
+            };
+            let (zp, zm) = (z_of(&mut aiding, &shifted(1.0)).z, z_of(&mut aiding, &shifted(-1.0)).z);
+            for (i, (p, m)) in zp.iter().zip(&zm).enumerate() {
+                let fd = (p - m) / (2.0 * d);
+                // code rows: z is a difference of ~2e7 m numbers (ulp 3.7e-9 m) over a 2d step
+                let tol = if i < m0.z.len() / 2 { 1e-5 } else { 1e-7 };
+                assert!((fd - m0.h[(i, k)]).abs() < tol, "row {i} state {k}: fd {fd} vs H {}", m0.h[(i, k)]);
+            }
+        }
+    }
+}
