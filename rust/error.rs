@@ -25,6 +25,7 @@ pub fn invalid(field: &str, reason: impl Into<String>) -> NavError {
 pub fn check_finite(field: &str, data: &[f64], width: usize) -> Result<()> {
     match data.iter().position(|x| !x.is_finite()) {
         None => Ok(()),
+        Some(i) if width == 1 => Err(invalid(field, format!("non-finite value {} at index {i}", data[i]))),
         Some(i) => Err(invalid(
             field,
             format!("non-finite value {} at index {} (column {})", data[i], i / width, i % width),

@@ -24,8 +24,15 @@ NOISE_TYPES = ("white_pm", "flicker_pm", "white_fm", "flicker_fm", "random_walk_
 TERMS = ("quantization", "arw", "bias_instability", "rrw", "ramp")
 
 
-def _series(x, name: str, min_len: int = 1) -> np.ndarray:
-    a = vector(x, None, name)
+def _series(x, name: str, min_len: int = 1, check_finite: bool = True) -> np.ndarray:
+    """1-D float64 series of at least ``min_len`` samples; ``check_finite=False`` leaves
+    the NaN/inf check (same message) to the Rust core, which does it in its first pass."""
+    if check_finite:
+        a = vector(x, None, name)
+    else:
+        a = np.ascontiguousarray(np.asarray(x, dtype=float))
+        if a.ndim != 1:
+            raise ValueError(f"{name}: expected shape (N,), got {a.shape}")
     if a.size < min_len:
         raise ValueError(f"{name}: series of {a.size} samples is too short; at least {min_len} are needed")
     return a
@@ -83,7 +90,7 @@ def allan_variance(data, tau0: float, m="octave", kind: str = "allan", data_type
     kind = choice(kind, KINDS, "kind")
     data_type = choice(data_type, DATA_TYPES, "data_type")
     noise = choice(noise, NOISE_TYPES, "noise")
-    x = _series(data, "data")
+    x = _series(data, "data", check_finite=False)
     set_name, ms = _m_list(m, taus, tau0)
     mm, tau, var, n = _core.allan_var(x, tau0, data_type, kind, set_name, ms)
     n_phase = x.size + 1 if data_type == "rate" else x.size
