@@ -4,7 +4,7 @@
 use super::convert::{rows, to_py_rows, vec3, vec3_rows, vec3_to_py, vec_to_py, vector};
 use super::imu::triad_from_dict;
 use super::trajectory::Motion;
-use super::filter::{ins_noise, PyAidedIns};
+use super::filter::{AidedSetup, PyAidedIns};
 use crate::cai::aiding::{CaiAiding, CaiConfig, CaiData, ForceMode};
 use nalgebra::DVector;
 use crate::cai::hybrid::{HybridRun, HybridScenario, PhaseSource};
@@ -563,30 +563,12 @@ impl CaiHybrid {
 /// either emulated (`phase` true phases + `noise` population noise, shots × channels, the
 /// laser phase steered inside the loop) or recorded (`population` + `laser_phase`).
 #[pyfunction]
-#[pyo3(signature = (t0, lla0, vel0, q0, kind, ba0, bg0, extra0, p0, accel_psd, gyro_psd, accel_bias, gyro_bias, predict_every, method, mode,
-    sequential, gate, ellipsoid, channels, t_sep, shots, readout, inflation, omega_dot, savgol_half_width, interpolation, substeps,
+#[pyo3(signature = (ins, extra0, channels, t_sep, shots, readout, inflation, omega_dot, savgol_half_width, interpolation, substeps,
     jacobian_euler, misalignment, lever_arm, force, data_kind, data_a, data_b))]
 #[allow(clippy::too_many_arguments)]
 fn cai_aided_ins(
-    t0: f64,
-    lla0: PyReadonlyArray1<'_, f64>,
-    vel0: PyReadonlyArray1<'_, f64>,
-    q0: PyReadonlyArray1<'_, f64>,
-    kind: &str,
-    ba0: PyReadonlyArray1<'_, f64>,
-    bg0: PyReadonlyArray1<'_, f64>,
+    ins: PyRef<'_, AidedSetup>,
     extra0: PyReadonlyArray1<'_, f64>,
-    p0: PyReadonlyArray2<'_, f64>,
-    accel_psd: f64,
-    gyro_psd: f64,
-    accel_bias: (String, f64, f64),
-    gyro_bias: (String, f64, f64),
-    predict_every: usize,
-    method: &str,
-    mode: &str,
-    sequential: bool,
-    gate: Option<f64>,
-    ellipsoid: &str,
     channels: &CaiChannels,
     t_sep: f64,
     shots: PyReadonlyArray1<'_, f64>,
@@ -606,7 +588,7 @@ fn cai_aided_ins(
 ) -> PyResult<PyAidedIns> {
     let mut cfg = cai_config(channels, t_sep, vector(&shots, "shots")?, readout, inflation, omega_dot, savgol_half_width, interpolation, substeps,
         jacobian_euler, misalignment, lever_arm, force)?;
-    cfg.kind = ImuKind::parse(kind)?;
+    cfg.kind = ins.kind;
     // (shots, channels) tables, read row-major; the aiding checks their sizes
     let flat = |a: &PyReadonlyArray2<'_, f64>| a.as_array().iter().copied().collect::<Vec<f64>>();
     let (a, b) = (flat(&data_a), flat(&data_b));
@@ -622,6 +604,5 @@ fn cai_aided_ins(
         }
     }
     let aiding = CaiAiding::new(cfg, data)?;
-    PyAidedIns::from_aiding(t0, &lla0, &vel0, &q0, kind, &ba0, &bg0, DVector::from_vec(vector(&extra0, "extra0")?), &p0,
-        ins_noise(accel_psd, gyro_psd, &accel_bias, &gyro_bias)?, predict_every, method, mode, sequential, gate, ellipsoid, Box::new(aiding))
+    PyAidedIns::from_aiding(&ins, DVector::from_vec(vector(&extra0, "extra0")?), Box::new(aiding))
 }

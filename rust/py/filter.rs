@@ -360,47 +360,71 @@ pub struct PyAidedIns {
 
 type OutputTuple<'py> = Bound<'py, pyo3::types::PyTuple>;
 
-impl PyAidedIns {
-    /// Build from the shared arguments of every factory and the sensor's model.
+/// The INS part every aided-INS factory shares (initial state, IMU kind, Earth model,
+/// initial bias estimates, P₀, noise and filter options), parsed and checked once; each
+/// sensor's factory takes it as `ins` and adds its own measurement model.
+#[pyclass(name = "AidedSetup", module = "atomnav._core", frozen)]
+pub struct AidedSetup {
+    initial: NavState,
+    pub(crate) kind: crate::imu::ImuKind,
+    ell: Ellipsoid,
+    ba0: crate::math::Vec3,
+    bg0: crate::math::Vec3,
+    p0: DMatrix<f64>,
+    cfg: AidedConfig,
+}
+
+#[pymethods]
+impl AidedSetup {
+    #[new]
+    #[pyo3(signature = (t0, lla0, vel0, q0, kind, ba0, bg0, p0, accel_psd, gyro_psd, accel_bias, gyro_bias, predict_every, method, mode, sequential=false, gate=None, ellipsoid="WGS84"))]
     #[allow(clippy::too_many_arguments)]
-    pub(crate) fn from_aiding(
+    fn new(
         t0: f64,
-        lla0: &PyReadonlyArray1<'_, f64>,
-        vel0: &PyReadonlyArray1<'_, f64>,
-        q0: &PyReadonlyArray1<'_, f64>,
+        lla0: PyReadonlyArray1<'_, f64>,
+        vel0: PyReadonlyArray1<'_, f64>,
+        q0: PyReadonlyArray1<'_, f64>,
         kind: &str,
-        ba0: &PyReadonlyArray1<'_, f64>,
-        bg0: &PyReadonlyArray1<'_, f64>,
-        extra0: DVector<f64>,
-        p0: &PyReadonlyArray2<'_, f64>,
-        noise: InsNoise,
+        ba0: PyReadonlyArray1<'_, f64>,
+        bg0: PyReadonlyArray1<'_, f64>,
+        p0: PyReadonlyArray2<'_, f64>,
+        accel_psd: f64,
+        gyro_psd: f64,
+        accel_bias: (String, f64, f64),
+        gyro_bias: (String, f64, f64),
         predict_every: usize,
         method: &str,
         mode: &str,
         sequential: bool,
         gate: Option<f64>,
         ellipsoid: &str,
-        aiding: Box<dyn Aiding>,
     ) -> PyResult<Self> {
         use super::convert::vec3;
-        let q = vector(q0, "q0")?;
+        let q = vector(&q0, "q0")?;
         if q.len() != 4 {
             return Err(invalid("q0", format!("expected 4 elements, got {}", q.len())).into());
         }
-        let initial = NavState { t: t0, lla: vec3(lla0, "lla0")?, vel: vec3(vel0, "vel0")?, q_nb: crate::math::quat(q[0], q[1], q[2], q[3]) };
+        let initial = NavState { t: t0, lla: vec3(&lla0, "lla0")?, vel: vec3(&vel0, "vel0")?, q_nb: crate::math::quat(q[0], q[1], q[2], q[3]) };
+        let noise = ins_noise(accel_psd, gyro_psd, &accel_bias, &gyro_bias)?;
         let cfg = AidedConfig { noise, predict_every, method: Discretization::by_name(method)?, mode: LoopMode::by_name(mode)?, sequential, gate };
-        let ins = AidedIns::new(
+        Ok(AidedSetup {
             initial,
-            crate::imu::ImuKind::parse(kind)?,
-            Ellipsoid::by_name(ellipsoid)?,
-            vec3(ba0, "ba0")?,
-            vec3(bg0, "bg0")?,
-            extra0,
-            mat(p0, "p0")?,
+            kind: crate::imu::ImuKind::parse(kind)?,
+            ell: Ellipsoid::by_name(ellipsoid)?,
+            ba0: vec3(&ba0, "ba0")?,
+            bg0: vec3(&bg0, "bg0")?,
+            p0: mat(&p0, "p0")?,
             cfg,
-            aiding,
-        )?;
-        Ok(PyAidedIns { inner: std::sync::Mutex::new(ins) })
+        })
+    }
+}
+
+impl PyAidedIns {
+    /// The aided INS of `ins` with the sensor's model and the initial estimate of its
+    /// extra blocks.
+    pub(crate) fn from_aiding(ins: &AidedSetup, extra0: DVector<f64>, aiding: Box<dyn Aiding>) -> PyResult<Self> {
+        let engine = AidedIns::new(ins.initial, ins.kind, ins.ell, ins.ba0, ins.bg0, extra0, ins.p0.clone(), ins.cfg, aiding)?;
+        Ok(PyAidedIns { inner: std::sync::Mutex::new(engine) })
     }
 
     fn output<'py>(py: Python<'py>, o: AidedOutput, n: usize) -> PyResult<OutputTuple<'py>> {
@@ -492,31 +516,7 @@ pub(crate) fn ins_noise(accel_psd: f64, gyro_psd: f64, accel_bias: &(String, f64
 /// Position-aided INS: fixes at `fix_t` (M,) with (lat, lon, h) `fix_lla` (M, 3) and NED
 /// covariance `fix_cov` (M, 3, 3) m².
 #[pyfunction]
-#[pyo3(signature = (t0, lla0, vel0, q0, kind, ba0, bg0, p0, fix_t, fix_lla, fix_cov, accel_psd, gyro_psd, accel_bias, gyro_bias, predict_every, method, mode, sequential=false, gate=None, ellipsoid="WGS84"))]
-#[allow(clippy::too_many_arguments)]
-fn position_aided_ins<'py>(
-    t0: f64,
-    lla0: PyReadonlyArray1<'py, f64>,
-    vel0: PyReadonlyArray1<'py, f64>,
-    q0: PyReadonlyArray1<'py, f64>,
-    kind: &str,
-    ba0: PyReadonlyArray1<'py, f64>,
-    bg0: PyReadonlyArray1<'py, f64>,
-    p0: PyReadonlyArray2<'py, f64>,
-    fix_t: PyReadonlyArray1<'py, f64>,
-    fix_lla: PyReadonlyArray2<'py, f64>,
-    fix_cov: PyReadonlyArray3<'py, f64>,
-    accel_psd: f64,
-    gyro_psd: f64,
-    accel_bias: (String, f64, f64),
-    gyro_bias: (String, f64, f64),
-    predict_every: usize,
-    method: &str,
-    mode: &str,
-    sequential: bool,
-    gate: Option<f64>,
-    ellipsoid: &str,
-) -> PyResult<PyAidedIns> {
+fn position_aided_ins(ins: PyRef<'_, AidedSetup>, fix_t: PyReadonlyArray1<'_, f64>, fix_lla: PyReadonlyArray2<'_, f64>, fix_cov: PyReadonlyArray3<'_, f64>) -> PyResult<PyAidedIns> {
     let (ft, fl, fc) = (vector(&fix_t, "fix_t")?, vec3_rows(&fix_lla, "fix_lla")?, mats(&fix_cov, "fix_cov")?);
     if fl.len() != ft.len() || fc.len() != ft.len() {
         return Err(invalid("fixes", format!("fix_t has {} entries but fix_lla {} and fix_cov {}", ft.len(), fl.len(), fc.len())).into());
@@ -525,25 +525,7 @@ fn position_aided_ins<'py>(
         return Err(invalid("fix_cov", format!("expected (M, 3, 3), entry {i} is {}x{}", fc[i].nrows(), fc[i].ncols())).into());
     }
     let fixes: Vec<PositionFix> = (0..ft.len()).map(|i| PositionFix { t: ft[i], lla: fl[i], cov_ned: crate::math::Mat3::from_fn(|r, c| fc[i][(r, c)]) }).collect();
-    PyAidedIns::from_aiding(
-        t0,
-        &lla0,
-        &vel0,
-        &q0,
-        kind,
-        &ba0,
-        &bg0,
-        DVector::zeros(0),
-        &p0,
-        ins_noise(accel_psd, gyro_psd, &accel_bias, &gyro_bias)?,
-        predict_every,
-        method,
-        mode,
-        sequential,
-        gate,
-        ellipsoid,
-        Box::new(PositionAiding::new(fixes)?),
-    )
+    PyAidedIns::from_aiding(&ins, DVector::zeros(0), Box::new(PositionAiding::new(fixes)?))
 }
 
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
@@ -556,6 +538,7 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(rts, m)?)?;
     m.add_function(wrap_pyfunction!(position_aided_ins, m)?)?;
     m.add_class::<PyAidedIns>()?;
+    m.add_class::<AidedSetup>()?;
     m.add_class::<KalmanFilter>()?;
     m.add_class::<Scenario>()?;
     Ok(())

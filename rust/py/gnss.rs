@@ -254,16 +254,13 @@ fn gnss_spp<'py>(
 /// table as for `gnss_spp`; `extra0` initial (c·τ_GPS m[, c·δt_r m, c·δṫ_r m/s]); `p0` for
 /// the whole layout (15 INS states, then the extra blocks).
 #[pyfunction]
-#[pyo3(signature = (eph, time, sat, channel, code, rate, formulation, lever_arm, sigma_code_gps, sigma_code_glo, sigma_rate, use_rate, iono, tropo, tau_psd, clock_h0, clock_hm2, baro_time, baro_h, sigma_baro, t0, lla0, vel0, q0, kind, ba0, bg0, extra0, p0, accel_psd, gyro_psd, accel_bias, gyro_bias, predict_every, method, mode, sequential, gate, ellipsoid="WGS84"))]
+#[pyo3(signature = (eph, time, sat, channel, code, rate, formulation, lever_arm, sigma_code_gps, sigma_code_glo, sigma_rate, use_rate, iono, tropo, tau_psd, clock_h0, clock_hm2, baro_time, baro_h, sigma_baro, ins, extra0))]
 #[allow(clippy::too_many_arguments)]
 fn gnss_tight_ins<'py>(
     eph: &PyEphemerides, time: PyReadonlyArray1<'py, f64>, sat: Vec<String>, channel: PyReadonlyArray1<'py, i64>,
     code: PyReadonlyArray1<'py, f64>, rate: PyReadonlyArray1<'py, f64>, formulation: &str, lever_arm: PyReadonlyArray1<'py, f64>,
     sigma_code_gps: f64, sigma_code_glo: f64, sigma_rate: f64, use_rate: bool, iono: bool, tropo: bool, tau_psd: f64, clock_h0: f64,
-    clock_hm2: f64, baro_time: PyReadonlyArray1<'py, f64>, baro_h: PyReadonlyArray1<'py, f64>, sigma_baro: f64, t0: f64, lla0: PyReadonlyArray1<'py, f64>, vel0: PyReadonlyArray1<'py, f64>, q0: PyReadonlyArray1<'py, f64>, kind: &str,
-    ba0: PyReadonlyArray1<'py, f64>, bg0: PyReadonlyArray1<'py, f64>, extra0: PyReadonlyArray1<'py, f64>, p0: PyReadonlyArray2<'py, f64>,
-    accel_psd: f64, gyro_psd: f64, accel_bias: (String, f64, f64), gyro_bias: (String, f64, f64), predict_every: usize, method: &str,
-    mode: &str, sequential: bool, gate: Option<f64>, ellipsoid: &str,
+    clock_hm2: f64, baro_time: PyReadonlyArray1<'py, f64>, baro_h: PyReadonlyArray1<'py, f64>, sigma_baro: f64, ins: PyRef<'py, super::filter::AidedSetup>, extra0: PyReadonlyArray1<'py, f64>,
 ) -> PyResult<PyAidedIns> {
     let obs = parse_obs(&sat, &channel, &code, &rate)?;
     let epochs = group_epochs(time.as_array().as_slice().ok_or_else(|| invalid("time", "must be contiguous"))?, &obs)?;
@@ -283,7 +280,7 @@ fn gnss_tight_ins<'py>(
         tau_psd,
         clock_h0,
         clock_hm2,
-        kind: crate::imu::ImuKind::parse(kind)?,
+        kind: ins.kind,
         sigma_baro,
     };
     let (bt, bh) = (vector(&baro_time, "baro_time")?, vector(&baro_h, "baro_h")?);
@@ -292,9 +289,7 @@ fn gnss_tight_ins<'py>(
     }
     let baro: Vec<(f64, f64)> = bt.into_iter().zip(bh).collect();
     let aiding = TightAiding::new(eph.inner.clone(), epochs, &baro, cfg)?;
-    let noise = super::filter::ins_noise(accel_psd, gyro_psd, &accel_bias, &gyro_bias)?;
-    let x0 = nalgebra::DVector::from_vec(vector(&extra0, "extra0")?);
-    PyAidedIns::from_aiding(t0, &lla0, &vel0, &q0, kind, &ba0, &bg0, x0, &p0, noise, predict_every, method, mode, sequential, gate, ellipsoid, Box::new(aiding))
+    PyAidedIns::from_aiding(&ins, nalgebra::DVector::from_vec(vector(&extra0, "extra0")?), Box::new(aiding))
 }
 
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {

@@ -450,7 +450,7 @@ def cai_aided_ins(t0: float, lla0, vel0, q0, sensor: CaiSensor, shots, *, phase=
     ``laser_phase`` (rad) the instrument applied. ``setup``: filter noise (default the
     seed-003 tuning); ``p0`` overrides ``setup.p0``; the initial state and the remaining
     options are those of :func:`atomnav.filter.position_aided_ins`."""
-    from ..filter.aided import AidedIns, ins_arguments
+    from ..filter.aided import AidedIns, ins_setup
     from ..filter.engine import BiasModel
 
     emulated = phase is not None or noise is not None
@@ -468,16 +468,16 @@ def cai_aided_ins(t0: float, lla0, vel0, q0, sensor: CaiSensor, shots, *, phase=
         tables.append(np.ascontiguousarray(x))
     setup = setup or seed003_filter()
     n_extra = sensor.n_extra()
-    args = ins_arguments(t0, lla0, vel0, q0, kind, setup.p0(n_extra) if p0 is None else p0, setup.accel_psd, setup.gyro_psd,
-                         BiasModel("random_walk", psd=setup.accel_bias_psd), BiasModel("random_walk", psd=setup.gyro_bias_psd),
-                         ba0, bg0, setup.predict_every, method, mode, sequential, gate, ellipsoid)
+    ins = ins_setup(t0, lla0, vel0, q0, kind, setup.p0(n_extra) if p0 is None else p0, setup.accel_psd, setup.gyro_psd,
+                    BiasModel("random_walk", psd=setup.accel_bias_psd), BiasModel("random_walk", psd=setup.gyro_bias_psd),
+                    ba0, bg0, setup.predict_every, method, mode, sequential, gate, ellipsoid)
     extra0 = vector(np.zeros(n_extra) if extra0 is None else extra0, n_extra, "extra0")
     shots = vector(shots, None, "shots")
     core = _core.cai_aided_ins(
-        extra0=extra0, channels=sensor.channels._native(), t_sep=positive(sensor.T, "T"), shots=shots,
+        ins=ins, extra0=extra0, channels=sensor.channels._native(), t_sep=positive(sensor.T, "T"), shots=shots,
         readout=(float(sensor.offset), float(sensor.contrast), float(sensor.sigma_p)), inflation=sensor.inflation,
         omega_dot=sensor.omega_dot, savgol_half_width=int(sensor.savgol_half_width), interpolation=sensor.interpolation,
         substeps=int(sensor.substeps), jacobian_euler=bool(sensor.jacobian_euler), misalignment=sensor.misalignment_psd,
         lever_arm=sensor.lever_arm_psd, force=sensor.force, data_kind="emulated" if emulated else "recorded",
-        data_a=tables[0], data_b=tables[1], **args)
+        data_a=tables[0], data_b=tables[1])
     return AidedIns(core, kind)

@@ -127,16 +127,15 @@ def _concat(parts: list[AidedResult]) -> AidedResult:
                        np.concatenate([p.innovation for p in parts]))
 
 
-def ins_arguments(t0, lla0, vel0, q0, kind, p0, accel_psd, gyro_psd, accel_bias: BiasModel, gyro_bias: BiasModel,
-                  ba0, bg0, predict_every, method, mode, sequential, gate, ellipsoid) -> dict:
-    """The checked arguments every sensor factory passes to the core (see
-    :func:`position_aided_ins` for their meaning)."""
+def ins_setup(t0, lla0, vel0, q0, kind, p0, accel_psd, gyro_psd, accel_bias: BiasModel, gyro_bias: BiasModel,
+              ba0, bg0, predict_every, method, mode, sequential, gate, ellipsoid) -> _core.AidedSetup:
+    """The INS part every sensor factory shares, checked once (see
+    :func:`position_aided_ins` for the meaning of the arguments)."""
     choice(kind, ("rates", "increments"), "kind")
-    return dict(t0=float(t0), lla0=vector(lla0, 3, "lla0"), vel0=vector(vel0, 3, "vel0"), q0=vector(q0, 4, "q0"),
-                kind=kind, ba0=vector(ba0, 3, "ba0"), bg0=vector(bg0, 3, "bg0"), p0=_mat(p0, "p0"),
-                accel_psd=float(accel_psd), gyro_psd=float(gyro_psd), accel_bias=accel_bias._parts(),
-                gyro_bias=gyro_bias._parts(), predict_every=int(predict_every), method=method, mode=mode,
-                sequential=bool(sequential), gate=None if gate is None else float(gate), ellipsoid=ellipsoid)
+    return _core.AidedSetup(float(t0), vector(lla0, 3, "lla0"), vector(vel0, 3, "vel0"), vector(q0, 4, "q0"), kind,
+                            vector(ba0, 3, "ba0"), vector(bg0, 3, "bg0"), _mat(p0, "p0"), float(accel_psd),
+                            float(gyro_psd), accel_bias._parts(), gyro_bias._parts(), int(predict_every), method, mode,
+                            bool(sequential), None if gate is None else float(gate), ellipsoid)
 
 
 def position_aided_ins(t0: float, lla0, vel0, q0, kind: str, fix_time, fix_lla, fix_cov, p0, accel_psd: float,
@@ -159,9 +158,9 @@ def position_aided_ins(t0: float, lla0, vel0, q0, kind: str, fix_time, fix_lla, 
     >>> result = ins.run(time, gyro, accel)        # doctest: +SKIP
     >>> truth.errors(result.nav)                   # doctest: +SKIP
     """
-    args = ins_arguments(t0, lla0, vel0, q0, kind, p0, accel_psd, gyro_psd, accel_bias, gyro_bias, ba0, bg0,
-                         predict_every, method, mode, sequential, gate, ellipsoid)
+    ins = ins_setup(t0, lla0, vel0, q0, kind, p0, accel_psd, gyro_psd, accel_bias, gyro_bias, ba0, bg0,
+                    predict_every, method, mode, sequential, gate, ellipsoid)
     core = _core.position_aided_ins(
-        fix_t=np.ascontiguousarray(np.asarray(fix_time, float).ravel()), fix_lla=rows(fix_lla, 3, "fix_lla"),
-        fix_cov=np.ascontiguousarray(np.asarray(fix_cov, float).reshape(-1, 3, 3)), **args)
+        ins, np.ascontiguousarray(np.asarray(fix_time, float).ravel()), rows(fix_lla, 3, "fix_lla"),
+        np.ascontiguousarray(np.asarray(fix_cov, float).reshape(-1, 3, 3)))
     return AidedIns(core, kind)

@@ -10,7 +10,7 @@ import pandas as pd
 
 from .. import _core
 from .._validate import choice, vector
-from ..filter.aided import AidedIns, ins_arguments
+from ..filter.aided import AidedIns, ins_setup
 from ..filter.engine import BiasModel
 from .ephemeris import Ephemerides
 from .observations import C_LIGHT, obs_arrays
@@ -52,8 +52,8 @@ def tight_ins(eph: Ephemerides, obs: pd.DataFrame, t0: float, lla0, vel0, q0, ki
     p0 = np.zeros((n, n))
     p0[:15, :15] = p_ins
     p0[15:, 15:] = np.diag(var)
-    args = ins_arguments(t0, lla0, vel0, q0, kind, p0, accel_psd, gyro_psd, accel_bias, gyro_bias, ba0, bg0,
-                         predict_every, method, mode, sequential, gate, ellipsoid)
+    ins = ins_setup(t0, lla0, vel0, q0, kind, p0, accel_psd, gyro_psd, accel_bias, gyro_bias, ba0, bg0,
+                    predict_every, method, mode, sequential, gate, ellipsoid)
     core = _core.gnss_tight_ins(
         eph._core, *obs_arrays(obs), formulation=formulation, lever_arm=vector(lever_arm, 3, "lever_arm"),
         sigma_code_gps=float(sigma_code), sigma_code_glo=float(sigma_code if sigma_code_glonass is None else sigma_code_glonass),
@@ -61,5 +61,5 @@ def tight_ins(eph: Ephemerides, obs: pd.DataFrame, t0: float, lla0, vel0, q0, ki
         tau_psd=C_LIGHT ** 2 * float(tau_psd), clock_h0=float(clock_h0), clock_hm2=float(clock_hm2),
         baro_time=vector(np.asarray(baro_time, float), None, "baro_time"), baro_h=vector(np.asarray(baro_h, float), None, "baro_h"),
         sigma_baro=float(sigma_baro),
-        extra0=np.array(extra), **args)
+        ins=ins, extra0=np.array(extra))
     return AidedIns(core, kind)
