@@ -211,6 +211,10 @@ pub struct Local {
     /// Normal gravity γ (m/s², down).
     pub gravity: f64,
     omega: f64,
+    /// 1/R_M, 1/R_P and tan φ, so the rates below need no division.
+    inv_rm: f64,
+    inv_rp: f64,
+    tan: f64,
 }
 
 impl Local {
@@ -220,11 +224,46 @@ impl Local {
     }
     /// ω_en^n = (v_E/R_P, −v_N/R_M, −v_E tan φ/R_P).
     pub fn transport_rate(&self, v: &Vec3) -> Vec3 {
-        Vec3::new(v.y / self.rp, -v.x / self.rm, -v.y * self.sin / (self.cos * self.rp))
+        Vec3::new(v.y * self.inv_rp, -v.x * self.inv_rm, -v.y * self.tan * self.inv_rp)
     }
     /// (φ̇, λ̇, ḣ) = (v_N/R_M, v_E/(R_P cos φ), −v_D).
     pub fn lla_rate(&self, v: &Vec3) -> Vec3 {
-        Vec3::new(v.x / self.rm, v.y / (self.rp * self.cos), -v.z)
+        Vec3::new(v.x * self.inv_rm, v.y * self.inv_rp / self.cos, -v.z)
+    }
+}
+
+/// The position-independent constants of `Ellipsoid::local`, computed once (a
+/// mechanization evaluates the Earth model at every step).
+#[derive(Debug, Clone, Copy)]
+pub struct LocalModel {
+    a: f64,
+    e2: f64,
+    /// a(1 − e²), for M = a(1 − e²)/W³.
+    a_1me2: f64,
+    omega: f64,
+    gamma_e: f64,
+    /// Somigliana's k.
+    k: f64,
+    /// Height correction 1 − (c₁ − c₂ sin²φ) h + c₃ h² with c₁ = 2(1 + f + m)/a,
+    /// c₂ = 4f/a, c₃ = 3/a² (spec gnss-ins-tight §2.1 Eq. 4).
+    c1: f64,
+    c2: f64,
+    c3: f64,
+}
+
+impl LocalModel {
+    /// Everything the mechanization needs at (lat rad, h m), with one sin/cos, one sqrt
+    /// and three divisions.
+    pub fn at(&self, lat: f64, h: f64) -> Local {
+        let (sin, cos) = lat.sin_cos();
+        let s2 = sin * sin;
+        let w2 = 1.0 - self.e2 * s2;
+        let inv_w = 1.0 / w2.sqrt();
+        let (m, n) = (self.a_1me2 * inv_w * inv_w * inv_w, self.a * inv_w);
+        let g0 = self.gamma_e * (1.0 + self.k * s2) * inv_w;
+        let gravity = g0 * (1.0 - (self.c1 - self.c2 * s2) * h + self.c3 * h * h);
+        let (rm, rp) = (m + h, n + h);
+        Local { sin, cos, rm, rp, gravity, omega: self.omega, inv_rm: 1.0 / rm, inv_rp: 1.0 / rp, tan: sin / cos }
     }
 }
 
@@ -245,18 +284,25 @@ pub fn check_latitude(field: &str, lat: f64, index: usize) -> Result<()> {
 }
 
 impl Ellipsoid {
-    /// Everything the mechanization needs at one position, with one sin/cos and one sqrt.
+    /// Everything the mechanization needs at one position (see `LocalModel::at`).
     pub fn local(&self, lat: f64, h: f64) -> Local {
-        let (sin, cos) = lat.sin_cos();
-        let e2 = self.e2();
-        let w2 = 1.0 - e2 * sin * sin;
-        let w = w2.sqrt();
-        let (m, n) = (self.a * (1.0 - e2) / (w2 * w), self.a / w);
-        let (a, f, mm, s2) = (self.a, self.f, self.m(), sin * sin);
-        let k = self.somigliana_k();
-        let g0 = self.gamma_e * (1.0 + k * s2) / w;
-        let gravity = g0 * (1.0 - 2.0 / a * (1.0 + f + mm - 2.0 * f * s2) * h + 3.0 * h * h / (a * a));
-        Local { sin, cos, rm: m + h, rp: n + h, gravity, omega: self.omega }
+        self.local_model().at(lat, h)
+    }
+
+    /// The constants of `local`, to compute once where it is evaluated at every step.
+    pub fn local_model(&self) -> LocalModel {
+        let (a, f) = (self.a, self.f);
+        LocalModel {
+            a,
+            e2: self.e2(),
+            a_1me2: a * (1.0 - self.e2()),
+            omega: self.omega,
+            gamma_e: self.gamma_e,
+            k: self.somigliana_k(),
+            c1: 2.0 / a * (1.0 + f + self.m()),
+            c2: 4.0 * f / a,
+            c3: 3.0 / (a * a),
+        }
     }
 
     /// NED coordinates (m) of ECEF point `r` relative to the geodetic origin `origin_lla`.

@@ -11,7 +11,7 @@
 //! One `Strapdown` object serves batch use (one call over a whole record) and streaming
 //! (successive chunks): it keeps the previous sample for coning/sculling.
 
-use crate::earth::{check_latitude, Ellipsoid};
+use crate::earth::{check_latitude, Ellipsoid, LocalModel};
 use crate::error::{invalid, Result};
 pub use crate::imu::ImuKind;
 use crate::math::{quat_from_rotvec, quat_normalize, quat_rotate, Quat, Vec3};
@@ -43,11 +43,13 @@ pub struct Strapdown {
     pub kind: ImuKind,
     pub vertical: Vertical,
     pub state: NavState,
+    /// `ell`'s constants of the Earth model evaluated at every step.
+    earth: LocalModel,
     /// Increments (Δθ, Δv) of up to the two previous intervals (most recent last), for
     /// the multi-interval coning and sculling terms.
-    prev_increments: Vec<(Vec3, Vec3)>,
+    prev_increments: History<(Vec3, Vec3)>,
     /// Up to the last two rate samples (t, ω, f), to turn rates into increments.
-    rate_history: Vec<(f64, Vec3, Vec3)>,
+    rate_history: History<(f64, Vec3, Vec3)>,
     /// Previous step: (Δlla, Δt, g − (2ω_ie + ω_en)×v at its midpoint), for the midpoint
     /// extrapolation.
     last_step: Option<(Vec3, f64, Vec3)>,
@@ -69,7 +71,7 @@ impl Strapdown {
             }
         }
         let state = NavState { q_nb: quat_normalize(&initial.q_nb), ..initial };
-        Ok(Strapdown { ell, kind, vertical, state, prev_increments: Vec::new(), rate_history: Vec::new(), last_step: None })
+        Ok(Strapdown { ell, kind, vertical, state, earth: ell.local_model(), prev_increments: History::default(), rate_history: History::default(), last_step: None })
     }
 
     /// Run over a chunk. `t[k]` is the sample time (rates) or the end of the interval
@@ -79,12 +81,18 @@ impl Strapdown {
     /// at the initial time only primes the integrator (its output is the initial state).
     /// On divergence `out` keeps every state computed before it.
     pub fn run(&mut self, t: &[f64], gyro: &[Vec3], accel: &[Vec3], h_ref: Option<&[f64]>, out: &mut Vec<NavState>) -> Result<()> {
-        self.validate(t, gyro, accel, h_ref)?;
+        self.validate(t, gyro, accel, h_ref, 0)?;
+        self.run_validated(t, gyro, accel, h_ref, 0, out)
+    }
+
+    /// `run` on samples already checked by `validate` (as one chunk, of which these are
+    /// rows `first_index`…, the index divergence errors report).
+    pub(crate) fn run_validated(&mut self, t: &[f64], gyro: &[Vec3], accel: &[Vec3], h_ref: Option<&[f64]>, first_index: usize, out: &mut Vec<NavState>) -> Result<()> {
         out.reserve(t.len());
         for k in 0..t.len() {
             let href = h_ref.map(|h| h[k]);
             self.step(t[k], &gyro[k], &accel[k], href);
-            self.check_diverged(k)?;
+            self.check_diverged(first_index + k)?;
             out.push(self.state);
         }
         Ok(())
@@ -105,8 +113,9 @@ impl Strapdown {
     }
 
     /// Checks of a chunk before it is run (shapes, time order from the current state,
-    /// finite samples, reference altitude).
-    pub(crate) fn validate(&self, t: &[f64], gyro: &[Vec3], accel: &[Vec3], h_ref: Option<&[f64]>) -> Result<()> {
+    /// finite samples, reference altitude). Messages give indices counted from
+    /// `first_index` (the chunk's position in the whole record).
+    pub(crate) fn validate(&self, t: &[f64], gyro: &[Vec3], accel: &[Vec3], h_ref: Option<&[f64]>, first_index: usize) -> Result<()> {
         let n = t.len();
         if gyro.len() != n || accel.len() != n {
             return Err(invalid("imu", format!("time has {n} samples but gyro {} and accel {}", gyro.len(), accel.len())));
@@ -114,29 +123,29 @@ impl Strapdown {
         let mut prev_t = self.state.t;
         for (k, &tk) in t.iter().enumerate() {
             if !tk.is_finite() {
-                return Err(invalid("time", format!("non-finite time {tk} at index {k}")));
+                return Err(invalid("time", format!("non-finite time {tk} at index {}", first_index + k)));
             }
             // With rates the very first sample may coincide with the initial time.
-            let first_rate_sample = self.kind == ImuKind::Rates && self.rate_history.is_empty() && k == 0;
+            let first_rate_sample = self.kind == ImuKind::Rates && self.rate_history.as_slice().is_empty() && k == 0;
             if first_rate_sample && tk != self.state.t {
-                return Err(invalid("time", format!("the first rate sample must be at the initial time {} s, got {tk} at index 0", self.state.t)));
+                return Err(invalid("time", format!("the first rate sample must be at the initial time {} s, got {tk} at index {first_index}", self.state.t)));
             }
             if !first_rate_sample && tk <= prev_t {
                 let what = if tk == prev_t { "duplicated" } else { "decreasing" };
-                return Err(invalid("time", format!("time not strictly increasing: {what} stamp {tk} at index {k}")));
+                return Err(invalid("time", format!("time not strictly increasing: {what} stamp {tk} at index {}", first_index + k)));
             }
             prev_t = tk;
         }
         for (name, data) in [("gyro", gyro), ("accel", accel)] {
             if let Some(k) = data.iter().position(|v| !v.iter().all(|x| x.is_finite())) {
-                return Err(invalid(name, format!("non-finite value at index {k}: {:?}", data[k].as_slice())));
+                return Err(invalid(name, format!("non-finite value at index {}: {:?}", first_index + k, data[k].as_slice())));
             }
         }
         match (self.vertical, h_ref) {
             (Vertical::Damped { .. }, None) => Err(invalid("h_ref", "a damped vertical channel needs a reference altitude per sample")),
             (_, Some(h)) if h.len() != n => Err(invalid("h_ref", format!("expected {n} samples, got {}", h.len()))),
             (_, Some(h)) => match h.iter().position(|x| !x.is_finite()) {
-                Some(k) => Err(invalid("h_ref", format!("non-finite value at index {k}"))),
+                Some(k) => Err(invalid("h_ref", format!("non-finite value at index {}", first_index + k))),
                 None => Ok(()),
             },
             _ => Ok(()),
@@ -148,16 +157,16 @@ impl Strapdown {
         let (dth, dv) = match self.kind {
             ImuKind::Increments => (*gyro, *accel),
             ImuKind::Rates => {
-                let inc = rates_to_increment(&self.rate_history, t, gyro, accel);
-                push_history(&mut self.rate_history, (t, *gyro, *accel));
+                let inc = rates_to_increment(self.rate_history.as_slice(), t, gyro, accel);
+                self.rate_history.push((t, *gyro, *accel));
                 match inc {
                     Some(inc) => inc,
                     None => return, // first rate sample at the initial time: nothing to integrate yet
                 }
             }
         };
-        let (phi, dv_body) = coning_sculling(&self.prev_increments, &dth, &dv);
-        push_history(&mut self.prev_increments, (dth, dv));
+        let (phi, dv_body) = coning_sculling(self.prev_increments.as_slice(), &dth, &dv);
+        self.prev_increments.push((dth, dv));
         let dt = t - self.state.t;
         self.integrate(t, dt, &phi, &dv_body, h_ref);
     }
@@ -167,19 +176,19 @@ impl Strapdown {
     /// and sculling included), both referred to the body frame at t_{k−1}.
     fn integrate(&mut self, t: f64, dt: f64, phi: &Vec3, dv_body: &Vec3, h_ref: Option<f64>) {
         let s0 = self.state;
-        let ell = &self.ell;
+        let model = &self.earth;
         let dv_sf_b = quat_rotate(&s0.q_nb, dv_body); // C_nb(k−1) Δv
         // midpoint: position extrapolated from the previous step; velocity from this step's
         // specific force and the previous gravity–Coriolis term (at t₀ on the first step)
         let (lla_mid, gc_prev) = match self.last_step {
             Some((dlla, dt_prev, gc)) => (s0.lla + dlla * (0.5 * dt / dt_prev), gc),
             None => {
-                let e = ell.local(s0.lla.x, s0.lla.z);
+                let e = model.at(s0.lla.x, s0.lla.z);
                 (s0.lla, Vec3::new(0.0, 0.0, e.gravity) - (2.0 * e.earth_rate() + e.transport_rate(&s0.vel)).cross(&s0.vel))
             }
         };
         let v_mid = s0.vel + 0.5 * (dv_sf_b + gc_prev * dt);
-        let earth = ell.local(lla_mid.x, lla_mid.z);
+        let earth = model.at(lla_mid.x, lla_mid.z);
         // Baro loop (spec Eq. 26): ḣ gets −K_v1(h − h_b), v̇_D gets +K_v2(h − h_b), with
         // K_v1 = 2ζω_v, K_v2 = ω_v² + 2γ/R₀ (R₀ = √(R_M R_P)).
         let (k1, k2, dh0) = match (self.vertical, h_ref) {
@@ -227,12 +236,25 @@ fn rates_to_increment(history: &[(f64, Vec3, Vec3)], t: f64, w: &Vec3, f: &Vec3)
     }
 }
 
-/// Keep the last two entries of a short history.
-fn push_history<T>(history: &mut Vec<T>, item: T) {
-    if history.len() == 2 {
-        history.remove(0);
+/// The last two entries of a stream (oldest first), kept without allocation.
+#[derive(Debug, Clone, Copy, Default)]
+struct History<T: Copy + Default> {
+    items: [T; 2],
+    len: usize,
+}
+
+impl<T: Copy + Default> History<T> {
+    fn push(&mut self, item: T) {
+        if self.len == 2 {
+            self.items[0] = self.items[1];
+            self.len = 1;
+        }
+        self.items[self.len] = item;
+        self.len += 1;
     }
-    history.push(item);
+    fn as_slice(&self) -> &[T] {
+        &self.items[..self.len]
+    }
 }
 
 /// Coning and sculling from this and the previous increments (most recent last).
@@ -269,12 +291,15 @@ fn coning_sculling(prev: &[(Vec3, Vec3)], dth: &Vec3, dv: &Vec3) -> (Vec3, Vec3)
 /// term (a one-time error of about |Δθ₀ × Δθ₁|/12 on the first step).
 pub fn integrate_attitude(q0: &Quat, dtheta: &[Vec3], dtheta_prev: &[Vec3]) -> Vec<Quat> {
     let mut q = quat_normalize(q0);
-    let mut prev: Vec<(Vec3, Vec3)> = dtheta_prev.iter().rev().take(2).rev().map(|d| (*d, Vec3::zeros())).collect();
+    let mut prev = History::default();
+    for d in dtheta_prev.iter().rev().take(2).rev() {
+        prev.push((*d, Vec3::zeros()));
+    }
     dtheta
         .iter()
         .map(|d| {
-            let (phi, _) = coning_sculling(&prev, d, &Vec3::zeros());
-            push_history(&mut prev, (*d, Vec3::zeros()));
+            let (phi, _) = coning_sculling(prev.as_slice(), d, &Vec3::zeros());
+            prev.push((*d, Vec3::zeros()));
             q = quat_normalize(&(q * quat_from_rotvec(&phi)));
             q
         })

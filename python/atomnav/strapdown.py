@@ -25,7 +25,8 @@ def _table(columns: np.ndarray) -> pd.DataFrame:
 
 
 def _imu_arrays(imu, kind: str):
-    """(time, gyro, accel) arrays from an IMU table of the given kind."""
+    """(time, gyro, accel) views of an IMU table of the given kind. Only shapes are checked
+    here: the core checks values (NaN/inf, time order) once, with indices in the record."""
     cols = IMU_COLUMNS[kind]
     if isinstance(imu, pd.DataFrame):
         missing = [c for c in cols if c not in imu.columns]
@@ -33,8 +34,10 @@ def _imu_arrays(imu, kind: str):
             raise ValueError(f"imu: missing column(s) {missing} for kind={kind!r} (expected {cols})")
         a = imu[cols].to_numpy(float)
     else:
-        a = rows(imu, 7, "imu")
-    return vector(a[:, 0], None, "time_s"), rows(a[:, 1:4], 3, "gyro"), rows(a[:, 4:7], 3, "accel")
+        a = np.asarray(imu, dtype=float)
+        if a.ndim != 2 or a.shape[1] != 7:
+            raise ValueError(f"imu: expected shape (N, 7), got {a.shape}")
+    return a[:, 0], a[:, 1:4], a[:, 4:7]
 
 
 class Strapdown:
@@ -85,7 +88,7 @@ def integrate(imu, t0, lla, vel_ned, q_nb, kind: str = "increments", ellipsoid: 
         for s in range(0, len(t), CHUNK):
             sl = slice(s, s + CHUNK)
             try:
-                out = sd._core.run(t[sl], g[sl], a[sl], None if h is None else h[sl])
+                out = sd._core.run(t[sl], g[sl], a[sl], None if h is None else h[sl], s)
             except _core.NumericalError as err:
                 err.partial = _table(np.hstack(parts + [err.partial]))
                 raise

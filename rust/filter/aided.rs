@@ -252,7 +252,7 @@ impl<A: Aiding> AidedIns<A> {
         if n == 0 {
             return Ok(());
         }
-        self.sd.validate(t, gyro, accel, None)?;
+        self.sd.validate(t, gyro, accel, None, 0)?;
         // A measurement before the first sample of the record can never be applied.
         if self.last_sample.is_none() {
             if let Some(&tm) = self.aiding.times().first().filter(|&&tm| tm < t[0]) {

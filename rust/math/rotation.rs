@@ -38,14 +38,16 @@ pub fn quat_mul(a: &Quat, b: &Quat) -> Quat {
 }
 
 /// Quaternion of the rotation vector φ (exponential map): [cos(|φ|/2), sin(|φ|/2) φ/|φ|].
-/// Uses the Taylor series below |φ| = 1e-4 so tiny rotations keep full relative accuracy.
+/// Below |φ| = 1e-2 (every strapdown step) the Taylor series through θ⁶ replaces sin/cos:
+/// the first omitted terms, θ⁸/10321920 and θ⁸/185794560, are < 1e-23 there, so the
+/// series is exact to rounding and tiny rotations keep full relative accuracy.
 pub fn quat_from_rotvec(phi: &Vec3) -> Quat {
     let th2 = phi.norm_squared();
-    let th = th2.sqrt();
-    let (c, s_over_th) = if th < 1e-4 {
-        // cos(θ/2) and sin(θ/2)/θ to O(θ⁶)
-        (1.0 - th2 / 8.0 + th2 * th2 / 384.0, 0.5 - th2 / 48.0 + th2 * th2 / 3840.0)
+    let (c, s_over_th) = if th2 < 1e-4 {
+        // cos(θ/2) = 1 − θ²/8 + θ⁴/384 − θ⁶/46080; sin(θ/2)/θ = ½ − θ²/48 + θ⁴/3840 − θ⁶/645120
+        (1.0 - th2 / 8.0 * (1.0 - th2 / 48.0 * (1.0 - th2 / 120.0)), 0.5 - th2 / 48.0 * (1.0 - th2 / 80.0 * (1.0 - th2 / 168.0)))
     } else {
+        let th = th2.sqrt();
         ((0.5 * th).cos(), (0.5 * th).sin() / th)
     };
     Quaternion::new(c, s_over_th * phi.x, s_over_th * phi.y, s_over_th * phi.z)

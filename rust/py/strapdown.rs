@@ -1,8 +1,8 @@
 //! Bindings of strapdown.rs: a streaming mechanization object and attitude integration.
 
-use super::convert::{flat_to_py, quat_rows, quat_to_py, vec3, vec3_rows, vector};
+use super::convert::{flat_to_py, quat_rows, quat_to_py, vec3, vec3_rows, vec3_rows_unchecked, vector};
 use crate::earth::Ellipsoid;
-use crate::error::invalid;
+use crate::error::{invalid, NavError};
 use crate::math::{euler_from_quat, quat, Vec3};
 use crate::strapdown::{integrate_attitude, ImuKind, NavState, Strapdown as Core, Vertical};
 use numpy::{PyArray2, PyReadonlyArray1, PyReadonlyArray2};
@@ -18,17 +18,65 @@ pub struct Strapdown {
 /// `atomnav.trajectory.COLUMNS` (time, lat, lon, h, v_N, v_E, v_D, q_nb (4), roll, pitch,
 /// yaw) — so that pandas can wrap its transpose without copying.
 pub(crate) fn states_to_columns<'py>(py: Python<'py>, s: &[NavState]) -> Bound<'py, PyArray2<f64>> {
-    let n = s.len();
-    let mut buf = vec![0.0; 14 * n];
+    let mut buf = vec![0.0; COLUMNS * s.len()];
+    write_columns(&mut buf, s.len(), 0, s);
+    flat_to_py(py, COLUMNS, s.len(), buf)
+}
+
+/// Number of columns of the navigation table.
+const COLUMNS: usize = 14;
+
+/// Write states as rows `first`… of an (14, n) column-major table `buf`.
+fn write_columns(buf: &mut [f64], n: usize, first: usize, s: &[NavState]) {
     for (i, x) in s.iter().enumerate() {
         let e = euler_from_quat(&x.q_nb);
         let q = &x.q_nb;
         let row = [x.t, x.lla.x, x.lla.y, x.lla.z, x.vel.x, x.vel.y, x.vel.z, q.w, q.i, q.j, q.k, e.x, e.y, e.z];
         for (c, v) in row.into_iter().enumerate() {
-            buf[c * n + i] = v;
+            buf[c * n + first + i] = v;
         }
     }
-    flat_to_py(py, 14, n, buf)
+}
+
+/// Samples integrated per block of the pipelined run: small enough that the states of
+/// two blocks stay in cache, large enough to amortise the thread hand-over.
+const PIPELINE_BLOCK: usize = 4096;
+
+/// Integrate a validated chunk while a second core turns the previous block's states into
+/// the column table (the Euler angles' three atan2 per row cost about as much as the
+/// mechanization step). Returns the table of the rows computed and, on divergence, the error.
+fn run_pipelined(core: &mut Core, t: &[f64], g: &[Vec3], a: &[Vec3], h: Option<&[f64]>, first_index: usize) -> (Vec<f64>, usize, Result<(), NavError>) {
+    let n = t.len();
+    let mut buf = vec![0.0; COLUMNS * n];
+    let (mut done, mut current) = (Vec::with_capacity(PIPELINE_BLOCK), Vec::with_capacity(PIPELINE_BLOCK));
+    let mut written = 0;
+    let mut result = Ok(());
+    for start in (0..n).step_by(PIPELINE_BLOCK) {
+        let end = (start + PIPELINE_BLOCK).min(n);
+        current.clear();
+        let (step, ()) = rayon::join(
+            || core.run_validated(&t[start..end], &g[start..end], &a[start..end], h.map(|h| &h[start..end]), first_index + start, &mut current),
+            || write_columns(&mut buf, n, written, &done),
+        );
+        written += done.len();
+        std::mem::swap(&mut done, &mut current);
+        if step.is_err() {
+            result = step;
+            break;
+        }
+    }
+    write_columns(&mut buf, n, written, &done);
+    written += done.len();
+    (buf, written, result)
+}
+
+/// The first `rows` rows of an (14, n) column-major table, as a (14, rows) array.
+fn table_rows<'py>(py: Python<'py>, buf: Vec<f64>, n: usize, rows: usize) -> Bound<'py, PyArray2<f64>> {
+    if rows == n {
+        return flat_to_py(py, COLUMNS, n, buf);
+    }
+    let cut: Vec<f64> = buf.chunks_exact(n).flat_map(|col| col[..rows].iter().copied()).collect();
+    flat_to_py(py, COLUMNS, rows, cut)
 }
 
 #[pymethods]
@@ -64,7 +112,8 @@ impl Strapdown {
     }
 
     /// Integrate one chunk; returns the state after each sample as a (14, N) column table.
-    #[pyo3(signature = (time, gyro, accel, h_ref=None))]
+    /// `first_index` is the chunk's first row in the whole record, for error messages.
+    #[pyo3(signature = (time, gyro, accel, h_ref=None, first_index=0))]
     fn run<'py>(
         &mut self,
         py: Python<'py>,
@@ -72,23 +121,25 @@ impl Strapdown {
         gyro: PyReadonlyArray2<'py, f64>,
         accel: PyReadonlyArray2<'py, f64>,
         h_ref: Option<PyReadonlyArray1<'py, f64>>,
+        first_index: usize,
     ) -> PyResult<Bound<'py, PyArray2<f64>>> {
         let t: Vec<f64> = time.as_array().iter().copied().collect();
-        let g = vec3_rows(&gyro, "gyro")?;
-        let a = vec3_rows(&accel, "accel")?;
+        // finiteness is checked by `validate`, with indices in the whole record
+        let g = vec3_rows_unchecked(&gyro, "gyro")?;
+        let a = vec3_rows_unchecked(&accel, "accel")?;
         let h: Option<Vec<f64>> = h_ref.map(|h| h.as_array().iter().copied().collect());
         let inner = &mut self.inner;
-        let mut out = Vec::new();
-        let result = py.detach(|| inner.run(&t, &g, &a, h.as_deref(), &mut out));
+        inner.validate(&t, &g, &a, h.as_deref(), first_index)?;
+        let (buf, rows, result) = py.detach(|| run_pipelined(inner, &t, &g, &a, h.as_deref(), first_index));
+        let table = table_rows(py, buf, t.len(), rows);
         match result {
-            Ok(()) => Ok(states_to_columns(py, &out)),
-            Err(e @ crate::error::NavError::Numerical(_)) => {
+            Ok(()) => Ok(table),
+            Err(e) => {
                 // keep what was computed: the exception carries the rows before the failure
                 let err: PyErr = e.into();
-                err.value(py).setattr("partial", states_to_columns(py, &out))?;
+                err.value(py).setattr("partial", table)?;
                 Err(err)
             }
-            Err(e) => Err(e.into()),
         }
     }
 
