@@ -79,7 +79,7 @@ impl Strapdown {
     /// at the initial time only primes the integrator (its output is the initial state).
     /// On divergence `out` keeps every state computed before it.
     pub fn run(&mut self, t: &[f64], gyro: &[Vec3], accel: &[Vec3], h_ref: Option<&[f64]>, out: &mut Vec<NavState>) -> Result<()> {
-        self.validate(t, gyro, accel, h_ref)?;
+        self.validate(t, gyro, accel, h_ref, 0)?;
         out.reserve(t.len());
         for k in 0..t.len() {
             let href = h_ref.map(|h| h[k]);
@@ -105,8 +105,9 @@ impl Strapdown {
     }
 
     /// Checks of a chunk before it is run (shapes, time order from the current state,
-    /// finite samples, reference altitude).
-    pub(crate) fn validate(&self, t: &[f64], gyro: &[Vec3], accel: &[Vec3], h_ref: Option<&[f64]>) -> Result<()> {
+    /// finite samples, reference altitude). Error messages name the index `offset + k` of
+    /// the chunk's sample k (the chunk's place in a streamed record).
+    pub(crate) fn validate(&self, t: &[f64], gyro: &[Vec3], accel: &[Vec3], h_ref: Option<&[f64]>, offset: usize) -> Result<()> {
         let n = t.len();
         if gyro.len() != n || accel.len() != n {
             return Err(invalid("imu", format!("time has {n} samples but gyro {} and accel {}", gyro.len(), accel.len())));
@@ -114,29 +115,29 @@ impl Strapdown {
         let mut prev_t = self.state.t;
         for (k, &tk) in t.iter().enumerate() {
             if !tk.is_finite() {
-                return Err(invalid("time", format!("non-finite time {tk} at index {k}")));
+                return Err(invalid("time", format!("non-finite time {tk} at index {}", offset + k)));
             }
             // With rates the very first sample may coincide with the initial time.
             let first_rate_sample = self.kind == ImuKind::Rates && self.rate_history.is_empty() && k == 0;
             if first_rate_sample && tk != self.state.t {
-                return Err(invalid("time", format!("the first rate sample must be at the initial time {} s, got {tk} at index 0", self.state.t)));
+                return Err(invalid("time", format!("the first rate sample must be at the initial time {} s, got {tk} at index {offset}", self.state.t)));
             }
             if !first_rate_sample && tk <= prev_t {
                 let what = if tk == prev_t { "duplicated" } else { "decreasing" };
-                return Err(invalid("time", format!("time not strictly increasing: {what} stamp {tk} at index {k}")));
+                return Err(invalid("time", format!("time not strictly increasing: {what} stamp {tk} at index {}", offset + k)));
             }
             prev_t = tk;
         }
         for (name, data) in [("gyro", gyro), ("accel", accel)] {
             if let Some(k) = data.iter().position(|v| !v.iter().all(|x| x.is_finite())) {
-                return Err(invalid(name, format!("non-finite value at index {k}: {:?}", data[k].as_slice())));
+                return Err(invalid(name, format!("non-finite value at index {}: {:?}", offset + k, data[k].as_slice())));
             }
         }
         match (self.vertical, h_ref) {
             (Vertical::Damped { .. }, None) => Err(invalid("h_ref", "a damped vertical channel needs a reference altitude per sample")),
             (_, Some(h)) if h.len() != n => Err(invalid("h_ref", format!("expected {n} samples, got {}", h.len()))),
             (_, Some(h)) => match h.iter().position(|x| !x.is_finite()) {
-                Some(k) => Err(invalid("h_ref", format!("non-finite value at index {k}"))),
+                Some(k) => Err(invalid("h_ref", format!("non-finite value at index {}", offset + k))),
                 None => Ok(()),
             },
             _ => Ok(()),

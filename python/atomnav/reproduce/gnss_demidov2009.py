@@ -64,9 +64,12 @@ def run(report):
     # open vs closed loop NEES over time
     dur = 1200.0 if q else 3600.0
     fig, ax = plt.subplots(1, 2, figsize=(11, 3.8), sharey=True)
+    worst = {}
     for a, cls in zip(ax, ("precise", "medium")):
         for mode in ("closed", "open"):
             e = S.run(S.Scenario(cls, motion="MOVE" if cls == "precise" else "STAT", duration_s=dur, mode=mode))["errors"]
+            d3 = np.sqrt(e.dpos_n_m ** 2 + e.dpos_e_m ** 2 + e.dpos_d_m ** 2)
+            worst[(cls, mode)] = float(d3[e.time_s > 60.0].max())
             w = e.groupby((e.time_s // 300).astype(int))
             a.semilogy(w.time_s.mean() / 60, w.nees.mean(), "o-", label=f"{mode} loop")
             inside = float(((e.nees > 4.60) & (e.nees < 32.80)).mean())
@@ -76,6 +79,10 @@ def run(report):
         a.set(xlabel="time (min)", title=f"{cls} INS", ylabel="NEES (5-min mean, 15 states, diagonal)")
         a.legend()
     report.figure(fig, "nees", "Open- vs closed-loop NEES (diagonal, 15 INS states), grey: χ²₁₅ 99 % band.")
+    ol, cl = worst[("precise", "open")], worst[("precise", "closed")]
+    report.row(f"precise INS (baro-damped vertical), max 3-D position error after 1 min over {dur / 60:.0f} min, "
+               "open / closed loop (m)", "OL ≤ 2 m, ≈ CL (within 20 %)", f"{ol:.2f} / {cl:.2f}",
+               bool(ol < 2.0 and cl < 2.0 and abs(ol / cl - 1) <= 0.2))
 
     # outages
     fig, ax = plt.subplots(1, 2, figsize=(11, 3.8))
