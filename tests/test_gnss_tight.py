@@ -127,12 +127,12 @@ def _check_constellation(duration):
     return res
 
 
-def test_three_satellites_close_to_full_constellation_reduced():
-    _check_constellation(1200.0)
-
-
-@pytest.mark.slow
 def test_three_satellites_close_to_full_constellation_40min():
+    """Spec row 13's 40-min run (about 10 s). With the baro-damped vertical channel a
+    20-min run is not enough for three satellites: the vertical accelerometer bias holds
+    the altitude off by b_a/ω_v² (≈ 2 m for 20 µg), which two first-difference rows
+    separate from the horizontal only slowly (3.07 × the full constellation at 20 min,
+    2.81 × at 40 min)."""
     _check_constellation(2400.0)
 
 

@@ -547,4 +547,41 @@ mod tests {
         // the index is the sample's place in the whole record (10 samples came before)
         assert!(err.to_string().contains("time not strictly increasing: decreasing stamp 0.05 at index 10"), "{err}");
     }
+
+    /// No measurements, one extra block (bias, drift) with ḃ = drift: the nominal bias
+    /// follows the drift through the `propagate_extra` hook, in both loop modes.
+    struct Drift;
+
+    impl Aiding for Drift {
+        fn extra_blocks(&self) -> Vec<(String, usize)> {
+            vec![("clk".to_string(), 2)]
+        }
+        fn times(&self) -> &[f64] {
+            &[]
+        }
+        fn measure(&mut self, _j: usize, _ctx: &AidingContext) -> Result<Option<Measurement>> {
+            Ok(None)
+        }
+        fn extra_dynamics(&self, layout: &Layout, f: &mut DMatrix<f64>, _qc: &mut DMatrix<f64>) {
+            let i = layout.get("clk").unwrap().start;
+            f[(i, i + 1)] = 1.0;
+        }
+        fn propagate_extra(&self, layout: &Layout, dt: f64, extra: &mut [f64]) {
+            let i = layout.get("clk").unwrap().start - 15;
+            extra[i] += extra[i + 1] * dt;
+        }
+    }
+
+    #[test]
+    fn nominal_extra_blocks_follow_their_dynamics() {
+        let (s0, t, g, a, _) = record();
+        let ell = Ellipsoid::by_name("WGS84").unwrap();
+        for mode in [LoopMode::Closed, LoopMode::Open] {
+            let p0 = DMatrix::identity(17, 17) * 1e-4;
+            let ins = AidedIns::new(s0, ImuKind::Rates, ell, Vec3::zeros(), Vec3::zeros(), DVector::from_vec(vec![1.0, 0.5]), p0, config(mode), Drift).unwrap();
+            let (out, _) = run_aided(ins, &t, &g, &a).unwrap();
+            let last = &out.extra[out.extra.len() - 2..];
+            assert!((last[0] - (1.0 + 0.5 * 5.0)).abs() < 1e-12 && last[1] == 0.5, "{mode:?}: {last:?}");
+        }
+    }
 }

@@ -50,16 +50,25 @@ def run(report):
     q = report.quick
     _tau_experiment(report, 6.0 if q else 24.0)
 
-    # class × satellite count: horizontal RMS over the last 10 min (fixed top-n satellites)
-    dur = 1200.0 if q else 2400.0
+    # class × satellite count: horizontal RMS over the last 10 min (fixed top-n satellites),
+    # over the spec's 40 min also when quick (with the baro-damped vertical channel three
+    # satellites need longer than 20 min to separate the altitude offset of the vertical
+    # accelerometer bias from the horizontal)
+    dur = 2400.0
     table = {}
     for cls in tqdm(("precise", "medium", "coarse"), desc="class × satellites", disable=q):
         for n in (None, 3, 2, 0):
             table[(cls, "all" if n is None else n)] = S.last_rms(S.run(S.Scenario(cls, duration_s=dur, n_sats=n))["errors"])
+    # spec row 13 (3 ≤ 3 × all) is for the precise class; the others are reported: with the
+    # baro-damped channel the vertical accelerometer bias holds the altitude off by
+    # b_a/ω_v² (≈ 300 m for the coarse class's 3 mg), which two first-difference rows
+    # separate from the horizontal slowly
     for cls in ("precise", "medium", "coarse"):
         full, three, two, free = (table[(cls, k)] for k in ("all", 3, 2, 0))
-        report.row(f"{cls}: horizontal RMS last 10 min, all / 3 / 2 / 0 satellites (m)", "3 ≈ all",
-                   f"{full:.2f} / {three:.2f} / {two:.0f} / {free:.0f}", bool(three <= 3 * full))
+        report.row(f"{cls}: horizontal RMS last 10 min, all / 3 / 2 / 0 satellites (m); 3 ÷ all",
+                   "3 ≤ 3 × all (precise)" if cls == "precise" else "– (spec: precise only)",
+                   f"{full:.2f} / {three:.2f} / {two:.0f} / {free:.0f}; {three / full:.1f}",
+                   bool(three <= 3 * full) if cls == "precise" else "")
 
     # open vs closed loop NEES over time
     dur = 1200.0 if q else 3600.0
