@@ -24,7 +24,7 @@ def _run(setup, obs=None, **kw):
     ins = tight_ins(setup["eph"], setup["obs"] if obs is None else obs, **{**setup["args"], **kw})
     m = setup["imu"]
     return ins.run(m["time_s"].to_numpy(), m[["dtheta_x_rad", "dtheta_y_rad", "dtheta_z_rad"]].to_numpy(),
-                   m[["dv_x_mps", "dv_y_mps", "dv_z_mps"]].to_numpy(), progress=False)
+                   m[["dv_x_mps", "dv_y_mps", "dv_z_mps"]].to_numpy(), h_ref=setup["h_ref"], progress=False)
 
 
 @pytest.mark.parametrize("mode", ["closed", "open"])
@@ -44,12 +44,20 @@ def test_receiver_clock_leaves_the_first_difference_solution_unchanged(mode):
         assert _pos_diff_m(nav, base) <= 1e-9
 
 
-def test_clock_state_formulation_tracks_the_receiver_clock():
-    r = S.run("precise_closed_1h", duration_s=300.0, formulation="clock_states", clock=(1e-4, 1e-8))
+@pytest.mark.parametrize("mode", ["closed", "open"])
+def test_clock_state_formulation_tracks_the_receiver_clock(mode):
+    """The nominal clock bias follows the drift between epochs (engine hook
+    `propagate_extra`): the bias estimate tracks c(b + d·t), which grows by 900 m over the
+    run, to metres (code σ 3 m)."""
+    b, d = 1e-4, 1e-8
+    r = S.run("precise_closed_1h", duration_s=300.0, formulation="clock_states", clock=(b, d), mode=mode)
     e = r["errors"]
     assert np.hypot(e.dpos_n_m, e.dpos_e_m).iloc[-60:].max() < 2.0
     nav = r["result"].nav
-    assert abs(nav["extra_clock[1]"].iloc[-1] - C * 1e-8) < 0.1
+    assert abs(nav["extra_clock[1]"].iloc[-1] - C * d) < 0.1
+    late = nav.time_s > 60.0
+    bias_err = nav["extra_clock[0]"][late] - C * (b + d * nav.time_s[late])
+    assert np.abs(bias_err).max() < 5.0, np.abs(bias_err).max()
 
 
 def _check_precise_closed(e):
@@ -70,6 +78,30 @@ def _check_medium(cl, ol, duration):
 
 def test_precise_closed_loop_reduced():
     _check_precise_closed(S.run("precise_closed_1h", duration_s=1200.0)["errors"])
+
+
+def _max_3d(e):
+    d3 = np.sqrt(e.dpos_n_m ** 2 + e.dpos_e_m ** 2 + e.dpos_d_m ** 2)
+    return float(d3[e.time_s > 60.0].max())
+
+
+def _check_precise_open_vs_closed(duration):
+    """Issue 8: precise INS, open and closed loop both below 2 m and within 20 % of each
+    other (max 3-D position error after the first minute)."""
+    cl = _max_3d(S.run("precise_closed_1h", duration_s=duration)["errors"])
+    ol = _max_3d(S.run("precise_open_1h", duration_s=duration)["errors"])
+    assert cl < 2.0 and ol < 2.0, (ol, cl)
+    assert abs(ol / cl - 1) <= 0.2, (ol, cl)
+    return ol, cl
+
+
+def test_precise_open_loop_equals_closed_loop_reduced():
+    _check_precise_open_vs_closed(1200.0)
+
+
+@pytest.mark.slow
+def test_precise_open_loop_equals_closed_loop_1h():
+    _check_precise_open_vs_closed(3600.0)
 
 
 def test_medium_open_loop_leaves_the_nees_band_closed_loop_stays_reduced():
@@ -95,12 +127,12 @@ def _check_constellation(duration):
     return res
 
 
-def test_three_satellites_close_to_full_constellation_reduced():
-    _check_constellation(1200.0)
-
-
-@pytest.mark.slow
 def test_three_satellites_close_to_full_constellation_40min():
+    """Spec row 13's 40-min run (about 10 s). With the baro-damped vertical channel a
+    20-min run is not enough for three satellites: the vertical accelerometer bias holds
+    the altitude off by b_a/ω_v² (≈ 2 m for 20 µg), which two first-difference rows
+    separate from the horizontal only slowly (3.07 × the full constellation at 20 min,
+    2.81 × at 40 min)."""
     _check_constellation(2400.0)
 
 

@@ -9,10 +9,15 @@
 //!
 //! [`AidedIns::process`] takes the IMU record chunk by chunk (streaming); feeding the
 //! whole record in one call, or in any chunks followed by [`AidedIns::finish`], gives the
-//! same result.
+//! same result. Error messages about samples name their index in the whole record.
+//!
+//! The vertical channel is free by default; [`AidedIns::with_damped_vertical`] damps it
+//! with a reference (barometric) altitude per IMU sample (spec decision 13, Eq. 26), and
+//! the filter's F then carries the baro loop (`ins::baro_loop_dynamics`) and, optionally,
+//! a `baro_bias` state appended after the aiding's extra blocks.
 
 use super::discretize::{discretize, Discretization};
-use super::ins::{error_dynamics, InsNoise};
+use super::ins::{baro_loop_dynamics, error_dynamics, BaroModel, InsNoise};
 use super::kf::{Kf, LoopMode};
 use super::layout::{Layout, INS15};
 use crate::earth::Ellipsoid;
@@ -70,6 +75,10 @@ pub trait Aiding: Send {
     fn measure(&mut self, j: usize, ctx: &AidingContext) -> Result<Option<Measurement>>;
     /// Continuous F and Q_c rows/columns of the extra blocks (INS blocks already filled).
     fn extra_dynamics(&self, _layout: &Layout, _f: &mut DMatrix<f64>, _qc: &mut DMatrix<f64>) {}
+    /// Propagate the nominal values of the extra blocks over `dt` s to the next prediction
+    /// epoch, consistently with `extra_dynamics` (e.g. clock bias += drift·dt); `extra`
+    /// holds every extra block in layout order after the 15 INS states. Default: constant.
+    fn propagate_extra(&self, _layout: &Layout, _dt: f64, _extra: &mut [f64]) {}
 }
 
 impl Aiding for Box<dyn Aiding> {
@@ -90,6 +99,9 @@ impl Aiding for Box<dyn Aiding> {
     }
     fn extra_dynamics(&self, layout: &Layout, f: &mut DMatrix<f64>, qc: &mut DMatrix<f64>) {
         (**self).extra_dynamics(layout, f, qc)
+    }
+    fn propagate_extra(&self, layout: &Layout, dt: f64, extra: &mut [f64]) {
+        (**self).propagate_extra(layout, dt, extra)
     }
 }
 
@@ -159,8 +171,10 @@ pub struct AidedIns<A: Aiding> {
     /// Time and compensated specific force (m/s²) of the last sample, for F.
     last_sample: Option<(f64, Vec3)>,
     steps_since: usize,
-    /// Samples processed so far (numerical errors name the sample of the whole record).
+    /// Samples processed so far (errors name the sample of the whole record).
     samples: usize,
+    /// Error model of the reference altitude (used with a damped vertical channel).
+    baro: BaroModel,
 }
 
 impl<A: Aiding> AidedIns<A> {
@@ -221,7 +235,37 @@ impl<A: Aiding> AidedIns<A> {
             last_sample: None,
             steps_since: 0,
             samples: 0,
+            baro: BaroModel { noise_psd: 0.0, bias: None },
         })
+    }
+
+    /// Damp the vertical channel with a reference altitude h_b per IMU sample (then
+    /// required by [`Self::process_ref`]): damping ratio ζ, natural frequency ω_v (rad/s)
+    /// of the baro loop (spec Eq. 26) and the error model of h_b. With `baro.bias` a
+    /// one-component `baro_bias` block (m, initial estimate 0 ± the given σ) is appended
+    /// to the layout, after the aiding's blocks; the engine compensates h_b − b̂. Only
+    /// before the first sample.
+    pub fn with_damped_vertical(mut self, zeta: f64, omega: f64, baro: BaroModel) -> Result<Self> {
+        if self.samples > 0 {
+            return Err(invalid("vertical", "must be set before the first sample"));
+        }
+        self.sd = Strapdown::new(self.sd.state, self.sd.kind, self.ell, Vertical::Damped { zeta, omega })?;
+        if !(baro.noise_psd.is_finite() && baro.noise_psd >= 0.0) {
+            return Err(invalid("baro_psd", format!("must be finite and >= 0, got {}", baro.noise_psd)));
+        }
+        if let Some((_, sigma0)) = baro.bias {
+            crate::error::check_positive("baro_bias_sigma0", sigma0)?;
+            let mut spec: Vec<(String, Option<usize>)> = self.layout.blocks().iter().map(|(b, r)| (b.clone(), Some(r.len()))).collect();
+            spec.push(("baro_bias".to_string(), Some(1)));
+            self.layout = Layout::new(&spec)?;
+            let n = self.layout.size();
+            let mut p0 = self.kf.p.clone().resize(n, n, 0.0);
+            p0[(n - 1, n - 1)] = sigma0 * sigma0;
+            self.kf = Kf::new(p0, self.cfg.mode)?;
+            self.extra = self.extra.clone().push(0.0);
+        }
+        self.baro = baro;
+        Ok(self)
     }
 
     pub fn layout(&self) -> &Layout {
@@ -245,14 +289,24 @@ impl<A: Aiding> AidedIns<A> {
     /// Feed one chunk of the IMU record (`t`, `gyro`, `accel` as for `Strapdown::run`);
     /// appends to `out`. On error `out` keeps every epoch computed before it.
     pub fn process(&mut self, t: &[f64], gyro: &[Vec3], accel: &[Vec3], out: &mut AidedOutput) -> Result<()> {
+        self.process_ref(t, gyro, accel, None, out)
+    }
+
+    /// [`Self::process`] with the reference altitude `h_ref` (m) per sample, required with
+    /// a damped vertical channel and refused with a free one.
+    pub fn process_ref(&mut self, t: &[f64], gyro: &[Vec3], accel: &[Vec3], h_ref: Option<&[f64]>, out: &mut AidedOutput) -> Result<()> {
         let n = t.len();
         if gyro.len() != n || accel.len() != n {
             return Err(invalid("imu", format!("time has {n} samples but gyro {} and accel {}", gyro.len(), accel.len())));
         }
+        if self.sd.vertical == Vertical::Free && h_ref.is_some() {
+            return Err(invalid("h_ref", "given, but the vertical channel is free (a reference altitude needs vertical=\"damped\")"));
+        }
         if n == 0 {
             return Ok(());
         }
-        self.sd.validate(t, gyro, accel, None, 0)?;
+        self.sd.validate(t, gyro, accel, h_ref, self.samples)?;
+        let baro_bias = self.layout.get("baro_bias").map(|r| r.start - 15);
         // A measurement before the first sample of the record can never be applied.
         if self.last_sample.is_none() {
             if let Some(&tm) = self.aiding.times().first().filter(|&&tm| tm < t[0]) {
@@ -265,7 +319,9 @@ impl<A: Aiding> AidedIns<A> {
                 ImuKind::Rates => (gyro[k] - self.gyro_bias, accel[k] - self.accel_bias),
                 ImuKind::Increments => (gyro[k] - self.gyro_bias * dt, accel[k] - self.accel_bias * dt),
             };
-            self.sd.step(t[k], &g, &a, None);
+            // reference altitude compensated by the baro bias estimate
+            let hb = h_ref.map(|h| h[k] - baro_bias.map_or(0.0, |i| self.extra[i]));
+            self.sd.step(t[k], &g, &a, hb);
             self.sd.check_diverged(self.samples)?;
             self.samples += 1;
             self.aiding.observe(t[k], dt, &g, &a, &self.sd.state);
@@ -303,10 +359,19 @@ impl<A: Aiding> AidedIns<A> {
             return Ok(());
         }
         let (mut f, mut qc) = error_dynamics(&self.layout, &self.ell, &self.sd.state, &f_b, &self.cfg.noise)?;
+        if let Vertical::Damped { zeta, omega } = self.sd.vertical {
+            baro_loop_dynamics(&self.layout, &self.ell, &self.sd.state, zeta, omega, &self.baro, &mut f, &mut qc)?;
+        }
         self.aiding.extra_dynamics(&self.layout, &mut f, &mut qc);
-        let (phi, qd) = discretize(&f, &qc, tk - self.t_last_predict, self.cfg.method);
+        let dt = tk - self.t_last_predict;
+        let (phi, qd) = discretize(&f, &qc, dt, self.cfg.method);
         self.kf.predict_unchecked(&phi, &qd)?;
         self.t_last_predict = tk;
+        // nominal values of the extra blocks follow their dynamics too (δx = nominal − true)
+        self.aiding.propagate_extra(&self.layout, dt, self.extra.as_mut_slice());
+        if let (Some(r), Some((model, _))) = (self.layout.get("baro_bias"), self.baro.bias) {
+            self.extra[r.start - 15] *= (model.dynamics().0 * dt).exp();
+        }
         while self.next_meas < self.aiding.times().len() && self.aiding.times()[self.next_meas] <= tk {
             let j = self.next_meas;
             self.next_meas += 1;
@@ -479,6 +544,44 @@ mod tests {
         let mut out = AidedOutput::default();
         ins.process(&t[..10], &g[..10], &a[..10], &mut out).unwrap();
         let err = ins.process(&t[5..10], &g[5..10], &a[5..10], &mut out).unwrap_err();
-        assert!(err.to_string().contains("time not strictly increasing: decreasing stamp 0.05 at index 0"), "{err}");
+        // the index is the sample's place in the whole record (10 samples came before)
+        assert!(err.to_string().contains("time not strictly increasing: decreasing stamp 0.05 at index 10"), "{err}");
+    }
+
+    /// No measurements, one extra block (bias, drift) with ḃ = drift: the nominal bias
+    /// follows the drift through the `propagate_extra` hook, in both loop modes.
+    struct Drift;
+
+    impl Aiding for Drift {
+        fn extra_blocks(&self) -> Vec<(String, usize)> {
+            vec![("clk".to_string(), 2)]
+        }
+        fn times(&self) -> &[f64] {
+            &[]
+        }
+        fn measure(&mut self, _j: usize, _ctx: &AidingContext) -> Result<Option<Measurement>> {
+            Ok(None)
+        }
+        fn extra_dynamics(&self, layout: &Layout, f: &mut DMatrix<f64>, _qc: &mut DMatrix<f64>) {
+            let i = layout.get("clk").unwrap().start;
+            f[(i, i + 1)] = 1.0;
+        }
+        fn propagate_extra(&self, layout: &Layout, dt: f64, extra: &mut [f64]) {
+            let i = layout.get("clk").unwrap().start - 15;
+            extra[i] += extra[i + 1] * dt;
+        }
+    }
+
+    #[test]
+    fn nominal_extra_blocks_follow_their_dynamics() {
+        let (s0, t, g, a, _) = record();
+        let ell = Ellipsoid::by_name("WGS84").unwrap();
+        for mode in [LoopMode::Closed, LoopMode::Open] {
+            let p0 = DMatrix::identity(17, 17) * 1e-4;
+            let ins = AidedIns::new(s0, ImuKind::Rates, ell, Vec3::zeros(), Vec3::zeros(), DVector::from_vec(vec![1.0, 0.5]), p0, config(mode), Drift).unwrap();
+            let (out, _) = run_aided(ins, &t, &g, &a).unwrap();
+            let last = &out.extra[out.extra.len() - 2..];
+            assert!((last[0] - (1.0 + 0.5 * 5.0)).abs() < 1e-12 && last[1] == 0.5, "{mode:?}: {last:?}");
+        }
     }
 }

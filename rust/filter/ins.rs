@@ -120,30 +120,91 @@ pub fn error_dynamics(layout: &Layout, ell: &Ellipsoid, nav: &NavState, f_b: &Ve
     Ok((f, qc))
 }
 
+/// Gains of the baro loop (spec gnss-ins-tight Eq. 26, as in `strapdown.rs`):
+/// K_v1 = 2ζω_v, K_v2 = ω_v² + 2γ/R₀ with R₀ = √(R_M R_P) at (lat, h).
+pub fn baro_gains(ell: &Ellipsoid, lat: f64, h: f64, zeta: f64, omega: f64) -> (f64, f64) {
+    let e = ell.local(lat, h);
+    (2.0 * zeta * omega, omega * omega + 2.0 * e.gravity / (e.rm * e.rp).sqrt())
+}
+
+/// Error model of the reference (barometric) altitude h_b that damps the vertical
+/// channel: h_b − h = b + n, with n white (two-sided PSD `noise_psd`, m²·s = m²/Hz; for
+/// independent samples of σ every Δt, or σ held over Δt, PSD = σ²Δt as long as Δt is
+/// short against the loop's 1/ω_v) and, when `bias` is given, a bias b carried as the
+/// one-component state `baro_bias` (m; δb = b̂ − b, the engine compensates h_b − b̂) with
+/// its process and initial σ (m). Without `bias` the filter assumes b = 0.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BaroModel {
+    pub noise_psd: f64,
+    pub bias: Option<(BiasModel, f64)>,
+}
+
+/// Add the baro-loop terms of a damped vertical channel to F and Q_c (spec gnss-ins-tight
+/// Eq. 28: F_rr[D,D] = −K_v1, F_vr[D,D] gets −K_v2; baro noise n_b enters as −K_v1·n_b into
+/// δṙ_D and −K_v2·n_b into δv̇_D). The altitude error seen by the loop is
+/// δh_b = (h_b − b̂) − h = −δb + n, so the `baro_bias` column (when the layout has it) is
+/// +K_v1 on δṙ_D and +K_v2 on δv̇_D. Derivation (δr_D = −δh): the INS integrates
+/// ḣ = −v_D − K_v1(ĥ − h_b), v̇_D += K_v2(ĥ − h_b), the truth ḣ = −v_D, so
+/// δṙ_D = δv_D − K_v1(δr_D + δh_b) and δv̇_D gets −K_v2(δr_D + δh_b).
+pub fn baro_loop_dynamics(layout: &Layout, ell: &Ellipsoid, nav: &NavState, zeta: f64, omega: f64, baro: &BaroModel, f: &mut DMatrix<f64>, qc: &mut DMatrix<f64>) -> Result<()> {
+    let (ir, iv) = (layout.range("position")?.start + 2, layout.range("velocity")?.start + 2);
+    let (k1, k2) = baro_gains(ell, nav.lla.x, nav.lla.z, zeta, omega);
+    f[(ir, ir)] -= k1;
+    f[(iv, ir)] -= k2;
+    // G = (−K_v1, −K_v2)ᵀ on (δr_D, δv_D): Q_c += G q Gᵀ
+    let q = baro.noise_psd;
+    qc[(ir, ir)] += k1 * k1 * q;
+    qc[(ir, iv)] += k1 * k2 * q;
+    qc[(iv, ir)] += k1 * k2 * q;
+    qc[(iv, iv)] += k2 * k2 * q;
+    if let (Some(b), Some((model, _))) = (layout.get("baro_bias"), baro.bias) {
+        let j = b.start;
+        f[(ir, j)] = k1;
+        f[(iv, j)] = k2;
+        let (fb, qb) = model.dynamics();
+        f[(j, j)] = fb;
+        qc[(j, j)] = qb;
+    }
+    Ok(())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::filter::layout::INS15 as INS15_SPEC;
     use crate::math::dcm_from_euler;
     use nalgebra::DVector;
 
-    /// Continuous mechanization (spec gnss-ins-tight Eq. 26, free vertical) with the sensor
-    /// bias errors: returns (llȧ, v̇, Ċ) for the state (lla, v, C) and sensed f, ω (body).
-    fn rates(ell: &Ellipsoid, lla: &Vec3, v: &Vec3, c: &Mat3, f: &Vec3, w: &Vec3) -> (Vec3, Vec3, Mat3) {
+    /// Continuous mechanization (spec gnss-ins-tight Eq. 26) with the sensor bias errors:
+    /// returns (llȧ, v̇, Ċ) for the state (lla, v, C) and sensed f, ω (body); `baro` =
+    /// (ζ, ω_v, h_b) damps the vertical channel.
+    fn rates(ell: &Ellipsoid, lla: &Vec3, v: &Vec3, c: &Mat3, f: &Vec3, w: &Vec3, baro: Option<(f64, f64, f64)>) -> (Vec3, Vec3, Mat3) {
         let loc = ell.local(lla.x, lla.z);
         let (w_ie, w_en) = (loc.earth_rate(), loc.transport_rate(v));
-        let vdot = c * f - (2.0 * w_ie + w_en).cross(v) + Vec3::new(0.0, 0.0, ell.gravity(lla.x, lla.z));
+        let mut vdot = c * f - (2.0 * w_ie + w_en).cross(v) + Vec3::new(0.0, 0.0, ell.gravity(lla.x, lla.z));
         let cdot = c * skew(w) - skew(&(w_ie + w_en)) * c;
-        (loc.lla_rate(v), vdot, cdot)
+        let mut lladot = loc.lla_rate(v);
+        if let Some((zeta, omega, hb)) = baro {
+            let (k1, k2) = baro_gains(ell, lla.x, lla.z, zeta, omega);
+            lladot.z -= k1 * (lla.z - hb);
+            vdot.z += k2 * (lla.z - hb);
+        }
+        (lladot, vdot, cdot)
     }
 
     /// Relative mismatch per block (position, velocity, attitude) between F·δx, with F the
     /// Jacobian at the true state, and the derivative of the error between a perturbed and
     /// the true trajectory (both from the mechanization): central difference in time, and
     /// symmetric in the perturbation ((D(δx) − D(−δx))/2) so that second-order terms
-    /// cancel and only the linearisation is tested.
-    fn mismatch(dr: Vec3, dv: Vec3, psi: Vec3, dba: Vec3, dbg: Vec3) -> [f64; 3] {
+    /// cancel and only the linearisation is tested. `damped` = (ζ, ω_v, δb_baro): both
+    /// run the baro loop on the true altitude, the estimate's compensated by −δb_baro.
+    fn mismatch(dr: Vec3, dv: Vec3, psi: Vec3, dba: Vec3, dbg: Vec3, damped: Option<(f64, f64, f64)>) -> [f64; 3] {
         let ell = Ellipsoid::by_name("WGS84").unwrap();
-        let layout = Layout::ins15();
+        let mut spec: Vec<(String, Option<usize>)> = INS15_SPEC.iter().map(|s| (s.to_string(), None)).collect();
+        if damped.is_some() {
+            spec.push(("baro_bias".to_string(), Some(1)));
+        }
+        let layout = Layout::new(&spec).unwrap();
         let lla = Vec3::new(0.9, 0.3, 300.0);
         let v = Vec3::new(60.0, -25.0, 1.5);
         let c = dcm_from_euler(0.1, -0.05, 2.0);
@@ -151,18 +212,27 @@ mod tests {
         let loc = ell.local(lla.x, lla.z);
         let nav = NavState { t: 0.0, lla, vel: v, q_nb: crate::math::quat_from_dcm(&c) };
         let noise = InsNoise { accel_psd: 0.0, gyro_psd: 0.0, accel_bias: BiasModel::RandomConstant, gyro_bias: BiasModel::RandomConstant };
-        let (f, _) = error_dynamics(&layout, &ell, &nav, &f_b, &noise).unwrap();
-        let x = DVector::from_iterator(15, dr.iter().chain(dv.iter()).chain(psi.iter()).chain(dba.iter()).chain(dbg.iter()).copied());
-        let fx = &f * &x;
+        let (mut f, mut qc) = error_dynamics(&layout, &ell, &nav, &f_b, &noise).unwrap();
+        let mut xs: Vec<f64> = dr.iter().chain(dv.iter()).chain(psi.iter()).chain(dba.iter()).chain(dbg.iter()).copied().collect();
+        if let Some((zeta, omega, dbb)) = damped {
+            let baro = BaroModel { noise_psd: 0.0, bias: Some((BiasModel::RandomConstant, 1.0)) };
+            baro_loop_dynamics(&layout, &ell, &nav, zeta, omega, &baro, &mut f, &mut qc).unwrap();
+            xs.push(dbb);
+        }
+        let fx = &f * DVector::from_vec(xs);
         // Time derivative of the error for perturbation sign s (central difference in time).
         let deriv = |s: f64| -> DVector<f64> {
             let lla_e = lla + Vec3::new(s * dr.x / loc.rm, s * dr.y / (loc.rp * loc.cos), -s * dr.z);
             let c_e = (Mat3::identity() - skew(&(s * psi))) * c;
             // δb = b̂ − b: the estimate's compensated sensor outputs differ by −δb.
             let (f_e, w_e, v_e) = (f_b - s * dba, w_b - s * dbg, v + s * dv);
+            let (baro_t, baro_e) = match damped {
+                Some((zeta, omega, dbb)) => (Some((zeta, omega, lla.z)), Some((zeta, omega, lla.z - s * dbb))),
+                None => (None, None),
+            };
             let err = |eps: f64| -> DVector<f64> {
-                let (a, b, cc) = rates(&ell, &lla, &v, &c, &f_b, &w_b);
-                let (ae, be, ce) = rates(&ell, &lla_e, &v_e, &c_e, &f_e, &w_e);
+                let (a, b, cc) = rates(&ell, &lla, &v, &c, &f_b, &w_b, baro_t);
+                let (ae, be, ce) = rates(&ell, &lla_e, &v_e, &c_e, &f_e, &w_e, baro_e);
                 let (l1, v1, c1) = (lla + a * eps, v + b * eps, c + cc * eps);
                 let (l2, v2, c2) = (lla_e + ae * eps, v_e + be * eps, c_e + ce * eps);
                 let lc = ell.local(l1.x, l1.z);
@@ -183,7 +253,7 @@ mod tests {
     #[test]
     fn f_matches_central_differences_of_mechanization() {
         let z = Vec3::zeros();
-        let rel = mismatch(Vec3::new(5.0, -5.0, 5.0), Vec3::new(0.05, 0.05, -0.05), Vec3::new(1e-4, -1e-4, 1e-4), z, z);
+        let rel = mismatch(Vec3::new(5.0, -5.0, 5.0), Vec3::new(0.05, 0.05, -0.05), Vec3::new(1e-4, -1e-4, 1e-4), z, z, None);
         assert!(rel.iter().all(|r| *r < 1e-4), "{rel:?}");
     }
 
@@ -191,8 +261,21 @@ mod tests {
     #[test]
     fn f_bias_columns_match_central_differences() {
         let z = Vec3::zeros();
-        let rel = mismatch(z, z, z, Vec3::new(1e-3, -2e-3, 1e-3), Vec3::new(1e-6, 2e-6, -1e-6));
+        let rel = mismatch(z, z, z, Vec3::new(1e-3, -2e-3, 1e-3), Vec3::new(1e-6, 2e-6, -1e-6), None);
         // position rows see no bias in one step (δṙ = δv = 0): only velocity and attitude.
         assert!(rel[1] < 1e-6 && rel[2] < 1e-6, "{rel:?}");
+    }
+
+    /// Damped vertical channel (spec decision 13): F with the baro-loop terms matches the
+    /// mechanization with the loop, at the §2.9 acceptance perturbation plus a 3 m baro
+    /// bias error; the vertical position and velocity rows are where the loop acts.
+    #[test]
+    fn f_with_baro_loop_matches_central_differences_of_damped_mechanization() {
+        let z = Vec3::zeros();
+        let rel = mismatch(Vec3::new(5.0, -5.0, 5.0), Vec3::new(0.05, 0.05, -0.05), Vec3::new(1e-4, -1e-4, 1e-4), z, z, Some((0.707, 0.01, 3.0)));
+        assert!(rel.iter().all(|r| *r < 1e-4), "{rel:?}");
+        // the baro bias column alone: only δṙ_D and δv̇_D respond
+        let rel = mismatch(z, z, z, z, z, Some((0.707, 0.01, 3.0)));
+        assert!(rel[0] < 1e-6 && rel[1] < 1e-6, "{rel:?}");
     }
 }

@@ -57,25 +57,16 @@ pub struct TightConfig {
     pub clock_hm2: f64,
     /// IMU record kind: the gyro sample gives the body rate for the lever-arm velocity.
     pub kind: ImuKind,
-    /// σ of the barometric altitude rows (m); spec §3: 1 m.
-    pub sigma_baro: f64,
 }
 
 pub struct TightAiding {
     eph: Ephemerides,
     times: Vec<f64>,
     epochs: Vec<Vec<Observation>>,
-    /// Barometric altitude (m) at each epoch, NaN when none.
-    baro: Vec<f64>,
     cfg: TightConfig,
     reference: Option<SatId>,
     /// Last compensated body rate (rad/s).
     omega_b: Vec3,
-    /// Clock-state option: the engine propagates only the error state, not the nominal
-    /// value of an extra block, so the nominal clock bias ∫ĉδṫ dt accumulated since the
-    /// start is kept here (m) and added to the `clock[0]` estimate in the prediction;
-    /// (time, value) of the last measurement.
-    clock_shift: (f64, f64),
 }
 
 /// One satellite's undifferenced innovation and rows for code and rate.
@@ -90,11 +81,11 @@ struct Row {
 }
 
 impl TightAiding {
-    /// `epochs`: (GPS time, observations) with strictly increasing time; `baro`: (time,
-    /// altitude m) readings of the barometric altimeter that damps the vertical channel
-    /// (spec decision 13, σ `cfg.sigma_baro`), merged with the GNSS epochs.
-    pub fn new(eph: Ephemerides, epochs: Vec<(f64, Vec<Observation>)>, baro: &[(f64, f64)], cfg: TightConfig) -> Result<TightAiding> {
-        for (field, s) in [("sigma_code_gps", cfg.sigma_code_gps), ("sigma_code_glo", cfg.sigma_code_glo), ("sigma_rate", cfg.sigma_rate), ("sigma_baro", cfg.sigma_baro)] {
+    /// `epochs`: (GPS time, observations) with strictly increasing time. A barometric
+    /// altimeter damps the INS's vertical channel in the engine
+    /// (`AidedIns::with_damped_vertical`, spec decision 13), not through rows here.
+    pub fn new(eph: Ephemerides, epochs: Vec<(f64, Vec<Observation>)>, cfg: TightConfig) -> Result<TightAiding> {
+        for (field, s) in [("sigma_code_gps", cfg.sigma_code_gps), ("sigma_code_glo", cfg.sigma_code_glo), ("sigma_rate", cfg.sigma_rate)] {
             crate::error::check_positive(field, s)?;
         }
         for (i, (_, obs)) in epochs.iter().enumerate() {
@@ -104,37 +95,13 @@ impl TightAiding {
                 }
             }
         }
-        for (i, w) in baro.windows(2).enumerate() {
-            if !(w[1].0 > w[0].0) {
-                return Err(invalid("baro_time", format!("not strictly increasing at index {}", i + 1)));
-            }
-        }
-        if let Some(i) = baro.iter().position(|b| !(b.0.is_finite() && b.1.is_finite())) {
-            return Err(invalid("baro", format!("non-finite time or altitude at index {i}")));
-        }
-        // merge the two sorted streams into one list of epochs
-        let (mut times, mut obs, mut alt) = (Vec::new(), Vec::new(), Vec::new());
-        let mut k = 0;
-        let mut epochs = epochs.into_iter().peekable();
-        while epochs.peek().is_some() || k < baro.len() {
-            let tg = epochs.peek().map_or(f64::INFINITY, |e| e.0);
-            let tb = baro.get(k).map_or(f64::INFINITY, |b| b.0);
-            let t = tg.min(tb);
-            times.push(t);
-            obs.push(if tg == t { epochs.next().expect("peeked").1 } else { Vec::new() });
-            alt.push(if tb == t { k += 1; baro[k - 1].1 } else { f64::NAN });
-        }
-        Ok(TightAiding { eph, times, epochs: obs, baro: alt, cfg, reference: None, omega_b: Vec3::zeros(), clock_shift: (f64::NAN, 0.0) })
+        let (times, epochs) = epochs.into_iter().unzip();
+        Ok(TightAiding { eph, times, epochs, cfg, reference: None, omega_b: Vec3::zeros() })
     }
 
     /// The FD reference satellite at the last measurement (None before the first).
     pub fn reference(&self) -> Option<SatId> {
         self.reference
-    }
-
-    /// Nominal clock bias accumulated from the drift estimate up to the current epoch (m).
-    pub fn clock_shift(&self) -> f64 {
-        self.clock_shift.1
     }
 
     fn rows(&mut self, j: usize, ctx: &AidingContext) -> Result<Vec<Row>> {
@@ -152,12 +119,6 @@ impl TightAiding {
         let extra = |name: &str| ctx.layout.get(name).map(|r| (r.start, ctx.extra[r.start - 15]));
         let tau = extra("c_tau_gps");
         let clock = extra("clock");
-        if let Some((i, _)) = clock {
-            let (t_prev, shift) = self.clock_shift;
-            let dt = if t_prev.is_finite() { t - t_prev } else { 0.0 };
-            self.clock_shift = (t, shift + ctx.extra[i - 15 + 1] * dt);
-        }
-        let shift = self.clock_shift.1;
         let lever_skew = skew(&lever_n);
         // v̂^e = C_n^e(r̂)v̂ⁿ: a position error δr turns the computed frame by δθ = A_ev·δr
         // (C(r̂) = C(r)(I + [δθ×])), so δv^e = C(δv − [vⁿ×]A_ev δr); the Doppler rows carry
@@ -202,7 +163,7 @@ impl TightAiding {
                 }
             }
             if let Some((i, cb)) = clock {
-                pred += cb + shift;
+                pred += cb;
                 pred_rate += ctx.extra[i - 15 + 1];
                 h_code[i] = 1.0;
                 h_rate[i + 1] = 1.0;
@@ -234,25 +195,6 @@ impl TightAiding {
         let i = best(System::Gps).or_else(|| best(System::Glonass)).expect("at least one row");
         self.reference = Some(rows[i].sat);
         i
-    }
-}
-
-impl TightAiding {
-    /// Append the barometric row z = ĥ − h_baro, H = −1 on δr_D (δr_D = −δh), when there
-    /// is a reading at epoch j; None when nothing is left to apply.
-    fn baro_row(&self, j: usize, ctx: &AidingContext, (mut z, h, r): (Vec<f64>, DMatrix<f64>, DMatrix<f64>)) -> Option<Measurement> {
-        let hb = self.baro[j];
-        let m = z.len();
-        if !hb.is_finite() {
-            return (m > 0).then_some(Measurement { z, h, r });
-        }
-        let ip = ctx.layout.get("position").expect("INS15 layout").start;
-        z.push(ctx.nav.lla.z - hb);
-        let mut h = h.resize_vertically(m + 1, 0.0);
-        h[(m, ip + 2)] = -1.0;
-        let mut r = r.resize(m + 1, m + 1, 0.0);
-        r[(m, m)] = self.cfg.sigma_baro * self.cfg.sigma_baro;
-        Some(Measurement { z, h, r })
     }
 }
 
@@ -313,7 +255,7 @@ impl Aiding for TightAiding {
         let fd = self.cfg.formulation == Formulation::FirstDifference;
         let n = ctx.layout.size();
         if rows.is_empty() || (fd && rows.len() < 2) {
-            return Ok(self.baro_row(j, ctx, (Vec::new(), DMatrix::zeros(0, n), DMatrix::zeros(0, 0))));
+            return Ok(None);
         }
         let r0 = if fd { Some(self.pick_reference(&rows)) } else { None };
         let zc: Vec<f64> = rows.iter().map(|r| r.z_code).collect();
@@ -335,7 +277,7 @@ impl Aiding for TightAiding {
             r = r.resize(m1 + m2, m1 + m2, 0.0);
             r.view_mut((m1, m1), (m2, m2)).copy_from(&r2);
         }
-        Ok(self.baro_row(j, ctx, (z, h, r)))
+        Ok(Some(Measurement { z, h, r }))
     }
 
     fn extra_dynamics(&self, layout: &Layout, f: &mut DMatrix<f64>, qc: &mut DMatrix<f64>) {
@@ -348,6 +290,14 @@ impl Aiding for TightAiding {
             f[(i, i + 1)] = 1.0;
             qc[(i, i)] = C_LIGHT * C_LIGHT * self.cfg.clock_h0 / 2.0;
             qc[(i + 1, i + 1)] = C_LIGHT * C_LIGHT * 2.0 * std::f64::consts::PI.powi(2) * self.cfg.clock_hm2;
+        }
+    }
+
+    fn propagate_extra(&self, layout: &Layout, dt: f64, extra: &mut [f64]) {
+        // nominal clock bias follows the drift (the F block above): c·δt_r += c·δṫ_r·Δt
+        if let Some(r) = layout.get("clock") {
+            let i = r.start - 15;
+            extra[i] += extra[i + 1] * dt;
         }
     }
 }
@@ -376,9 +326,9 @@ mod tests {
         let obs: Vec<Observation> = simulate(&eph, &[100.0], &[lla], &[vel], &sim, &Visibility::default()).unwrap().remove(0).into_iter().map(|x| x.0).collect();
         let tc = TightConfig {
             formulation: Formulation::ClockStates, lever_arm: Vec3::new(1.0, -0.5, -2.0), sigma_code_gps: 3.0, sigma_code_glo: 3.0, sigma_rate: 0.05,
-            use_rate: true, atm, tau_psd: 0.0, clock_h0: 0.0, clock_hm2: 0.0, kind: ImuKind::Rates, sigma_baro: 1.0,
+            use_rate: true, atm, tau_psd: 0.0, clock_h0: 0.0, clock_hm2: 0.0, kind: ImuKind::Rates,
         };
-        let mut aiding = TightAiding::new(eph, vec![(100.0, obs)], &[], tc).unwrap();
+        let mut aiding = TightAiding::new(eph, vec![(100.0, obs)], tc).unwrap();
         let mut spec: Vec<(String, Option<usize>)> = INS15.iter().map(|s| (s.to_string(), None)).collect();
         spec.extend(aiding.extra_blocks().into_iter().map(|(b, k)| (b, Some(k))));
         let layout = Layout::new(&spec).unwrap();

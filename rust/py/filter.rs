@@ -6,7 +6,7 @@ use crate::error::{invalid, NavError};
 use crate::filter::aided::{AidedConfig, AidedIns, AidedOutput, Aiding, PositionAiding, PositionFix};
 use crate::filter::analysis::Scenario as CoreScenario;
 use crate::filter::discretize::{discretize, Discretization};
-use crate::filter::ins::{error_dynamics, BiasModel, InsNoise};
+use crate::filter::ins::{error_dynamics, BaroModel, BiasModel, InsNoise};
 use crate::filter::kf::{rts as core_rts, Kf, LoopMode, StoredStep};
 use crate::filter::layout::Layout;
 use crate::filter::riccati;
@@ -372,12 +372,18 @@ pub struct AidedSetup {
     bg0: crate::math::Vec3,
     p0: DMatrix<f64>,
     cfg: AidedConfig,
+    /// Damped vertical channel: (ζ, ω_v rad/s, reference-altitude error model).
+    damped: Option<(f64, f64, BaroModel)>,
 }
 
 #[pymethods]
 impl AidedSetup {
+    /// `vertical` "free" (default) or "damped" with the baro loop's ζ, ω_v (rad/s) and the
+    /// reference-altitude error model: white-noise PSD `baro_psd` (m²·s) and optionally a
+    /// bias state `baro_bias` = (model, p1, p2) as for the IMU biases with initial σ
+    /// `baro_bias_sigma0` (m).
     #[new]
-    #[pyo3(signature = (t0, lla0, vel0, q0, kind, ba0, bg0, p0, accel_psd, gyro_psd, accel_bias, gyro_bias, predict_every, method, mode, sequential=false, gate=None, ellipsoid="WGS84"))]
+    #[pyo3(signature = (t0, lla0, vel0, q0, kind, ba0, bg0, p0, accel_psd, gyro_psd, accel_bias, gyro_bias, predict_every, method, mode, sequential=false, gate=None, ellipsoid="WGS84", vertical="free", zeta=0.707, omega=0.01, baro_psd=0.0, baro_bias=None, baro_bias_sigma0=None))]
     #[allow(clippy::too_many_arguments)]
     fn new(
         t0: f64,
@@ -398,6 +404,12 @@ impl AidedSetup {
         sequential: bool,
         gate: Option<f64>,
         ellipsoid: &str,
+        vertical: &str,
+        zeta: f64,
+        omega: f64,
+        baro_psd: f64,
+        baro_bias: Option<(String, f64, f64)>,
+        baro_bias_sigma0: Option<f64>,
     ) -> PyResult<Self> {
         use super::convert::vec3;
         let q = vector(&q0, "q0")?;
@@ -407,6 +419,17 @@ impl AidedSetup {
         let initial = NavState { t: t0, lla: vec3(&lla0, "lla0")?, vel: vec3(&vel0, "vel0")?, q_nb: crate::math::quat(q[0], q[1], q[2], q[3]) };
         let noise = ins_noise(accel_psd, gyro_psd, &accel_bias, &gyro_bias)?;
         let cfg = AidedConfig { noise, predict_every, method: Discretization::by_name(method)?, mode: LoopMode::by_name(mode)?, sequential, gate };
+        let bias = match (baro_bias, baro_bias_sigma0) {
+            (Some((kind, p1, p2)), Some(s0)) => Some((BiasModel::from_parts("baro_bias", &kind, p1, p2)?, s0)),
+            (None, None) => None,
+            (Some(_), None) => return Err(invalid("baro_bias_sigma0", "required with baro_bias (initial σ of the bias state, m)").into()),
+            (None, Some(_)) => return Err(invalid("baro_bias_sigma0", "given without baro_bias").into()),
+        };
+        let damped = match vertical {
+            "free" => None,
+            "damped" => Some((zeta, omega, BaroModel { noise_psd: baro_psd, bias })),
+            _ => return Err(invalid("vertical", format!("unknown {vertical:?} (free, damped)")).into()),
+        };
         Ok(AidedSetup {
             initial,
             kind: crate::imu::ImuKind::parse(kind)?,
@@ -415,6 +438,7 @@ impl AidedSetup {
             bg0: vec3(&bg0, "bg0")?,
             p0: mat(&p0, "p0")?,
             cfg,
+            damped,
         })
     }
 }
@@ -423,7 +447,10 @@ impl PyAidedIns {
     /// The aided INS of `ins` with the sensor's model and the initial estimate of its
     /// extra blocks.
     pub(crate) fn from_aiding(ins: &AidedSetup, extra0: DVector<f64>, aiding: Box<dyn Aiding>) -> PyResult<Self> {
-        let engine = AidedIns::new(ins.initial, ins.kind, ins.ell, ins.ba0, ins.bg0, extra0, ins.p0.clone(), ins.cfg, aiding)?;
+        let mut engine = AidedIns::new(ins.initial, ins.kind, ins.ell, ins.ba0, ins.bg0, extra0, ins.p0.clone(), ins.cfg, aiding)?;
+        if let Some((zeta, omega, baro)) = ins.damped {
+            engine = engine.with_damped_vertical(zeta, omega, baro)?;
+        }
         Ok(PyAidedIns { inner: std::sync::Mutex::new(engine) })
     }
 
@@ -468,10 +495,21 @@ impl PyAidedIns {
 
 #[pymethods]
 impl PyAidedIns {
-    /// Feed one chunk: time (N,) s, gyro and accel (N, 3) as rates or increments.
-    fn process<'py>(&self, py: Python<'py>, t: PyReadonlyArray1<'py, f64>, gyro: PyReadonlyArray2<'py, f64>, accel: PyReadonlyArray2<'py, f64>) -> PyResult<OutputTuple<'py>> {
-        let (tt, g, a) = (vector(&t, "time")?, vec3_rows(&gyro, "gyro")?, vec3_rows(&accel, "accel")?);
-        self.call(py, move |ins, out| ins.process(&tt, &g, &a, out))
+    /// Feed one chunk: time (N,) s, gyro and accel (N, 3) as rates or increments, the
+    /// reference altitude h_ref (N,) m of a damped vertical channel. The engine checks the
+    /// samples and names their index in the whole streamed record.
+    #[pyo3(signature = (t, gyro, accel, h_ref=None))]
+    fn process<'py>(
+        &self,
+        py: Python<'py>,
+        t: PyReadonlyArray1<'py, f64>,
+        gyro: PyReadonlyArray2<'py, f64>,
+        accel: PyReadonlyArray2<'py, f64>,
+        h_ref: Option<PyReadonlyArray1<'py, f64>>,
+    ) -> PyResult<OutputTuple<'py>> {
+        let (tt, g, a) = (t.as_array().to_vec(), unchecked_vec3_rows(&gyro, "gyro")?, unchecked_vec3_rows(&accel, "accel")?);
+        let h = h_ref.map(|h| h.as_array().to_vec());
+        self.call(py, move |ins, out| ins.process_ref(&tt, &g, &a, h.as_deref(), out))
     }
 
     /// End of the record: one last epoch at the last sample.
@@ -496,6 +534,16 @@ impl PyAidedIns {
     fn pending(&self) -> usize {
         self.inner.lock().map(|g| g.pending()).unwrap_or(0)
     }
+}
+
+/// The rows of an (N, 3) array, shape-checked only: the aided engine checks finiteness
+/// itself and names the sample's index in the whole record, not in the chunk.
+fn unchecked_vec3_rows(a: &PyReadonlyArray2<'_, f64>, field: &str) -> Result<Vec<crate::math::Vec3>, NavError> {
+    let v = a.as_array();
+    if v.ncols() != 3 {
+        return Err(invalid(field, format!("expected shape (N, 3), got ({}, {})", v.nrows(), v.ncols())));
+    }
+    Ok(v.outer_iter().map(|r| crate::math::Vec3::new(r[0], r[1], r[2])).collect())
 }
 
 /// INS noise model from the Python arguments.

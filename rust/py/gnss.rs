@@ -254,13 +254,13 @@ fn gnss_spp<'py>(
 /// table as for `gnss_spp`; `extra0` initial (c·τ_GPS m[, c·δt_r m, c·δṫ_r m/s]); `p0` for
 /// the whole layout (15 INS states, then the extra blocks).
 #[pyfunction]
-#[pyo3(signature = (eph, time, sat, channel, code, rate, formulation, lever_arm, sigma_code_gps, sigma_code_glo, sigma_rate, use_rate, iono, tropo, tau_psd, clock_h0, clock_hm2, baro_time, baro_h, sigma_baro, ins, extra0))]
+#[pyo3(signature = (eph, time, sat, channel, code, rate, formulation, lever_arm, sigma_code_gps, sigma_code_glo, sigma_rate, use_rate, iono, tropo, tau_psd, clock_h0, clock_hm2, ins, extra0))]
 #[allow(clippy::too_many_arguments)]
 fn gnss_tight_ins<'py>(
     eph: &PyEphemerides, time: PyReadonlyArray1<'py, f64>, sat: Vec<String>, channel: PyReadonlyArray1<'py, i64>,
     code: PyReadonlyArray1<'py, f64>, rate: PyReadonlyArray1<'py, f64>, formulation: &str, lever_arm: PyReadonlyArray1<'py, f64>,
     sigma_code_gps: f64, sigma_code_glo: f64, sigma_rate: f64, use_rate: bool, iono: bool, tropo: bool, tau_psd: f64, clock_h0: f64,
-    clock_hm2: f64, baro_time: PyReadonlyArray1<'py, f64>, baro_h: PyReadonlyArray1<'py, f64>, sigma_baro: f64, ins: PyRef<'py, super::filter::AidedSetup>, extra0: PyReadonlyArray1<'py, f64>,
+    clock_hm2: f64, ins: PyRef<'py, super::filter::AidedSetup>, extra0: PyReadonlyArray1<'py, f64>,
 ) -> PyResult<PyAidedIns> {
     let obs = parse_obs(&sat, &channel, &code, &rate)?;
     let epochs = group_epochs(time.as_array().as_slice().ok_or_else(|| invalid("time", "must be contiguous"))?, &obs)?;
@@ -281,14 +281,8 @@ fn gnss_tight_ins<'py>(
         clock_h0,
         clock_hm2,
         kind: ins.kind,
-        sigma_baro,
     };
-    let (bt, bh) = (vector(&baro_time, "baro_time")?, vector(&baro_h, "baro_h")?);
-    if bt.len() != bh.len() {
-        return Err(invalid("baro_h", format!("{} altitudes for {} times", bh.len(), bt.len())).into());
-    }
-    let baro: Vec<(f64, f64)> = bt.into_iter().zip(bh).collect();
-    let aiding = TightAiding::new(eph.inner.clone(), epochs, &baro, cfg)?;
+    let aiding = TightAiding::new(eph.inner.clone(), epochs, cfg)?;
     PyAidedIns::from_aiding(&ins, nalgebra::DVector::from_vec(vector(&extra0, "extra0")?), Box::new(aiding))
 }
 

@@ -3,7 +3,9 @@ aiding sensor. A sensor's factory (:func:`position_aided_ins`, and the CAI and G
 factories of their packages) builds an :class:`AidedIns`; :meth:`AidedIns.run` feeds a
 whole IMU record in chunks with a progress bar, :meth:`AidedIns.process` /
 :meth:`AidedIns.finish` stream it yourself. Closed loop (feedback) or open loop
-(estimation) is chosen at construction."""
+(estimation) is chosen at construction, and so is the vertical channel: free, or
+damped by a reference (barometric) altitude per IMU sample (``vertical="damped"``, spec
+gnss-ins-tight decision 13), which :meth:`AidedIns.run` then takes as ``h_ref``."""
 
 from __future__ import annotations
 
@@ -14,7 +16,7 @@ import pandas as pd
 from tqdm.auto import tqdm
 
 from .. import _core
-from .._validate import choice, increasing, positive, rows, vector
+from .._validate import choice, positive, rows, vector
 from ..strapdown import _table
 from .engine import BiasModel
 from .riccati import _mat
@@ -67,15 +69,18 @@ class AidedIns:
         meas = pd.DataFrame({"time_s": mt, "rows": mrows, "nis": nis, "rejected_rows": rejected})
         return AidedResult(table, meas, innov)
 
-    def process(self, time, gyro, accel) -> AidedResult:
+    def process(self, time, gyro, accel, h_ref=None) -> AidedResult:
         """Feed one chunk of the IMU record: ``time`` (N,) s, ``gyro``/``accel`` (N, 3) as
         rates (rad/s, m/s²) or increments (rad, m/s) per the ``kind`` given at
-        construction; time must keep increasing across chunks. Returns the epochs and
-        measurements of this chunk. If it stops on an error (bad sample, divergence, loss
-        of positive definiteness), the exception's ``partial`` attribute is the
+        construction, ``h_ref`` (N,) m the reference altitude of a damped vertical
+        channel (required then, refused with a free one); time must keep increasing
+        across chunks. Returns the epochs and measurements of this chunk. Bad samples
+        (non-finite, time not increasing) raise ``ValueError`` naming their index in the
+        whole streamed record. If it stops on an error (bad sample, divergence, loss of
+        positive definiteness), the exception's ``partial`` attribute is the
         :class:`AidedResult` of the epochs computed before it."""
-        t = vector(time, None, "time")
-        return self._call(self._core.process, t, rows(gyro, 3, "gyro"), rows(accel, 3, "accel"))
+        t, g, a, h = _imu(time, gyro, accel, h_ref)
+        return self._call(self._core.process, t, g, a, h)
 
     def _call(self, fn, *args) -> AidedResult:
         try:
@@ -89,36 +94,57 @@ class AidedIns:
         """End of the record: a last epoch at the last sample if steps are left over."""
         return self._call(self._core.finish)
 
-    def run(self, time, gyro, accel, chunk_s: float = 60.0, progress: bool = True) -> AidedResult:
-        """Run a whole IMU record (see :meth:`process`) in chunks of ``chunk_s`` seconds
-        with a progress bar. Every measurement must lie inside the record. The result is
-        the same for any chunk length. On an error the exception's ``partial`` attribute
-        holds every epoch computed before it."""
-        t = vector(time, None, "time")
-        g, a = rows(gyro, 3, "gyro"), rows(accel, 3, "accel")
+    def run(self, time, gyro, accel, h_ref=None, chunk_s: float = 60.0, progress: bool = True) -> AidedResult:
+        """Run a whole IMU record (see :meth:`process`; ``h_ref`` (N,) m with a damped
+        vertical channel) in chunks of about ``chunk_s`` seconds (a fixed number of
+        samples) with a progress bar. Every measurement must lie inside the record. The
+        result is the same for any chunk length. Bad samples raise ``ValueError`` naming
+        their index in the record (the Rust engine checks them chunk by chunk). On an
+        error the exception's ``partial`` attribute holds every epoch computed before it."""
+        t, g, a, h = _imu(time, gyro, accel, h_ref)
         positive(chunk_s, "chunk_s")
-        increasing(t, "time")
-        if len(t) < 2:
-            raise ValueError(f"time: need >= 2 samples, got {len(t)}")
+        n = len(t)
+        if n < 2:
+            raise ValueError(f"time: need >= 2 samples, got {n}")
         mt = np.asarray(self._core.measurement_times)
         outside = np.nonzero((mt < t[0]) | (mt > t[-1]))[0]
         if outside.size:
             i = outside[0]
             raise ValueError(f"measurements: time {mt[i]:g} s at index {i} is outside the IMU span [{t[0]:g}, {t[-1]:g}] s")
-        edges = np.searchsorted(t, np.arange(t[0], t[-1], chunk_s)[1:], side="left")
-        bounds = np.r_[0, edges, len(t)]
+        # chunks of a fixed sample count from the mean step (one chunk when the end times
+        # are not usable; the engine then names the bad sample)
+        step = (t[-1] - t[0]) / (n - 1)
+        size = max(1, int(chunk_s / step)) if np.isfinite(step) and step > 0 else n
+        bounds = list(range(0, n, size)) + [n]
         parts = []
         try:
             for lo, hi in tqdm(list(zip(bounds[:-1], bounds[1:])), desc="aided INS", unit="chunk",
                                disable=not progress or len(bounds) <= 2):
-                if hi > lo:
-                    parts.append(self.process(t[lo:hi], g[lo:hi], a[lo:hi]))
+                parts.append(self.process(t[lo:hi], g[lo:hi], a[lo:hi], None if h is None else h[lo:hi]))
             parts.append(self.finish())
         except (ValueError, _core.NumericalError) as e:
             if isinstance(getattr(e, "partial", None), AidedResult):
                 e.partial = _concat(parts + [e.partial])
             raise
         return _concat(parts)
+
+
+def _imu(time, gyro, accel, h_ref):
+    """Shapes of an IMU chunk; finiteness and time order are the engine's checks."""
+    def arr(x, width, name):
+        a = np.ascontiguousarray(np.asarray(x, dtype=float))
+        want = (width is None and a.ndim == 1) or (width is not None and a.ndim == 2 and a.shape[1] == width)
+        if not want:
+            raise ValueError(f"{name}: expected shape {'(N,)' if width is None else f'(N, {width})'}, got {a.shape}")
+        return a
+
+    t = arr(time, None, "time")
+    g, a = arr(gyro, 3, "gyro"), arr(accel, 3, "accel")
+    h = None if h_ref is None else arr(h_ref, None, "h_ref")
+    for name, x in (("gyro", g), ("accel", a), ("h_ref", h)):
+        if x is not None and len(x) != len(t):
+            raise ValueError(f"{name}: expected {len(t)} rows like time, got {len(x)}")
+    return t, g, a, h
 
 
 def _concat(parts: list[AidedResult]) -> AidedResult:
@@ -128,21 +154,26 @@ def _concat(parts: list[AidedResult]) -> AidedResult:
 
 
 def ins_setup(t0, lla0, vel0, q0, kind, p0, accel_psd, gyro_psd, accel_bias: BiasModel, gyro_bias: BiasModel,
-              ba0, bg0, predict_every, method, mode, sequential, gate, ellipsoid) -> _core.AidedSetup:
+              ba0, bg0, predict_every, method, mode, sequential, gate, ellipsoid, vertical: str = "free",
+              zeta: float = 0.707, omega: float = 0.01, baro_psd: float = 0.0, baro_bias: BiasModel | None = None,
+              baro_bias_sigma0: float | None = None) -> _core.AidedSetup:
     """The INS part every sensor factory shares, checked once (see
     :func:`position_aided_ins` for the meaning of the arguments)."""
     choice(kind, ("rates", "increments"), "kind")
+    choice(vertical, ("free", "damped"), "vertical")
     return _core.AidedSetup(float(t0), vector(lla0, 3, "lla0"), vector(vel0, 3, "vel0"), vector(q0, 4, "q0"), kind,
                             vector(ba0, 3, "ba0"), vector(bg0, 3, "bg0"), _mat(p0, "p0"), float(accel_psd),
                             float(gyro_psd), accel_bias._parts(), gyro_bias._parts(), int(predict_every), method, mode,
-                            bool(sequential), None if gate is None else float(gate), ellipsoid)
+                            bool(sequential), None if gate is None else float(gate), ellipsoid, vertical, float(zeta),
+                            float(omega), float(baro_psd), None if baro_bias is None else baro_bias._parts(),
+                            None if baro_bias_sigma0 is None else float(baro_bias_sigma0))
 
 
 def position_aided_ins(t0: float, lla0, vel0, q0, kind: str, fix_time, fix_lla, fix_cov, p0, accel_psd: float,
                        gyro_psd: float, accel_bias: BiasModel = BiasModel(), gyro_bias: BiasModel = BiasModel(),
                        ba0=(0, 0, 0), bg0=(0, 0, 0), predict_every: int = 1, method: str = "van_loan",
                        mode: str = "closed", sequential: bool = False, gate: float | None = None,
-                       ellipsoid: str = "WGS84") -> AidedIns:
+                       ellipsoid: str = "WGS84", **vertical) -> AidedIns:
     """A position-aided 15-state INS.
 
     Initial state t0 (s), lla0 (rad, rad, m), vel0 NED (m/s), q0 = q_nb; IMU output
@@ -154,12 +185,21 @@ def position_aided_ins(t0: float, lla0, vel0, q0, kind: str, fix_time, fix_lla, 
     every fix; ``method`` "van_loan" or "first_order"; ``mode`` "closed" or "open";
     ``sequential`` scalar updates; ``gate`` χ² threshold.
 
+    Vertical channel (keywords of :func:`ins_setup`): ``vertical`` "free" (default) or
+    "damped", then :meth:`AidedIns.run` needs ``h_ref``, the reference (barometric)
+    altitude (m) per IMU sample; ``zeta``, ``omega`` (rad/s) of the baro loop
+    (K_v1 = 2ζω, K_v2 = ω² + 2γ/R₀; spec gnss-ins-tight Eq. 26); the reference-altitude
+    error h_b − h = b + n: ``baro_psd`` the PSD of the white part n (m²·s; σ²Δt for
+    independent samples of σ every Δt), ``baro_bias`` a :class:`BiasModel` of b carried as
+    the state ``baro_bias`` (m, after the sensor's extra states) with initial σ
+    ``baro_bias_sigma0`` (m); without it the filter assumes b = 0.
+
     >>> ins = position_aided_ins(...)              # doctest: +SKIP
     >>> result = ins.run(time, gyro, accel)        # doctest: +SKIP
     >>> truth.errors(result.nav)                   # doctest: +SKIP
     """
     ins = ins_setup(t0, lla0, vel0, q0, kind, p0, accel_psd, gyro_psd, accel_bias, gyro_bias, ba0, bg0,
-                    predict_every, method, mode, sequential, gate, ellipsoid)
+                    predict_every, method, mode, sequential, gate, ellipsoid, **vertical)
     core = _core.position_aided_ins(
         ins, np.ascontiguousarray(np.asarray(fix_time, float).ravel()), rows(fix_lla, 3, "fix_lla"),
         np.ascontiguousarray(np.asarray(fix_cov, float).reshape(-1, 3, 3)))

@@ -50,23 +50,35 @@ def run(report):
     q = report.quick
     _tau_experiment(report, 6.0 if q else 24.0)
 
-    # class × satellite count: horizontal RMS over the last 10 min (fixed top-n satellites)
-    dur = 1200.0 if q else 2400.0
+    # class × satellite count: horizontal RMS over the last 10 min (fixed top-n satellites),
+    # over the spec's 40 min also when quick (with the baro-damped vertical channel three
+    # satellites need longer than 20 min to separate the altitude offset of the vertical
+    # accelerometer bias from the horizontal)
+    dur = 2400.0
     table = {}
     for cls in tqdm(("precise", "medium", "coarse"), desc="class × satellites", disable=q):
         for n in (None, 3, 2, 0):
             table[(cls, "all" if n is None else n)] = S.last_rms(S.run(S.Scenario(cls, duration_s=dur, n_sats=n))["errors"])
+    # spec row 13 (3 ≤ 3 × all) is for the precise class; the others are reported: with the
+    # baro-damped channel the vertical accelerometer bias holds the altitude off by
+    # b_a/ω_v² (≈ 300 m for the coarse class's 3 mg), which two first-difference rows
+    # separate from the horizontal slowly
     for cls in ("precise", "medium", "coarse"):
         full, three, two, free = (table[(cls, k)] for k in ("all", 3, 2, 0))
-        report.row(f"{cls}: horizontal RMS last 10 min, all / 3 / 2 / 0 satellites (m)", "3 ≈ all",
-                   f"{full:.2f} / {three:.2f} / {two:.0f} / {free:.0f}", bool(three <= 3 * full))
+        report.row(f"{cls}: horizontal RMS last 10 min, all / 3 / 2 / 0 satellites (m); 3 ÷ all",
+                   "3 ≤ 3 × all (precise)" if cls == "precise" else "– (spec: precise only)",
+                   f"{full:.2f} / {three:.2f} / {two:.0f} / {free:.0f}; {three / full:.1f}",
+                   bool(three <= 3 * full) if cls == "precise" else "")
 
     # open vs closed loop NEES over time
     dur = 1200.0 if q else 3600.0
     fig, ax = plt.subplots(1, 2, figsize=(11, 3.8), sharey=True)
+    worst = {}
     for a, cls in zip(ax, ("precise", "medium")):
         for mode in ("closed", "open"):
             e = S.run(S.Scenario(cls, motion="MOVE" if cls == "precise" else "STAT", duration_s=dur, mode=mode))["errors"]
+            d3 = np.sqrt(e.dpos_n_m ** 2 + e.dpos_e_m ** 2 + e.dpos_d_m ** 2)
+            worst[(cls, mode)] = float(d3[e.time_s > 60.0].max())
             w = e.groupby((e.time_s // 300).astype(int))
             a.semilogy(w.time_s.mean() / 60, w.nees.mean(), "o-", label=f"{mode} loop")
             inside = float(((e.nees > 4.60) & (e.nees < 32.80)).mean())
@@ -76,6 +88,10 @@ def run(report):
         a.set(xlabel="time (min)", title=f"{cls} INS", ylabel="NEES (5-min mean, 15 states, diagonal)")
         a.legend()
     report.figure(fig, "nees", "Open- vs closed-loop NEES (diagonal, 15 INS states), grey: χ²₁₅ 99 % band.")
+    ol, cl = worst[("precise", "open")], worst[("precise", "closed")]
+    report.row(f"precise INS (baro-damped vertical), max 3-D position error after 1 min over {dur / 60:.0f} min, "
+               "open / closed loop (m)", "OL ≤ 2 m, ≈ CL (within 20 %)", f"{ol:.2f} / {cl:.2f}",
+               bool(ol < 2.0 and cl < 2.0 and abs(ol / cl - 1) <= 0.2))
 
     # outages
     fig, ax = plt.subplots(1, 2, figsize=(11, 3.8))
