@@ -107,6 +107,7 @@ impl GyroErrorModel {
 /// E + X + Xᵀ − S X (Sᵀ = −S, so S E = −Xᵀ). Written out over the non-zero entries of S
 /// and the six unique entries of the symmetric result: 30 multiplications instead of the
 /// 54 of two dense 3×3 products (the hot loop of the calibration benchmark).
+#[inline(always)]
 fn transport(e: &Mat3, rho: &Vec3) -> Mat3 {
     let (x, y, z) = (rho.x, rho.y, rho.z);
     // X = E S, S columns (0, z, −y), (−z, 0, x), (y, −x, 0)
@@ -144,7 +145,8 @@ impl ErrorPropagator {
 
     /// One sample: E ← (I − [ρ×]) E (I + [ρ×]) + P_ρ (E7, D12); in consistent mode also
     /// J_m ← (I − [ρ×])J_m + I₃⊗ρᵀ and J_b ← (I − [ρ×])J_b + T I (E8).
-    #[inline]
+    // inlined into the per-interval loop so that E stays in registers
+    #[inline(always)]
     fn step(&mut self, rho: &Vec3, model: &GyroErrorModel, period: f64) {
         match self.mode {
             GyroErrorMode::Paper => self.e = transport(&self.e, rho) + model.sample_cov(rho, period),
