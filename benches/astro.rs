@@ -19,7 +19,7 @@ fn astro(c: &mut Criterion) {
         b.iter(|| black_box(integrate_increments(&rec, &scn.epochs, &scn.gyro, TaylorVariant::Corrected).unwrap()))
     });
     g.bench_function("star_attitudes_73_epochs", |b| {
-        b.iter(|| black_box(star_attitudes(&r.observations, scn.epochs.len(), &scn.cameras, scn.sigma_s, Some((&scn.up_gcrs, scn.n_refr))).unwrap()))
+        b.iter(|| black_box(star_attitudes(&r.observations, scn.epochs.len(), &scn.cameras, scn.sigma_s, Some((&scn.up_gcrs, scn.n_refr)), None).unwrap()))
     });
     g.bench_function("gauss_newton_and_covariance", |b| b.iter(|| black_box(calibrate(&r.ds_imu, &r.ds_avu, &Options::default()).unwrap())));
     g.finish();

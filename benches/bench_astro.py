@@ -16,7 +16,7 @@ Prints both wall times, their ratio, and the difference of the two mount estimat
 from __future__ import annotations
 
 import argparse
-import time
+import os
 
 import numpy as np
 from scipy.spatial.transform import Rotation
@@ -161,7 +161,8 @@ def main():
     diff = Rotation.from_matrix(c_an.T @ c_np).magnitude() / units.ARCSEC
     print(f"atomnav      : {t_an * 1e3:9.1f} ms  (best of {args.repeat})")
     print(f"numpy/scipy  : {t_np * 1e3:9.1f} ms  (best of {args.repeat})")
-    print(f"ratio        : {t_np / t_an:9.1f}x  (target >= 20x)")
+    print(f"ratio        : {t_np / t_an:9.1f}x  (target >= 20x; load average {os.getloadavg()[0]:.2f} "
+          f"on {os.cpu_count()} cores)")
     print(f"mount difference atomnav vs numpy: {diff:.2e} arcsec; "
           f"E^imu max relative difference {np.abs(e_an - e_np).max() / np.abs(e_an).max():.1e}")
 

@@ -100,3 +100,97 @@ def test_camera_not_a_rotation_rejected():
     cams = np.stack([np.eye(3), np.diag([1.0, 1.0, -1.0])])
     with pytest.raises(ValueError, match="cameras.*not a rotation matrix at index 1"):
         astro.star_attitudes(_three_stars(), 2, cams, 16 * AS)
+
+
+def test_aberration_matches_exact_relativistic_formula():
+    # Oracle: special relativity, cos θ' = (cos θ + β)/(1 + β cos θ) for the angle θ between
+    # the geometric direction and the observer velocity (Einstein 1905 §7); first order
+    # θ − θ' = β sin θ. Earth's orbital speed, β ≈ 1e-4: agreement to O(β²).
+    v = np.array([0.0, 0.0, 29_780.0])
+    beta = np.linalg.norm(v) / 299_792_458.0
+    th = np.radians([5.0, 30.0, 60.0, 90.0, 120.0, 175.0])
+    lam = np.radians([0.0, 40.0, 100.0, 200.0, 290.0, 330.0])
+    s = np.column_stack([np.sin(th) * np.cos(lam), np.sin(th) * np.sin(lam), np.cos(th)])
+    app = astro.aberration(s, v)
+    th_app = np.arccos(np.clip(app[:, 2], -1, 1))
+    exact = np.arccos((np.cos(th) + beta) / (1 + beta * np.cos(th)))
+    assert np.abs(th_app - exact).max() < beta ** 2
+    assert np.abs((th - th_app) - beta * np.sin(th)).max() < beta ** 2
+    assert np.abs(np.arctan2(app[:, 1], app[:, 0]) - np.arctan2(s[:, 1], s[:, 0])).max() < 1e-12  # toward v only
+    # per-row velocities give the same answer
+    assert np.abs(astro.aberration(s, np.tile(v, (len(s), 1))) - app).max() == 0.0
+
+
+def test_aberration_rejects_relativistic_velocity():
+    with pytest.raises(ValueError, match="velocity.*index 0"):
+        astro.aberration(np.eye(3), [0.0, 0.0, 1e6])
+
+
+def test_aberration_rejects_non_unit_direction():
+    with pytest.raises(ValueError, match="directions.*not a unit vector at index 1"):
+        astro.aberration(np.array([[1.0, 0, 0], [0, 1.1, 0]]), [0.0, 0.0, 3e4])
+
+
+@pytest.fixture(scope="module")
+def run7():
+    return astro.Vasilyuk2024().run(7)
+
+
+def _attitudes(tr, r, **kw):
+    return astro.star_attitudes(r["observations"], len(tr["epochs"]), tr["cameras"], tr["sigma_s"],
+                                up_gcrs=tr["up_gcrs"], n_refr=tr["n_refr"], **kw)
+
+
+def test_user_p_avu_replaces_default_and_drives_p_beta(scn, run7):
+    r, cal = run7, run7["calibration"]
+    s, p_def, _ = _attitudes(scn, r)
+    # the Python model_covariance reproduces the scenario's P_β^model from the default P^avu
+    pb_def, _ = astro.model_covariance(cal, r["ds_imu"], r["ds_avu"], r["e_imu"], p_def)
+    assert np.allclose(pb_def, r["p_beta_model"], rtol=1e-10, atol=0)
+    # a user P^avu: the default plus (10″)² about the VF z axis at every epoch
+    extra = np.zeros_like(p_def)
+    extra[:, 2, 2] = (10 * AS) ** 2
+    s_u, p_u, _ = _attitudes(scn, r, p_avu=p_def + extra)
+    assert np.array_equal(p_u, p_def + extra) and np.array_equal(s_u, s)
+    ds_avu, e_avu = astro.astro_increments(s_u, p_u)
+    want = extra[1:] + np.einsum("nji,njk,nkl->nil", ds_avu, extra[:-1], ds_avu)
+    assert np.abs(e_avu - r["e_avu"] - want).max() < 1e-9 * np.abs(want).max()
+    pb_u, _ = astro.model_covariance(cal, r["ds_imu"], ds_avu, r["e_imu"], p_u)
+    # predicted change: P_β^model is linear in (E^imu, P^avu), so the increase is exactly the
+    # P_β^model of the added term alone, positive semi-definite, and doubling P^avu doubles it
+    zero = np.zeros_like(r["e_imu"])
+    pb_extra, _ = astro.model_covariance(cal, r["ds_imu"], ds_avu, zero, extra)
+    assert np.allclose(pb_u - pb_def, pb_extra, rtol=1e-8, atol=1e-12 * np.abs(pb_extra).max())
+    assert np.linalg.eigvalsh(pb_extra).min() > -1e-12 * np.abs(pb_extra).max()
+    assert np.all(np.diag(pb_u) > np.diag(pb_def) * 1.1)
+    pb2, _ = astro.model_covariance(cal, r["ds_imu"], ds_avu, zero, 2 * extra)
+    assert np.allclose(pb2, 2 * pb_extra, rtol=1e-12, atol=0)
+    # P^mfa of a new fix uses it as well (Eq. 8)
+    assert np.allclose(cal.p_mfa(p_u[0]) - cal.p_mfa(p_def[0]), cal.c @ extra[0] @ cal.c.T, rtol=1e-12, atol=0)
+
+
+def _bad_p_avu(scn, run7, p, match):
+    with pytest.raises(ValueError, match=match):
+        _attitudes(scn, run7, p_avu=p)
+
+
+def test_user_p_avu_wrong_shape_rejected(scn, run7):
+    _bad_p_avu(scn, run7, np.tile(np.eye(3) * 1e-10, (72, 1, 1)), "p_avu: expected 73 covariances, got 72")
+
+
+def test_user_p_avu_non_finite_rejected(scn, run7):
+    p = np.tile(np.eye(3) * 1e-10, (73, 1, 1))
+    p[4, 1, 1] = np.nan
+    _bad_p_avu(scn, run7, p, "p_avu: non-finite value at index 4")
+
+
+def test_user_p_avu_not_symmetric_rejected(scn, run7):
+    p = np.tile(np.eye(3) * 1e-10, (73, 1, 1))
+    p[5, 0, 1] = 1e-11
+    _bad_p_avu(scn, run7, p, "p_avu: not symmetric.*at index 5")
+
+
+def test_user_p_avu_not_psd_rejected(scn, run7):
+    p = np.tile(np.eye(3) * 1e-10, (73, 1, 1))
+    p[2] = np.array([[1.0, 2.0, 0.0], [2.0, 1.0, 0.0], [0.0, 0.0, 1.0]]) * 1e-10
+    _bad_p_avu(scn, run7, p, "p_avu: not positive semi-definite.*at index 2")

@@ -189,7 +189,8 @@ pub struct Calibration {
     pub observability: Observability,
 }
 
-fn check_increments(ds_imu: &[Mat3], ds_avu: &[Mat3]) -> Result<()> {
+/// Pairs of increments: equal, non-zero counts of rotation matrices.
+pub fn check_increments(ds_imu: &[Mat3], ds_avu: &[Mat3]) -> Result<()> {
     if ds_imu.len() != ds_avu.len() {
         return Err(invalid("ds_avu", format!("expected {} increments like ds_imu, got {}", ds_imu.len(), ds_avu.len())));
     }
@@ -354,12 +355,11 @@ pub struct ConstantGyroErrors<'a> {
 /// cov(ε_n, ε_{n+1}) = −P_n^avu ΔS_{n+1}, and with constant gyro errors the cross blocks
 /// Cᵀ(J_m,n P_m J_m,pᵀ + J_b,n P_b J_b,pᵀ)C — and its systematic part
 /// P_β^sys = G_mP_mG_mᵀ + G_bP_bG_bᵀ, G = −(HᵀH)⁻¹Σ_n H_nᵀCᵀJ_n. Returns (P_β^model, P_β^sys) in rad².
-pub fn model_covariance(cal: &Calibration, ds_imu: &[Mat3], ds_avu: &[Mat3], e_imu: &[Mat3], p_avu: &[Mat3], constant: Option<&ConstantGyroErrors>) -> Result<(Mat3, Mat3)> {
+pub fn model_covariance(c: &Mat3, ds_imu: &[Mat3], ds_avu: &[Mat3], e_imu: &[Mat3], p_avu: &[Mat3], constant: Option<&ConstantGyroErrors>) -> Result<(Mat3, Mat3)> {
     let m = ds_imu.len();
     if e_imu.len() != m || p_avu.len() != m + 1 || constant.is_some_and(|k| k.sensitivities.len() != m) {
         return Err(invalid("e_imu", format!("expected {m} interval covariances (and sensitivities) and {} epoch covariances", m + 1)));
     }
-    let c = &cal.c;
     let h: Vec<Mat3> = ds_imu.iter().zip(ds_avu).map(|(i, a)| jacobian_block(c, i, a)).collect();
     let a_inv = h.iter().map(|h| h.transpose() * h).sum::<Mat3>().try_inverse().ok_or_else(|| NavError::Numerical("singular HᵀH".into()))?;
     let (mut g_m, mut g_b) = (SMatrix::<f64, 3, 9>::zeros(), Mat3::zeros());
@@ -380,7 +380,7 @@ pub fn model_covariance(cal: &Calibration, ds_imu: &[Mat3], ds_avu: &[Mat3], e_i
             mid += x + x.transpose();
         }
     }
-    let d1_inv = d1(&cal.beta).try_inverse().ok_or_else(|| NavError::Numerical("Euler angles at gimbal lock (|ϑ| = 90°)".into()))?;
+    let d1_inv = d1(&euler_from_dcm(c)).try_inverse().ok_or_else(|| NavError::Numerical("Euler angles at gimbal lock (|ϑ| = 90°)".into()))?;
     let to_beta = |p: Mat3| d1_inv * p * d1_inv.transpose();
     let p_sys = match constant {
         Some(k) => {

@@ -8,6 +8,7 @@
 use crate::error::{check_increasing, check_positive, invalid, Result};
 use crate::math::{dcm_from_quat, quat, quat_normalize, skew, Mat3, Quat, Vec3};
 use nalgebra::SMatrix;
+use rayon::prelude::*;
 
 /// Scalar-part coefficient c of the E4 intra-sample quaternion (spec D1).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -102,12 +103,26 @@ impl GyroErrorModel {
     }
 }
 
-/// (I − [ρ×]) E (I − [ρ×])ᵀ for symmetric E: with S = [ρ×] and X = E S, this is
-/// E + X + Xᵀ − S X (Sᵀ = −S), one product fewer than the two dense ones.
+/// (I − [ρ×]) E (I − [ρ×])ᵀ for symmetric E (E7): with S = [ρ×] and X = E S this is
+/// E + X + Xᵀ − S X (Sᵀ = −S, so S E = −Xᵀ). Written out over the non-zero entries of S
+/// and the six unique entries of the symmetric result: 30 multiplications instead of the
+/// 54 of two dense 3×3 products (the hot loop of the calibration benchmark).
+#[inline(always)]
 fn transport(e: &Mat3, rho: &Vec3) -> Mat3 {
-    let s = skew(rho);
-    let x = e * s;
-    e + x + x.transpose() - s * x
+    let (x, y, z) = (rho.x, rho.y, rho.z);
+    // X = E S, S columns (0, z, −y), (−z, 0, x), (y, −x, 0)
+    let xm = |i: usize| [e[(i, 1)] * z - e[(i, 2)] * y, e[(i, 2)] * x - e[(i, 0)] * z, e[(i, 0)] * y - e[(i, 1)] * x];
+    let (x0, x1, x2) = (xm(0), xm(1), xm(2));
+    // (S X)[i, k]: rows of S (0, −z, y), (z, 0, −x), (−y, x, 0)
+    let sx = |i: usize, k: usize| match i {
+        0 => y * x2[k] - z * x1[k],
+        1 => z * x0[k] - x * x2[k],
+        _ => x * x1[k] - y * x0[k],
+    };
+    let xr = [x0, x1, x2];
+    let r = |i: usize, k: usize| e[(i, k)] + xr[i][k] + xr[k][i] - sx(i, k);
+    let (a, b, c, d, f, g) = (r(0, 0), r(0, 1), r(0, 2), r(1, 1), r(1, 2), r(2, 2));
+    Mat3::new(a, b, c, b, d, f, c, f, g)
 }
 
 /// Error state of one interval (E7/E8), started at zero; only the selected mode's terms
@@ -130,11 +145,13 @@ impl ErrorPropagator {
 
     /// One sample: E ← (I − [ρ×]) E (I + [ρ×]) + P_ρ (E7, D12); in consistent mode also
     /// J_m ← (I − [ρ×])J_m + I₃⊗ρᵀ and J_b ← (I − [ρ×])J_b + T I (E8).
+    // inlined into the per-interval loop so that E stays in registers
+    #[inline(always)]
     fn step(&mut self, rho: &Vec3, model: &GyroErrorModel, period: f64) {
-        let a = Mat3::identity() - skew(rho);
         match self.mode {
             GyroErrorMode::Paper => self.e = transport(&self.e, rho) + model.sample_cov(rho, period),
             GyroErrorMode::Consistent => {
+                let a = Mat3::identity() - skew(rho);
                 self.e = transport(&self.e, rho) + Mat3::identity() * (model.sigma_w * model.sigma_w * period);
                 self.j_m = a * self.j_m;
                 for i in 0..3 {
@@ -162,21 +179,32 @@ impl ErrorPropagator {
     }
 }
 
-/// A gyro increment record: `rho[j]` (rad) over [t_start + jT, t_start + (j+1)T].
+/// A gyro increment record: `rho[j]` (rad) over [t_start + jT, t_start + (j+1)T]. The rows
+/// are `Vec3` or plain `[f64; 3]` (so that a numpy buffer is read in place, without a copy).
 #[derive(Debug, Clone, Copy)]
-pub struct ImuRecord<'a> {
+pub struct ImuRecord<'a, R = Vec3> {
     pub t_start: f64,
     pub period: f64,
-    pub rho: &'a [Vec3],
+    pub rho: &'a [R],
 }
 
-impl ImuRecord<'_> {
+impl<R: Copy + Into<Vec3> + Sync> ImuRecord<'_, R> {
+    #[inline]
+    fn rho(&self, j: usize) -> Vec3 {
+        self.rho[j].into()
+    }
+
     fn validate(&self) -> Result<()> {
         check_positive("period", self.period)?;
         if !self.t_start.is_finite() {
             return Err(invalid("t_start", format!("must be finite, got {}", self.t_start)));
         }
-        match self.rho.iter().position(|v| !v.iter().all(|x| x.is_finite())) {
+        // one branch-free pass (vectorisable) before looking for the first bad row
+        let any_bad = self.rho.iter().fold(false, |bad, &v| {
+            let v: Vec3 = v.into();
+            bad | !(v.x.is_finite() & v.y.is_finite() & v.z.is_finite())
+        });
+        match any_bad.then(|| self.rho.iter().position(|&v| !Into::<Vec3>::into(v).iter().all(|x| x.is_finite()))).flatten() {
             None => Ok(()),
             Some(i) => Err(invalid("gyro_increments", format!("non-finite value at index {i}"))),
         }
@@ -204,7 +232,33 @@ impl ImuRecord<'_> {
 
     /// Δρ_j = ρ_j − ρ_{j−1}, zero for the first sample of the record (E3, D14).
     fn drho(&self, j: usize) -> Vec3 {
-        if j == 0 { Vec3::zeros() } else { self.rho[j] - self.rho[j - 1] }
+        if j == 0 { Vec3::zeros() } else { self.rho(j) - self.rho(j - 1) }
+    }
+
+    /// The increment between instants `ta` < `tb` (E5–E8) in one pass over the samples
+    /// touched: q_1 = r(x_a)* ∘ r(x_end of the first sample), then whole samples r(1), then
+    /// r(x_b); E7/E8 over every sample from the one holding `ta` to the one holding `tb`.
+    /// The quaternion is normalised once at the end: |q ∘ r| = |q| |r|, so normalising
+    /// after every product (E5) only rescales and leaves the direction unchanged.
+    fn interval(&self, ta: f64, tb: f64, model: &GyroErrorModel, variant: TaylorVariant) -> Increment {
+        let ((ja, xa), (jb, xb)) = (self.locate(ta), self.locate(tb));
+        let r = |j: usize, x: f64| intra_sample(&self.rho(j), &self.drho(j), x, variant);
+        let first_end = if ja == jb { xb } else { 1.0 };
+        let mut q = r(ja, xa).conjugate() * r(ja, first_end);
+        let mut p = ErrorPropagator::zero(model.mode);
+        let mut prev = self.rho(ja);
+        p.step(&prev, model, self.period);
+        for j in ja + 1..jb {
+            let rho = self.rho(j);
+            q *= full_sample(&rho, &(rho - prev));
+            p.step(&rho, model, self.period);
+            prev = rho;
+        }
+        if jb > ja {
+            q *= r(jb, xb);
+            p.step(&self.rho(jb), model, self.period);
+        }
+        Increment { q: quat_normalize(&q), cov: p.cov(model), sensitivities: p.sensitivities() }
     }
 }
 
@@ -247,36 +301,18 @@ impl Increment {
     }
 }
 
-/// Increments between consecutive epochs (N epochs → N − 1 increments), E3–E8.
-pub fn integrate_increments(rec: &ImuRecord, epochs: &[f64], model: &GyroErrorModel, variant: TaylorVariant) -> Result<Vec<Increment>> {
+/// Increments between consecutive epochs (N epochs → N − 1 increments), E3–E8; the
+/// intervals are independent and run in parallel.
+pub fn integrate_increments<R: Copy + Into<Vec3> + Sync>(rec: &ImuRecord<R>, epochs: &[f64], model: &GyroErrorModel, variant: TaylorVariant) -> Result<Vec<Increment>> {
     rec.validate()?;
     model.validate()?;
     rec.check_epochs(epochs)?;
-    let r = |j: usize, x: f64| intra_sample(&rec.rho[j], &rec.drho(j), x, variant);
-    let interval = |w: &[f64]| {
-        let ((ja, xa), (jb, xb)) = (rec.locate(w[0]), rec.locate(w[1]));
-        // E5: q_1 = N(r(x0)* ∘ r(x_end of first sample)), then whole samples, then r(x_e).
-        let first_end = if ja == jb { xb } else { 1.0 };
-        let mut q = quat_normalize(&(r(ja, xa).conjugate() * r(ja, first_end)));
-        for j in ja + 1..jb {
-            q = quat_normalize(&(q * r(j, 1.0)));
-        }
-        if jb > ja {
-            q = quat_normalize(&(q * r(jb, xb)));
-        }
-        // E7/E8 over every sample touched by the interval.
-        let mut p = ErrorPropagator::zero(model.mode);
-        for rho in &rec.rho[ja..=jb] {
-            p.step(rho, model, rec.period);
-        }
-        Increment { q, cov: p.cov(model), sensitivities: p.sensitivities() }
-    };
-    Ok(epochs.windows(2).map(interval).collect())
+    Ok(epochs.par_windows(2).map(|w| rec.interval(w[0], w[1], model, variant)).collect())
 }
 
 /// Continuous dead-reckoning covariance P_n^imu at every epoch (spec E20): E7/E8 run from
 /// the start of the sample holding the first epoch, linearly interpolated at t_En.
-pub fn dead_reckoning_cov(rec: &ImuRecord, epochs: &[f64], model: &GyroErrorModel) -> Result<Vec<Mat3>> {
+pub fn dead_reckoning_cov<R: Copy + Into<Vec3> + Sync>(rec: &ImuRecord<R>, epochs: &[f64], model: &GyroErrorModel) -> Result<Vec<Mat3>> {
     rec.validate()?;
     model.validate()?;
     rec.check_epochs(epochs)?;
@@ -286,12 +322,12 @@ pub fn dead_reckoning_cov(rec: &ImuRecord, epochs: &[f64], model: &GyroErrorMode
     for &t in epochs {
         let (jt, x) = rec.locate(t);
         while j < jt {
-            p.step(&rec.rho[j], model, rec.period);
+            p.step(&rec.rho(j), model, rec.period);
             j += 1;
         }
         let before = p.cov(model);
         let mut next = p;
-        next.step(&rec.rho[jt], model, rec.period);
+        next.step(&rec.rho(jt), model, rec.period);
         out.push(before * (1.0 - x) + next.cov(model) * x);
     }
     Ok(out)

@@ -136,7 +136,7 @@ pub fn run(scn: &Scenario, seed: u64, opt: &Options, diff_form: DiffForm) -> Res
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     let rho = corrupt_gyro(&scn.rho_true, &scn.gyro, scn.period, &mut rng);
     let obs = simulate_observations(&scn.catalog, &scn.s_gcrs_vf, &scn.up_gcrs, &scn.cameras, scn.fov_half, scn.m_lim, scn.sigma_s, scn.n_refr, &mut rng);
-    let att = star_attitudes(&obs, scn.epochs.len(), &scn.cameras, scn.sigma_s, Some((&scn.up_gcrs, scn.n_refr)))?;
+    let att = star_attitudes(&obs, scn.epochs.len(), &scn.cameras, scn.sigma_s, Some((&scn.up_gcrs, scn.n_refr)), None)?;
     let rec = ImuRecord { t_start: scn.t_start, period: scn.period, rho: &rho };
     let inc = integrate_increments(&rec, &scn.epochs, &scn.gyro, TaylorVariant::Corrected)?;
     let (ds_imu, e_imu): (Vec<Mat3>, Vec<Mat3>) = inc.iter().map(|i| (i.dcm(), i.cov)).unzip();
@@ -144,7 +144,7 @@ pub fn run(scn: &Scenario, seed: u64, opt: &Options, diff_form: DiffForm) -> Res
     let cal = calibrate(&ds_imu, &ds_avu, opt)?;
     let sens: Vec<_> = inc.iter().filter_map(|i| i.sensitivities).collect();
     let constant = (scn.gyro.mode == GyroErrorMode::Consistent).then(|| ConstantGyroErrors { sensitivities: &sens, p_m: scn.gyro.p_m(), sigma_b: scn.gyro.sigma_b });
-    let (p_beta_model, p_beta_sys) = model_covariance(&cal, &ds_imu, &ds_avu, &e_imu, &att.p, constant.as_ref())?;
+    let (p_beta_model, p_beta_sys) = model_covariance(&cal.c, &ds_imu, &ds_avu, &e_imu, &att.p, constant.as_ref())?;
     let p_imu = dead_reckoning_cov(&rec, &scn.epochs, &scn.gyro)?;
     let (theta_diff, p_diff) = dead_reckoning_check(&cal.c, &att.s, &ds_imu, &att.p, &p_imu, &cal.p_clb, diff_form)?;
     let beta_true = super::euler_from_dcm(&scn.c_true);

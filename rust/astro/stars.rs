@@ -92,7 +92,7 @@ impl Catalog {
     }
 }
 
-fn check_unit(field: &str, v: &[Vec3]) -> Result<()> {
+pub fn check_unit(field: &str, v: &[Vec3]) -> Result<()> {
     // NaN norms fail too: `is_nan() ||` keeps them out of the accepted set
     match v.iter().position(|s| (s.norm() - 1.0).is_nan() || (s.norm() - 1.0).abs() > UNIT_TOLERANCE) {
         None => Ok(()),
@@ -115,6 +115,15 @@ pub fn refraction_correct(s: &Vec3, u: &Vec3, n: f64) -> Vec3 {
 pub fn refraction_apply(s: &Vec3, u: &Vec3, n: f64) -> Vec3 {
     let c = u.dot(s);
     (s - u * c) / n + u * (1.0 - (1.0 - c * c) / (n * n)).sqrt()
+}
+
+/// First-order (classical) stellar aberration: the apparent direction of a star of geometric
+/// unit direction `s` seen by an observer moving with velocity `v` (m/s, same frame),
+/// s' = normalize(s + v/c) = s + (v/c − (s·v/c) s) + O((v/c)²) (spec §7; Explanatory
+/// Supplement to the Astronomical Almanac, 1992, Eq. 3.252-1 to first order). The
+/// exact (relativistic) form differs by O((v/c)²): ≈ 1e-8 rad for Earth's 30 km/s orbit.
+pub fn aberration(s: &Vec3, v: &Vec3) -> Vec3 {
+    (s + v / crate::gnss::C_LIGHT).normalize()
 }
 
 /// A rigid camera of the set: C_VF^CFⁱ (maps camera into VF) and the covariance P_aⁱ of
@@ -147,11 +156,38 @@ pub struct StarAttitudes {
     pub stars: Vec<usize>,
 }
 
+/// `n` finite, symmetric, positive semi-definite 3×3 covariances, e.g. a user-supplied
+/// P_n^avu of every epoch (E12 "users may instead supply P_n^avu directly").
+pub fn check_covariances(field: &str, p: &[Mat3], n: usize) -> Result<()> {
+    if p.len() != n {
+        return Err(invalid(field, format!("expected {n} covariances, got {}", p.len())));
+    }
+    for (e, m) in p.iter().enumerate() {
+        crate::filter::matrix::check_covariance(field, &nalgebra::DMatrix::from_column_slice(3, 3, m.as_slice()), Some(3), false)
+            .map_err(|err| match err {
+                crate::error::NavError::InvalidInput { reason, .. } => invalid(field, format!("{reason} at index {e}")),
+                other => other,
+            })?;
+    }
+    Ok(())
+}
+
 /// Merge the cameras into VF (E9), remove refraction about the local vertical from a
 /// first-pass attitude (E10, D13), solve Wahba (E11) and form P^avu (E12, project default:
-/// σ_s²K_n + K_n(Σᵢ Cᵢ Aᵢ D1(αⁱ) P_aⁱ D1(αⁱ)ᵀ Aᵢ Cᵢᵀ)K_n, K_n = (Σ(I − ssᵀ))⁻¹).
+/// σ_s²K_n + K_n(Σᵢ Cᵢ Aᵢ D1(αⁱ) P_aⁱ D1(αⁱ)ᵀ Aᵢ Cᵢᵀ)K_n, K_n = (Σ(I − ssᵀ))⁻¹), or take
+/// the user's `p_avu` (one per epoch, rad², VF) in its place (E12, D11).
 /// `up_gcrs` (one per epoch) and `n_refr` enable refraction; `None` skips it.
-pub fn star_attitudes(obs: &Observations, n_epochs: usize, cameras: &[Camera], sigma_s: f64, refraction: Option<(&[Vec3], f64)>) -> Result<StarAttitudes> {
+pub fn star_attitudes(
+    obs: &Observations,
+    n_epochs: usize,
+    cameras: &[Camera],
+    sigma_s: f64,
+    refraction: Option<(&[Vec3], f64)>,
+    p_avu: Option<&[Mat3]>,
+) -> Result<StarAttitudes> {
+    if let Some(p) = p_avu {
+        check_covariances("p_avu", p, n_epochs)?;
+    }
     for (i, c) in cameras.iter().enumerate() {
         check_rotation("cameras", i, &c.c_vf_cf)?;
     }
@@ -221,7 +257,10 @@ pub fn star_attitudes(obs: &Observations, n_epochs: usize, cameras: &[Camera], s
             })
             .sum();
         out.s.push(att);
-        out.p.push(k_n * sigma_s * sigma_s + k_n * att_terms * k_n);
+        out.p.push(match p_avu {
+            Some(p) => p[e],
+            None => k_n * sigma_s * sigma_s + k_n * att_terms * k_n,
+        });
         out.stars.push(idx.len());
     }
     Ok(out)
@@ -304,6 +343,25 @@ mod tests {
             let snell = z - (z.sin() / n).asin();
             assert!((dz - snell).abs() / ARCSEC < 1e-3, "{zdeg}°: {}″ vs {}″", dz / ARCSEC, snell / ARCSEC);
             assert!((refraction_correct(&app, &u, n) - truth).norm() < 1e-15);
+        }
+    }
+
+    #[test]
+    fn aberration_matches_the_exact_relativistic_formula_to_second_order() {
+        // Oracle: the exact aberration angle of special relativity between the geometric
+        // direction and v: cos θ' = (cos θ + β)/(1 + β cos θ) (Einstein 1905 §7), θ' toward v.
+        let c = crate::gnss::C_LIGHT;
+        let v = Vec3::new(0.0, 29_780.0, 0.0);
+        let beta = v.norm() / c;
+        for deg in [10.0f64, 45.0, 90.0, 135.0, 170.0] {
+            let th = deg.to_radians();
+            let s = Vec3::new(th.sin(), th.cos(), 0.0);
+            let app = aberration(&s, &v);
+            let th_app = app.dot(&v.normalize()).clamp(-1.0, 1.0).acos();
+            let exact = ((th.cos() + beta) / (1.0 + beta * th.cos())).acos();
+            assert!((th_app - exact).abs() < beta * beta, "{deg}°: {:e} rad", th_app - exact);
+            assert!(((th - th_app) - beta * th.sin()).abs() < beta * beta, "first-order shift β sin θ at {deg}°");
+            assert!(app.dot(&s.cross(&v.normalize())).abs() < 1e-15 && (app.norm() - 1.0).abs() < 1e-15, "in the plane of s and v");
         }
     }
 

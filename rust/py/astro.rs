@@ -13,6 +13,7 @@ use numpy::ndarray::Array3;
 use numpy::{IntoPyArray, PyArray1, PyArray2, PyArray3, PyReadonlyArray1, PyReadonlyArray2, PyReadonlyArray3, PyUntypedArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
+use std::borrow::Cow;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 
@@ -80,14 +81,27 @@ fn astro_d1_d2<'py>(py: Python<'py>, beta: PyReadonlyArray2<'py, f64>) -> PyResu
     Ok((mats_to_py(py, &b.iter().map(d1).collect::<Vec<_>>()), mats_to_py(py, &b.iter().map(d2).collect::<Vec<_>>())))
 }
 
+/// An (N, 3) array read in place when C-contiguous (copied otherwise). NaN/inf are left to
+/// the core's validation pass, which names the first bad row: no second pass here.
+fn rows3<'a>(a: &'a PyReadonlyArray2<'_, f64>, field: &str) -> Result<Cow<'a, [[f64; 3]]>, NavError> {
+    let s = a.shape();
+    if s[1] != 3 {
+        return Err(invalid(field, format!("expected shape (N, 3), got ({}, {})", s[0], s[1])));
+    }
+    Ok(match a.as_slice() {
+        Ok(flat) => Cow::Borrowed(flat.as_chunks::<3>().0),
+        Err(_) => Cow::Owned(a.as_array().outer_iter().map(|r| [r[0], r[1], r[2]]).collect()),
+    })
+}
+
 /// The gyro increments, camera epochs and gyro error model shared by the increment calls.
-fn gyro_record(
-    rho: &PyReadonlyArray2<'_, f64>,
+fn gyro_record<'a>(
+    rho: &'a PyReadonlyArray2<'_, f64>,
     epochs: &PyReadonlyArray1<'_, f64>,
     sigmas: (f64, f64, f64, f64),
     mode: &str,
-) -> PyResult<(Vec<Vec3>, Vec<f64>, GyroErrorModel)> {
-    Ok((vec3_rows(rho, "gyro_increments")?, vector(epochs, "epochs")?, gyro_model(sigmas, mode)?))
+) -> PyResult<(Cow<'a, [[f64; 3]]>, Vec<f64>, GyroErrorModel)> {
+    Ok((rows3(rho, "gyro_increments")?, vector(epochs, "epochs")?, gyro_model(sigmas, mode)?))
 }
 
 type IncrementArrays<'py> = (Bound<'py, PyArray2<f64>>, Bound<'py, PyArray3<f64>>, Option<(Bound<'py, PyArray3<f64>>, Bound<'py, PyArray3<f64>>)>);
@@ -106,7 +120,7 @@ fn astro_increments<'py>(
 ) -> PyResult<IncrementArrays<'py>> {
     let (rho, epochs, model) = gyro_record(&rho, &epochs, sigmas, mode)?;
     let variant = TaylorVariant::parse(taylor_variant)?;
-    let inc = py.detach(|| increments::integrate_increments(&ImuRecord { t_start, period, rho: &rho }, &epochs, &model, variant))?;
+    let inc = py.detach(|| increments::integrate_increments(&ImuRecord { t_start, period, rho: &rho[..] }, &epochs, &model, variant))?;
     let q: Vec<_> = inc.iter().map(|i| i.q).collect();
     let cov: Vec<Mat3> = inc.iter().map(|i| i.cov).collect();
     let sens = (model.mode == GyroErrorMode::Consistent).then(|| {
@@ -127,7 +141,7 @@ fn astro_dead_reckoning_cov<'py>(
     mode: &str,
 ) -> PyResult<Bound<'py, PyArray3<f64>>> {
     let (rho, epochs, model) = gyro_record(&rho, &epochs, sigmas, mode)?;
-    let p = py.detach(|| increments::dead_reckoning_cov(&ImuRecord { t_start, period, rho: &rho }, &epochs, &model))?;
+    let p = py.detach(|| increments::dead_reckoning_cov(&ImuRecord { t_start, period, rho: &rho[..] }, &epochs, &model))?;
     Ok(mats_to_py(py, &p))
 }
 
@@ -246,7 +260,7 @@ fn indices(a: &PyReadonlyArray1<'_, i64>, field: &str) -> Result<Vec<usize>, Nav
 }
 
 #[pyfunction]
-#[pyo3(signature = (epoch, camera, s_cf, g, n_epochs, cameras, p_alpha, sigma_s, up_gcrs=None, n_refr=1.0))]
+#[pyo3(signature = (epoch, camera, s_cf, g, n_epochs, cameras, p_alpha, sigma_s, up_gcrs=None, n_refr=1.0, p_avu=None))]
 #[allow(clippy::too_many_arguments)]
 fn astro_star_attitudes<'py>(
     py: Python<'py>,
@@ -260,11 +274,13 @@ fn astro_star_attitudes<'py>(
     sigma_s: f64,
     up_gcrs: Option<PyReadonlyArray2<'py, f64>>,
     n_refr: f64,
+    p_avu: Option<PyReadonlyArray3<'py, f64>>,
 ) -> PyResult<(Arr3<'py>, Arr3<'py>, Bound<'py, PyArray1<i64>>)> {
     let obs = Observations { epoch: indices(&epoch, "epoch")?, camera: indices(&camera, "camera")?, s_cf: vec3_rows(&s_cf, "star_directions")?, g: vec3_rows(&g, "catalog_directions")? };
     let cams = cameras_arg(&cameras, &p_alpha)?;
     let up = up_gcrs.map(|u| vec3_rows(&u, "up_gcrs")).transpose()?;
-    let att = py.detach(|| stars::star_attitudes(&obs, n_epochs, &cams, sigma_s, up.as_deref().map(|u| (u, n_refr))))?;
+    let p_avu = p_avu.map(|p| mats::<3, 3>(&p, "p_avu")).transpose()?;
+    let att = py.detach(|| stars::star_attitudes(&obs, n_epochs, &cams, sigma_s, up.as_deref().map(|u| (u, n_refr)), p_avu.as_deref()))?;
     let counts: Vec<i64> = att.stars.iter().map(|&k| k as i64).collect();
     Ok((mats_to_py(py, &att.s), mats_to_py(py, &att.p), counts.into_pyarray(py)))
 }
@@ -280,6 +296,61 @@ fn astro_astro_increments<'py>(py: Python<'py>, s: PyReadonlyArray3<'py, f64>, p
     }
     let (ds, e) = stars::astro_increments(&s, &p);
     Ok((mats_to_py(py, &ds), mats_to_py(py, &e)))
+}
+
+/// P_β^model and P_β^sys (rad², E18) at the mount `c` from the interval and epoch
+/// covariances; with the consistent gyro mode's sensitivities `j_m` (M, 3, 9), `j_b`
+/// (M, 3, 3) and the budget `sigmas` the constant-error cross terms are included.
+#[pyfunction]
+#[pyo3(signature = (c, ds_imu, ds_avu, e_imu, p_avu, j_m=None, j_b=None, sigmas=None))]
+#[allow(clippy::too_many_arguments)]
+fn astro_model_covariance<'py>(
+    py: Python<'py>,
+    c: PyReadonlyArray2<'py, f64>,
+    ds_imu: PyReadonlyArray3<'py, f64>,
+    ds_avu: PyReadonlyArray3<'py, f64>,
+    e_imu: PyReadonlyArray3<'py, f64>,
+    p_avu: PyReadonlyArray3<'py, f64>,
+    j_m: Option<PyReadonlyArray3<'py, f64>>,
+    j_b: Option<PyReadonlyArray3<'py, f64>>,
+    sigmas: Option<(f64, f64, f64, f64)>,
+) -> PyResult<(Bound<'py, PyArray2<f64>>, Bound<'py, PyArray2<f64>>)> {
+    let c = mat3_arg(&c, "c")?;
+    crate::astro::check_rotation("c", 0, &c)?;
+    let (a, b) = (mats::<3, 3>(&ds_imu, "ds_imu")?, mats::<3, 3>(&ds_avu, "ds_avu")?);
+    calibration::check_increments(&a, &b)?;
+    let (e, p) = (mats::<3, 3>(&e_imu, "e_imu")?, mats::<3, 3>(&p_avu, "p_avu")?);
+    stars::check_covariances("e_imu", &e, a.len())?;
+    stars::check_covariances("p_avu", &p, a.len() + 1)?;
+    let sens: Option<(Vec<_>, GyroErrorModel)> = match (j_m, j_b, sigmas) {
+        (None, None, None) => None,
+        (Some(jm), Some(jb), Some(sg)) => {
+            let (jm, jb) = (mats::<3, 9>(&jm, "j_m")?, mats::<3, 3>(&jb, "j_b")?);
+            if jm.len() != a.len() || jb.len() != a.len() {
+                return Err(invalid("j_m", format!("expected {} sensitivities, got {} and {}", a.len(), jm.len(), jb.len())).into());
+            }
+            Some((jm.into_iter().zip(jb).collect(), gyro_model(sg, "consistent")?))
+        }
+        _ => return Err(invalid("j_m", "give j_m, j_b and sigmas together (consistent gyro mode) or none of them").into()),
+    };
+    let constant = sens.as_ref().map(|(s, m)| calibration::ConstantGyroErrors { sensitivities: s, p_m: m.p_m(), sigma_b: m.sigma_b });
+    let (pm, ps) = calibration::model_covariance(&c, &a, &b, &e, &p, constant.as_ref())?;
+    Ok((mat_to_py(py, &pm), mat_to_py(py, &ps)))
+}
+
+#[pyfunction]
+fn astro_aberration<'py>(py: Python<'py>, s: PyReadonlyArray2<'py, f64>, v: PyReadonlyArray2<'py, f64>) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    let (s, v) = (vec3_rows(&s, "directions")?, vec3_rows(&v, "velocity")?);
+    if v.len() != s.len() && v.len() != 1 {
+        return Err(invalid("velocity", format!("expected 1 or {} rows like directions, got {}", s.len(), v.len())).into());
+    }
+    stars::check_unit("directions", &s)?;
+    // above 1e-3 c the neglected second-order term exceeds ~1e-6 rad (0.2″)
+    if let Some(i) = v.iter().position(|v| v.norm() >= 1e-3 * crate::gnss::C_LIGHT) {
+        return Err(invalid("velocity", format!("|v| = {} m/s at index {i}: the first-order formula needs |v| < 1e-3 c", v[i].norm())).into());
+    }
+    let out: Vec<Vec3> = s.iter().enumerate().map(|(i, s)| stars::aberration(s, &v[if v.len() == 1 { 0 } else { i }])).collect();
+    Ok(vec3_to_py(py, &out))
 }
 
 type CatalogArrays<'py> = (Bound<'py, PyArray2<f64>>, Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<u64>>);
@@ -461,6 +532,8 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(astro_astro_increments, m)?)?;
     m.add_function(wrap_pyfunction!(astro_synthetic_catalog, m)?)?;
     m.add_function(wrap_pyfunction!(astro_refraction, m)?)?;
+    m.add_function(wrap_pyfunction!(astro_aberration, m)?)?;
+    m.add_function(wrap_pyfunction!(astro_model_covariance, m)?)?;
     m.add_function(wrap_pyfunction!(astro_refractive_index, m)?)?;
     m.add_function(wrap_pyfunction!(astro_simulate_observations, m)?)?;
     m.add_function(wrap_pyfunction!(astro_vasilyuk2024_gyro_budget, m)?)?;

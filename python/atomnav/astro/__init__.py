@@ -41,6 +41,15 @@ def _mats(x, name: str) -> np.ndarray:
     return np.ascontiguousarray(a)
 
 
+def _rows3_unchecked(x, name: str) -> np.ndarray:
+    """(N, 3) C-contiguous float64 with only the shape checked: the core's validation pass
+    rejects NaN/inf naming the first bad row, so no second numpy pass over long records."""
+    a = np.ascontiguousarray(x, dtype=float)
+    if a.ndim != 2 or a.shape[1] != 3:
+        raise ValueError(f"{name}: expected shape (N, 3), got {a.shape}")
+    return a
+
+
 def _single(fn, x):
     a = np.asarray(x, dtype=float)
     out = fn(rows(a, 3, "beta"))
@@ -117,7 +126,7 @@ def gyro_increments(t_start: float, period: float, rho, epochs, model: GyroError
     ``taylor_variant`` "corrected" (c = 1/8, default) or "paper_literal" (c = 1/4) (D1).
     """
     choice(taylor_variant, {"corrected", "paper_literal"}, "taylor_variant")
-    q, cov, sens = _core.astro_increments(float(t_start), positive(period, "period"), rows(rho, 3, "gyro_increments"),
+    q, cov, sens = _core.astro_increments(float(t_start), positive(period, "period"), _rows3_unchecked(rho, "gyro_increments"),
                                             vector(epochs, None, "epochs"), model._sigmas(), model.mode, taylor_variant)
     jm, jb = sens if sens is not None else (None, None)
     return Increments(q=q, dcm=_core.dcm_from_quat_rows(q) if len(q) else np.zeros((0, 3, 3)), cov=cov, j_m=jm, j_b=jb)
@@ -125,7 +134,7 @@ def gyro_increments(t_start: float, period: float, rho, epochs, model: GyroError
 
 def dead_reckoning_cov(t_start: float, period: float, rho, epochs, model: GyroErrorModel) -> np.ndarray:
     """P^imu at every epoch (rad², (N, 3, 3)): E7/E8 run from the first epoch (spec E20)."""
-    return _core.astro_dead_reckoning_cov(float(t_start), positive(period, "period"), rows(rho, 3, "gyro_increments"),
+    return _core.astro_dead_reckoning_cov(float(t_start), positive(period, "period"), _rows3_unchecked(rho, "gyro_increments"),
                                           vector(epochs, None, "epochs"), model._sigmas(), model.mode)
 
 
@@ -282,10 +291,13 @@ class Observations:
 
 
 def star_attitudes(obs: Observations, n_epochs: int, cameras, sigma_s_rad: float, p_alpha=None,
-                   up_gcrs=None, n_refr: float = 1.0):
+                   up_gcrs=None, n_refr: float = 1.0, p_avu=None):
     """Merge the cameras into VF (``cameras`` (I, 3, 3) = C_VF^CFⁱ, camera 0 = identity), remove
     refraction about ``up_gcrs`` (N, 3) with index ``n_refr``, solve Wahba per epoch and form
-    P^avu = σ_s²K + K(Σ Cᵢ Aᵢ D1(αⁱ) P_aⁱ D1ᵀ Aᵢ Cᵢᵀ)K (spec E9–E12; ``p_alpha`` (I, 3, 3) rad²).
+    P^avu = σ_s²K + K(Σ Cᵢ Aᵢ D1(αⁱ) P_aⁱ D1ᵀ Aᵢ Cᵢᵀ)K (spec E9–E12; ``p_alpha`` (I, 3, 3) rad²),
+    or take the user's ``p_avu`` (N, 3, 3) rad² in VF (finite, symmetric, PSD) in place of that
+    default model (E12, D11); it then flows into :func:`astro_increments`,
+    :func:`model_covariance` and :meth:`Calibration.p_mfa`.
 
     Returns (S_GCRS^VF (N, 3, 3), P^avu (N, 3, 3) rad², stars per epoch (N,)).
     """
@@ -295,12 +307,37 @@ def star_attitudes(obs: Observations, n_epochs: int, cameras, sigma_s_rad: float
     return _core.astro_star_attitudes(np.ascontiguousarray(obs.epoch, dtype=np.int64),
                                       np.ascontiguousarray(obs.camera, dtype=np.int64),
                                       rows(obs.s_cf, 3, "star_directions"), rows(obs.g, 3, "catalog_directions"),
-                                      int(n_epochs), cams, pa, float(sigma_s_rad), up, float(n_refr))
+                                      int(n_epochs), cams, pa, float(sigma_s_rad), up, float(n_refr),
+                                      None if p_avu is None else _mats(p_avu, "p_avu"))
 
 
 def astro_increments(s_vf, p_avu):
     """ΔS_n^avu = S_{n−1}ᵀ S_n and E_n^avu = P_n + ΔS_nᵀ P_{n−1} ΔS_n (spec E13)."""
     return _core.astro_astro_increments(_mats(s_vf, "s_vf"), _mats(p_avu, "p_avu"))
+
+
+def model_covariance(cal: Calibration, ds_imu, ds_avu, e_imu, p_avu, increments: Increments | None = None,
+                     model: GyroErrorModel | None = None):
+    """Model-form (P_β^model, P_β^sys) in rad² at ``cal``'s mount (spec E18): the sandwich
+    (HᵀH)⁻¹HᵀΣ_fH(HᵀH)⁻¹ with Σ_f built from the gyro interval covariances ``e_imu``
+    (M, 3, 3) and the star-attitude covariances ``p_avu`` (M + 1, 3, 3) — diagonal blocks
+    CᵀE_n^imuC + E_n^avu and the E13 neighbour correlations — converted to Euler angles.
+    With ``model.mode == "consistent"`` the constant-error cross terms use
+    ``increments.j_m``/``j_b``; P_β^sys is their part (zero otherwise)."""
+    consistent = model is not None and model.mode == "consistent"
+    if consistent and (increments is None or increments.j_m is None):
+        raise ValueError("increments: the consistent gyro mode needs the Increments with j_m, j_b")
+    extra = (increments.j_m, increments.j_b, model._sigmas()) if consistent else (None, None, None)
+    return _core.astro_model_covariance(rows(cal.c, 3, "c"), _mats(ds_imu, "ds_imu"), _mats(ds_avu, "ds_avu"),
+                                        _mats(e_imu, "e_imu"), _mats(p_avu, "p_avu"), *extra)
+
+
+def aberration(directions, velocity_mps) -> np.ndarray:
+    """First-order stellar aberration: apparent unit directions normalize(s + v/c) of stars
+    with geometric unit directions ``directions`` (N, 3) seen by an observer moving with
+    ``velocity_mps`` ((3,) or (N, 3), m/s, same frame, |v| < 1e-3 c); exact special
+    relativity differs by O((v/c)²) ≈ 1e-8 rad at Earth's orbital 30 km/s (spec §7)."""
+    return _core.astro_aberration(rows(directions, 3, "directions"), rows(velocity_mps, 3, "velocity"))
 
 
 def simulate_observations(catalog: Catalog, s_gcrs_vf, up_gcrs, cameras, fov_half_rad: float, m_lim: float,
@@ -320,5 +357,6 @@ __all__ = [
     "NED_TO_ENU", "D17_CAVEAT", "euler_dcm", "euler_from_dcm", "d1", "d2", "GyroErrorModel", "Increments",
     "gyro_increments", "dead_reckoning_cov", "observability", "Calibration", "calibrate", "Catalog",
     "synthetic_catalog", "load_catalog", "refractive_index", "refraction_correct", "refraction_apply",
-    "Observations", "star_attitudes", "astro_increments", "simulate_observations", "Vasilyuk2024",
+    "Observations", "star_attitudes", "astro_increments", "model_covariance", "aberration", "simulate_observations",
+    "Vasilyuk2024",
 ]
