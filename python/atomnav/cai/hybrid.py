@@ -80,6 +80,13 @@ class CaiSensor:
     def n_extra(self) -> int:
         return 3 * ((self.misalignment_psd is not None) + (self.lever_arm_psd is not None) + (self.force is not None))
 
+    def _native(self):
+        """The checked core sensor (``_core.CaiSensor``) that the Monte Carlo, :func:`cai_aided_ins`
+        and :func:`in_shot_noise` take together with their shots."""
+        return _core.CaiSensor(self.channels._native(), positive(self.T, "T"), (float(self.offset), float(self.contrast), float(self.sigma_p)),
+                               self.inflation, self.omega_dot, int(self.savgol_half_width), self.interpolation, int(self.substeps),
+                               bool(self.jacobian_euler), self.misalignment_psd, self.lever_arm_psd, self.force)
+
 
 @dataclass
 class FilterSetup:
@@ -217,10 +224,7 @@ def _simulate(name: str, motion, *, ellipsoid: str, rate_hz: float, truth_rate_h
     n_extra = sensor.n_extra()
     core = _core.CaiHybrid(
         motion, ellipsoid, positive(rate_hz, "rate_hz"), truth_rate_hz, *imu._to_core(),
-        None if reference is None else reference._to_core(), sensor.channels._native(), positive(sensor.T, "T"), shots,
-        (float(sensor.offset), float(sensor.contrast), float(sensor.sigma_p)), sensor.inflation, sensor.omega_dot,
-        int(sensor.savgol_half_width), sensor.interpolation, int(sensor.substeps), bool(sensor.jacobian_euler),
-        sensor.misalignment_psd, sensor.lever_arm_psd, sensor.force,
+        None if reference is None else reference._to_core(), sensor._native(), shots,
         (setup.accel_psd, setup.gyro_psd, setup.accel_bias_psd, setup.gyro_bias_psd), int(setup.predict_every),
         setup.p0(n_extra), bool(aiding), bool(draw_initial))
     import os
@@ -345,14 +349,41 @@ def hexapod(runs: int = 100, seed: int = 2000, *, progress: bool = True) -> Hybr
                      sensor=sensor, setup=setup, runs=runs, seed=seed, progress=progress)
 
 
+def in_shot_noise(sensor: CaiSensor, dt: float, q_accel: float, q_gyro: float, f=None) -> tuple[np.ndarray, np.ndarray]:
+    """In-shot IMU noise of one shot of ``sensor`` driven by an IMU sampled every ``dt`` s with
+    white-noise PSDs ``q_accel`` (m²/s³) and ``q_gyro`` (rad²/s) (seed 000 decision 14,
+    ``rust/cai/in_shot.rs``): the phase covariance Σ (C, C) rad² from the predictor's
+    sensitivity to every sample — which, unlike the closed form (E38) of
+    :func:`atomnav.cai.predictor.in_shot_noise_covariance`, includes the atom Euler term
+    (gyro variance 4T³q_g(kv0)² instead of (8/3)T³q_g(kv0)², i.e. 0.3667 instead of 0.2994 rad
+    for the seed-003 IMU) and the lever-arm Euler term (2Tq_g|l × k|², 0.370 rad for
+    l = 0.1 m ⊥ k) — and, for each 15-state model ``f`` (S, 15, 15) held over a filter step
+    of one shot, the cross-covariance E[w δφ̂ᵀ] (S, 15, C) of the step's process noise with
+    the shot's phase noise (the readout senses the same IMU noise that drives the error)."""
+    f = np.zeros((0, 15, 15)) if f is None else np.ascontiguousarray(np.asarray(f, dtype=float))
+    if f.ndim != 3:
+        raise ValueError(f"f: expected an (S, 15, 15) stack, got shape {f.shape}")
+    return _core.cai_in_shot_noise(sensor._native(), positive(dt, "dt"), float(q_accel), float(q_gyro), f)
+
+
 def slalom_covariance(gravity: str = "earth", *, duration: float = 60.0, attitude_sigma: float | None = None,
                       lever=(0.0, 0.0, 0.1)) -> pd.DataFrame:
     """Covariance-only analysis of the slalom (estimation engine, ``atomnav.filter.Scenario``):
     the 15-state error model along the exact trajectory, one stacked CAI update per shot
-    (H = (C/2) ∂φ/∂(b_a, b_g) from the predictor at the mean specific force, R inflated as in
-    the Monte Carlo). With ``attitude_sigma`` (rad) every shot also carries a direct attitude
-    measurement ψ + n (a star camera; GNSS heading/tilt acts alike). Returns per epoch the
-    RMS velocity-error norm √tr P_vv of the free INS and of the hybrid filter and their ratio.
+    (H = (C/2) ∂φ/∂(b_a, b_g) from the predictor at the mean specific force, R inflated by the
+    in-shot IMU noise exactly as the Monte-Carlo filter does, :func:`in_shot_noise`). With
+    ``attitude_sigma`` (rad) every shot also carries a direct attitude measurement ψ + n (a
+    star camera; GNSS heading/tilt acts alike). Returns per epoch the RMS velocity-error norm
+    √tr P_vv of the free INS, of the hybrid filter's own covariance (``hybrid_vel_rms_mps``,
+    ``ratio``) and of its true error (``hybrid_true_vel_rms_mps``, ``ratio_true``).
+
+    The true error (:func:`atomnav.filter.analysis.true_error_analysis`) differs from the
+    filter's own σ because the readout is not independent of the process noise: the phase
+    predicted from the IMU carries the in-shot IMU noise (which is why R is inflated), and
+    that same noise drives the velocity and tilt errors of the step. The filter, treating it
+    as independent readout noise, is conservative: in Earth gravity its true velocity error
+    is ≈ 0.6 × its σ (the differential A/B readout senses the gyro noise over [T, 2T] with
+    correlation 1/√2 to the tilt increment of the step). The Monte Carlo shows the true error.
 
     Why the gain is capped in Earth gravity (spec atom-strapdown decision 11): the CAI phase
     depends on specific force and rate, never on the navigation attitude, so H has zero
@@ -361,8 +392,8 @@ def slalom_covariance(gravity: str = "earth", *, duration: float = 60.0, attitud
     the hybrid solution, which caps their ratio; in kinematic mode f^n is the small vehicle
     acceleration and the cap disappears; an attitude aid observes ψ directly and lifts it."""
     from ..filter import BiasModel, Scenario, covariance_analysis, ins_error_model
+    from ..filter.analysis import true_error_analysis
     from ..trajectory import slalom as slalom_trajectory
-    from .predictor import in_shot_noise_covariance
 
     choice(gravity, ("kinematic", "earth"), "gravity")
     sensor, setup = seed003_sensor(lever), seed003_filter()
@@ -380,23 +411,31 @@ def slalom_covariance(gravity: str = "earth", *, duration: float = 60.0, attitud
     fm = np.tile(f_b.mean(axis=0), (len(t), 1))
     jac = phase_jacobian(t, fm, np.zeros_like(fm), [0.0], sensor.T, sensor.channels, omega_dot="zero")[0]
     half_c = 0.5 * sensor.contrast
-    h = np.zeros((len(sensor.channels), 15))
+    m = len(sensor.channels)
+    h = np.zeros((m, 15))
     h[:, 9:15] = half_c * jac[:, :6]
-    r = sensor.sigma_p**2 * np.eye(len(h)) + half_c**2 * in_shot_noise_covariance(sensor.channels, *sensor.inflation, sensor.T)
+    # the filter's R (its inflation PSDs) and the truth (the IMU's noise, same values here)
+    sigma_f, _ = in_shot_noise(sensor, 0.005, *sensor.inflation)
+    sigma_t, cross = in_shot_noise(sensor, 0.005, setup.accel_psd, setup.gyro_psd, f[:-1])
+    r = sensor.sigma_p**2 * np.eye(m) + half_c**2 * sigma_f
+    r_true = sensor.sigma_p**2 * np.eye(m) + half_c**2 * sigma_t
+    cross = half_c * cross
     if attitude_sigma is not None:
         ha = np.zeros((3, 15))
         ha[:, 6:9] = np.eye(3)
         h = np.vstack([h, ha])
-        r = np.block([[r, np.zeros((len(r), 3))], [np.zeros((3, len(r))), positive(attitude_sigma, "attitude_sigma")**2 * np.eye(3)]])
+        ra = positive(attitude_sigma, "attitude_sigma")**2 * np.eye(3)
+        r, r_true = (np.block([[x, np.zeros((m, 3))], [np.zeros((3, m)), ra]]) for x in (r, r_true))
+        cross = np.concatenate([cross, np.zeros((len(cross), 15, 3))], axis=2)
     dt = np.diff(traj.time)
     p0 = setup.p0(0)
     n = len(dt)
-    sig = {}
-    for name, meas in (("free", [False] * (n + 1)), ("hybrid", [False] + [True] * n)):
-        cov = covariance_analysis(Scenario(f[:-1], qc[:-1], dt, p0, h, r, meas, times=traj.time))
-        sig[name] = np.sqrt((cov.iloc[:, 4:7].to_numpy() ** 2).sum(axis=1))
-    return pd.DataFrame({"time_s": traj.time, "free_vel_rms_mps": sig["free"], "hybrid_vel_rms_mps": sig["hybrid"],
-                         "ratio": sig["free"] / sig["hybrid"]})
+    vel = lambda cov: np.sqrt((cov.iloc[:, 4:7].to_numpy() ** 2).sum(axis=1))  # noqa: E731
+    free = vel(covariance_analysis(Scenario(f[:-1], qc[:-1], dt, p0, h, r, [False] * (n + 1), times=traj.time)))
+    scn = Scenario(f[:-1], qc[:-1], dt, p0, h, r, [False] + [True] * n, times=traj.time)
+    hyb, true = vel(covariance_analysis(scn)), vel(true_error_analysis(scn, r_true, cross))
+    return pd.DataFrame({"time_s": traj.time, "free_vel_rms_mps": free, "hybrid_vel_rms_mps": hyb, "hybrid_true_vel_rms_mps": true,
+                         "ratio": free / hyb, "ratio_true": free / true})
 
 
 def satellite_steady_state(res: HybridResult) -> dict:
@@ -473,11 +512,6 @@ def cai_aided_ins(t0: float, lla0, vel0, q0, sensor: CaiSensor, shots, *, phase=
                     ba0, bg0, setup.predict_every, method, mode, sequential, gate, ellipsoid)
     extra0 = vector(np.zeros(n_extra) if extra0 is None else extra0, n_extra, "extra0")
     shots = vector(shots, None, "shots")
-    core = _core.cai_aided_ins(
-        ins=ins, extra0=extra0, channels=sensor.channels._native(), t_sep=positive(sensor.T, "T"), shots=shots,
-        readout=(float(sensor.offset), float(sensor.contrast), float(sensor.sigma_p)), inflation=sensor.inflation,
-        omega_dot=sensor.omega_dot, savgol_half_width=int(sensor.savgol_half_width), interpolation=sensor.interpolation,
-        substeps=int(sensor.substeps), jacobian_euler=bool(sensor.jacobian_euler), misalignment=sensor.misalignment_psd,
-        lever_arm=sensor.lever_arm_psd, force=sensor.force, data_kind="emulated" if emulated else "recorded",
-        data_a=tables[0], data_b=tables[1])
+    core = _core.cai_aided_ins(ins=ins, extra0=extra0, sensor=sensor._native(), shots=shots,
+                               data_kind="emulated" if emulated else "recorded", data_a=tables[0], data_b=tables[1])
     return AidedIns(core, kind)
