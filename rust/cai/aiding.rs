@@ -542,9 +542,13 @@ mod tests {
     }
 
     /// R inflation (decision 14) at mid-fringe reproduces the spec's in-shot phase noise
-    /// (atom-strapdown §4: 0.1838 rad accelerometer, 0.2994 rad gyro at T = 25 ms) and the
-    /// A/B correlation (common accelerometer, opposite Coriolis part).
-    #[test]
+    /// (atom-strapdown §4: 0.1838 rad accelerometer, 0.2994 rad gyro at T = 25 ms, the
+    /// closed form (E38) of a continuous record without Euler terms, as here with ω̇ = 0) and
+    /// the A/B correlation (common accelerometer, opposite Coriolis part), sampled at 200 Hz:
+    /// with linear interpolation the sample weights are c_i = ∫ w ℓ_i dt (ℓ_i the hat
+    /// functions): Δt·w(t_i) inside, Δt(T − Δt/3) at the apex, Δt²/6 at the ends, so
+    /// Σ c_i²/Δt = Δt³[2(1 + 4 + 9 + 16) + (5 − 1/3)² + 1/18] = 81.833 Δt³ against
+    /// ∫ w² = 2T³/3 = 83.333 Δt³ (T = 5Δt): a factor 0.98200 on both parts.
     fn inflated_r_matches_in_shot_noise_values() {
         let mut cfg = config(cyclic(Vec3::zeros(), Mat3::identity()), vec![0.005]);
         cfg.inflation = Some((1.25e-11, 1.0576e-12));
@@ -554,8 +558,9 @@ mod tests {
         feed(&mut a, &|_| Vec3::zeros(), &|_| Vec3::zeros(), Vec3::zeros(), Vec3::zeros());
         let m = a.shot_measurement(0, &DVector::zeros(lay.size()), &DVector::zeros(lay.size() - 15), &lay).unwrap();
         let (sa, sg) = (0.1838f64, 0.2994f64);
-        let diag = 1e-3 + 0.25 * (sa * sa + sg * sg);
-        let cross = 0.25 * (sa * sa - sg * sg);
+        let sampled = (2.0 * 30.0 + (5.0f64 - 1.0 / 3.0).powi(2) + 1.0 / 18.0) / (2.0 * 125.0 / 3.0);
+        let diag = 1e-3 + 0.25 * sampled * (sa * sa + sg * sg);
+        let cross = 0.25 * sampled * (sa * sa - sg * sg);
         assert!((m.r[(0, 0)] / diag - 1.0).abs() < 1e-3, "{} vs {diag}", m.r[(0, 0)]);
         assert!((m.r[(0, 1)] / cross - 1.0).abs() < 2e-3, "{} vs {cross}", m.r[(0, 1)]);
         assert!(m.r[(0, 2)].abs() < 1e-12);
