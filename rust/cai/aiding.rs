@@ -549,6 +549,7 @@ mod tests {
     /// functions): Δt·w(t_i) inside, Δt(T − Δt/3) at the apex, Δt²/6 at the ends, so
     /// Σ c_i²/Δt = Δt³[2(1 + 4 + 9 + 16) + (5 − 1/3)² + 1/18] = 81.833 Δt³ against
     /// ∫ w² = 2T³/3 = 83.333 Δt³ (T = 5Δt): a factor 0.98200 on both parts.
+    #[test]
     fn inflated_r_matches_in_shot_noise_values() {
         let mut cfg = config(cyclic(Vec3::zeros(), Mat3::identity()), vec![0.005]);
         cfg.inflation = Some((1.25e-11, 1.0576e-12));
