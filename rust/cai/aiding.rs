@@ -297,7 +297,10 @@ impl CaiAiding {
     /// Drop the samples no later shot needs.
     fn prune(&mut self, next_shot: Option<f64>) {
         let keep_from = match next_shot {
-            Some(ts) => self.buf_t.partition_point(|&t| t < ts).saturating_sub(self.pad()),
+            // the same rounding margin as the shot times, so that a sample on the next shot's
+            // start is never dropped and the kept window (and the noise cache key) is the same
+            // for every shot
+            Some(ts) => self.buf_t.partition_point(|&t| t < ts - 1e-9 * self.cfg.t_sep).saturating_sub(self.pad()),
             None => self.buf_t.len(),
         };
         self.buf_t.drain(..keep_from);
