@@ -81,7 +81,8 @@ def numpy_run(t, gyro, accel, shots, phase, noise, sensor, setup, p0, vel0, q0):
     ba, bg = np.zeros(3), np.zeros(3)
     P = p0.copy()
     half = 0.5 * sensor.contrast
-    R = sensor.sigma_p**2 * np.eye(6) + half**2 * an.cai.in_shot_noise_covariance(ch, *sensor.inflation, sensor.T)
+    # the in-shot noise covariance from the predictor's sample sensitivities, as the Rust aiding
+    R = sensor.sigma_p**2 * np.eye(6) + half**2 * hybrid.in_shot_noise(sensor, DT, *sensor.inflation)[0]
     qc = np.zeros((15, 15))
     qc[3:6, 3:6] = setup.accel_psd * np.eye(3)
     qc[6:9, 6:9] = setup.gyro_psd * np.eye(3)

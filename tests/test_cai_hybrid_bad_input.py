@@ -79,3 +79,22 @@ def test_shot_period_shorter_than_the_shot():
 def test_zero_runs():
     with pytest.raises(ValueError, match=r"runs: must be >= 1"):
         hybrid.slalom(0, progress=False)
+
+
+def test_in_shot_noise_rejects_a_non_positive_sample_interval():
+    with pytest.raises(ValueError, match="dt"):
+        hybrid.in_shot_noise(hybrid.seed003_sensor(), 0.0, 1e-11, 1e-12)
+
+
+def test_in_shot_noise_rejects_a_model_that_is_not_15_by_15():
+    with pytest.raises(ValueError, match="f:.*15 × 15"):
+        hybrid.in_shot_noise(hybrid.seed003_sensor(), 0.005, 1e-11, 1e-12, np.zeros((2, 9, 9)))
+
+
+def test_true_error_analysis_rejects_a_cross_covariance_of_the_wrong_shape():
+    from atomnav.filter import Scenario
+    from atomnav.filter.analysis import true_error_analysis
+
+    scn = Scenario(np.zeros((3, 2, 2)), np.zeros((3, 2, 2)), np.ones(3), np.eye(2), np.eye(2), np.eye(2), [True] * 4)
+    with pytest.raises(ValueError, match="cross: entry 0 is 2 × 1"):
+        true_error_analysis(scn, np.eye(2), np.zeros((3, 2, 1)))

@@ -14,13 +14,15 @@
 //! - H_j = (C/2) sin(φ̂_j + φ0_j) J_j, J_j = ∂φ̂_j/∂(δb_a, δb_g, δl, δγ) from the
 //!   tangent-linear predictor                                         (cai-ekf E33)
 //! - R = σ_p² I + (C/2)² sin² · Σ_shot (in-shot IMU white noise, full 6 × 6 with the A/B
-//!   correlation, decision 14): Σ = (2T³/3)[q_a K Kᵀ + 4 q_g V Vᵀ], K_j = C_sbᵀ k_j,
-//!   V_j = C_sbᵀ (v0_j × k_j)                                          (atom-strapdown E38)
+//!   correlation, decision 14): Σ = Σ_i s_i Q_i s_iᵀ from the predictor's sensitivity s_i to
+//!   each IMU sample (`in_shot.rs`; it includes the atom and lever-arm Euler terms that the
+//!   closed form (E38) (2T³/3)[q_a K Kᵀ + 4 q_g V Vᵀ] leaves out)
 //!
 //! Signs: the compensated force is f̃ − b̂ = f − δb (δb = b̂ − b), so φ̂ − φ = J δx with J
 //! the predictor's derivative with respect to the subtracted bias; the extra blocks follow
 //! the same convention (δl = l̂ − l, δγ = γ̂ − γ, C_sb = exp(−[γ×]) C_sb,0).
 
+use super::in_shot;
 use super::predictor::{jacobian, predict, Channel, Imu, Interpolation, OmegaDot, PredictorConfig};
 use crate::error::{check_finite, check_positive, invalid, Result};
 use crate::filter::aided::{Aiding, AidingContext, Measurement};
@@ -114,6 +116,8 @@ pub struct CaiAiding {
     buf_w: Vec<Vec3>,
     /// Ĉ_b^n of the latest solution (for the force block's velocity coupling).
     c_nb: Mat3,
+    /// In-shot noise covariance Σ with the sample offsets (t_i − t_s) it was computed for.
+    noise_cache: Option<(Vec<f64>, DMatrix<f64>)>,
     pub log: ShotLog,
 }
 
@@ -134,42 +138,55 @@ pub fn shot_times(t0: f64, t_end: f64, t_sep: f64, dead_time: f64) -> Result<Vec
     Ok((0..(n.max(-1.0) + 1.0) as usize).map(|i| t0 + i as f64 * period).collect())
 }
 
-impl CaiAiding {
-    pub fn new(cfg: CaiConfig, data: CaiData) -> Result<Self> {
-        check_positive("T", cfg.t_sep)?;
-        if cfg.channels.is_empty() {
+impl CaiConfig {
+    /// Checks everything but the shots (which [`CaiAiding::new`] checks against the data).
+    pub fn check(&self) -> Result<()> {
+        check_positive("T", self.t_sep)?;
+        if self.channels.is_empty() {
             return Err(invalid("channels", "at least one interferometer channel is required"));
         }
-        if cfg.substeps == 0 {
+        if self.substeps == 0 {
             return Err(invalid("substeps", "must be >= 1"));
         }
-        check_positive("sigma_p", cfg.sigma_p)?;
-        check_positive("contrast", cfg.contrast)?;
-        check_finite("offset", &[cfg.offset], 1)?;
-        check_finite("shots", &cfg.shots, 1)?;
-        for i in 1..cfg.shots.len() {
-            let end = cfg.shots[i - 1] + 2.0 * cfg.t_sep;
-            if cfg.shots[i] < end - 1e-9 * cfg.t_sep {
-                return Err(invalid("shots", format!("shot {i} starts at {} s, before shot {} ends at {end} s (shots must not overlap)", cfg.shots[i], i - 1)));
-            }
-        }
-        if let Some((qa, qg)) = cfg.inflation {
+        check_positive("sigma_p", self.sigma_p)?;
+        check_positive("contrast", self.contrast)?;
+        check_finite("offset", &[self.offset], 1)?;
+        if let Some((qa, qg)) = self.inflation {
             for (name, q) in [("inflation q_accel", qa), ("inflation q_gyro", qg)] {
                 if !(q.is_finite() && q >= 0.0) {
                     return Err(invalid(name, format!("must be finite and >= 0, got {q}")));
                 }
             }
         }
-        for (name, q) in [("misalignment psd", cfg.misalignment), ("lever_arm psd", cfg.lever_arm)] {
+        for (name, q) in [("misalignment psd", self.misalignment), ("lever_arm psd", self.lever_arm)] {
             if let Some(q) = q {
                 if !(q.is_finite() && q >= 0.0) {
                     return Err(invalid(name, format!("must be finite and >= 0, got {q}")));
                 }
             }
         }
-        if let ForceMode::Direct { tau, sigma } = cfg.force {
+        if let ForceMode::Direct { tau, sigma } = self.force {
             check_positive("force tau", tau)?;
             check_positive("force sigma", sigma)?;
+        }
+        // the predictor validates the channels on its first call; do it now instead
+        let probe_t = [0.0, 2.0 * self.t_sep];
+        let z = [Vec3::zeros(); 2];
+        let probe = PredictorConfig { omega_dot: OmegaDot::Zero, ..CaiAiding::predictor_config(self) };
+        predict(Imu { t: &probe_t, f: &z, w: &z }, &[0.0], &self.channels, &probe)?;
+        Ok(())
+    }
+}
+
+impl CaiAiding {
+    pub fn new(cfg: CaiConfig, data: CaiData) -> Result<Self> {
+        cfg.check()?;
+        check_finite("shots", &cfg.shots, 1)?;
+        for i in 1..cfg.shots.len() {
+            let end = cfg.shots[i - 1] + 2.0 * cfg.t_sep;
+            if cfg.shots[i] < end - 1e-9 * cfg.t_sep {
+                return Err(invalid("shots", format!("shot {i} starts at {} s, before shot {} ends at {end} s (shots must not overlap)", cfg.shots[i], i - 1)));
+            }
         }
         let expected = cfg.shots.len() * cfg.channels.len();
         let (a, b, na, nb) = match &data {
@@ -192,15 +209,10 @@ impl CaiAiding {
             }
             check_finite(name, v, cfg.channels.len())?;
         }
-        // the predictor validates the channels on its first call; do it now instead
-        let probe_t = [0.0, 2.0 * cfg.t_sep];
-        let z = [Vec3::zeros(); 2];
-        let probe = PredictorConfig { omega_dot: OmegaDot::Zero, ..Self::predictor_config(&cfg) };
-        predict(Imu { t: &probe_t, f: &z, w: &z }, &[0.0], &cfg.channels, &probe)?;
         // last pulse t_s + 2T, less a rounding margin so that a shot ending on an IMU sample
         // is applied at that sample (0.05·i + 0.05 may exceed the grid value by 1 ulp)
         let times = cfg.shots.iter().map(|s| s + 2.0 * cfg.t_sep - 1e-9 * cfg.t_sep).collect();
-        Ok(CaiAiding { cfg, data, times, buf_t: Vec::new(), buf_f: Vec::new(), buf_w: Vec::new(), c_nb: Mat3::identity(), log: ShotLog::default() })
+        Ok(CaiAiding { cfg, data, times, buf_t: Vec::new(), buf_f: Vec::new(), buf_w: Vec::new(), c_nb: Mat3::identity(), noise_cache: None, log: ShotLog::default() })
     }
 
     pub fn config(&self) -> &CaiConfig {
@@ -252,14 +264,25 @@ impl CaiAiding {
         Ok(j)
     }
 
-    /// In-shot IMU-noise phase covariance Σ (rad²) of the channels (decision 14).
-    fn in_shot_covariance(&self, channels: &[Channel]) -> DMatrix<f64> {
-        let m = channels.len();
-        let Some((qa, qg)) = self.cfg.inflation else { return DMatrix::zeros(m, m) };
-        let kb: Vec<Vec3> = channels.iter().map(|c| c.c_sb.transpose() * c.k).collect();
-        let vb: Vec<Vec3> = channels.iter().map(|c| c.c_sb.transpose() * c.v0.cross(&c.k)).collect();
-        let t = self.cfg.t_sep;
-        DMatrix::from_fn(m, m, |a, b| 2.0 * t.powi(3) / 3.0 * (qa * kb[a].dot(&kb[b]) + 4.0 * qg * vb[a].dot(&vb[b])))
+    /// In-shot IMU-noise phase covariance Σ (rad²) of the shot starting at `ts` (decision
+    /// 14, `in_shot.rs`): from the predictor's sensitivity to every buffered sample, for the
+    /// nominal channels (the small lever-arm / misalignment corrections do not change it).
+    /// The sensitivities depend only on the sample times relative to the shot start, so Σ
+    /// is cached and recomputed only when that pattern changes (first shots, irregular data).
+    fn in_shot_covariance(&mut self, ts: f64) -> Result<DMatrix<f64>> {
+        let m = self.cfg.channels.len();
+        let Some((qa, qg)) = self.cfg.inflation else { return Ok(DMatrix::zeros(m, m)) };
+        let offsets: Vec<f64> = self.buf_t.iter().map(|t| t - ts).collect();
+        let tol = 1e-9 * self.cfg.t_sep;
+        if let Some((key, sigma)) = &self.noise_cache {
+            if key.len() == offsets.len() && key.iter().zip(&offsets).all(|(a, b)| (a - b).abs() <= tol) {
+                return Ok(sigma.clone());
+            }
+        }
+        let sens = in_shot::sensitivity(&self.buf_t, ts, &self.cfg.channels, &Self::predictor_config(&self.cfg))?;
+        let sigma = in_shot::covariance(&self.buf_t, &sens, qa, qg, m);
+        self.noise_cache = Some((offsets, sigma.clone()));
+        Ok(sigma)
     }
 
     /// Samples to keep before a shot start: the interpolation stencil, or a whole
@@ -274,7 +297,10 @@ impl CaiAiding {
     /// Drop the samples no later shot needs.
     fn prune(&mut self, next_shot: Option<f64>) {
         let keep_from = match next_shot {
-            Some(ts) => self.buf_t.partition_point(|&t| t < ts).saturating_sub(self.pad()),
+            // the same rounding margin as the shot times, so that a sample on the next shot's
+            // start is never dropped and the kept window (and the noise cache key) is the same
+            // for every shot
+            Some(ts) => self.buf_t.partition_point(|&t| t < ts - 1e-9 * self.cfg.t_sep).saturating_sub(self.pad()),
             None => self.buf_t.len(),
         };
         self.buf_t.drain(..keep_from);
@@ -324,7 +350,7 @@ impl CaiAiding {
         }
         let g = DMatrix::from_diagonal(&DVector::from_vec(gain));
         let h = &g * jac;
-        let r = DMatrix::identity(m, m) * self.cfg.sigma_p.powi(2) + &g * self.in_shot_covariance(&channels) * &g;
+        let r = DMatrix::identity(m, m) * self.cfg.sigma_p.powi(2) + &g * self.in_shot_covariance(ts)? * &g;
         self.prune(self.cfg.shots.get(j + 1).copied());
         Ok(Measurement { z, h, r })
     }
@@ -519,8 +545,13 @@ mod tests {
     }
 
     /// R inflation (decision 14) at mid-fringe reproduces the spec's in-shot phase noise
-    /// (atom-strapdown §4: 0.1838 rad accelerometer, 0.2994 rad gyro at T = 25 ms) and the
-    /// A/B correlation (common accelerometer, opposite Coriolis part).
+    /// (atom-strapdown §4: 0.1838 rad accelerometer, 0.2994 rad gyro at T = 25 ms, the
+    /// closed form (E38) of a continuous record without Euler terms, as here with ω̇ = 0) and
+    /// the A/B correlation (common accelerometer, opposite Coriolis part), sampled at 200 Hz:
+    /// with linear interpolation the sample weights are c_i = ∫ w ℓ_i dt (ℓ_i the hat
+    /// functions): Δt·w(t_i) inside, Δt(T − Δt/3) at the apex, Δt²/6 at the ends, so
+    /// Σ c_i²/Δt = Δt³[2(1 + 4 + 9 + 16) + (5 − 1/3)² + 1/18] = 81.833 Δt³ against
+    /// ∫ w² = 2T³/3 = 83.333 Δt³ (T = 5Δt): a factor 0.98200 on both parts.
     #[test]
     fn inflated_r_matches_in_shot_noise_values() {
         let mut cfg = config(cyclic(Vec3::zeros(), Mat3::identity()), vec![0.005]);
@@ -531,8 +562,9 @@ mod tests {
         feed(&mut a, &|_| Vec3::zeros(), &|_| Vec3::zeros(), Vec3::zeros(), Vec3::zeros());
         let m = a.shot_measurement(0, &DVector::zeros(lay.size()), &DVector::zeros(lay.size() - 15), &lay).unwrap();
         let (sa, sg) = (0.1838f64, 0.2994f64);
-        let diag = 1e-3 + 0.25 * (sa * sa + sg * sg);
-        let cross = 0.25 * (sa * sa - sg * sg);
+        let sampled = (2.0 * 30.0 + (5.0f64 - 1.0 / 3.0).powi(2) + 1.0 / 18.0) / (2.0 * 125.0 / 3.0);
+        let diag = 1e-3 + 0.25 * sampled * (sa * sa + sg * sg);
+        let cross = 0.25 * sampled * (sa * sa - sg * sg);
         assert!((m.r[(0, 0)] / diag - 1.0).abs() < 1e-3, "{} vs {diag}", m.r[(0, 0)]);
         assert!((m.r[(0, 1)] / cross - 1.0).abs() < 2e-3, "{} vs {cross}", m.r[(0, 1)]);
         assert!(m.r[(0, 2)].abs() < 1e-12);

@@ -10,6 +10,7 @@
 pub mod aiding;
 pub mod closed_form;
 pub mod hybrid;
+pub mod in_shot;
 pub mod noise_id;
 pub mod oracle;
 pub mod predictor;

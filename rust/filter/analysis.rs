@@ -10,7 +10,7 @@
 use super::discretize::{discretize, Discretization};
 use super::kf::{Kf, LoopMode};
 use super::matrix::{check_covariance, check_square};
-use crate::error::{invalid, Result};
+use crate::error::{invalid, NavError, Result};
 use nalgebra::{DMatrix, DVector, SymmetricEigen};
 use rand::SeedableRng;
 use rand_chacha::ChaCha20Rng;
@@ -115,6 +115,50 @@ impl Scenario {
         Ok(out)
     }
 
+    /// True-error covariance analysis of the filter as built (suboptimal-filter analysis):
+    /// the gains K come from the filter's own model (its P, R), while the true measurement
+    /// noise has covariance `r_true` and is correlated with the process noise of the step
+    /// that ends at the measurement epoch: `cross[k − 1]` = E[w_{k−1} v_kᵀ] (n × m), e.g. a
+    /// CAI whose readout also senses the IMU noise of its shot. With e⁺ = (I − KH)e⁻ − Kv:
+    ///   P⁻ = Φ P⁺ Φᵀ + Q,
+    ///   P⁺ = (I−KH) P⁻ (I−KH)ᵀ + K R_t Kᵀ − (I−KH) S Kᵀ − K Sᵀ (I−KH)ᵀ.
+    /// Returns the σ of the true error after each epoch (epochs × n, row-major); with
+    /// R_t = R and S = 0 it is [`Scenario::sigmas`] (for a Van Loan filter).
+    pub fn true_sigmas(&self, r_true: &DMatrix<f64>, cross: &[DMatrix<f64>]) -> Result<Vec<f64>> {
+        let n = self.size();
+        let m = self.h.nrows();
+        check_covariance("r_true", r_true, Some(m), false)?;
+        if cross.len() != self.phi.len() {
+            return Err(invalid("cross", format!("expected one n × m matrix per step ({}), got {}", self.phi.len(), cross.len())));
+        }
+        if let Some(k) = cross.iter().position(|c| c.nrows() != n || c.ncols() != m) {
+            return Err(invalid("cross", format!("entry {k} is {} × {}, expected {n} × {m}", cross[k].nrows(), cross[k].ncols())));
+        }
+        let mut pf = self.p0.clone();
+        let mut pt = self.p0.clone();
+        let eye = DMatrix::<f64>::identity(n, n);
+        let mut out = Vec::with_capacity(self.epochs() * n);
+        for k in 0..self.epochs() {
+            if k > 0 {
+                pf = &self.phi[k - 1] * &pf * self.phi[k - 1].transpose() + &self.qd[k - 1];
+                let sq = &self.sqrt_qd_true[k - 1];
+                pt = &self.phi_true[k - 1] * &pt * self.phi_true[k - 1].transpose() + sq * sq.transpose();
+            }
+            if self.measure[k] {
+                let s = &self.h * &pf * self.h.transpose() + &self.r;
+                let chol = s.cholesky().ok_or_else(|| NavError::Numerical(format!("epoch {k}: innovation covariance not positive definite")))?;
+                let gain = chol.solve(&(&self.h * &pf)).transpose();
+                let ikh = &eye - &gain * &self.h;
+                pf = &ikh * &pf * ikh.transpose() + &gain * &self.r * gain.transpose();
+                let c = if k > 0 { cross[k - 1].clone() } else { DMatrix::zeros(n, m) };
+                let corr = &ikh * &c * gain.transpose();
+                pt = &ikh * &pt * ikh.transpose() + &gain * r_true * gain.transpose() - &corr - corr.transpose();
+            }
+            out.extend((0..n).map(|i| pt[(i, i)].max(0.0).sqrt()));
+        }
+        Ok(out)
+    }
+
     /// One Monte-Carlo run with the seed of run `run` under `master_seed` (ChaCha20
     /// stream = run index, so any subset of runs reproduces the same numbers anywhere).
     pub fn run(&self, master_seed: u64, run: u64, mode: LoopMode) -> Result<RunResult> {
@@ -189,5 +233,30 @@ mod tests {
             p = p * 0.4 / (p + 0.4);
             assert!((sg * sg / p - 1.0).abs() < 1e-12);
         }
+    }
+
+    /// A scalar random walk x observed as z = x + v, where v = u_k − u'_k shares the last
+    /// step's process noise u_k (w = u_k): S = E[w v] = q, R_t = q + r'. The true error
+    /// variance follows the scalar recursion with the filter's own gain.
+    #[test]
+    fn true_sigmas_follow_scalar_recursion_with_correlated_noise() {
+        let steps = 15;
+        let (q, rp, r_f) = (0.3, 0.1, 0.5);
+        let f = vec![DMatrix::zeros(1, 1); steps];
+        let qc = vec![DMatrix::from_element(1, 1, q); steps];
+        let s = Scenario::new(&f, &qc, &vec![1.0; steps], DMatrix::from_element(1, 1, 2.0), DMatrix::from_element(1, 1, 1.0), DMatrix::from_element(1, 1, r_f), vec![true; steps + 1], Discretization::VanLoan, false).unwrap();
+        let cross = vec![DMatrix::from_element(1, 1, q); steps];
+        let sig = s.true_sigmas(&DMatrix::from_element(1, 1, q + rp), &cross).unwrap();
+        let (mut pf, mut pt): (f64, f64) = (2.0, 2.0);
+        for (k, sg) in sig.iter().enumerate() {
+            let c = if k > 0 { pf += q; pt += q; q } else { 0.0 };
+            let g = pf / (pf + r_f);
+            pf = (1.0 - g) * pf;
+            pt = (1.0 - g).powi(2) * pt + g * g * (q + rp) - 2.0 * (1.0 - g) * g * c;
+            assert!((sg * sg / pt - 1.0).abs() < 1e-12, "epoch {k}: {} vs {pt}", sg * sg);
+        }
+        // no correlation and R_t = R: the filter's own covariance
+        let own = s.true_sigmas(&DMatrix::from_element(1, 1, r_f), &vec![DMatrix::zeros(1, 1); steps]).unwrap();
+        assert!(own.iter().zip(s.sigmas().unwrap()).all(|(a, b)| (a - b).abs() < 1e-12));
     }
 }

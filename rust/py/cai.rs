@@ -6,6 +6,7 @@ use super::imu::triad_from_dict;
 use super::trajectory::Motion;
 use super::filter::{AidedSetup, PyAidedIns};
 use crate::cai::aiding::{CaiAiding, CaiConfig, CaiData, ForceMode};
+use crate::cai::in_shot;
 use nalgebra::DVector;
 use crate::cai::hybrid::{HybridRun, HybridScenario, PhaseSource};
 use crate::earth::Ellipsoid;
@@ -369,6 +370,8 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<CaiMotion>()?;
     m.add_class::<CaiHybrid>()?;
     m.add_function(wrap_pyfunction!(cai_aided_ins, m)?)?;
+    m.add_function(wrap_pyfunction!(cai_in_shot_noise, m)?)?;
+    m.add_class::<CaiSensor>()?;
     m.add_function(wrap_pyfunction!(cai_phase_closed_form, m)?)?;
     m.add_function(wrap_pyfunction!(cai_sensitivity, m)?)?;
     m.add_function(wrap_pyfunction!(cai_convolution_phase, m)?)?;
@@ -403,40 +406,89 @@ fn interpolation_mode(name: &str) -> PyResult<Interpolation> {
     }
 }
 
-/// CAI aiding configuration from the Python keyword set (see `atomnav.hybrid.CaiSensor`).
-#[allow(clippy::too_many_arguments)]
-fn cai_config(
-    channels: &CaiChannels,
-    t_sep: f64,
-    shots: Vec<f64>,
-    readout: (f64, f64, f64),
-    inflation: Option<(f64, f64)>,
-    omega_dot: &str,
-    savgol_half_width: usize,
-    interpolation: &str,
-    substeps: usize,
-    jacobian_euler: bool,
-    misalignment: Option<f64>,
-    lever_arm: Option<f64>,
-    force: Option<(f64, f64)>,
-) -> PyResult<CaiConfig> {
-    Ok(CaiConfig {
-        channels: channels.0.clone(),
-        t_sep,
-        shots,
-        offset: readout.0,
-        contrast: readout.1,
-        sigma_p: readout.2,
-        inflation,
-        omega_dot: omega_dot_mode(omega_dot, savgol_half_width)?,
-        interpolation: interpolation_mode(interpolation)?,
-        substeps,
-        jacobian_euler,
-        misalignment,
-        lever_arm,
-        force: force.map_or(ForceMode::Bias, |(tau, sigma)| ForceMode::Direct { tau, sigma }),
-        kind: ImuKind::Rates,
-    })
+/// The CAI sensor as the aiding sees it (channels, T, readout, R inflation, predictor and
+/// Jacobian options, extra states, force mode), checked once; built by
+/// `atomnav.cai.hybrid.CaiSensor._native()` and taken, with their shots, by the Monte Carlo
+/// (`CaiHybrid`), `cai_aided_ins` and `cai_in_shot_noise`.
+#[pyclass(name = "CaiSensor", module = "atomnav._core", frozen)]
+pub struct CaiSensor(CaiConfig);
+
+#[pymethods]
+impl CaiSensor {
+    #[new]
+    #[allow(clippy::too_many_arguments)]
+    #[pyo3(signature = (channels, t_sep, readout, inflation, omega_dot, savgol_half_width, interpolation, substeps, jacobian_euler,
+        misalignment, lever_arm, force))]
+    fn new(
+        channels: &CaiChannels,
+        t_sep: f64,
+        readout: (f64, f64, f64),
+        inflation: Option<(f64, f64)>,
+        omega_dot: &str,
+        savgol_half_width: usize,
+        interpolation: &str,
+        substeps: usize,
+        jacobian_euler: bool,
+        misalignment: Option<f64>,
+        lever_arm: Option<f64>,
+        force: Option<(f64, f64)>,
+    ) -> PyResult<Self> {
+        let cfg = CaiConfig {
+            channels: channels.0.clone(),
+            t_sep,
+            shots: Vec::new(),
+            offset: readout.0,
+            contrast: readout.1,
+            sigma_p: readout.2,
+            inflation,
+            omega_dot: omega_dot_mode(omega_dot, savgol_half_width)?,
+            interpolation: interpolation_mode(interpolation)?,
+            substeps,
+            jacobian_euler,
+            misalignment,
+            lever_arm,
+            force: force.map_or(ForceMode::Bias, |(tau, sigma)| ForceMode::Direct { tau, sigma }),
+            kind: ImuKind::Rates,
+        };
+        cfg.check()?;
+        Ok(CaiSensor(cfg))
+    }
+}
+
+impl CaiSensor {
+    fn with_shots(&self, shots: &PyReadonlyArray1<'_, f64>) -> PyResult<CaiConfig> {
+        Ok(CaiConfig { shots: vector(shots, "shots")?, ..self.0.clone() })
+    }
+}
+
+/// In-shot IMU noise of one shot of `sensor` on a regular record of spacing `dt` (s)
+/// (samples from the interpolation / ω̇ window before the shot to its end, as the aiding
+/// holds them), white PSDs q_a (m²/s³), q_g (rad²/s): the phase covariance Σ (channels ×
+/// channels, rad²) and, for each 15-state model f[k] (steps, 15, 15) held over a filter
+/// step of one shot, E[w δφ̂ᵀ] (steps, 15, channels) (see cai/in_shot.rs).
+#[pyfunction]
+fn cai_in_shot_noise<'py>(py: Python<'py>, sensor: &CaiSensor, dt: f64, q_a: f64, q_g: f64, f: PyReadonlyArray3<'py, f64>) -> PyResult<(Arr2<'py>, Bound<'py, numpy::PyArray3<f64>>)> {
+    crate::error::check_positive("dt", dt)?;
+    for (name, q) in [("q_a", q_a), ("q_g", q_g)] {
+        if !(q.is_finite() && q >= 0.0) {
+            return Err(invalid(name, format!("must be finite and >= 0, got {q}")).into());
+        }
+    }
+    let cfg = &sensor.0;
+    let pad = match cfg.omega_dot { OmegaDot::Savgol { half_width } => 3.max(2 * half_width + 1), _ => 3 };
+    let n = (2.0 * cfg.t_sep / dt + 1e-9).floor() as usize + pad + 1;
+    let t: Vec<f64> = (0..n).map(|i| (i as f64 - pad as f64) * dt).collect();
+    let fs = super::filter::mats(&f, "f")?;
+    let m = cfg.channels.len();
+    let (sigma, cross) = py.detach(|| -> crate::Result<_> {
+        let pcfg = PredictorConfig { t_sep: cfg.t_sep, substeps: cfg.substeps, gradient: None, bias_a: Vec3::zeros(), bias_g: Vec3::zeros(), omega_dot: cfg.omega_dot.clone(), interpolation: cfg.interpolation };
+        let sens = in_shot::sensitivity(&t, 0.0, &cfg.channels, &pcfg)?;
+        let sigma = in_shot::covariance(&t, &sens, q_a, q_g, m);
+        let cross: Vec<_> = fs.iter().map(|fk| in_shot::cross_covariance(fk, &t, 0.0, cfg.t_sep, &sens, q_a, q_g)).collect::<crate::Result<_>>()?;
+        Ok((sigma, cross))
+    })?;
+    let flat: Vec<f64> = cross.iter().flat_map(|c| (0..15).flat_map(move |i| (0..m).map(move |j| c[(i, j)]))).collect();
+    Ok((super::filter::mat_to_py(py, &sigma), numpy::PyArray1::from_vec(py, flat).reshape([cross.len(), 15, m])?))
 }
 
 /// A CAI-aided INS scenario (truth, IMU errors, CAI, filter), built once; `monte_carlo`
@@ -448,8 +500,7 @@ struct CaiHybrid(HybridScenario);
 impl CaiHybrid {
     #[new]
     #[allow(clippy::too_many_arguments)]
-    #[pyo3(signature = (motion, ellipsoid, rate_hz, truth_rate_hz, imu_accel, imu_gyro, reference, channels, t_sep, shots, readout,
-        inflation, omega_dot, savgol_half_width, interpolation, substeps, jacobian_euler, misalignment, lever_arm, force,
+    #[pyo3(signature = (motion, ellipsoid, rate_hz, truth_rate_hz, imu_accel, imu_gyro, reference, sensor, shots,
         noise, predict_every, p0, aiding, draw_initial))]
     fn new(
         py: Python<'_>,
@@ -460,19 +511,8 @@ impl CaiHybrid {
         imu_accel: &Bound<'_, PyDict>,
         imu_gyro: &Bound<'_, PyDict>,
         reference: Option<(Bound<'_, PyDict>, Bound<'_, PyDict>)>,
-        channels: &CaiChannels,
-        t_sep: f64,
+        sensor: &CaiSensor,
         shots: PyReadonlyArray1<'_, f64>,
-        readout: (f64, f64, f64),
-        inflation: Option<(f64, f64)>,
-        omega_dot: &str,
-        savgol_half_width: usize,
-        interpolation: &str,
-        substeps: usize,
-        jacobian_euler: bool,
-        misalignment: Option<f64>,
-        lever_arm: Option<f64>,
-        force: Option<(f64, f64)>,
         noise: (f64, f64, f64, f64),
         predict_every: usize,
         p0: PyReadonlyArray2<'_, f64>,
@@ -480,8 +520,7 @@ impl CaiHybrid {
         draw_initial: bool,
     ) -> PyResult<Self> {
         let ell = Ellipsoid::by_name(ellipsoid)?;
-        let cai = cai_config(channels, t_sep, vector(&shots, "shots")?, readout, inflation, omega_dot, savgol_half_width, interpolation, substeps,
-            jacobian_euler, misalignment, lever_arm, force)?;
+        let cai = sensor.with_shots(&shots)?;
         let imu_model = error_model(imu_accel, imu_gyro, "imu")?;
         let reference = reference.map(|(a, g)| error_model(&a, &g, "reference")).transpose()?;
         let p0 = super::filter::mat(&p0, "p0")?;
@@ -563,31 +602,18 @@ impl CaiHybrid {
 /// either emulated (`phase` true phases + `noise` population noise, shots × channels, the
 /// laser phase steered inside the loop) or recorded (`population` + `laser_phase`).
 #[pyfunction]
-#[pyo3(signature = (ins, extra0, channels, t_sep, shots, readout, inflation, omega_dot, savgol_half_width, interpolation, substeps,
-    jacobian_euler, misalignment, lever_arm, force, data_kind, data_a, data_b))]
+#[pyo3(signature = (ins, extra0, sensor, shots, data_kind, data_a, data_b))]
 #[allow(clippy::too_many_arguments)]
 fn cai_aided_ins(
     ins: PyRef<'_, AidedSetup>,
     extra0: PyReadonlyArray1<'_, f64>,
-    channels: &CaiChannels,
-    t_sep: f64,
+    sensor: &CaiSensor,
     shots: PyReadonlyArray1<'_, f64>,
-    readout: (f64, f64, f64),
-    inflation: Option<(f64, f64)>,
-    omega_dot: &str,
-    savgol_half_width: usize,
-    interpolation: &str,
-    substeps: usize,
-    jacobian_euler: bool,
-    misalignment: Option<f64>,
-    lever_arm: Option<f64>,
-    force: Option<(f64, f64)>,
     data_kind: &str,
     data_a: PyReadonlyArray2<'_, f64>,
     data_b: PyReadonlyArray2<'_, f64>,
 ) -> PyResult<PyAidedIns> {
-    let mut cfg = cai_config(channels, t_sep, vector(&shots, "shots")?, readout, inflation, omega_dot, savgol_half_width, interpolation, substeps,
-        jacobian_euler, misalignment, lever_arm, force)?;
+    let mut cfg = sensor.with_shots(&shots)?;
     cfg.kind = ins.kind;
     // (shots, channels) tables, read row-major; the aiding checks their sizes
     let flat = |a: &PyReadonlyArray2<'_, f64>| a.as_array().iter().copied().collect::<Vec<f64>>();

@@ -90,7 +90,7 @@ fn kalman_recursion<'py>(
 }
 
 /// A stack (N, r, c) as N matrices, checked for NaN/inf.
-fn mats(a: &PyReadonlyArray3<'_, f64>, field: &str) -> Result<Vec<DMatrix<f64>>, NavError> {
+pub(crate) fn mats(a: &PyReadonlyArray3<'_, f64>, field: &str) -> Result<Vec<DMatrix<f64>>, NavError> {
     let s = a.shape();
     let v = a.as_array();
     if let Some(((k, i, j), x)) = v.indexed_iter().find(|(_, x)| !x.is_finite()) {
@@ -321,6 +321,16 @@ impl Scenario {
     fn sigmas<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
         let n = self.inner.size();
         let s = py.detach(|| self.inner.sigmas())?;
+        Ok(Array2::from_shape_vec((s.len() / n, n), s).expect("epochs x n").into_pyarray(py))
+    }
+
+    /// σ of the true error of the filter as built when the measurement noise has
+    /// covariance `r_true` and cross-covariance `cross` (steps, n, m) with the process noise
+    /// of the step before each epoch (see filter/analysis.rs): (epochs, n).
+    fn true_sigmas<'py>(&self, py: Python<'py>, r_true: PyReadonlyArray2<'py, f64>, cross: PyReadonlyArray3<'py, f64>) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        let n = self.inner.size();
+        let (r_true, cross) = (mat(&r_true, "r_true")?, mats(&cross, "cross")?);
+        let s = py.detach(|| self.inner.true_sigmas(&r_true, &cross))?;
         Ok(Array2::from_shape_vec((s.len() / n, n), s).expect("epochs x n").into_pyarray(py))
     }
 

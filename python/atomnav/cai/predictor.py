@@ -366,7 +366,11 @@ def in_shot_noise_covariance(channels: Channels, q_accel: float, q_gyro: float, 
     Decision 14, full matrix including the A/B correlation). To leading order the noise acts
     as an atom acceleration −C_sb n_a (phase −∫w k·C_sb n_a) and a Coriolis acceleration
     −2(C_sb n_g)×v0 (phase −2∫w n_g·C_sbᵀ(v0×k)), so with ∫w² = 2T³/3:
-    Σ = (2T³/3) [q_a K Kᵀ + 4 q_g V Vᵀ],  K_j = C_sb,jᵀ k_j,  V_j = C_sb,jᵀ (v0_j × k_j)."""
+    Σ = (2T³/3) [q_a K Kᵀ + 4 q_g V Vᵀ],  K_j = C_sb,jᵀ k_j,  V_j = C_sb,jᵀ (v0_j × k_j).
+    This is the spec's closed form (E38): it leaves out the atom Euler term (with ω̇ taken
+    from the same gyro the rotation phase depends on the gyro over [T, 2T] only, variance
+    4T³q_g(kv0)², 1.5× the Coriolis part here) and the lever-arm Euler term (2Tq_g|l × k|²).
+    The aiding's R uses :func:`atomnav.cai.hybrid.in_shot_noise`, which includes both."""
     in_shot_noise_phase(q_accel, q_gyro, T)  # validates q and T
     kb = np.einsum("cji,cj->ci", channels.c_sb, channels.k)
     vb = np.einsum("cji,cj->ci", channels.c_sb, np.cross(channels.v0, channels.k))

@@ -77,6 +77,22 @@ def covariance_analysis(scenario: Scenario) -> pd.DataFrame:
     return df
 
 
+def true_error_analysis(scenario: Scenario, r_true, cross) -> pd.DataFrame:
+    """σ of the TRUE error of the filter as built (suboptimal-filter analysis): the gains
+    come from the scenario's own model (its P and R), while the real measurement noise has
+    covariance ``r_true`` (m, m) and is correlated with the process noise of the step before
+    each measurement, ``cross`` (steps, n, m) = E[w_{k−1} v_kᵀ] (e.g. a CAI readout that
+    also senses the IMU noise of its shot). With ``r_true`` = R and zero ``cross`` it equals
+    :func:`covariance_analysis`. Columns as there."""
+    cross = np.ascontiguousarray(np.asarray(cross, dtype=float))
+    if cross.ndim != 3:
+        raise ValueError(f"cross: expected a (steps, n, m) stack, got shape {cross.shape}")
+    s = scenario._core.true_sigmas(_mat(r_true, "r_true"), cross)
+    df = pd.DataFrame(s, columns=scenario.labels)
+    df.insert(0, "time_s", scenario.times)
+    return df
+
+
 def chi2_band(dof: int, runs: int, p: float = 0.95) -> tuple[float, float]:
     """Two-sided p band of the run-average of ``runs`` χ²(dof) variables (NEES or NIS):
     χ²_{runs·dof} quantiles / runs."""
