@@ -209,7 +209,9 @@ impl Strapdown {
         self.last_step = Some((lla - s0.lla, dt, gc));
         // C_nb(k) = C_{n(k−1)}^{n(k)} C_nb(k−1) C_{b(k)}^{b(k−1)}
         let q = quat_from_rotvec(&(-zeta)) * s0.q_nb * quat_from_rotvec(phi);
-        self.state = NavState { t, lla, vel, q_nb: quat_normalize(&q) };
+        // renormalise by one Newton step for 1/|q|: |q|² = 1 + ε with ε at rounding level
+        // after a product of unit quaternions, so (3 − |q|²)/2 leaves O(ε²) — no sqrt, no divide
+        self.state = NavState { t, lla, vel, q_nb: q * (1.5 - 0.5 * q.norm_squared()) };
     }
 }
 
