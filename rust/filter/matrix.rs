@@ -246,61 +246,94 @@ impl<const C: usize> Padded<C> {
         }
     }
 
-    /// Columns `cols` of the padded buffer `m`: col_j ← col_j − col_j[p]·u, with the chunk of
-    /// u held in registers across the columns; `f` is scratch for the col_j[p].
+    /// Columns `cols` of the padded buffer `m`: B consecutive Gauss–Jordan steps at pivots
+    /// p..p+B with the multiplier columns u_0..u_B (B padded columns of `u`), fused so that
+    /// each column is loaded and stored once: f_b = col_j[p+b] − Σ_{a<b} f_a u_a[p+b],
+    /// col_j ← col_j − Σ_b f_b u_b, with the chunks of u in registers across the columns;
+    /// `f` is scratch for B·|cols| values.
     #[inline(always)]
-    fn eliminate(&self, m: &mut [f64], cols: std::ops::Range<usize>, p: usize, u: &[f64], f: &mut [f64]) {
+    fn eliminate<const B: usize>(&self, m: &mut [f64], cols: std::ops::Range<usize>, p: usize, u: &[f64], f: &mut [f64]) {
         let s = self.stride;
-        let f = &mut f[..cols.len()];
-        for (fj, j) in f.iter_mut().zip(cols.clone()) {
-            *fj = m[j * s + p];
+        let f = &mut f[..B * cols.len()];
+        for (fj, j) in f.chunks_exact_mut(B).zip(cols.clone()) {
+            for b in 0..B {
+                fj[b] = (0..b).fold(m[j * s + p + b], |acc, a| (-fj[a]).mul_add(u[a * s + p + b], acc));
+            }
         }
         for r0 in (0..s).step_by(C) {
-            let v = *chunk::<C>(u, 0, 0, r0);
-            for (&fj, j) in f.iter().zip(cols.clone()) {
+            let v: [[f64; C]; B] = std::array::from_fn(|b| *chunk::<C>(u, s, b, r0));
+            for (fj, j) in f.chunks_exact(B).zip(cols.clone()) {
                 let c: &mut [f64; C] = (&mut m[j * s + r0..j * s + r0 + C]).try_into().expect("chunk of C values");
+                let nf: [f64; B] = std::array::from_fn(|b| -fj[b]);
                 for i in 0..C {
-                    c[i] = (-fj).mul_add(v[i], c[i]);
+                    c[i] = (0..B).fold(c[i], |acc, b| nf[b].mul_add(v[b][i], acc));
                 }
             }
         }
     }
 
+    /// Partial pivoting at step p: the row of the largest |W[i, p]| (i ≥ p) is swapped into
+    /// row p in W's columns p.., in all `cols` columns of b and in the first `k` (not yet
+    /// applied) multiplier columns of u; then u_k = W[:, p]/piv with u_k[p] = 1 − 1/piv, so
+    /// that col − col[p]·u_k eliminates column p from every other row and divides row p by
+    /// the pivot. False when W is singular.
+    #[inline(always)]
+    fn pivot(&self, w: &mut [f64], b: &mut [f64], cols: usize, p: usize, u: &mut [f64], k: usize) -> bool {
+        let (n, s) = (self.n, self.stride);
+        let mut r = p;
+        for i in p + 1..n {
+            if w[p * s + i].abs() > w[p * s + r].abs() {
+                r = i;
+            }
+        }
+        let piv = w[p * s + r];
+        if piv == 0.0 || !piv.is_finite() {
+            return false;
+        }
+        if r != p {
+            for j in p..n {
+                w.swap(j * s + p, j * s + r);
+            }
+            for j in 0..cols {
+                b.swap(j * s + p, j * s + r);
+            }
+            for a in 0..k {
+                u.swap(a * s + p, a * s + r);
+            }
+        }
+        let inv = 1.0 / piv;
+        for (ui, wi) in u[k * s..(k + 1) * s].iter_mut().zip(&w[p * s..(p + 1) * s]) {
+            *ui = wi * inv;
+        }
+        u[k * s + p] = 1.0 - inv;
+        true
+    }
+
     /// Solve W Y = B in place by Gauss–Jordan elimination with partial pivoting: `b` holds
-    /// `cols` padded right-hand-side columns and becomes Y; `w` is destroyed, `u` (one padded
-    /// column) and `f` (`cols` values) are scratch. Each pivot step is one rank-1 update of
-    /// whole columns (no triangular-solve dependency chain). Returns false when W is singular.
+    /// `cols` padded right-hand-side columns and becomes Y; `w` is destroyed, `u` (two padded
+    /// columns) and `f` (2·`cols` values) are scratch. Pivots are taken in pairs, each pair one
+    /// fused rank-2 update of whole columns (no triangular-solve dependency chain). Returns
+    /// false when W is singular.
     #[inline(always)]
     pub fn solve(&self, w: &mut [f64], b: &mut [f64], cols: usize, u: &mut [f64], f: &mut [f64]) -> bool {
         let (n, s) = (self.n, self.stride);
-        for p in 0..n {
-            let mut r = p;
-            for i in p + 1..n {
-                if w[p * s + i].abs() > w[p * s + r].abs() {
-                    r = i;
-                }
-            }
-            let piv = w[p * s + r];
-            if piv == 0.0 || !piv.is_finite() {
+        let mut p = 0;
+        while p < n {
+            if !self.pivot(w, b, cols, p, u, 0) {
                 return false;
             }
-            if r != p {
-                for j in p..n {
-                    w.swap(j * s + p, j * s + r);
-                }
-                for j in 0..cols {
-                    b.swap(j * s + p, j * s + r);
-                }
+            if p + 1 == n {
+                self.eliminate::<1>(b, 0..cols, p, u, f);
+                break;
             }
-            // u = W[:, p]/piv with u[p] = 1 − 1/piv: col_j − col_j[p]·u eliminates row p's
-            // multiple of column p from every other row and divides row p by the pivot.
-            let inv = 1.0 / piv;
-            for (ui, wi) in u.iter_mut().zip(&w[p * s..(p + 1) * s]) {
-                *ui = wi * inv;
+            // Step p on W's column p + 1 alone, which the pivot of step p + 1 needs.
+            self.eliminate::<1>(w, p + 1..p + 2, p, u, f);
+            if !self.pivot(w, b, cols, p + 1, u, 1) {
+                return false;
             }
-            u[p] = 1.0 - inv;
-            self.eliminate(w, p + 1..n, p, u, f);
-            self.eliminate(b, 0..cols, p, u, f);
+            self.eliminate::<2>(w, p + 2..n, p, &u[..2 * s], f);
+            self.eliminate::<2>(b, 0..cols, p, &u[..2 * s], f);
+            p += 2;
         }
         true
     }
@@ -351,7 +384,7 @@ mod tests {
             assert!((d.transpose(&mut at, &pa) - a.norm_squared()).abs() < 1e-12 * a.norm_squared());
             assert_eq!(unpad(&at), a.transpose());
             let (mut w, mut rhs) = (pa.clone(), [pb.clone(), pa.clone()].concat());
-            assert!(d.solve(&mut w, &mut rhs, 2 * n, &mut vec![0.0; d.stride], &mut vec![0.0; 2 * n]));
+            assert!(d.solve(&mut w, &mut rhs, 2 * n, &mut vec![0.0; 2 * d.stride], &mut vec![0.0; 4 * n]));
             let lu = a.clone().lu();
             for (k, m) in [&b, &a].into_iter().enumerate() {
                 let want = lu.solve(m).unwrap();
@@ -360,11 +393,12 @@ mod tests {
             }
             // A singular W is reported, not divided by.
             let mut z = vec![0.0; d.buffer_len()];
-            assert!(!d.solve(&mut z, &mut pa.clone(), n, &mut vec![0.0; d.stride], &mut vec![0.0; n]));
+            assert!(!d.solve(&mut z, &mut pa.clone(), n, &mut vec![0.0; 2 * d.stride], &mut vec![0.0; 2 * n]));
         }
         check::<24>(21);
         check::<16>(37);
         check::<4>(1);
+        check::<8>(6);
     }
 
     /// Every size path (fixed and general) equals nalgebra's ΦPΦᵀ + Q.

@@ -137,7 +137,7 @@ fn doubling_padded<const C: usize>(
 ) -> Option<usize> {
     let (n, s, len) = (d.n, d.stride, d.buffer_len());
     // One allocation for the whole iteration: A, Aᵀ, G, H, W, [W⁻¹A | W⁻¹G], T, scratch.
-    let mut ws = vec![0.0; 8 * len + s + 2 * n];
+    let mut ws = vec![0.0; 8 * len + 2 * s + 4 * n];
     let (a, rest) = ws.split_at_mut(len);
     let (at, rest) = rest.split_at_mut(len);
     let (g, rest) = rest.split_at_mut(len);
@@ -145,7 +145,7 @@ fn doubling_padded<const C: usize>(
     let (w, rest) = rest.split_at_mut(len);
     let (rhs, rest) = rest.split_at_mut(2 * len);
     let (t, rest) = rest.split_at_mut(len);
-    let (u, f) = rest.split_at_mut(s);
+    let (u, f) = rest.split_at_mut(2 * s);
     for j in 0..n {
         for i in 0..n {
             (a[j * s + i], g[j * s + i], x[j * s + i]) = (a0(i, j), g0(i, j), x0(i, j));
