@@ -267,11 +267,15 @@ mod tests {
     }
 
     /// The doubling result satisfies the filter DARE (spec cai-ekf E24) to round-off, with
-    /// one register chunk (n = 21) and several (n = 40), for an unstable Φ.
+    /// one register chunk (n = 21) and several (n = 40), for an unstable Φ (scipy agrees to 1e-14
+    /// on these systems).
     #[test]
     fn dare_residual_vanishes_one_and_several_chunks() {
         for (n, m) in [(21, 6), (40, 7)] {
-            let phi = DMatrix::from_fn(n, n, |i, j| if i == j { 1.02 } else { 0.3 * (((i * 7 + j * 3) % 11) as f64 - 5.0) / (5.0 * n as f64) });
+            // Diagonal 0.4..1.05 (a few unstable modes, observed through h) plus a weak coupling.
+            let phi = DMatrix::from_fn(n, n, |i, j| {
+                if i == j { 0.4 + 0.65 * i as f64 / (n - 1) as f64 } else { 0.3 * (((i * 7 + j * 3) % 11) as f64 - 5.0) / (5.0 * n as f64) }
+            });
             let g = DMatrix::from_fn(n, n, |i, j| (((i * 5 + j * 13) % 17) as f64 - 8.0) / 8.0);
             let q = &g * g.transpose() / n as f64 + DMatrix::identity(n, n) * 1e-3;
             let h = DMatrix::from_fn(m, n, |i, j| (((i * 3 + j * 11) % 7) as f64 - 3.0) / 3.0 + if i == j % m { 1.0 } else { 0.0 });
@@ -280,7 +284,7 @@ mod tests {
             let s = &h * &p * h.transpose() + &r;
             let k = &phi * &p * h.transpose() * s.try_inverse().unwrap();
             let rhs = &phi * &p * phi.transpose() + &q - &k * &h * &p * phi.transpose();
-            assert!((&rhs - &p).abs().max() < 1e-9 * p.abs().max(), "n = {n}: {}", (&rhs - &p).abs().max() / p.abs().max());
+            assert!((&rhs - &p).abs().max() < 1e-12 * p.abs().max(), "n = {n}: {}", (&rhs - &p).abs().max() / p.abs().max());
         }
     }
 
