@@ -3,7 +3,7 @@
 * 15-state predict step (P ← ΦPΦᵀ + Q): atomnav (Rust loop over steps, one call) vs
   filterpy ``KalmanFilter.predict`` called per step (how it is used); the per-call
   atomnav path from Python is printed as well.
-* 21-state DARE: atomnav (doubling, faer) vs ``scipy.linalg.solve_discrete_are``.
+* 21-state DARE: atomnav (structure-preserving doubling) vs ``scipy.linalg.solve_discrete_are``.
 
     pip install filterpy scipy
     python benches/bench_filter.py [--steps 20000] [--repeat 3]

@@ -125,18 +125,20 @@ fn add_columns(acc: &mut [f64], m: &[f64], n: usize, a: impl Fn(usize) -> f64, r
     }
 }
 
-/// Column `k` of a column-major buffer with columns of S values.
+/// The C values from row `row0` of column `k` of a column-major buffer with columns of
+/// `stride` values.
 #[inline(always)]
-fn col<const S: usize>(m: &[f64], k: usize) -> &[f64; S] {
-    m[k * S..(k + 1) * S].try_into().expect("column of S values")
+fn chunk<const C: usize>(m: &[f64], stride: usize, k: usize, row0: usize) -> &[f64; C] {
+    m[k * stride + row0..k * stride + row0 + C].try_into().expect("chunk of C values")
 }
 
-/// acc + Σ_k a(k) · column k (k < N) of the column-major buffer `m` (columns of S values).
+/// acc + Σ_k a(k) · rows row0..row0+C of column k (k < n) of the column-major buffer `m`
+/// (columns of `stride` values); `acc` lives in vector registers.
 #[inline(always)]
-fn sum_columns<const N: usize, const S: usize>(mut acc: [f64; S], m: &[f64], a: impl Fn(usize) -> f64) -> [f64; S] {
-    for k in 0..N {
-        let (ak, mk) = (a(k), col::<S>(m, k));
-        for i in 0..S {
+fn sum_columns<const C: usize>(mut acc: [f64; C], m: &[f64], stride: usize, row0: usize, n: usize, a: impl Fn(usize) -> f64) -> [f64; C] {
+    for (k, col) in m[..n * stride].chunks_exact(stride).enumerate() {
+        let (ak, mk): (f64, &[f64; C]) = (a(k), col[row0..row0 + C].try_into().expect("chunk of C values"));
+        for i in 0..C {
             acc[i] = mk[i].mul_add(ak, acc[i]);
         }
     }
@@ -162,18 +164,18 @@ fn propagate_fixed<const N: usize, const S: usize>(p: &mut [f64], x: Option<&mut
     pad::<N, S>(phi, phi_p);
     pad::<N, S>(p, p_p);
     if let Some(x) = x {
-        let y = sum_columns::<N, S>([0.0; S], phi_p, |k| x[k]);
+        let y = sum_columns::<S>([0.0; S], phi_p, S, 0, N, |k| x[k]);
         x.copy_from_slice(&y[..N]);
     }
     // T[:, j] = Σ_k P[:, k] Φ[j, k]
     for j in 0..N {
-        tt[j * S..(j + 1) * S].copy_from_slice(&sum_columns::<N, S>([0.0; S], p_p, |k| phi[k * N + j]));
+        tt[j * S..(j + 1) * S].copy_from_slice(&sum_columns::<S>([0.0; S], p_p, S, 0, N, |k| phi[k * N + j]));
     }
     // P[:, j] = Q[:, j] + Σ_k Φ[:, k] T[k, j]; the upper triangle is then taken from the lower
     for j in 0..N {
         let mut acc = [0.0; S];
         acc[..N].copy_from_slice(&q[j * N..(j + 1) * N]);
-        let acc = sum_columns::<N, S>(acc, phi_p, |k| tt[j * S + k]);
+        let acc = sum_columns::<S>(acc, phi_p, S, 0, N, |k| tt[j * S + k]);
         p[j * N..(j + 1) * N].copy_from_slice(&acc[..N]);
     }
     mirror_lower(p, N);
@@ -208,10 +210,196 @@ fn mirror_lower(p: &mut [f64], n: usize) {
     }
 }
 
+/// Layout of n × n matrices in column-major buffers whose columns hold `stride` values
+/// (rows n.. are zero padding, stride a multiple of C), processed in row chunks of C
+/// values that live in vector registers: the products and the solve of the DARE doubling
+/// (riccati.rs), for any n (one chunk when n ≤ C, several otherwise). Callers compile
+/// these `inline(always)` methods inside an AVX2 + FMA region when the CPU has it.
+#[derive(Clone, Copy)]
+pub(crate) struct Padded<const C: usize> {
+    pub n: usize,
+    pub stride: usize,
+}
+
+impl<const C: usize> Padded<C> {
+    pub fn new(n: usize) -> Self {
+        Self { n, stride: n.div_ceil(C).max(1) * C }
+    }
+
+    /// Values in one padded n × n buffer.
+    pub fn buffer_len(&self) -> usize {
+        self.stride * self.n
+    }
+
+    /// out[:, j] = (out[:, j] when `add`) + Σ_k m[:, k] b[k, j] for j < n (all padded rows).
+    #[inline(always)]
+    pub fn mul(&self, out: &mut [f64], add: bool, m: &[f64], b: &[f64]) {
+        let (n, s) = (self.n, self.stride);
+        for j in 0..n {
+            let bj = &b[j * s..j * s + n];
+            for r0 in (0..s).step_by(C) {
+                let acc = if add { *chunk::<C>(out, s, j, r0) } else { [0.0; C] };
+                // One chunk (n ≤ C): a constant stride lets the compiler drop the bounds checks.
+                let y = if s == C { sum_columns::<C>(acc, m, C, 0, n, |k| bj[k]) } else { sum_columns::<C>(acc, m, s, r0, n, |k| bj[k]) };
+                out[j * s + r0..j * s + r0 + C].copy_from_slice(&y);
+            }
+        }
+    }
+
+    /// Columns `cols` of the padded buffer `m`: B consecutive Gauss–Jordan steps at pivots
+    /// p..p+B with the multiplier columns u_0..u_B (B padded columns of `u`), fused so that
+    /// each column is loaded and stored once: f_b = col_j[p+b] − Σ_{a<b} f_a u_a[p+b],
+    /// col_j ← col_j − Σ_b f_b u_b, with the chunks of u in registers across the columns;
+    /// `f` is scratch for B·|cols| values.
+    #[inline(always)]
+    fn eliminate<const B: usize>(&self, m: &mut [f64], cols: std::ops::Range<usize>, p: usize, u: &[f64], f: &mut [f64]) {
+        let s = self.stride;
+        let f = &mut f[..B * cols.len()];
+        for (fj, j) in f.chunks_exact_mut(B).zip(cols.clone()) {
+            for b in 0..B {
+                fj[b] = (0..b).fold(m[j * s + p + b], |acc, a| (-fj[a]).mul_add(u[a * s + p + b], acc));
+            }
+        }
+        for r0 in (0..s).step_by(C) {
+            let v: [[f64; C]; B] = std::array::from_fn(|b| *chunk::<C>(u, s, b, r0));
+            for (fj, j) in f.chunks_exact(B).zip(cols.clone()) {
+                let c: &mut [f64; C] = (&mut m[j * s + r0..j * s + r0 + C]).try_into().expect("chunk of C values");
+                let nf: [f64; B] = std::array::from_fn(|b| -fj[b]);
+                for i in 0..C {
+                    c[i] = (0..B).fold(c[i], |acc, b| nf[b].mul_add(v[b][i], acc));
+                }
+            }
+        }
+    }
+
+    /// Partial pivoting at step p: the row of the largest |W[i, p]| (i ≥ p) is swapped into
+    /// row p in W's columns p.., in all `cols` columns of b and in the first `k` (not yet
+    /// applied) multiplier columns of u; then u_k = W[:, p]/piv with u_k[p] = 1 − 1/piv, so
+    /// that col − col[p]·u_k eliminates column p from every other row and divides row p by
+    /// the pivot. False when W is singular.
+    #[inline(always)]
+    fn pivot(&self, w: &mut [f64], b: &mut [f64], cols: usize, p: usize, u: &mut [f64], k: usize) -> bool {
+        let (n, s) = (self.n, self.stride);
+        let mut r = p;
+        for i in p + 1..n {
+            if w[p * s + i].abs() > w[p * s + r].abs() {
+                r = i;
+            }
+        }
+        let piv = w[p * s + r];
+        if piv == 0.0 || !piv.is_finite() {
+            return false;
+        }
+        if r != p {
+            for j in p..n {
+                w.swap(j * s + p, j * s + r);
+            }
+            for j in 0..cols {
+                b.swap(j * s + p, j * s + r);
+            }
+            for a in 0..k {
+                u.swap(a * s + p, a * s + r);
+            }
+        }
+        let inv = 1.0 / piv;
+        for (ui, wi) in u[k * s..(k + 1) * s].iter_mut().zip(&w[p * s..(p + 1) * s]) {
+            *ui = wi * inv;
+        }
+        u[k * s + p] = 1.0 - inv;
+        true
+    }
+
+    /// Solve W Y = B in place by Gauss–Jordan elimination with partial pivoting: `b` holds
+    /// `cols` padded right-hand-side columns and becomes Y; `w` is destroyed, `u` (two padded
+    /// columns) and `f` (2·`cols` values) are scratch. Pivots are taken in pairs, each pair one
+    /// fused rank-2 update of whole columns (no triangular-solve dependency chain). Returns
+    /// false when W is singular.
+    #[inline(always)]
+    pub fn solve(&self, w: &mut [f64], b: &mut [f64], cols: usize, u: &mut [f64], f: &mut [f64]) -> bool {
+        let (n, s) = (self.n, self.stride);
+        let mut p = 0;
+        while p < n {
+            if !self.pivot(w, b, cols, p, u, 0) {
+                return false;
+            }
+            if p + 1 == n {
+                self.eliminate::<1>(b, 0..cols, p, u, f);
+                break;
+            }
+            // Step p on W's column p + 1 alone, which the pivot of step p + 1 needs.
+            self.eliminate::<1>(w, p + 1..p + 2, p, u, f);
+            if !self.pivot(w, b, cols, p + 1, u, 1) {
+                return false;
+            }
+            self.eliminate::<2>(w, p + 2..n, p, &u[..2 * s], f);
+            self.eliminate::<2>(b, 0..cols, p, &u[..2 * s], f);
+            p += 2;
+        }
+        true
+    }
+
+    /// out = mᵀ; returns the squared Frobenius norm of m.
+    #[inline(always)]
+    pub fn transpose(&self, out: &mut [f64], m: &[f64]) -> f64 {
+        let (n, s) = (self.n, self.stride);
+        let mut f2 = 0.0;
+        for j in 0..n {
+            for i in 0..n {
+                let v = m[j * s + i];
+                out[i * s + j] = v;
+                f2 += v * v;
+            }
+        }
+        f2
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
     use nalgebra::DVector;
+
+    /// The padded products and the Gauss–Jordan solve equal nalgebra's, with one chunk
+    /// (n = 21 in chunks of 24) and several (n = 37 in chunks of 16).
+    #[test]
+    fn padded_mul_and_solve_match_dense() {
+        fn check<const C: usize>(n: usize) {
+            let d = Padded::<C>::new(n);
+            let a = DMatrix::from_fn(n, n, |i, j| ((i * 7 + j * 3) % 11) as f64 / 11.0 - 0.4 + if i == j { 2.0 } else { 0.0 });
+            let b = DMatrix::from_fn(n, n, |i, j| ((i * 5 + j * 13) % 17) as f64 / 17.0 - 0.5);
+            let pad = |m: &DMatrix<f64>| {
+                let mut v = vec![0.0; d.buffer_len()];
+                for j in 0..n {
+                    v[j * d.stride..j * d.stride + n].copy_from_slice(m.column(j).as_slice());
+                }
+                v
+            };
+            let unpad = |v: &[f64]| DMatrix::from_fn(n, n, |i, j| v[j * d.stride + i]);
+            let (pa, pb) = (pad(&a), pad(&b));
+            let mut out = pad(&b);
+            d.mul(&mut out, true, &pa, &pb);
+            let want = &a * &b + &b;
+            assert!((unpad(&out) - &want).abs().max() < 1e-13 * want.abs().max(), "mul, n = {n}");
+            let mut at = vec![0.0; d.buffer_len()];
+            assert!((d.transpose(&mut at, &pa) - a.norm_squared()).abs() < 1e-12 * a.norm_squared());
+            assert_eq!(unpad(&at), a.transpose());
+            let (mut w, mut rhs) = (pa.clone(), [pb.clone(), pa.clone()].concat());
+            assert!(d.solve(&mut w, &mut rhs, 2 * n, &mut vec![0.0; 2 * d.stride], &mut vec![0.0; 4 * n]));
+            let lu = a.clone().lu();
+            for (k, m) in [&b, &a].into_iter().enumerate() {
+                let want = lu.solve(m).unwrap();
+                let got = unpad(&rhs[k * d.buffer_len()..(k + 1) * d.buffer_len()]);
+                assert!((got - &want).abs().max() < 1e-12 * want.abs().max(), "solve, n = {n}");
+            }
+            // A singular W is reported, not divided by.
+            let mut z = vec![0.0; d.buffer_len()];
+            assert!(!d.solve(&mut z, &mut pa.clone(), n, &mut vec![0.0; 2 * d.stride], &mut vec![0.0; 2 * n]));
+        }
+        check::<24>(21);
+        check::<16>(37);
+        check::<4>(1);
+        check::<8>(6);
+    }
 
     /// Every size path (fixed and general) equals nalgebra's ΦPΦᵀ + Q.
     #[test]

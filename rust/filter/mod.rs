@@ -1,6 +1,6 @@
 //! Estimation engine: error-state Kalman filter, discretisation, Riccati analysis,
 //! consistency measures. Dense algebra on nalgebra `DMatrix` (state sizes 1–30),
-//! the DARE on faer.
+//! the DARE doubling on the padded register-chunk kernels of matrix.rs.
 
 pub mod matrix;
 pub mod riccati;

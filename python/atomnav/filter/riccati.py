@@ -1,4 +1,4 @@
-"""Steady-state Kalman filter analysis (Rust core, faer).
+"""Steady-state Kalman filter analysis (Rust core).
 
 Filter-form discrete algebraic Riccati equation (spec cai-ekf E24/E25, seed 000 Eq. 31)::
 
