@@ -211,24 +211,27 @@ pub struct Local {
     /// Normal gravity γ (m/s², down).
     pub gravity: f64,
     omega: f64,
-    /// 1/R_M, 1/R_P and tan φ, so the rates below need no division.
+    /// 1/R_M, 1/R_P and 1/(R_P cos φ), so the rates below need no division.
     inv_rm: f64,
     inv_rp: f64,
-    tan: f64,
+    inv_rp_cos: f64,
 }
 
 impl Local {
     /// ω_ie^n = Ω (cos φ, 0, −sin φ).
+    #[inline]
     pub fn earth_rate(&self) -> Vec3 {
         Vec3::new(self.omega * self.cos, 0.0, -self.omega * self.sin)
     }
     /// ω_en^n = (v_E/R_P, −v_N/R_M, −v_E tan φ/R_P).
+    #[inline]
     pub fn transport_rate(&self, v: &Vec3) -> Vec3 {
-        Vec3::new(v.y * self.inv_rp, -v.x * self.inv_rm, -v.y * self.tan * self.inv_rp)
+        Vec3::new(v.y * self.inv_rp, -v.x * self.inv_rm, -v.y * self.sin * self.inv_rp_cos)
     }
     /// (φ̇, λ̇, ḣ) = (v_N/R_M, v_E/(R_P cos φ), −v_D).
+    #[inline]
     pub fn lla_rate(&self, v: &Vec3) -> Vec3 {
-        Vec3::new(v.x * self.inv_rm, v.y * self.inv_rp / self.cos, -v.z)
+        Vec3::new(v.x * self.inv_rm, v.y * self.inv_rp_cos, -v.z)
     }
 }
 
@@ -253,17 +256,65 @@ pub struct LocalModel {
 
 impl LocalModel {
     /// Everything the mechanization needs at (lat rad, h m), with one sin/cos, one sqrt
-    /// and three divisions.
+    /// and one division (the divider is the scarce unit of a mechanization step). With
+    /// W = √(1 − e² sin²φ): R_M = M + h = X/W³, X = a(1 − e²) + hW³, and R_P = N + h = Y/W,
+    /// Y = a + hW; the one reciprocal r = 1/(X·Y·W·cos φ) gives 1/W = XY cos φ·r,
+    /// 1/R_M = W⁴Y cos φ·r, 1/R_P = W²X cos φ·r and 1/(R_P cos φ) = W²X·r.
     pub fn at(&self, lat: f64, h: f64) -> Local {
-        let (sin, cos) = lat.sin_cos();
+        self.at_sin_cos(lat.sin_cos(), h)
+    }
+
+    /// `at` from (sin φ, cos φ), e.g. of an `AnchoredSinCos`.
+    #[inline]
+    pub fn at_sin_cos(&self, (sin, cos): (f64, f64), h: f64) -> Local {
         let s2 = sin * sin;
         let w2 = 1.0 - self.e2 * s2;
-        let inv_w = 1.0 / w2.sqrt();
-        let (m, n) = (self.a_1me2 * inv_w * inv_w * inv_w, self.a * inv_w);
+        let w = w2.sqrt();
+        let (x, y) = (self.a_1me2 + h * w2 * w, self.a + h * w);
+        let r = 1.0 / (x * y * w * cos);
+        let w2xr = w2 * x * r;
+        let inv_w = x * y * cos * r;
         let g0 = self.gamma_e * (1.0 + self.k * s2) * inv_w;
         let gravity = g0 * (1.0 - (self.c1 - self.c2 * s2) * h + self.c3 * h * h);
-        let (rm, rp) = (m + h, n + h);
-        Local { sin, cos, rm, rp, gravity, omega: self.omega, inv_rm: 1.0 / rm, inv_rp: 1.0 / rp, tan: sin / cos }
+        let (rm, rp) = (x * inv_w * inv_w * inv_w, y * inv_w);
+        Local { sin, cos, rm, rp, gravity, omega: self.omega, inv_rm: w2 * w2 * y * cos * r, inv_rp: w2xr * cos, inv_rp_cos: w2xr }
+    }
+}
+
+/// sin φ and cos φ of a slowly moving latitude φ from an exact anchor φ_a by the
+/// addition theorem, sin(φ_a + δ) = sin φ_a + (sin φ_a (cos δ − 1) + cos φ_a sin δ) and
+/// likewise for cos, with cos δ − 1 = −δ²/2 + δ⁴/24 and sin δ = δ − δ³/6 + δ⁵/120. For
+/// |δ| ≤ `REACH` = 1e-3 rad (6 km) the first omitted terms, δ⁶/720 and δ⁷/5040, are below
+/// 1.4e-21, so the result is as exact as `f64::sin_cos` at about a sixth of its cost; a
+/// latitude beyond the reach becomes the new anchor. A mechanization step moves the
+/// latitude by ~1e-7 rad, so the anchor is renewed every few thousand steps.
+#[derive(Debug, Clone, Copy)]
+pub struct AnchoredSinCos {
+    lat: f64,
+    sin: f64,
+    cos: f64,
+}
+
+impl AnchoredSinCos {
+    pub const REACH: f64 = 1e-3;
+
+    pub fn new(lat: f64) -> Self {
+        let (sin, cos) = lat.sin_cos();
+        Self { lat, sin, cos }
+    }
+
+    /// (sin φ, cos φ); NaN in, NaN out.
+    #[inline]
+    pub fn sin_cos(&mut self, lat: f64) -> (f64, f64) {
+        let d = lat - self.lat;
+        if !(d.abs() <= Self::REACH) {
+            *self = Self::new(lat);
+            return (self.sin, self.cos);
+        }
+        let d2 = d * d;
+        let cos_d_m1 = -d2 * (0.5 - d2 * (1.0 / 24.0));
+        let sin_d = d * (1.0 - d2 * (1.0 / 6.0 - d2 * (1.0 / 120.0)));
+        (self.sin + (self.sin * cos_d_m1 + self.cos * sin_d), self.cos + (self.cos * cos_d_m1 - self.sin * sin_d))
     }
 }
 
@@ -362,6 +413,36 @@ impl Helmert {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The anchored sin/cos equals libm's within 2 ulp anywhere in its reach, renews its
+    /// anchor beyond it, and passes NaN through; the one-division `LocalModel::at` equals
+    /// the textbook radii and gravity.
+    #[test]
+    fn anchored_sin_cos_and_local_model_match_direct_formulas() {
+        for lat0 in [-1.5707963267948966, -1.2, -0.3, 0.0, 0.4, 0.97, 1.5, 1.5707963267948966] {
+            let mut a = AnchoredSinCos::new(lat0);
+            for d in [0.0, 1e-9, -3e-7, 2.5e-4, -7e-4, 1e-3, -1e-3, 0.02, -0.5] {
+                let lat = lat0 + d;
+                let (s, c) = a.sin_cos(lat);
+                let (s0, c0) = lat.sin_cos();
+                assert!((s - s0).abs() <= 2.0 * f64::EPSILON && (c - c0).abs() <= 2.0 * f64::EPSILON, "lat {lat}: ({s}, {c}) vs ({s0}, {c0})");
+            }
+        }
+        assert!(AnchoredSinCos::new(0.3).sin_cos(f64::NAN).0.is_nan());
+        let model = WGS84.local_model();
+        for (lat, h) in [(0.0, 0.0), (0.97, 200.0), (-1.3, 8000.0), (1.57, -50.0)] {
+            let loc = model.at(lat, h);
+            let (m, n) = WGS84.radii(lat);
+            let rel = |a: f64, b: f64| ((a - b) / b).abs();
+            assert!(rel(loc.rm, m + h) < 1e-15 && rel(loc.rp, n + h) < 1e-15, "radii at {lat}");
+            assert!(rel(loc.gravity, WGS84.gravity(lat, h)) < 1e-14, "gravity at {lat}");
+            let v = Vec3::new(100.0, -40.0, 3.0);
+            let want = WGS84.transport_rate_ned(lat, h, &v);
+            assert!((loc.transport_rate(&v) - want).norm() < 1e-14 * want.norm(), "transport rate at {lat}");
+            let want = WGS84.lla_rate(lat, h, &v);
+            assert!((loc.lla_rate(&v) - want).norm() < 1e-14 * want.norm(), "lla rate at {lat}");
+        }
+    }
 
     /// Kinematic mode: no gravity, no gradient, no Earth rate; WGS-84 geometry.
     #[test]

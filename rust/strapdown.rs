@@ -11,7 +11,7 @@
 //! One `Strapdown` object serves batch use (one call over a whole record) and streaming
 //! (successive chunks): it keeps the previous sample for coning/sculling.
 
-use crate::earth::{check_latitude, Ellipsoid, LocalModel};
+use crate::earth::{check_latitude, AnchoredSinCos, Ellipsoid, LocalModel};
 use crate::error::{invalid, Result};
 pub use crate::imu::ImuKind;
 use crate::math::{quat_from_rotvec, quat_normalize, quat_rotate, Quat, Vec3};
@@ -45,6 +45,8 @@ pub struct Strapdown {
     pub state: NavState,
     /// `ell`'s constants of the Earth model evaluated at every step.
     earth: LocalModel,
+    /// sin/cos of the midpoint latitude, from an exact anchor (a sixth of libm's cost).
+    lat_sin_cos: AnchoredSinCos,
     /// Increments (Δθ, Δv) of up to the two previous intervals (most recent last), for
     /// the multi-interval coning and sculling terms.
     prev_increments: History<(Vec3, Vec3)>,
@@ -71,7 +73,7 @@ impl Strapdown {
             }
         }
         let state = NavState { q_nb: quat_normalize(&initial.q_nb), ..initial };
-        Ok(Strapdown { ell, kind, vertical, state, earth: ell.local_model(), prev_increments: History::default(), rate_history: History::default(), last_step: None })
+        Ok(Strapdown { ell, kind, vertical, state, earth: ell.local_model(), lat_sin_cos: AnchoredSinCos::new(state.lla.x), prev_increments: History::default(), rate_history: History::default(), last_step: None })
     }
 
     /// Run over a chunk. `t[k]` is the sample time (rates) or the end of the interval
@@ -116,17 +118,25 @@ impl Strapdown {
     /// finite samples, reference altitude). Messages give indices counted from
     /// `first_index` (the chunk's position in the whole record).
     pub(crate) fn validate(&self, t: &[f64], gyro: &[Vec3], accel: &[Vec3], h_ref: Option<&[f64]>, first_index: usize) -> Result<()> {
+        self.validate_block(t, gyro, accel, h_ref, first_index, None)
+    }
+
+    /// `validate` of one block of a chunk checked block by block: `after` is the time of
+    /// the previous block's last sample, or None for the chunk's first block (which
+    /// continues from the current state).
+    pub(crate) fn validate_block(&self, t: &[f64], gyro: &[Vec3], accel: &[Vec3], h_ref: Option<&[f64]>, first_index: usize, after: Option<f64>) -> Result<()> {
         let n = t.len();
         if gyro.len() != n || accel.len() != n {
             return Err(invalid("imu", format!("time has {n} samples but gyro {} and accel {}", gyro.len(), accel.len())));
         }
-        let mut prev_t = self.state.t;
+        let mut prev_t = after.unwrap_or(self.state.t);
+        let primed = after.is_some() || !self.rate_history.as_slice().is_empty();
         for (k, &tk) in t.iter().enumerate() {
             if !tk.is_finite() {
                 return Err(invalid("time", format!("non-finite time {tk} at index {}", first_index + k)));
             }
             // With rates the very first sample may coincide with the initial time.
-            let first_rate_sample = self.kind == ImuKind::Rates && self.rate_history.as_slice().is_empty() && k == 0;
+            let first_rate_sample = self.kind == ImuKind::Rates && !primed && k == 0;
             if first_rate_sample && tk != self.state.t {
                 return Err(invalid("time", format!("the first rate sample must be at the initial time {} s, got {tk} at index {first_index}", self.state.t)));
             }
@@ -153,6 +163,7 @@ impl Strapdown {
     }
 
     /// One mechanization step to time `t` with one IMU sample (rates or increments).
+    #[inline]
     pub fn step(&mut self, t: f64, gyro: &Vec3, accel: &Vec3, h_ref: Option<f64>) {
         let (dth, dv) = match self.kind {
             ImuKind::Increments => (*gyro, *accel),
@@ -174,6 +185,7 @@ impl Strapdown {
     /// Attitude, velocity and position over one interval, given the body rotation vector
     /// `phi` (coning included) and the body-frame velocity increment `dv_body` (rotation
     /// and sculling included), both referred to the body frame at t_{k−1}.
+    #[inline(always)]
     fn integrate(&mut self, t: f64, dt: f64, phi: &Vec3, dv_body: &Vec3, h_ref: Option<f64>) {
         let s0 = self.state;
         let model = &self.earth;
@@ -188,7 +200,7 @@ impl Strapdown {
             }
         };
         let v_mid = s0.vel + 0.5 * (dv_sf_b + gc_prev * dt);
-        let earth = model.at(lla_mid.x, lla_mid.z);
+        let earth = model.at_sin_cos(self.lat_sin_cos.sin_cos(lla_mid.x), lla_mid.z);
         // Baro loop (spec Eq. 26): ḣ gets −K_v1(h − h_b), v̇_D gets +K_v2(h − h_b), with
         // K_v1 = 2ζω_v, K_v2 = ω_v² + 2γ/R₀ (R₀ = √(R_M R_P)).
         let (k1, k2, dh0) = match (self.vertical, h_ref) {
@@ -272,16 +284,20 @@ impl<T: Copy + Default> History<T> {
 /// term is the second-order rotation of the specific force within the step; it is
 /// rectified (always opposes f's component across the rotation axis), so leaving it
 /// out biases the vertical channel by ≈ ⅙|Δθ|²g/Δt (1.5e-7 m/s² for 0.03 rad/s at 100 Hz).
+#[inline(always)]
 fn coning_sculling(prev: &[(Vec3, Vec3)], dth: &Vec3, dv: &Vec3) -> (Vec3, Vec3) {
-    let rot = 0.5 * dth.cross(dv) + dth.cross(&dth.cross(dv)) / 6.0;
+    // constant divisors as multipliers (a division is ~4× a multiplication's throughput)
+    const SIXTH: f64 = 1.0 / 6.0;
+    const TWELFTH: f64 = 1.0 / 12.0;
+    let rot = 0.5 * dth.cross(dv) + SIXTH * dth.cross(&dth.cross(dv));
     match prev {
         [] => (*dth, dv + rot),
         [.., (pth, pv)] => {
             let coning = match prev {
                 [(ppth, _), _] => (7.0 / 60.0 * pth - 1.0 / 60.0 * ppth).cross(dth),
-                _ => pth.cross(dth) / 12.0,
+                _ => TWELFTH * pth.cross(dth),
             };
-            (dth + coning, dv + rot + (pth.cross(dv) + pv.cross(dth)) / 12.0)
+            (dth + coning, dv + rot + TWELFTH * (pth.cross(dv) + pv.cross(dth)))
         }
     }
 }

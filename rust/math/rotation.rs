@@ -41,11 +41,14 @@ pub fn quat_mul(a: &Quat, b: &Quat) -> Quat {
 /// Below |φ| = 1e-2 (every strapdown step) the Taylor series through θ⁶ replaces sin/cos:
 /// the first omitted terms, θ⁸/10321920 and θ⁸/185794560, are < 1e-23 there, so the
 /// series is exact to rounding and tiny rotations keep full relative accuracy.
+#[inline]
 pub fn quat_from_rotvec(phi: &Vec3) -> Quat {
     let th2 = phi.norm_squared();
     let (c, s_over_th) = if th2 < 1e-4 {
         // cos(θ/2) = 1 − θ²/8 + θ⁴/384 − θ⁶/46080; sin(θ/2)/θ = ½ − θ²/48 + θ⁴/3840 − θ⁶/645120
-        (1.0 - th2 / 8.0 * (1.0 - th2 / 48.0 * (1.0 - th2 / 120.0)), 0.5 - th2 / 48.0 * (1.0 - th2 / 80.0 * (1.0 - th2 / 168.0)))
+        // (the divisors as multipliers: this runs twice per strapdown step)
+        let (c8, c48, c80, c120, c168) = (1.0 / 8.0, 1.0 / 48.0, 1.0 / 80.0, 1.0 / 120.0, 1.0 / 168.0);
+        (1.0 - th2 * c8 * (1.0 - th2 * c48 * (1.0 - th2 * c120)), 0.5 - th2 * c48 * (1.0 - th2 * c80 * (1.0 - th2 * c168)))
     } else {
         let th = th2.sqrt();
         ((0.5 * th).cos(), (0.5 * th).sin() / th)
@@ -165,6 +168,7 @@ pub fn rotvec_from_dcm(c: &Mat3) -> Vec3 {
 }
 
 /// Rotate a vector: C(q) v, without forming the matrix.
+#[inline]
 pub fn quat_rotate(q: &Quat, v: &Vec3) -> Vec3 {
     let u = q.imag();
     let t = 2.0 * u.cross(v);

@@ -50,16 +50,6 @@ pub fn vec3_rows(a: &PyReadonlyArray2<'_, f64>, field: &str) -> Result<Vec<Vec3>
     Ok(rows::<3>(a, field)?.into_iter().map(Vec3::from).collect())
 }
 
-/// An (N, 3) array as vectors, any strides, checking only the shape: for callers whose own
-/// validation checks finiteness (with indices in a larger record).
-pub fn vec3_rows_unchecked(a: &PyReadonlyArray2<'_, f64>, field: &str) -> Result<Vec<Vec3>, NavError> {
-    let shape = a.shape();
-    if shape[1] != 3 {
-        return Err(invalid(field, format!("expected shape (N, 3), got ({}, {})", shape[0], shape[1])));
-    }
-    Ok(a.as_array().outer_iter().map(|r| Vec3::new(r[0], r[1], r[2])).collect())
-}
-
 pub fn quat_rows(a: &PyReadonlyArray2<'_, f64>, field: &str) -> Result<Vec<Quat>, NavError> {
     Ok(rows::<4>(a, field)?.into_iter().map(|r| quat(r[0], r[1], r[2], r[3])).collect())
 }

@@ -1,11 +1,13 @@
 //! Bindings of strapdown.rs: a streaming mechanization object and attitude integration.
 
-use super::convert::{flat_to_py, quat_rows, quat_to_py, vec3, vec3_rows, vec3_rows_unchecked, vector};
+use super::convert::{flat_to_py, quat_rows, quat_to_py, vec3, vec3_rows, vector};
 use crate::earth::Ellipsoid;
 use crate::error::{invalid, NavError};
 use crate::math::{euler_from_quat, quat, Vec3};
 use crate::strapdown::{integrate_attitude, ImuKind, NavState, Strapdown as Core, Vertical};
-use numpy::{PyArray2, PyReadonlyArray1, PyReadonlyArray2};
+use numpy::ndarray::{s, ArrayView1, ArrayView2};
+use numpy::{PyArray2, PyArrayMethods, PyReadonlyArray1, PyReadonlyArray2, PyUntypedArrayMethods};
+use std::sync::mpsc;
 use pyo3::prelude::*;
 
 /// Streaming strapdown INS (NED). Feed chunks with `run`; state carries over.
@@ -26,7 +28,8 @@ pub(crate) fn states_to_columns<'py>(py: Python<'py>, s: &[NavState]) -> Bound<'
 /// Number of columns of the navigation table.
 const COLUMNS: usize = 14;
 
-/// Write states as rows `first`… of an (14, n) column-major table `buf`.
+/// Write states as rows `first`… of an (14, n) row-major table `buf` (column c of the
+/// navigation table is buf[c·n..(c+1)·n]).
 fn write_columns(buf: &mut [f64], n: usize, first: usize, s: &[NavState]) {
     for (i, x) in s.iter().enumerate() {
         let e = euler_from_quat(&x.q_nb);
@@ -38,44 +41,122 @@ fn write_columns(buf: &mut [f64], n: usize, first: usize, s: &[NavState]) {
     }
 }
 
-/// Samples integrated per block of the pipelined run: small enough that the states of
-/// two blocks stay in cache, large enough to amortise the thread hand-over.
+/// Rows per block of the pipelined run: small enough that a block's IMU rows and states
+/// stay in cache, large enough to amortise the hand-over to the writer thread.
 const PIPELINE_BLOCK: usize = 4096;
 
-/// Integrate a validated chunk while a second core turns the previous block's states into
-/// the column table (the Euler angles' three atan2 per row cost about as much as the
-/// mechanization step). Returns the table of the rows computed and, on divergence, the error.
-fn run_pipelined(core: &mut Core, t: &[f64], g: &[Vec3], a: &[Vec3], h: Option<&[f64]>, first_index: usize) -> (Vec<f64>, usize, Result<(), NavError>) {
-    let n = t.len();
-    let mut buf = vec![0.0; COLUMNS * n];
-    let (mut done, mut current) = (Vec::with_capacity(PIPELINE_BLOCK), Vec::with_capacity(PIPELINE_BLOCK));
-    let mut written = 0;
-    let mut result = Ok(());
-    for start in (0..n).step_by(PIPELINE_BLOCK) {
-        let end = (start + PIPELINE_BLOCK).min(n);
-        current.clear();
-        let (step, ()) = rayon::join(
-            || core.run_validated(&t[start..end], &g[start..end], &a[start..end], h.map(|h| &h[start..end]), first_index + start, &mut current),
-            || write_columns(&mut buf, n, written, &done),
-        );
-        written += done.len();
-        std::mem::swap(&mut done, &mut current);
-        if step.is_err() {
-            result = step;
-            break;
-        }
-    }
-    write_columns(&mut buf, n, written, &done);
-    written += done.len();
-    (buf, written, result)
+/// The IMU chunk as numpy views, read in place (any strides, e.g. columns of one (N, 7)
+/// table); `Block::fill` copies one block of rows into reusable buffers.
+struct ImuView<'a> {
+    time: ArrayView1<'a, f64>,
+    gyro: ArrayView2<'a, f64>,
+    accel: ArrayView2<'a, f64>,
+    h_ref: Option<ArrayView1<'a, f64>>,
 }
 
-/// The first `rows` rows of an (14, n) column-major table, as a (14, rows) array.
-fn table_rows<'py>(py: Python<'py>, buf: Vec<f64>, n: usize, rows: usize) -> Bound<'py, PyArray2<f64>> {
-    if rows == n {
-        return flat_to_py(py, COLUMNS, n, buf);
+impl ImuView<'_> {
+    fn len(&self) -> usize {
+        self.time.len()
     }
-    let cut: Vec<f64> = buf.chunks_exact(n).flat_map(|col| col[..rows].iter().copied()).collect();
+}
+
+/// One block of IMU rows, in buffers reused from block to block (no allocation, no page
+/// faults after the first block).
+#[derive(Default)]
+struct Block {
+    t: Vec<f64>,
+    gyro: Vec<Vec3>,
+    accel: Vec<Vec3>,
+    h_ref: Vec<f64>,
+    has_h_ref: bool,
+}
+
+impl Block {
+    fn fill(&mut self, imu: &ImuView<'_>, rows: std::ops::Range<usize>) {
+        let row = |a: &ArrayView2<'_, f64>, k: usize| Vec3::new(a[[k, 0]], a[[k, 1]], a[[k, 2]]);
+        self.t.clear();
+        self.t.extend(rows.clone().map(|k| imu.time[k]));
+        self.gyro.clear();
+        self.gyro.extend(rows.clone().map(|k| row(&imu.gyro, k)));
+        self.accel.clear();
+        self.accel.extend(rows.clone().map(|k| row(&imu.accel, k)));
+        self.h_ref.clear();
+        self.has_h_ref = imu.h_ref.is_some();
+        if let Some(h) = &imu.h_ref {
+            self.h_ref.extend(rows.map(|k| h[k]));
+        }
+    }
+
+    fn h_ref(&self) -> Option<&[f64]> {
+        self.has_h_ref.then_some(&self.h_ref[..])
+    }
+}
+
+/// Check a whole chunk block by block (nothing is integrated when any row is bad).
+fn validate(core: &Core, imu: &ImuView<'_>, first_index: usize) -> Result<(), NavError> {
+    let (n, mut blk) = (imu.len(), Block::default());
+    if imu.gyro.nrows() != n || imu.accel.nrows() != n {
+        return Err(invalid("imu", format!("time has {n} samples but gyro {} and accel {}", imu.gyro.nrows(), imu.accel.nrows())));
+    }
+    if let Some(h) = imu.h_ref.as_ref().filter(|h| h.len() != n) {
+        return Err(invalid("h_ref", format!("expected {n} samples, got {}", h.len())));
+    }
+    let mut after = None;
+    for start in (0..n.max(1)).step_by(PIPELINE_BLOCK) {
+        blk.fill(imu, start..(start + PIPELINE_BLOCK).min(n));
+        core.validate_block(&blk.t, &blk.gyro, &blk.accel, blk.h_ref(), first_index + start, after)?;
+        after = blk.t.last().copied().or(after);
+    }
+    Ok(())
+}
+
+/// Integrate a validated chunk on this thread while a second thread turns each finished
+/// block of states into rows of the (14, n) table `table` (the Euler angles' three atan2
+/// per row cost about half a mechanization step). Returns the number of rows computed
+/// and, on divergence, the error; the rows before it are in `table`.
+fn run_pipelined(core: &mut Core, imu: &ImuView<'_>, table: &mut [f64], first_index: usize) -> (usize, Result<(), NavError>) {
+    let n = imu.len();
+    let (to_writer, blocks) = mpsc::channel::<(usize, Vec<NavState>)>();
+    let (recycle, free) = mpsc::channel::<Vec<NavState>>();
+    // the sender is moved in, so it is dropped when the producer returns (ending the writer)
+    let mut produce = |to_writer: mpsc::Sender<(usize, Vec<NavState>)>| {
+        let mut blk = Block::default();
+        for start in (0..n).step_by(PIPELINE_BLOCK) {
+            blk.fill(imu, start..(start + PIPELINE_BLOCK).min(n));
+            let mut states = free.try_recv().unwrap_or_else(|_| Vec::with_capacity(PIPELINE_BLOCK));
+            states.clear();
+            let step = core.run_validated(&blk.t, &blk.gyro, &blk.accel, blk.h_ref(), first_index + start, &mut states);
+            let rows = start + states.len();
+            to_writer.send((start, states)).expect("the writer thread outlives the producer");
+            if step.is_err() {
+                return (rows, step);
+            }
+        }
+        (n, Ok(()))
+    };
+    if n <= PIPELINE_BLOCK {
+        // one block: not worth a thread
+        let out = produce(to_writer);
+        for (first, states) in blocks.try_iter() {
+            write_columns(table, n, first, &states);
+        }
+        return out;
+    }
+    std::thread::scope(|s| {
+        s.spawn(move || {
+            for (first, states) in blocks {
+                write_columns(table, n, first, &states);
+                let _ = recycle.send(states); // the producer may have finished already
+            }
+        });
+        produce(to_writer)
+    })
+}
+
+/// The first `rows` columns of a (14, n) table, as a (14, rows) array.
+fn table_rows<'py>(py: Python<'py>, table: &Bound<'py, PyArray2<f64>>, rows: usize) -> Bound<'py, PyArray2<f64>> {
+    let full = table.readonly();
+    let cut: Vec<f64> = full.as_array().rows().into_iter().flat_map(|col| col.slice(s![..rows]).to_vec()).collect();
     flat_to_py(py, COLUMNS, rows, cut)
 }
 
@@ -113,6 +194,7 @@ impl Strapdown {
 
     /// Integrate one chunk; returns the state after each sample as a (14, N) column table.
     /// `first_index` is the chunk's first row in the whole record, for error messages.
+    /// The inputs are read in place (any strides); the table is allocated by numpy.
     #[pyo3(signature = (time, gyro, accel, h_ref=None, first_index=0))]
     fn run<'py>(
         &mut self,
@@ -123,24 +205,34 @@ impl Strapdown {
         h_ref: Option<PyReadonlyArray1<'py, f64>>,
         first_index: usize,
     ) -> PyResult<Bound<'py, PyArray2<f64>>> {
-        let t: Vec<f64> = time.as_array().iter().copied().collect();
-        // finiteness is checked by `validate`, with indices in the whole record
-        let g = vec3_rows_unchecked(&gyro, "gyro")?;
-        let a = vec3_rows_unchecked(&accel, "accel")?;
-        let h: Option<Vec<f64>> = h_ref.map(|h| h.as_array().iter().copied().collect());
-        let inner = &mut self.inner;
-        inner.validate(&t, &g, &a, h.as_deref(), first_index)?;
-        let (buf, rows, result) = py.detach(|| run_pipelined(inner, &t, &g, &a, h.as_deref(), first_index));
-        let table = table_rows(py, buf, t.len(), rows);
-        match result {
-            Ok(()) => Ok(table),
-            Err(e) => {
-                // keep what was computed: the exception carries the rows before the failure
-                let err: PyErr = e.into();
-                err.value(py).setattr("partial", table)?;
-                Err(err)
+        for (name, a) in [("gyro", &gyro), ("accel", &accel)] {
+            if a.shape()[1] != 3 {
+                return Err(invalid(name, format!("expected shape (N, 3), got ({}, {})", a.shape()[0], a.shape()[1])).into());
             }
         }
+        let imu = ImuView { time: time.as_array(), gyro: gyro.as_array(), accel: accel.as_array(), h_ref: h_ref.as_ref().map(|h| h.as_array()) };
+        let n = imu.len();
+        let inner = &mut self.inner;
+        // values checked here, once, with indices in the whole record
+        py.detach(|| validate(inner, &imu, first_index))?;
+        // numpy's allocator advises huge pages for large arrays: a few page faults instead
+        // of one per 4 KiB of the 112 bytes/row table
+        let table = PyArray2::<f64>::zeros(py, [COLUMNS, n], false);
+        let rows = {
+            let mut guard = table.readwrite();
+            let buf = guard.as_slice_mut().expect("a new C-contiguous array");
+            let (rows, result) = py.detach(|| run_pipelined(inner, &imu, buf, first_index));
+            if let Err(e) = result {
+                drop(guard);
+                // keep what was computed: the exception carries the rows before the failure
+                let err: PyErr = e.into();
+                err.value(py).setattr("partial", table_rows(py, &table, rows))?;
+                return Err(err);
+            }
+            rows
+        };
+        debug_assert_eq!(rows, n);
+        Ok(table)
     }
 
     /// Current state as a (14, 1) column table.
