@@ -79,36 +79,51 @@ pub fn symmetrize(p: &mut DMatrix<f64>) {
 /// P ← Φ P Φᵀ + Q for a symmetric P in a column-major n × n buffer (the result is exactly
 /// symmetric), and x ← Φx when `x` is given; `t` is scratch. T = PΦᵀ, then
 /// the lower triangle of Q + ΦT, mirrored; every column is built as a sum of scaled
-/// columns. The common error-state sizes get a fixed-size kernel whose accumulator lives
-/// in vector registers, compiled for AVX2 + FMA when the CPU has them: several times
-/// faster than a general matmul dispatch at these sizes.
+/// columns. The common error-state sizes get a fixed-size kernel whose accumulators live
+/// in vector registers, compiled for AVX-512 or AVX2 + FMA when the CPU has them: several
+/// times faster than a general matmul dispatch at these sizes.
 pub fn propagate_covariance(p: &mut [f64], x: Option<&mut [f64]>, phi: &[f64], q: &[f64], n: usize, t: &mut Vec<f64>) {
     assert!(p.len() == n * n && phi.len() == n * n && q.len() == n * n, "propagate_covariance: buffers must be n x n");
     assert!(x.as_ref().is_none_or(|x| x.len() == n), "propagate_covariance: x must have n entries");
-    t.resize(3 * (n + 3) * n, 0.0);
+    t.resize(2 * (n + 3) * n, 0.0);
+    #[cfg(target_arch = "x86_64")]
+    if std::arch::is_x86_feature_detected!("avx512f") {
+        // SAFETY: the CPU supports AVX-512F (checked just above).
+        return unsafe { propagate_avx512(p, x, phi, q, n, t) };
+    }
     #[cfg(target_arch = "x86_64")]
     if std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("fma") {
         // SAFETY: the CPU supports AVX2 and FMA (checked just above).
         return unsafe { propagate_avx2_fma(p, x, phi, q, n, t) };
     }
-    propagate_sizes(p, x, phi, q, n, t)
+    propagate_sizes::<1>(p, x, phi, q, n, t)
 }
 
+/// 32 registers of 8 values: four output columns at a time.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx512f")]
+unsafe fn propagate_avx512(p: &mut [f64], x: Option<&mut [f64]>, phi: &[f64], q: &[f64], n: usize, t: &mut [f64]) {
+    propagate_sizes::<4>(p, x, phi, q, n, t)
+}
+
+/// 16 registers of 4 values: two output columns at a time.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2,fma")]
 unsafe fn propagate_avx2_fma(p: &mut [f64], x: Option<&mut [f64]>, phi: &[f64], q: &[f64], n: usize, t: &mut [f64]) {
-    propagate_sizes(p, x, phi, q, n, t)
+    propagate_sizes::<2>(p, x, phi, q, n, t)
 }
 
+/// `J` output columns are built at once (J independent accumulator sets hide the
+/// multiply-add latency; J divides 4).
 #[inline(always)]
-fn propagate_sizes(p: &mut [f64], x: Option<&mut [f64]>, phi: &[f64], q: &[f64], n: usize, t: &mut [f64]) {
+fn propagate_sizes<const J: usize>(p: &mut [f64], x: Option<&mut [f64]>, phi: &[f64], q: &[f64], n: usize, t: &mut [f64]) {
     match n {
-        9 => propagate_fixed::<9, 12>(p, x, phi, q, t),
-        15 => propagate_fixed::<15, 16>(p, x, phi, q, t),
-        16 => propagate_fixed::<16, 16>(p, x, phi, q, t),
-        17 => propagate_fixed::<17, 20>(p, x, phi, q, t),
-        18 => propagate_fixed::<18, 20>(p, x, phi, q, t),
-        21 => propagate_fixed::<21, 24>(p, x, phi, q, t),
+        9 => propagate_fixed::<9, 12, J>(p, x, phi, q, t),
+        15 => propagate_fixed::<15, 16, J>(p, x, phi, q, t),
+        16 => propagate_fixed::<16, 16, J>(p, x, phi, q, t),
+        17 => propagate_fixed::<17, 20, J>(p, x, phi, q, t),
+        18 => propagate_fixed::<18, 20, J>(p, x, phi, q, t),
+        21 => propagate_fixed::<21, 24, J>(p, x, phi, q, t),
         _ => propagate_any(p, x, phi, q, n, t),
     }
 }
@@ -132,51 +147,74 @@ fn chunk<const C: usize>(m: &[f64], stride: usize, k: usize, row0: usize) -> &[f
     m[k * stride + row0..k * stride + row0 + C].try_into().expect("chunk of C values")
 }
 
-/// acc + Σ_k a(k) · rows row0..row0+C of column k (k < n) of the column-major buffer `m`
-/// (columns of `stride` values); `acc` lives in vector registers.
+/// For J outputs j at once: acc_j + Σ_k a(j, k) · rows row0..row0+C of column k (k < n)
+/// of the column-major buffer `m` (columns of `stride` values); the accumulators live in
+/// vector registers, and each chunk of `m` is loaded once for all J.
 #[inline(always)]
-fn sum_columns<const C: usize>(mut acc: [f64; C], m: &[f64], stride: usize, row0: usize, n: usize, a: impl Fn(usize) -> f64) -> [f64; C] {
+fn sum_columns<const C: usize, const J: usize>(mut acc: [[f64; C]; J], m: &[f64], stride: usize, row0: usize, n: usize, a: impl Fn(usize, usize) -> f64) -> [[f64; C]; J] {
     for (k, col) in m[..n * stride].chunks_exact(stride).enumerate() {
-        let (ak, mk): (f64, &[f64; C]) = (a(k), col[row0..row0 + C].try_into().expect("chunk of C values"));
-        for i in 0..C {
-            acc[i] = mk[i].mul_add(ak, acc[i]);
+        let mk: &[f64; C] = col[row0..row0 + C].try_into().expect("chunk of C values");
+        for (j, acc) in acc.iter_mut().enumerate() {
+            let ak = a(j, k);
+            for i in 0..C {
+                acc[i] = mk[i].mul_add(ak, acc[i]);
+            }
         }
     }
     acc
 }
 
 /// Copy the N × N column-major `m` into columns of S ≥ N values (zero padding), so that
-/// every column operation is whole vector registers.
+/// every column operation is whole vector registers. Each padded column is assembled in
+/// registers and stored whole: a column pieced together in memory from narrower stores
+/// and read back at once cannot be store-forwarded, and the reload stalls until the
+/// stores retire.
 #[inline(always)]
 fn pad<const N: usize, const S: usize>(m: &[f64], out: &mut [f64]) {
+    let mut last = [0.0; S];
+    last[..N].copy_from_slice(&m[(N - 1) * N..]);
     for k in 0..N {
-        let mut c = [0.0; S];
-        c[..N].copy_from_slice(&m[k * N..(k + 1) * N]);
+        // S values from the start of column k (running into column k + 1), padding zeroed
+        let mut c: [f64; S] = if k * N + S <= m.len() { m[k * N..k * N + S].try_into().expect("S values") } else { last };
+        for v in &mut c[N..] {
+            *v = 0.0;
+        }
         out[k * S..(k + 1) * S].copy_from_slice(&c);
     }
 }
 
-/// Fixed size N, columns padded to S = N rounded up to a multiple of 4; `t` holds 3·S·N.
+/// Fixed size N, columns padded to S = N rounded up to a multiple of 4, J output columns
+/// at a time; `t` holds 2·S·N values. U = ΦP, then P ← Q + UΦᵀ: the vector operands are
+/// columns of Φ and U (stored whole, in padded columns), P is read only entry by entry, so
+/// no reload has to wait for the narrower stores that wrote the previous P.
 #[inline(always)]
-fn propagate_fixed<const N: usize, const S: usize>(p: &mut [f64], x: Option<&mut [f64]>, phi: &[f64], q: &[f64], t: &mut [f64]) {
-    let (phi_p, rest) = t.split_at_mut(S * N);
-    let (p_p, tt) = rest.split_at_mut(S * N);
+fn propagate_fixed<const N: usize, const S: usize, const J: usize>(p: &mut [f64], x: Option<&mut [f64]>, phi: &[f64], q: &[f64], t: &mut [f64]) {
+    let (phi_p, u) = t.split_at_mut(S * N);
     pad::<N, S>(phi, phi_p);
-    pad::<N, S>(p, p_p);
     if let Some(x) = x {
-        let y = sum_columns::<S>([0.0; S], phi_p, S, 0, N, |k| x[k]);
+        let [y] = sum_columns::<S, 1>([[0.0; S]], phi_p, S, 0, N, |_, k| x[k]);
         x.copy_from_slice(&y[..N]);
     }
-    // T[:, j] = Σ_k P[:, k] Φ[j, k]
-    for j in 0..N {
-        tt[j * S..(j + 1) * S].copy_from_slice(&sum_columns::<S>([0.0; S], p_p, S, 0, N, |k| phi[k * N + j]));
+    // U[:, j] = Σ_k Φ[:, k] P[k, j] (the last group's columns from N on are not used)
+    for j0 in (0..N).step_by(J) {
+        let cols = sum_columns::<S, J>([[0.0; S]; J], phi_p, S, 0, N, |j, k| if j0 + j < N { p[(j0 + j) * N + k] } else { 0.0 });
+        for (j, c) in cols.iter().enumerate().take(N - j0) {
+            u[(j0 + j) * S..(j0 + j + 1) * S].copy_from_slice(c);
+        }
     }
-    // P[:, j] = Q[:, j] + Σ_k Φ[:, k] T[k, j]; the upper triangle is then taken from the lower
-    for j in 0..N {
-        let mut acc = [0.0; S];
-        acc[..N].copy_from_slice(&q[j * N..(j + 1) * N]);
-        let acc = sum_columns::<S>(acc, phi_p, S, 0, N, |k| tt[j * S + k]);
-        p[j * N..(j + 1) * N].copy_from_slice(&acc[..N]);
+    // P[:, j] = Q[:, j] + Σ_k U[:, k] Φ[j, k]; the upper triangle is then taken from the lower
+    for j0 in (0..N).step_by(J) {
+        let acc = std::array::from_fn(|j| {
+            let mut c = [0.0; S];
+            if j0 + j < N {
+                c[..N].copy_from_slice(&q[(j0 + j) * N..(j0 + j + 1) * N]);
+            }
+            c
+        });
+        let cols = sum_columns::<S, J>(acc, u, S, 0, N, |j, k| phi_p[k * S + j0 + j]);
+        for (j, c) in cols.iter().enumerate().take(N - j0) {
+            p[(j0 + j) * N..(j0 + j + 1) * N].copy_from_slice(&c[..N]);
+        }
     }
     mirror_lower(p, N);
 }
@@ -240,7 +278,7 @@ impl<const C: usize> Padded<C> {
             for r0 in (0..s).step_by(C) {
                 let acc = if add { *chunk::<C>(out, s, j, r0) } else { [0.0; C] };
                 // One chunk (n ≤ C): a constant stride lets the compiler drop the bounds checks.
-                let y = if s == C { sum_columns::<C>(acc, m, C, 0, n, |k| bj[k]) } else { sum_columns::<C>(acc, m, s, r0, n, |k| bj[k]) };
+                let [y] = if s == C { sum_columns::<C, 1>([acc], m, C, 0, n, |_, k| bj[k]) } else { sum_columns::<C, 1>([acc], m, s, r0, n, |_, k| bj[k]) };
                 out[j * s + r0..j * s + r0 + C].copy_from_slice(&y);
             }
         }
@@ -404,17 +442,31 @@ mod tests {
     /// Every size path (fixed and general) equals nalgebra's ΦPΦᵀ + Q.
     #[test]
     fn propagate_matches_dense_product() {
-        for n in [1, 9, 14, 15, 21, 30] {
+        for n in [1, 9, 14, 15, 16, 17, 18, 21, 30] {
             let phi = DMatrix::from_fn(n, n, |i, j| ((i * 7 + j * 3) % 11) as f64 / 11.0 - 0.4);
             let g = DMatrix::from_fn(n, n, |i, j| ((i * 5 + j * 13) % 17) as f64 / 17.0);
             let (p0, q) = (&g * g.transpose(), DMatrix::from_fn(n, n, |i, j| if i == j { 0.5 } else { 0.0 }));
             let want = &phi * &p0 * phi.transpose() + &q;
-            let mut p = p0.clone();
             let x0 = DVector::from_fn(n, |i, _| i as f64 - 3.0);
-            let mut x = x0.clone();
-            propagate_covariance(p.as_mut_slice(), Some(x.as_mut_slice()), phi.as_slice(), q.as_slice(), n, &mut Vec::new());
-            assert!((p - &want).abs().max() < 1e-12 * want.abs().max(), "n = {n}");
-            assert!((x - &phi * &x0).abs().max() < 1e-12 * x0.abs().max(), "n = {n}");
+            // the dispatched kernel, then each column grouping compiled for any CPU
+            for j in [0, 1, 2, 4] {
+                let (mut p, mut x, mut t) = (p0.clone(), x0.clone(), Vec::new());
+                let (pm, xm) = (p.as_mut_slice(), Some(x.as_mut_slice()));
+                match j {
+                    0 => propagate_covariance(pm, xm, phi.as_slice(), q.as_slice(), n, &mut t),
+                    _ => {
+                        t.resize(2 * (n + 3) * n, 0.0);
+                        match j {
+                            1 => propagate_sizes::<1>(pm, xm, phi.as_slice(), q.as_slice(), n, &mut t),
+                            2 => propagate_sizes::<2>(pm, xm, phi.as_slice(), q.as_slice(), n, &mut t),
+                            _ => propagate_sizes::<4>(pm, xm, phi.as_slice(), q.as_slice(), n, &mut t),
+                        }
+                    }
+                }
+                assert!((&p - &want).abs().max() < 1e-12 * want.abs().max(), "n = {n}, J = {j}");
+                assert_eq!(p, p.transpose(), "n = {n}, J = {j}: not exactly symmetric");
+                assert!((x - &phi * &x0).abs().max() < 1e-12 * x0.abs().max(), "n = {n}, J = {j}");
+            }
         }
     }
 }
