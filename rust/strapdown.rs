@@ -47,11 +47,8 @@ pub struct Strapdown {
     earth: LocalModel,
     /// sin/cos of the midpoint latitude, from an exact anchor (a sixth of libm's cost).
     lat_sin_cos: AnchoredSinCos,
-    /// Increments (Δθ, Δv) of up to the two previous intervals (most recent last), for
-    /// the multi-interval coning and sculling terms.
-    prev_increments: History<(Vec3, Vec3)>,
-    /// Up to the last two rate samples (t, ω, f), to turn rates into increments.
-    rate_history: History<(f64, Vec3, Vec3)>,
+    /// The IMU-only half of each step (rates to increments, coning, sculling).
+    pub(crate) front: BodyFront,
     /// Previous step: (Δlla, Δt, g − (2ω_ie + ω_en)×v at its midpoint), for the midpoint
     /// extrapolation.
     last_step: Option<(Vec3, f64, Vec3)>,
@@ -73,7 +70,7 @@ impl Strapdown {
             }
         }
         let state = NavState { q_nb: quat_normalize(&initial.q_nb), ..initial };
-        Ok(Strapdown { ell, kind, vertical, state, earth: ell.local_model(), lat_sin_cos: AnchoredSinCos::new(state.lla.x), prev_increments: History::default(), rate_history: History::default(), last_step: None })
+        Ok(Strapdown { ell, kind, vertical, state, earth: ell.local_model(), lat_sin_cos: AnchoredSinCos::new(state.lla.x), front: BodyFront::new(kind), last_step: None })
     }
 
     /// Run over a chunk. `t[k]` is the sample time (rates) or the end of the interval
@@ -90,10 +87,20 @@ impl Strapdown {
     /// `run` on samples already checked by `validate` (as one chunk, of which these are
     /// rows `first_index`…, the index divergence errors report).
     pub(crate) fn run_validated(&mut self, t: &[f64], gyro: &[Vec3], accel: &[Vec3], h_ref: Option<&[f64]>, first_index: usize, out: &mut Vec<NavState>) -> Result<()> {
+        let mut body = Vec::new();
+        self.front.push_block(t, gyro, accel, &mut body);
+        self.run_body(t, &body, h_ref, first_index, out)
+    }
+
+    /// The navigation half of `run_validated`: `body[k]` is `BodyFront::push` of sample k
+    /// by a front that has seen the same samples as this one's (a pipelined run computes
+    /// it on another core; the caller then sets `front` to that front).
+    pub(crate) fn run_body(&mut self, t: &[f64], body: &[BodyStep], h_ref: Option<&[f64]>, first_index: usize, out: &mut Vec<NavState>) -> Result<()> {
         out.reserve(t.len());
-        for k in 0..t.len() {
-            let href = h_ref.map(|h| h[k]);
-            self.step(t[k], &gyro[k], &accel[k], href);
+        for (k, b) in body.iter().enumerate() {
+            if let Some(b) = b {
+                self.integrate(t[k], b, h_ref.map(|h| h[k]));
+            }
             self.check_diverged(first_index + k)?;
             out.push(self.state);
         }
@@ -118,78 +125,30 @@ impl Strapdown {
     /// finite samples, reference altitude). Messages give indices counted from
     /// `first_index` (the chunk's position in the whole record).
     pub(crate) fn validate(&self, t: &[f64], gyro: &[Vec3], accel: &[Vec3], h_ref: Option<&[f64]>, first_index: usize) -> Result<()> {
-        self.validate_block(t, gyro, accel, h_ref, first_index, None)
+        self.sample_check().check(t, gyro, accel, h_ref, first_index)
     }
 
-    /// `validate` of one block of a chunk checked block by block: `after` is the time of
-    /// the previous block's last sample, or None for the chunk's first block (which
-    /// continues from the current state).
-    pub(crate) fn validate_block(&self, t: &[f64], gyro: &[Vec3], accel: &[Vec3], h_ref: Option<&[f64]>, first_index: usize, after: Option<f64>) -> Result<()> {
-        let n = t.len();
-        if gyro.len() != n || accel.len() != n {
-            return Err(invalid("imu", format!("time has {n} samples but gyro {} and accel {}", gyro.len(), accel.len())));
-        }
-        let mut prev_t = after.unwrap_or(self.state.t);
-        let primed = after.is_some() || !self.rate_history.as_slice().is_empty();
-        for (k, &tk) in t.iter().enumerate() {
-            if !tk.is_finite() {
-                return Err(invalid("time", format!("non-finite time {tk} at index {}", first_index + k)));
-            }
-            // With rates the very first sample may coincide with the initial time.
-            let first_rate_sample = self.kind == ImuKind::Rates && !primed && k == 0;
-            if first_rate_sample && tk != self.state.t {
-                return Err(invalid("time", format!("the first rate sample must be at the initial time {} s, got {tk} at index {first_index}", self.state.t)));
-            }
-            if !first_rate_sample && tk <= prev_t {
-                let what = if tk == prev_t { "duplicated" } else { "decreasing" };
-                return Err(invalid("time", format!("time not strictly increasing: {what} stamp {tk} at index {}", first_index + k)));
-            }
-            prev_t = tk;
-        }
-        for (name, data) in [("gyro", gyro), ("accel", accel)] {
-            if let Some(k) = data.iter().position(|v| !v.iter().all(|x| x.is_finite())) {
-                return Err(invalid(name, format!("non-finite value at index {}: {:?}", first_index + k, data[k].as_slice())));
-            }
-        }
-        match (self.vertical, h_ref) {
-            (Vertical::Damped { .. }, None) => Err(invalid("h_ref", "a damped vertical channel needs a reference altitude per sample")),
-            (_, Some(h)) if h.len() != n => Err(invalid("h_ref", format!("expected {n} samples, got {}", h.len()))),
-            (_, Some(h)) => match h.iter().position(|x| !x.is_finite()) {
-                Some(k) => Err(invalid("h_ref", format!("non-finite value at index {}", first_index + k))),
-                None => Ok(()),
-            },
-            _ => Ok(()),
-        }
+    /// The checks `validate` applies to samples that follow the current state.
+    pub(crate) fn sample_check(&self) -> SampleCheck {
+        SampleCheck { kind: self.kind, damped: matches!(self.vertical, Vertical::Damped { .. }), prev_t: self.state.t, primed: self.front.primed() }
     }
 
     /// One mechanization step to time `t` with one IMU sample (rates or increments).
     #[inline]
     pub fn step(&mut self, t: f64, gyro: &Vec3, accel: &Vec3, h_ref: Option<f64>) {
-        let (dth, dv) = match self.kind {
-            ImuKind::Increments => (*gyro, *accel),
-            ImuKind::Rates => {
-                let inc = rates_to_increment(self.rate_history.as_slice(), t, gyro, accel);
-                self.rate_history.push((t, *gyro, *accel));
-                match inc {
-                    Some(inc) => inc,
-                    None => return, // first rate sample at the initial time: nothing to integrate yet
-                }
-            }
-        };
-        let (phi, dv_body) = coning_sculling(self.prev_increments.as_slice(), &dth, &dv);
-        self.prev_increments.push((dth, dv));
-        let dt = t - self.state.t;
-        self.integrate(t, dt, &phi, &dv_body, h_ref);
+        if let Some(b) = self.front.push(t, gyro, accel) {
+            self.integrate(t, &b, h_ref);
+        }
     }
 
-    /// Attitude, velocity and position over one interval, given the body rotation vector
-    /// `phi` (coning included) and the body-frame velocity increment `dv_body` (rotation
-    /// and sculling included), both referred to the body frame at t_{k−1}.
+    /// Attitude, velocity and position over one interval (t_{k−1}, t], given the body
+    /// step of `BodyFront::push`.
     #[inline(always)]
-    fn integrate(&mut self, t: f64, dt: f64, phi: &Vec3, dv_body: &Vec3, h_ref: Option<f64>) {
+    fn integrate(&mut self, t: f64, &(q_phi, dv_body): &(Quat, Vec3), h_ref: Option<f64>) {
         let s0 = self.state;
+        let dt = t - s0.t;
         let model = &self.earth;
-        let dv_sf_b = quat_rotate(&s0.q_nb, dv_body); // C_nb(k−1) Δv
+        let dv_sf_b = quat_rotate(&s0.q_nb, &dv_body); // C_nb(k−1) Δv
         // midpoint: position extrapolated from the previous step; velocity from this step's
         // specific force and the previous gravity–Coriolis term (at t₀ on the first step)
         let (lla_mid, gc_prev) = match self.last_step {
@@ -220,10 +179,116 @@ impl Strapdown {
         lla.z -= k1 * dh0 * dt;
         self.last_step = Some((lla - s0.lla, dt, gc));
         // C_nb(k) = C_{n(k−1)}^{n(k)} C_nb(k−1) C_{b(k)}^{b(k−1)}
-        let q = quat_from_rotvec(&(-zeta)) * s0.q_nb * quat_from_rotvec(phi);
+        let q = quat_from_rotvec(&(-zeta)) * s0.q_nb * q_phi;
         // renormalise by one Newton step for 1/|q|: |q|² = 1 + ε with ε at rounding level
         // after a product of unit quaternions, so (3 − |q|²)/2 leaves O(ε²) — no sqrt, no divide
         self.state = NavState { t, lla, vel, q_nb: q * (1.5 - 0.5 * q.norm_squared()) };
+    }
+}
+
+/// One sample's body-frame step: q(φ) of the rotation vector φ (coning included) and the
+/// velocity increment Δv_b (rotation and sculling included), both referred to the body
+/// frame at t_{k−1}; None for the rate sample that only primes the integrator.
+pub type BodyStep = Option<(Quat, Vec3)>;
+
+/// The IMU-only half of a mechanization step: rates turned into increments, then coning
+/// and sculling over the last intervals. It depends on the IMU record alone, so a
+/// pipelined run computes it for the next block on another core while the navigation
+/// half integrates this one.
+#[derive(Debug, Clone)]
+pub struct BodyFront {
+    kind: ImuKind,
+    /// Increments (Δθ, Δv) of up to the two previous intervals (most recent last), for
+    /// the multi-interval coning and sculling terms.
+    prev_increments: History<(Vec3, Vec3)>,
+    /// Up to the last two rate samples (t, ω, f), to turn rates into increments.
+    rate_history: History<(f64, Vec3, Vec3)>,
+}
+
+impl BodyFront {
+    pub fn new(kind: ImuKind) -> Self {
+        Self { kind, prev_increments: History::default(), rate_history: History::default() }
+    }
+
+    /// False until the first rate sample (which only primes the integrator) has been seen.
+    pub fn primed(&self) -> bool {
+        self.kind == ImuKind::Increments || !self.rate_history.as_slice().is_empty()
+    }
+
+    /// The body step of one sample at time `t` (rates or increments).
+    #[inline(always)]
+    pub fn push(&mut self, t: f64, gyro: &Vec3, accel: &Vec3) -> BodyStep {
+        let (dth, dv) = match self.kind {
+            ImuKind::Increments => (*gyro, *accel),
+            ImuKind::Rates => {
+                let inc = rates_to_increment(self.rate_history.as_slice(), t, gyro, accel);
+                self.rate_history.push((t, *gyro, *accel));
+                inc? // None: the first rate sample at the initial time, nothing to integrate yet
+            }
+        };
+        let (phi, dv_body) = coning_sculling(self.prev_increments.as_slice(), &dth, &dv);
+        self.prev_increments.push((dth, dv));
+        Some((quat_from_rotvec(&phi), dv_body))
+    }
+
+    /// `push` of each sample of a block, into `out` (cleared first).
+    pub fn push_block(&mut self, t: &[f64], gyro: &[Vec3], accel: &[Vec3], out: &mut Vec<BodyStep>) {
+        out.clear();
+        out.extend(t.iter().zip(gyro).zip(accel).map(|((&t, g), a)| self.push(t, g, a)));
+    }
+}
+
+/// The input checks of samples following time `prev_t`: shapes, strictly increasing finite
+/// time (a first rate sample, when not yet `primed`, must be at `prev_t`, the initial
+/// time), finite samples, a finite reference altitude per sample when `damped`.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct SampleCheck {
+    pub kind: ImuKind,
+    pub damped: bool,
+    pub prev_t: f64,
+    pub primed: bool,
+}
+
+impl SampleCheck {
+    /// Check one chunk (messages give indices counted from `first_index`), then move past it.
+    pub fn check(&mut self, t: &[f64], gyro: &[Vec3], accel: &[Vec3], h_ref: Option<&[f64]>, first_index: usize) -> Result<()> {
+        let n = t.len();
+        if gyro.len() != n || accel.len() != n {
+            return Err(invalid("imu", format!("time has {n} samples but gyro {} and accel {}", gyro.len(), accel.len())));
+        }
+        let t0 = self.prev_t;
+        for (k, &tk) in t.iter().enumerate() {
+            if !tk.is_finite() {
+                return Err(invalid("time", format!("non-finite time {tk} at index {}", first_index + k)));
+            }
+            // With rates the very first sample may coincide with the initial time.
+            let first_rate_sample = self.kind == ImuKind::Rates && !self.primed && k == 0;
+            if first_rate_sample && tk != t0 {
+                return Err(invalid("time", format!("the first rate sample must be at the initial time {t0} s, got {tk} at index {first_index}")));
+            }
+            if !first_rate_sample && tk <= self.prev_t {
+                let what = if tk == self.prev_t { "duplicated" } else { "decreasing" };
+                return Err(invalid("time", format!("time not strictly increasing: {what} stamp {tk} at index {}", first_index + k)));
+            }
+            self.prev_t = tk;
+        }
+        for (name, data) in [("gyro", gyro), ("accel", accel)] {
+            if let Some(k) = data.iter().position(|v| !v.iter().all(|x| x.is_finite())) {
+                return Err(invalid(name, format!("non-finite value at index {}: {:?}", first_index + k, data[k].as_slice())));
+            }
+        }
+        match h_ref {
+            None if self.damped => return Err(invalid("h_ref", "a damped vertical channel needs a reference altitude per sample")),
+            Some(h) if h.len() != n => return Err(invalid("h_ref", format!("expected {n} samples, got {}", h.len()))),
+            Some(h) => {
+                if let Some(k) = h.iter().position(|x| !x.is_finite()) {
+                    return Err(invalid("h_ref", format!("non-finite value at index {}", first_index + k)));
+                }
+            }
+            None => {}
+        }
+        self.primed |= n > 0;
+        Ok(())
     }
 }
 

@@ -119,17 +119,34 @@ def test_time_outside_motion_span():
         m.truth(np.array([0.0, 0.5, 5.0]))
 
 
-def test_divergence_keeps_computed_rows(traj):
-    """An accelerometer stream growing tenfold every 8 samples (finite, so input checks
-    pass) overflows the solution after ~1200 samples: NumericalError names the sample,
-    and the rows before it are kept."""
-    long = an.trajectory.stationary(400.0, 10.0)
+def test_bad_row_in_a_later_block_leaves_the_stream_unchanged():
+    """The core checks each 4096-row block just before integrating it: a NaN in a later
+    block still names its index in the record, and the streaming object is left where
+    the chunk started, so the corrected chunk gives what a fresh object gives."""
+    long = an.trajectory.sinusoidal(200.0, rate_hz=100.0)
+    good = long.ideal_imu("increments")
+    bad = good.copy()
+    bad.loc[10_000, "dv_y_mps"] = np.nan
+    sd = an.strapdown.Strapdown(**long.initial_state())
+    with pytest.raises(ValueError, match=r"accel.*index 10000"):
+        sd.run(bad)
+    fresh = an.strapdown.Strapdown(**long.initial_state())
+    pd.testing.assert_frame_equal(sd.run(good), fresh.run(good))
+
+
+@pytest.mark.parametrize("growth_from", [0, 9000])
+def test_divergence_keeps_computed_rows(growth_from):
+    """An accelerometer stream growing tenfold every 8 samples from `growth_from` (finite,
+    so input checks pass) overflows the solution ~1200 samples later: NumericalError names
+    the sample, and the rows before it are kept (also when they span several of the
+    core's 4096-row blocks)."""
+    long = an.trajectory.stationary(1400.0, 10.0)
     imu = long.ideal_imu("increments")
-    imu["dv_x_mps"] += 10.0 ** np.minimum(np.arange(len(imu)) / 8.0, 300.0)
+    imu["dv_x_mps"] += 10.0 ** np.minimum(np.maximum(np.arange(len(imu)) - growth_from, 0) / 8.0, 300.0)
     with pytest.raises(an.NumericalError, match=r"diverged at sample (\d+)") as info:
         an.strapdown.integrate(imu, **long.initial_state(), progress=False)
     k = int(__import__("re").search(r"sample (\d+)", str(info.value)).group(1))
     partial = info.value.partial
-    assert 10 < k < len(imu) and len(partial) == k
+    assert growth_from + 10 < k < len(imu) and len(partial) == k
     np.testing.assert_array_equal(partial["time_s"], imu["time_s"].iloc[:k])
     assert np.all(np.abs(partial["lat_rad"]) <= np.pi / 2)

@@ -4,7 +4,7 @@ use super::convert::{flat_to_py, quat_rows, quat_to_py, vec3, vec3_rows, vector}
 use crate::earth::Ellipsoid;
 use crate::error::{invalid, NavError};
 use crate::math::{euler_from_quat, quat, Vec3};
-use crate::strapdown::{integrate_attitude, ImuKind, NavState, Strapdown as Core, Vertical};
+use crate::strapdown::{integrate_attitude, BodyFront, BodyStep, ImuKind, NavState, SampleCheck, Strapdown as Core, Vertical};
 use numpy::ndarray::{s, ArrayView1, ArrayView2};
 use numpy::{PyArray2, PyArrayMethods, PyReadonlyArray1, PyReadonlyArray2, PyUntypedArrayMethods};
 use std::sync::mpsc;
@@ -61,7 +61,7 @@ impl ImuView<'_> {
 }
 
 /// One block of IMU rows, in buffers reused from block to block (no allocation, no page
-/// faults after the first block).
+/// faults after the first blocks).
 #[derive(Default)]
 struct Block {
     t: Vec<f64>,
@@ -92,65 +92,128 @@ impl Block {
     }
 }
 
-/// Check a whole chunk block by block (nothing is integrated when any row is bad).
-fn validate(core: &Core, imu: &ImuView<'_>, first_index: usize) -> Result<(), NavError> {
-    let (n, mut blk) = (imu.len(), Block::default());
+/// The chunk's lengths agree (its values are checked block by block).
+fn check_lengths(imu: &ImuView<'_>) -> Result<(), NavError> {
+    let n = imu.len();
     if imu.gyro.nrows() != n || imu.accel.nrows() != n {
         return Err(invalid("imu", format!("time has {n} samples but gyro {} and accel {}", imu.gyro.nrows(), imu.accel.nrows())));
     }
-    if let Some(h) = imu.h_ref.as_ref().filter(|h| h.len() != n) {
-        return Err(invalid("h_ref", format!("expected {n} samples, got {}", h.len())));
+    match &imu.h_ref {
+        Some(h) if h.len() != n => Err(invalid("h_ref", format!("expected {n} samples, got {}", h.len()))),
+        _ => Ok(()),
     }
-    let mut after = None;
-    for start in (0..n.max(1)).step_by(PIPELINE_BLOCK) {
-        blk.fill(imu, start..(start + PIPELINE_BLOCK).min(n));
-        core.validate_block(&blk.t, &blk.gyro, &blk.accel, blk.h_ref(), first_index + start, after)?;
-        after = blk.t.last().copied().or(after);
-    }
-    Ok(())
 }
 
-/// Integrate a validated chunk on this thread while a second thread turns each finished
-/// block of states into rows of the (14, n) table `table` (the Euler angles' three atan2
-/// per row cost about half a mechanization step). Returns the number of rows computed
-/// and, on divergence, the error; the rows before it are in `table`.
+/// The IMU-only work on a block, ready for the navigation half: checked rows, their body
+/// steps (`BodyFront::push`), the reference altitudes.
+#[derive(Default)]
+struct Prepared {
+    start: usize,
+    block: Block,
+    body: Vec<BodyStep>,
+}
+
+/// What is done to a chunk off the integrating thread: checking and the body half of each
+/// step one block ahead, turning finished states into table rows behind. `check` and
+/// `front` continue from the state the chunk starts at.
+struct Helper<'a, 'v> {
+    imu: &'a ImuView<'v>,
+    first_index: usize,
+    check: SampleCheck,
+    front: BodyFront,
+}
+
+impl Helper<'_, '_> {
+    /// Block `j` copied out of the numpy views, checked, and its body steps computed.
+    fn prepare(&mut self, j: usize, mut into: Prepared) -> Result<Prepared, NavError> {
+        let (start, n) = (j * PIPELINE_BLOCK, self.imu.len());
+        into.start = start;
+        into.block.fill(self.imu, start..(start + PIPELINE_BLOCK).min(n));
+        let b = &into.block;
+        self.check.check(&b.t, &b.gyro, &b.accel, b.h_ref(), self.first_index + start)?;
+        self.front.push_block(&b.t, &b.gyro, &b.accel, &mut into.body);
+        Ok(into)
+    }
+}
+
+/// Check and integrate a chunk in blocks: this thread runs the navigation half of every
+/// step; a second thread prepares the next block (copy, checks, coning and sculling) and
+/// turns the finished one into rows of the (14, n) table `table` (the Euler angles' three
+/// atan2 per row cost about half a mechanization step). A bad row restores the state the
+/// chunk started from, so bad input integrates nothing. Returns the number of rows
+/// computed and the error, if any; on divergence the rows before it are in `table`.
 fn run_pipelined(core: &mut Core, imu: &ImuView<'_>, table: &mut [f64], first_index: usize) -> (usize, Result<(), NavError>) {
-    let n = imu.len();
-    let (to_writer, blocks) = mpsc::channel::<(usize, Vec<NavState>)>();
-    let (recycle, free) = mpsc::channel::<Vec<NavState>>();
-    // the sender is moved in, so it is dropped when the producer returns (ending the writer)
-    let mut produce = |to_writer: mpsc::Sender<(usize, Vec<NavState>)>| {
-        let mut blk = Block::default();
-        for start in (0..n).step_by(PIPELINE_BLOCK) {
-            blk.fill(imu, start..(start + PIPELINE_BLOCK).min(n));
-            let mut states = free.try_recv().unwrap_or_else(|_| Vec::with_capacity(PIPELINE_BLOCK));
+    let (n, initial) = (imu.len(), core.clone());
+    let blocks = n.div_ceil(PIPELINE_BLOCK).max(1);
+    let mut helper = Helper { imu, first_index, check: core.sample_check(), front: core.front.clone() };
+    let (to_core, prepared) = mpsc::channel::<Result<Prepared, NavError>>();
+    let (to_writer, finished) = mpsc::channel::<(usize, Vec<NavState>, Prepared)>();
+    // the navigation half; `to_writer` is moved in, so the writer's loop ends when it returns
+    let integrate = |core: &mut Core, to_writer: mpsc::Sender<(usize, Vec<NavState>, Prepared)>, spare: &mpsc::Receiver<Vec<NavState>>| {
+        for p in prepared.iter() {
+            let p = match p {
+                Ok(p) => p,
+                Err(e) => return (0, Err(e)),
+            };
+            let mut states = spare.try_recv().unwrap_or_else(|_| Vec::with_capacity(PIPELINE_BLOCK));
             states.clear();
-            let step = core.run_validated(&blk.t, &blk.gyro, &blk.accel, blk.h_ref(), first_index + start, &mut states);
-            let rows = start + states.len();
-            to_writer.send((start, states)).expect("the writer thread outlives the producer");
+            let step = core.run_body(&p.block.t, &p.body, p.block.h_ref(), first_index + p.start, &mut states);
+            let rows = p.start + states.len();
+            let _ = to_writer.send((p.start, states, p)); // the helper stops early on bad input
             if step.is_err() {
                 return (rows, step);
             }
         }
         (n, Ok(()))
     };
-    if n <= PIPELINE_BLOCK {
+    let (rows, result, front) = if n <= PIPELINE_BLOCK {
         // one block: not worth a thread
-        let out = produce(to_writer);
-        for (first, states) in blocks.try_iter() {
+        let _ = to_core.send(helper.prepare(0, Prepared::default()));
+        drop(to_core);
+        let (_, spare) = mpsc::channel();
+        let (rows, result) = integrate(core, to_writer, &spare);
+        for (first, states, _) in finished.try_iter() {
             write_columns(table, n, first, &states);
         }
-        return out;
+        (rows, result, helper.front)
+    } else {
+        let (recycle, spare) = mpsc::channel::<Vec<NavState>>();
+        std::thread::scope(|s| {
+            let writer = s.spawn(move || {
+                let mut reuse = Prepared::default();
+                for j in 0..=blocks {
+                    // block j while the core integrates block j − 1, whose rows come next
+                    if j < blocks {
+                        let p = helper.prepare(j, std::mem::take(&mut reuse));
+                        let bad = p.is_err();
+                        if to_core.send(p).is_err() || bad {
+                            break; // the core has stopped, or bad input: stop preparing
+                        }
+                    }
+                    if j > 0 {
+                        let Ok((first, states, p)) = finished.recv() else { break };
+                        write_columns(table, n, first, &states);
+                        reuse = p;
+                        let _ = recycle.send(states);
+                    }
+                }
+                drop(to_core);
+                // after an early stop: the rows the core still sends
+                for (first, states, _) in finished.iter() {
+                    write_columns(table, n, first, &states);
+                }
+                helper.front
+            });
+            let (rows, result) = integrate(core, to_writer, &spare);
+            (rows, result, writer.join().expect("the pipeline's writer thread does not panic"))
+        })
+    };
+    match result {
+        Ok(()) => core.front = front,
+        Err(NavError::InvalidInput { .. }) => *core = initial,
+        Err(_) => {} // diverged: the state is where it failed
     }
-    std::thread::scope(|s| {
-        s.spawn(move || {
-            for (first, states) in blocks {
-                write_columns(table, n, first, &states);
-                let _ = recycle.send(states); // the producer may have finished already
-            }
-        });
-        produce(to_writer)
-    })
+    (rows, result)
 }
 
 /// The first `rows` columns of a (14, n) table, as a (14, rows) array.
@@ -211,28 +274,26 @@ impl Strapdown {
             }
         }
         let imu = ImuView { time: time.as_array(), gyro: gyro.as_array(), accel: accel.as_array(), h_ref: h_ref.as_ref().map(|h| h.as_array()) };
-        let n = imu.len();
-        let inner = &mut self.inner;
-        // values checked here, once, with indices in the whole record
-        py.detach(|| validate(inner, &imu, first_index))?;
+        check_lengths(&imu)?;
         // numpy's allocator advises huge pages for large arrays: a few page faults instead
         // of one per 4 KiB of the 112 bytes/row table
-        let table = PyArray2::<f64>::zeros(py, [COLUMNS, n], false);
-        let rows = {
+        let table = PyArray2::<f64>::zeros(py, [COLUMNS, imu.len()], false);
+        let (rows, result) = {
             let mut guard = table.readwrite();
             let buf = guard.as_slice_mut().expect("a new C-contiguous array");
-            let (rows, result) = py.detach(|| run_pipelined(inner, &imu, buf, first_index));
-            if let Err(e) = result {
-                drop(guard);
+            let inner = &mut self.inner;
+            py.detach(|| run_pipelined(inner, &imu, buf, first_index))
+        };
+        match result {
+            Ok(()) => Ok(table),
+            Err(e @ NavError::Numerical(_)) => {
                 // keep what was computed: the exception carries the rows before the failure
                 let err: PyErr = e.into();
                 err.value(py).setattr("partial", table_rows(py, &table, rows))?;
-                return Err(err);
+                Err(err)
             }
-            rows
-        };
-        debug_assert_eq!(rows, n);
-        Ok(table)
+            Err(e) => Err(e.into()),
+        }
     }
 
     /// Current state as a (14, 1) column table.
