@@ -40,7 +40,6 @@ pub enum Vertical {
 #[derive(Debug, Clone)]
 pub struct Strapdown {
     pub ell: Ellipsoid,
-    pub kind: ImuKind,
     pub vertical: Vertical,
     pub state: NavState,
     /// `ell`'s constants of the Earth model evaluated at every step.
@@ -70,7 +69,12 @@ impl Strapdown {
             }
         }
         let state = NavState { q_nb: quat_normalize(&initial.q_nb), ..initial };
-        Ok(Strapdown { ell, kind, vertical, state, earth: ell.local_model(), lat_sin_cos: AnchoredSinCos::new(state.lla.x), front: BodyFront::new(kind), last_step: None })
+        Ok(Strapdown { ell, vertical, state, earth: ell.local_model(), lat_sin_cos: AnchoredSinCos::new(state.lla.x), front: BodyFront::new(kind), last_step: None })
+    }
+
+    /// Rates or increments.
+    pub fn kind(&self) -> ImuKind {
+        self.front.kind
     }
 
     /// Run over a chunk. `t[k]` is the sample time (rates) or the end of the interval
@@ -81,20 +85,15 @@ impl Strapdown {
     /// On divergence `out` keeps every state computed before it.
     pub fn run(&mut self, t: &[f64], gyro: &[Vec3], accel: &[Vec3], h_ref: Option<&[f64]>, out: &mut Vec<NavState>) -> Result<()> {
         self.validate(t, gyro, accel, h_ref, 0)?;
-        self.run_validated(t, gyro, accel, h_ref, 0, out)
-    }
-
-    /// `run` on samples already checked by `validate` (as one chunk, of which these are
-    /// rows `first_index`…, the index divergence errors report).
-    pub(crate) fn run_validated(&mut self, t: &[f64], gyro: &[Vec3], accel: &[Vec3], h_ref: Option<&[f64]>, first_index: usize, out: &mut Vec<NavState>) -> Result<()> {
         let mut body = Vec::new();
         self.front.push_block(t, gyro, accel, &mut body);
-        self.run_body(t, &body, h_ref, first_index, out)
+        self.run_body(t, &body, h_ref, 0, out)
     }
 
-    /// The navigation half of `run_validated`: `body[k]` is `BodyFront::push` of sample k
-    /// by a front that has seen the same samples as this one's (a pipelined run computes
-    /// it on another core; the caller then sets `front` to that front).
+    /// The navigation half of `run` on checked samples (rows `first_index`… of the record,
+    /// the index divergence errors report): `body[k]` is `BodyFront::push` of sample k by a
+    /// front that has seen the same samples as this one's (a pipelined run computes it on
+    /// another core; the caller then sets `front` to that front).
     pub(crate) fn run_body(&mut self, t: &[f64], body: &[BodyStep], h_ref: Option<&[f64]>, first_index: usize, out: &mut Vec<NavState>) -> Result<()> {
         out.reserve(t.len());
         for (k, b) in body.iter().enumerate() {
@@ -130,7 +129,7 @@ impl Strapdown {
 
     /// The checks `validate` applies to samples that follow the current state.
     pub(crate) fn sample_check(&self) -> SampleCheck {
-        SampleCheck { kind: self.kind, damped: matches!(self.vertical, Vertical::Damped { .. }), prev_t: self.state.t, primed: self.front.primed() }
+        SampleCheck { kind: self.kind(), damped: matches!(self.vertical, Vertical::Damped { .. }), prev_t: self.state.t, primed: self.front.primed() }
     }
 
     /// One mechanization step to time `t` with one IMU sample (rates or increments).
@@ -252,10 +251,7 @@ pub(crate) struct SampleCheck {
 impl SampleCheck {
     /// Check one chunk (messages give indices counted from `first_index`), then move past it.
     pub fn check(&mut self, t: &[f64], gyro: &[Vec3], accel: &[Vec3], h_ref: Option<&[f64]>, first_index: usize) -> Result<()> {
-        let n = t.len();
-        if gyro.len() != n || accel.len() != n {
-            return Err(invalid("imu", format!("time has {n} samples but gyro {} and accel {}", gyro.len(), accel.len())));
-        }
+        check_lengths(t.len(), gyro.len(), accel.len(), h_ref.map(<[f64]>::len))?;
         let t0 = self.prev_t;
         for (k, &tk) in t.iter().enumerate() {
             if !tk.is_finite() {
@@ -279,7 +275,6 @@ impl SampleCheck {
         }
         match h_ref {
             None if self.damped => return Err(invalid("h_ref", "a damped vertical channel needs a reference altitude per sample")),
-            Some(h) if h.len() != n => return Err(invalid("h_ref", format!("expected {n} samples, got {}", h.len()))),
             Some(h) => {
                 if let Some(k) = h.iter().position(|x| !x.is_finite()) {
                     return Err(invalid("h_ref", format!("non-finite value at index {}", first_index + k)));
@@ -287,8 +282,20 @@ impl SampleCheck {
             }
             None => {}
         }
-        self.primed |= n > 0;
+        self.primed |= !t.is_empty();
         Ok(())
+    }
+}
+
+/// A chunk's gyro, accel and reference-altitude (when given) lengths equal its `n` time
+/// stamps.
+pub(crate) fn check_lengths(n: usize, gyro: usize, accel: usize, h_ref: Option<usize>) -> Result<()> {
+    if gyro != n || accel != n {
+        return Err(invalid("imu", format!("time has {n} samples but gyro {gyro} and accel {accel}")));
+    }
+    match h_ref {
+        Some(h) if h != n => Err(invalid("h_ref", format!("expected {n} samples, got {h}"))),
+        _ => Ok(()),
     }
 }
 

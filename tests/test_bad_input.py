@@ -134,12 +134,14 @@ def test_bad_row_in_a_later_block_leaves_the_stream_unchanged():
     pd.testing.assert_frame_equal(sd.run(good), fresh.run(good))
 
 
-@pytest.mark.parametrize("growth_from", [0, 9000])
-def test_divergence_keeps_computed_rows(growth_from):
+@pytest.mark.parametrize("growth_from, chunk", [(0, None), (9000, None), (9000, 4000)])
+def test_divergence_keeps_computed_rows(growth_from, chunk, monkeypatch):
     """An accelerometer stream growing tenfold every 8 samples from `growth_from` (finite,
     so input checks pass) overflows the solution ~1200 samples later: NumericalError names
     the sample, and the rows before it are kept (also when they span several of the
-    core's 4096-row blocks)."""
+    core's 4096-row blocks, or several `integrate` chunks)."""
+    if chunk:
+        monkeypatch.setattr(an.strapdown, "CHUNK", chunk)
     long = an.trajectory.stationary(1400.0, 10.0)
     imu = long.ideal_imu("increments")
     imu["dv_x_mps"] += 10.0 ** np.minimum(np.maximum(np.arange(len(imu)) - growth_from, 0) / 8.0, 300.0)
@@ -150,3 +152,14 @@ def test_divergence_keeps_computed_rows(growth_from):
     assert growth_from + 10 < k < len(imu) and len(partial) == k
     np.testing.assert_array_equal(partial["time_s"], imu["time_s"].iloc[:k])
     assert np.all(np.abs(partial["lat_rad"]) <= np.pi / 2)
+
+
+@pytest.mark.parametrize("out, why", [(np.empty((14, 10)), r"out: expected a \(14, >= \d+\) table"),
+                                      (np.empty((14, 400))[:, ::2], "out: must be a C-contiguous"),
+                                      (np.empty((13, 200)), r"out: expected a \(14")])
+def test_run_into_rejects_a_bad_table(traj, imu, out, why):
+    from atomnav.strapdown import _imu_arrays
+    sd = an.strapdown.Strapdown(**traj.initial_state())
+    t, g, a = _imu_arrays(imu, "increments")
+    with pytest.raises(ValueError, match=why):
+        sd._core.run_into(t, g, a, out)

@@ -54,6 +54,16 @@ def test_streaming_equals_batch(ten_minutes, kind, chunk):
     np.testing.assert_array_equal(batch.to_numpy(), chunks.to_numpy())
 
 
+def test_integrate_in_chunks_equals_one_call(ten_minutes, monkeypatch):
+    """`integrate` fills one table chunk by chunk (`CHUNK` rows per call into Rust): the
+    result does not depend on the chunk size."""
+    imu = ten_minutes.ideal_imu("increments").iloc[:10_000]
+    whole = an.strapdown.integrate(imu, **ten_minutes.initial_state())
+    monkeypatch.setattr(an.strapdown, "CHUNK", 3001)
+    chunked = an.strapdown.integrate(imu, **ten_minutes.initial_state(), progress=True)
+    np.testing.assert_array_equal(whole.to_numpy(), chunked.to_numpy())
+
+
 def test_trajectory_csv_round_trip(tmp_path, ten_minutes):
     path = ten_minutes.to_csv(tmp_path / "traj.csv")
     back = an.trajectory.Trajectory.from_csv(path)

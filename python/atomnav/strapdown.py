@@ -81,20 +81,20 @@ def integrate(imu, t0, lla, vel_ned, q_nb, kind: str = "increments", ellipsoid: 
     h = None if h_ref is None else vector(h_ref, len(t), "h_ref")
     sd = Strapdown(t0, lla, vel_ned, q_nb, kind, ellipsoid, vertical, zeta, omega)
     show = len(t) > 1_000_000 if progress is None else progress
-    parts = []
+    # one table for the whole record, filled chunk by chunk in place (no concatenation)
+    table = np.empty((len(COLUMNS), len(t)))
     from tqdm.auto import tqdm
 
     with tqdm(total=len(t), disable=not show, unit="sample", desc="strapdown") as bar:
         for s in range(0, len(t), CHUNK):
             sl = slice(s, s + CHUNK)
             try:
-                out = sd._core.run(t[sl], g[sl], a[sl], None if h is None else h[sl], s)
+                sd._core.run_into(t[sl], g[sl], a[sl], table, None if h is None else h[sl], s)
             except _core.NumericalError as err:
-                err.partial = _table(np.hstack(parts + [err.partial]))
+                err.partial = _table(table[:, :s + err.rows])
                 raise
-            parts.append(out)
-            bar.update(out.shape[1])
-    return _table(parts[0] if len(parts) == 1 else np.hstack(parts) if parts else np.zeros((len(COLUMNS), 0)))
+            bar.update(len(t[sl]))
+    return _table(table)
 
 
 def integrate_attitude(q0, dtheta, dtheta_prev=None) -> np.ndarray:

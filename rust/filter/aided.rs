@@ -249,7 +249,7 @@ impl<A: Aiding> AidedIns<A> {
         if self.samples > 0 {
             return Err(invalid("vertical", "must be set before the first sample"));
         }
-        self.sd = Strapdown::new(self.sd.state, self.sd.kind, self.ell, Vertical::Damped { zeta, omega })?;
+        self.sd = Strapdown::new(self.sd.state, self.sd.kind(), self.ell, Vertical::Damped { zeta, omega })?;
         if !(baro.noise_psd.is_finite() && baro.noise_psd >= 0.0) {
             return Err(invalid("baro_psd", format!("must be finite and >= 0, got {}", baro.noise_psd)));
         }
@@ -315,7 +315,7 @@ impl<A: Aiding> AidedIns<A> {
         }
         for k in 0..n {
             let dt = t[k] - self.sd.state.t;
-            let (g, a) = match self.sd.kind {
+            let (g, a) = match self.sd.kind() {
                 ImuKind::Rates => (gyro[k] - self.gyro_bias, accel[k] - self.accel_bias),
                 ImuKind::Increments => (gyro[k] - self.gyro_bias * dt, accel[k] - self.accel_bias * dt),
             };
@@ -325,7 +325,7 @@ impl<A: Aiding> AidedIns<A> {
             self.sd.check_diverged(self.samples)?;
             self.samples += 1;
             self.aiding.observe(t[k], dt, &g, &a, &self.sd.state);
-            let f_b = match self.sd.kind {
+            let f_b = match self.sd.kind() {
                 ImuKind::Rates => a,
                 ImuKind::Increments => a / dt,
             };

@@ -77,9 +77,8 @@ pub fn symmetrize(p: &mut DMatrix<f64>) {
 }
 
 /// P ← Φ P Φᵀ + Q for a symmetric P in a column-major n × n buffer (the result is exactly
-/// symmetric), and x ← Φx when `x` is given; `t` is scratch. T = PΦᵀ, then
-/// the lower triangle of Q + ΦT, mirrored; every column is built as a sum of scaled
-/// columns. The common error-state sizes get a fixed-size kernel whose accumulators live
+/// symmetric), and x ← Φx when `x` is given; `t` is scratch. U = ΦP, then the lower
+/// triangle of Q + UΦᵀ, mirrored; every column is built as a sum of scaled columns. The common error-state sizes get a fixed-size kernel whose accumulators live
 /// in vector registers, compiled for AVX-512 or AVX2 + FMA when the CPU has them: several
 /// times faster than a general matmul dispatch at these sizes.
 pub fn propagate_covariance(p: &mut [f64], x: Option<&mut [f64]>, phi: &[f64], q: &[f64], n: usize, t: &mut Vec<f64>) {

@@ -4,7 +4,7 @@ use super::convert::{flat_to_py, quat_rows, quat_to_py, vec3, vec3_rows, vector}
 use crate::earth::Ellipsoid;
 use crate::error::{invalid, NavError};
 use crate::math::{euler_from_quat, quat, Vec3};
-use crate::strapdown::{integrate_attitude, BodyFront, BodyStep, ImuKind, NavState, SampleCheck, Strapdown as Core, Vertical};
+use crate::strapdown::{check_lengths, integrate_attitude, BodyFront, BodyStep, ImuKind, NavState, SampleCheck, Strapdown as Core, Vertical};
 use numpy::ndarray::{s, ArrayView1, ArrayView2};
 use numpy::{PyArray2, PyArrayMethods, PyReadonlyArray1, PyReadonlyArray2, PyUntypedArrayMethods};
 use std::sync::mpsc;
@@ -38,6 +38,21 @@ fn write_columns(buf: &mut [f64], n: usize, first: usize, s: &[NavState]) {
         for (c, v) in row.into_iter().enumerate() {
             buf[c * n + first + i] = v;
         }
+    }
+}
+
+/// Where a run writes its rows: columns `row0`… of a (14, stride) row-major table (the
+/// chunk's own table, or the whole record's).
+struct TableOut<'a> {
+    buf: &'a mut [f64],
+    stride: usize,
+    row0: usize,
+}
+
+impl TableOut<'_> {
+    /// The states of the chunk's rows `first`….
+    fn write(&mut self, first: usize, states: &[NavState]) {
+        write_columns(self.buf, self.stride, self.row0 + first, states);
     }
 }
 
@@ -92,18 +107,6 @@ impl Block {
     }
 }
 
-/// The chunk's lengths agree (its values are checked block by block).
-fn check_lengths(imu: &ImuView<'_>) -> Result<(), NavError> {
-    let n = imu.len();
-    if imu.gyro.nrows() != n || imu.accel.nrows() != n {
-        return Err(invalid("imu", format!("time has {n} samples but gyro {} and accel {}", imu.gyro.nrows(), imu.accel.nrows())));
-    }
-    match &imu.h_ref {
-        Some(h) if h.len() != n => Err(invalid("h_ref", format!("expected {n} samples, got {}", h.len()))),
-        _ => Ok(()),
-    }
-}
-
 /// The IMU-only work on a block, ready for the navigation half: checked rows, their body
 /// steps (`BodyFront::push`), the reference altitudes.
 #[derive(Default)]
@@ -138,18 +141,18 @@ impl Helper<'_, '_> {
 
 /// Check and integrate a chunk in blocks: this thread runs the navigation half of every
 /// step; a second thread prepares the next block (copy, checks, coning and sculling) and
-/// turns the finished one into rows of the (14, n) table `table` (the Euler angles' three
-/// atan2 per row cost about half a mechanization step). A bad row restores the state the
+/// turns the finished one into rows of `out` (the Euler angles' three atan2 per row cost
+/// about half a mechanization step). A bad row restores the state the
 /// chunk started from, so bad input integrates nothing. Returns the number of rows
-/// computed and the error, if any; on divergence the rows before it are in `table`.
-fn run_pipelined(core: &mut Core, imu: &ImuView<'_>, table: &mut [f64], first_index: usize) -> (usize, Result<(), NavError>) {
+/// computed and the error, if any; on divergence the rows before it are in `out`.
+fn run_pipelined(core: &mut Core, imu: &ImuView<'_>, mut out: TableOut<'_>, first_index: usize) -> (usize, Result<(), NavError>) {
     let (n, initial) = (imu.len(), core.clone());
     let blocks = n.div_ceil(PIPELINE_BLOCK).max(1);
     let mut helper = Helper { imu, first_index, check: core.sample_check(), front: core.front.clone() };
     let (to_core, prepared) = mpsc::channel::<Result<Prepared, NavError>>();
-    let (to_writer, finished) = mpsc::channel::<(usize, Vec<NavState>, Prepared)>();
+    let (to_writer, finished) = mpsc::channel::<(Vec<NavState>, Prepared)>();
     // the navigation half; `to_writer` is moved in, so the writer's loop ends when it returns
-    let integrate = |core: &mut Core, to_writer: mpsc::Sender<(usize, Vec<NavState>, Prepared)>, spare: &mpsc::Receiver<Vec<NavState>>| {
+    let integrate = |core: &mut Core, to_writer: mpsc::Sender<(Vec<NavState>, Prepared)>, spare: &mpsc::Receiver<Vec<NavState>>| {
         for p in prepared.iter() {
             let p = match p {
                 Ok(p) => p,
@@ -159,7 +162,7 @@ fn run_pipelined(core: &mut Core, imu: &ImuView<'_>, table: &mut [f64], first_in
             states.clear();
             let step = core.run_body(&p.block.t, &p.body, p.block.h_ref(), first_index + p.start, &mut states);
             let rows = p.start + states.len();
-            let _ = to_writer.send((p.start, states, p)); // the helper stops early on bad input
+            let _ = to_writer.send((states, p)); // the helper stops early on bad input
             if step.is_err() {
                 return (rows, step);
             }
@@ -172,8 +175,8 @@ fn run_pipelined(core: &mut Core, imu: &ImuView<'_>, table: &mut [f64], first_in
         drop(to_core);
         let (_, spare) = mpsc::channel();
         let (rows, result) = integrate(core, to_writer, &spare);
-        for (first, states, _) in finished.try_iter() {
-            write_columns(table, n, first, &states);
+        for (states, p) in finished.try_iter() {
+            out.write(p.start, &states);
         }
         (rows, result, helper.front)
     } else {
@@ -191,16 +194,16 @@ fn run_pipelined(core: &mut Core, imu: &ImuView<'_>, table: &mut [f64], first_in
                         }
                     }
                     if j > 0 {
-                        let Ok((first, states, p)) = finished.recv() else { break };
-                        write_columns(table, n, first, &states);
+                        let Ok((states, p)) = finished.recv() else { break };
+                        out.write(p.start, &states);
                         reuse = p;
                         let _ = recycle.send(states);
                     }
                 }
                 drop(to_core);
                 // after an early stop: the rows the core still sends
-                for (first, states, _) in finished.iter() {
-                    write_columns(table, n, first, &states);
+                for (states, p) in finished.iter() {
+                    out.write(p.start, &states);
                 }
                 helper.front
             });
@@ -214,6 +217,41 @@ fn run_pipelined(core: &mut Core, imu: &ImuView<'_>, table: &mut [f64], first_in
         Err(_) => {} // diverged: the state is where it failed
     }
     (rows, result)
+}
+
+impl Strapdown {
+    /// The shared body of `run` and `run_into`: the chunk's shapes checked, its values
+    /// checked and integrated into columns `row0`… of `out`. Bad input is an `Err` (nothing
+    /// integrated); a divergence is the error beside the number of rows written before it.
+    #[allow(clippy::too_many_arguments)]
+    fn run_chunk<'py>(
+        &mut self,
+        py: Python<'py>,
+        time: &PyReadonlyArray1<'py, f64>,
+        gyro: &PyReadonlyArray2<'py, f64>,
+        accel: &PyReadonlyArray2<'py, f64>,
+        h_ref: Option<&PyReadonlyArray1<'py, f64>>,
+        first_index: usize,
+        out: &Bound<'py, PyArray2<f64>>,
+        row0: usize,
+    ) -> PyResult<(usize, Result<(), NavError>)> {
+        for (name, a) in [("gyro", gyro), ("accel", accel)] {
+            if a.shape()[1] != 3 {
+                return Err(invalid(name, format!("expected shape (N, 3), got ({}, {})", a.shape()[0], a.shape()[1])).into());
+            }
+        }
+        let imu = ImuView { time: time.as_array(), gyro: gyro.as_array(), accel: accel.as_array(), h_ref: h_ref.map(|h| h.as_array()) };
+        check_lengths(imu.len(), imu.gyro.nrows(), imu.accel.nrows(), imu.h_ref.as_ref().map(|h| h.len()))?;
+        let mut guard = out.try_readwrite().map_err(|e| invalid("out", format!("not writable: {e}")))?;
+        let stride = out.shape()[1];
+        let buf = guard.as_slice_mut().map_err(|_| invalid("out", "must be a C-contiguous float64 array"))?;
+        let inner = &mut self.inner;
+        let (rows, result) = py.detach(|| run_pipelined(inner, &imu, TableOut { buf, stride, row0 }, first_index));
+        match result {
+            Err(e @ NavError::InvalidInput { .. }) => Err(e.into()),
+            other => Ok((rows, other)),
+        }
+    }
 }
 
 /// The first `rows` columns of a (14, n) table, as a (14, rows) array.
@@ -268,31 +306,46 @@ impl Strapdown {
         h_ref: Option<PyReadonlyArray1<'py, f64>>,
         first_index: usize,
     ) -> PyResult<Bound<'py, PyArray2<f64>>> {
-        for (name, a) in [("gyro", &gyro), ("accel", &accel)] {
-            if a.shape()[1] != 3 {
-                return Err(invalid(name, format!("expected shape (N, 3), got ({}, {})", a.shape()[0], a.shape()[1])).into());
-            }
-        }
-        let imu = ImuView { time: time.as_array(), gyro: gyro.as_array(), accel: accel.as_array(), h_ref: h_ref.as_ref().map(|h| h.as_array()) };
-        check_lengths(&imu)?;
         // numpy's allocator advises huge pages for large arrays: a few page faults instead
         // of one per 4 KiB of the 112 bytes/row table
-        let table = PyArray2::<f64>::zeros(py, [COLUMNS, imu.len()], false);
-        let (rows, result) = {
-            let mut guard = table.readwrite();
-            let buf = guard.as_slice_mut().expect("a new C-contiguous array");
-            let inner = &mut self.inner;
-            py.detach(|| run_pipelined(inner, &imu, buf, first_index))
-        };
-        match result {
-            Ok(()) => Ok(table),
-            Err(e @ NavError::Numerical(_)) => {
+        let table = PyArray2::<f64>::zeros(py, [COLUMNS, time.len()], false);
+        match self.run_chunk(py, &time, &gyro, &accel, h_ref.as_ref(), first_index, &table, 0)? {
+            (_, Ok(())) => Ok(table),
+            (rows, Err(e)) => {
                 // keep what was computed: the exception carries the rows before the failure
                 let err: PyErr = e.into();
                 err.value(py).setattr("partial", table_rows(py, &table, rows))?;
                 Err(err)
             }
-            Err(e) => Err(e.into()),
+        }
+    }
+
+    /// `run` into columns `first_index`… of `out`, a C-contiguous (14, M) table of the
+    /// whole record, so that a record integrated in chunks is never copied. On divergence
+    /// the exception's `rows` is the number of this chunk's rows written before it.
+    #[pyo3(signature = (time, gyro, accel, out, h_ref=None, first_index=0))]
+    #[allow(clippy::too_many_arguments)]
+    fn run_into<'py>(
+        &mut self,
+        py: Python<'py>,
+        time: PyReadonlyArray1<'py, f64>,
+        gyro: PyReadonlyArray2<'py, f64>,
+        accel: PyReadonlyArray2<'py, f64>,
+        out: Bound<'py, PyArray2<f64>>,
+        h_ref: Option<PyReadonlyArray1<'py, f64>>,
+        first_index: usize,
+    ) -> PyResult<()> {
+        let (n, shape) = (time.len(), out.shape().to_vec());
+        if shape[0] != COLUMNS || shape[1] < first_index + n {
+            return Err(invalid("out", format!("expected a ({COLUMNS}, >= {}) table, got {shape:?}", first_index + n)).into());
+        }
+        match self.run_chunk(py, &time, &gyro, &accel, h_ref.as_ref(), first_index, &out, first_index)? {
+            (_, Ok(())) => Ok(()),
+            (rows, Err(e)) => {
+                let err: PyErr = e.into();
+                err.value(py).setattr("rows", rows)?;
+                Err(err)
+            }
         }
     }
 
