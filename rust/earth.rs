@@ -51,18 +51,14 @@ pub const PZ90_11: Ellipsoid = Ellipsoid {
     gamma_p: 9.832188005043,
 };
 
-impl Ellipsoid {
-    /// Look up an ellipsoid by name ("WGS84", "PZ90.11"; case and punctuation ignored).
-    pub fn by_name(name: &str) -> Result<Ellipsoid> {
-        let key: String = name.chars().filter(|c| c.is_alphanumeric()).collect::<String>().to_lowercase();
-        match key.as_str() {
-            "wgs84" => Ok(WGS84),
-            "pz9011" | "pz90" => Ok(PZ90_11),
-            "kinematic" => Ok(KINEMATIC),
-            _ => Err(invalid("ellipsoid", format!("unknown ellipsoid '{name}' (known: WGS84, PZ90.11, kinematic)"))),
-        }
-    }
+/// Ellipsoids by name: "WGS84" (default everywhere), "PZ90.11" (GLONASS), and
+/// "kinematic" (WGS-84's shape with no rotation and no gravity, for purely kinematic tests).
+impl crate::options::Choice for Ellipsoid {
+    const PARAMETER: &'static str = "ellipsoid";
+    const CHOICES: &'static [(&'static str, Self)] = &[("WGS84", WGS84), ("PZ90.11", PZ90_11), ("kinematic", KINEMATIC)];
+}
 
+impl Ellipsoid {
     /// First eccentricity squared e² = f(2 − f).
     pub fn e2(&self) -> f64 {
         self.f * (2.0 - self.f)
@@ -378,16 +374,20 @@ pub struct Helmert {
     pub scale: f64,
 }
 
+/// The datum transformation of GLONASS positions into WGS-84: `identity` (default: PZ-90.11
+/// ≈ WGS-84 to a few cm) or `pz90_02_to_wgs84` (T = (−0.36, +0.08, +0.18) m, for pre-2014
+/// GLONASS ephemerides).
+impl crate::options::Choice for Helmert {
+    const PARAMETER: &'static str = "datum";
+    const CHOICES: &'static [(&'static str, Self)] = &[
+        ("identity", Helmert::IDENTITY),
+        ("pz90_02_to_wgs84", Helmert { translation: Vec3::new(-0.36, 0.08, 0.18), rotation: Vec3::new(0.0, 0.0, 0.0), scale: 0.0 }),
+    ];
+}
+
 impl Helmert {
-    /// `identity` (default: PZ-90.11 ≈ WGS-84 to a few cm) or `pz90_02_to_wgs84`
-    /// (T = (−0.36, +0.08, +0.18) m, for pre-2014 GLONASS ephemerides), spec Eq. 6.
-    pub fn by_name(name: &str) -> Result<Helmert> {
-        match name {
-            "identity" => Ok(Helmert { translation: Vec3::zeros(), rotation: Vec3::zeros(), scale: 0.0 }),
-            "pz90_02_to_wgs84" => Ok(Helmert { translation: Vec3::new(-0.36, 0.08, 0.18), rotation: Vec3::zeros(), scale: 0.0 }),
-            _ => Err(invalid("datum", format!("unknown datum transformation '{name}' (known: identity, pz90_02_to_wgs84)"))),
-        }
-    }
+    /// No transformation.
+    pub const IDENTITY: Helmert = Helmert { translation: Vec3::new(0.0, 0.0, 0.0), rotation: Vec3::new(0.0, 0.0, 0.0), scale: 0.0 };
 
     fn rot(&self) -> Mat3 {
         let r = self.rotation;

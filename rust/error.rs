@@ -8,7 +8,10 @@ pub enum NavError {
     /// Input that can never give a meaningful result: names the field and, for series,
     /// the first offending index.
     #[error("{field}: {reason}")]
-    InvalidInput { field: String, reason: String },
+    InvalidInput { field: String, reason: String, index: Option<usize> },
+    /// An allocation sized by input that this machine cannot hold (mapped to `MemoryError`).
+    #[error("{field}: cannot allocate {bytes} bytes")]
+    OutOfMemory { field: String, bytes: u128 },
     /// A computation that failed on valid input (loss of positive definiteness, divergence).
     #[error("numerical failure: {0}")]
     Numerical(String),
@@ -18,16 +21,45 @@ pub type Result<T> = std::result::Result<T, NavError>;
 
 /// Shorthand used by every validator: `invalid("gyro", "NaN at index 12")`.
 pub fn invalid(field: &str, reason: impl Into<String>) -> NavError {
-    NavError::InvalidInput { field: field.to_string(), reason: reason.into() }
+    NavError::InvalidInput { field: field.to_string(), reason: reason.into(), index: None }
+}
+
+/// Like [`invalid`], for array input: `index` is the first offending row, which Python
+/// sees as `InputError.index`.
+pub fn invalid_at(field: &str, index: usize, reason: impl Into<String>) -> NavError {
+    NavError::InvalidInput { field: field.to_string(), reason: reason.into(), index: Some(index) }
+}
+
+/// A count or size taken from input, checked against its meaningful range before anything
+/// is allocated from it.
+pub fn check_count(field: &str, n: usize, min: usize, max: usize) -> Result<usize> {
+    if (min..=max).contains(&n) {
+        Ok(n)
+    } else {
+        Err(invalid(field, format!("must be in [{min}, {max}], got {n}")))
+    }
+}
+
+/// A vector of `n` elements whose size comes from input: `OutOfMemory` (Python's
+/// `MemoryError`, naming the size) instead of an abort when the machine cannot hold it.
+pub fn try_vec<T: Clone>(field: &str, n: usize, value: T) -> Result<Vec<T>> {
+    let mut v = Vec::new();
+    v.try_reserve_exact(n).map_err(|_| NavError::OutOfMemory {
+        field: field.to_string(),
+        bytes: n as u128 * std::mem::size_of::<T>() as u128,
+    })?;
+    v.resize(n, value);
+    Ok(v)
 }
 
 /// Reject NaN/inf values in a flat slice of `width`-wide rows, naming the first bad row.
 pub fn check_finite(field: &str, data: &[f64], width: usize) -> Result<()> {
     match data.iter().position(|x| !x.is_finite()) {
         None => Ok(()),
-        Some(i) if width == 1 => Err(invalid(field, format!("non-finite value {} at index {i}", data[i]))),
-        Some(i) => Err(invalid(
+        Some(i) if width == 1 => Err(invalid_at(field, i, format!("non-finite value {} at index {i}", data[i]))),
+        Some(i) => Err(invalid_at(
             field,
+            i / width,
             format!("non-finite value {} at index {} (column {})", data[i], i / width, i % width),
         )),
     }
@@ -39,8 +71,9 @@ pub fn check_increasing(field: &str, t: &[f64]) -> Result<()> {
     for k in 1..t.len() {
         if t[k] <= t[k - 1] {
             let what = if t[k] == t[k - 1] { "duplicated" } else { "decreasing" };
-            return Err(invalid(
+            return Err(invalid_at(
                 field,
+                k,
                 format!("time not strictly increasing: {what} stamp {} at index {k} (previous {})", t[k], t[k - 1]),
             ));
         }

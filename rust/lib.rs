@@ -13,6 +13,7 @@ pub mod gnss;
 pub mod imu;
 pub mod math;
 pub mod noise;
+pub mod options;
 pub mod strapdown;
 pub mod trajectory;
 pub mod units;

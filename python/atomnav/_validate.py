@@ -1,29 +1,49 @@
-"""Input checks shared by the Python wrappers. Every failure is a ``ValueError`` that
-names the field and, for series, the first offending index."""
+"""Input checks shared by the Python wrappers. Every failure is an
+:class:`atomnav.InputError` (a ``ValueError``) whose ``parameter`` names the argument and,
+for series, whose ``index`` is the first offending row."""
 
 from __future__ import annotations
 
 import numpy as np
 
+from ._core import InputError
+
+
+def input_error(parameter: str, reason: str, index: int | None = None) -> InputError:
+    """An :class:`InputError` for argument ``parameter`` (message ``"parameter: reason"``)."""
+    err = InputError(f"{parameter}: {reason}")
+    err.parameter = parameter
+    err.index = None if index is None else int(index)
+    return err
+
+
+def as_floats(x, name: str) -> np.ndarray:
+    """``x`` as a float64 array; anything that is not numbers is a ``TypeError`` naming
+    ``name``."""
+    try:
+        return np.asarray(x, dtype=float)
+    except (TypeError, ValueError) as e:
+        raise TypeError(f"{name}: expected numbers, got {type(x).__name__} ({e})") from None
+
 
 def rows(x, width: int, name: str) -> np.ndarray:
     """``x`` as a C-contiguous float64 array of shape (N, width); a single row of length
     ``width`` is promoted to (1, width)."""
-    a = np.asarray(x, dtype=float)
+    a = as_floats(x, name)
     if a.ndim == 1 and a.shape[0] == width:
         a = a[None, :]
     if a.ndim != 2 or a.shape[1] != width:
-        raise ValueError(f"{name}: expected shape (N, {width}), got {a.shape}")
+        raise input_error(name, f"expected shape (N, {width}), got {a.shape}")
     finite(a, name)
     return np.ascontiguousarray(a)
 
 
 def vector(x, length: int | None, name: str) -> np.ndarray:
     """``x`` as a 1-D float64 array (of exactly ``length`` elements when given)."""
-    a = np.asarray(x, dtype=float)
+    a = as_floats(x, name)
     if a.ndim != 1 or (length is not None and a.shape[0] != length):
         want = f"({length},)" if length is not None else "(N,)"
-        raise ValueError(f"{name}: expected shape {want}, got {a.shape}")
+        raise input_error(name, f"expected shape {want}, got {a.shape}")
     finite(a, name)
     return np.ascontiguousarray(a)
 
@@ -32,7 +52,7 @@ def finite(a: np.ndarray, name: str) -> None:
     bad = ~np.isfinite(a)
     if bad.any():
         idx = np.argwhere(bad)[0]
-        raise ValueError(f"{name}: non-finite value {a[tuple(idx)]} at index {idx[0]}")
+        raise input_error(name, f"non-finite value {a[tuple(idx)]} at index {idx[0]}", idx[0])
 
 
 def increasing(t: np.ndarray, name: str) -> None:
@@ -41,17 +61,24 @@ def increasing(t: np.ndarray, name: str) -> None:
     if bad.size:
         k = bad[0] + 1
         what = "duplicated" if t[k] == t[k - 1] else "decreasing"
-        raise ValueError(f"{name}: time not strictly increasing: {what} stamp {t[k]} at index {k}")
+        raise input_error(name, f"time not strictly increasing: {what} stamp {t[k]} at index {k}", k)
+
+
+def scalar(x, name: str) -> float:
+    """``x`` as a float; a non-number or an array is a ``TypeError`` naming ``name``."""
+    if isinstance(x, (str, bytes)) or np.ndim(x) != 0:
+        raise TypeError(f"{name}: expected a number, got {type(x).__name__}")
+    return float(as_floats(x, name))
 
 
 def positive(x: float, name: str) -> float:
-    x = float(x)
+    x = scalar(x, name)
     if not np.isfinite(x) or x <= 0:
-        raise ValueError(f"{name}: must be finite and > 0, got {x}")
+        raise input_error(name, f"must be finite and > 0, got {x}")
     return x
 
 
 def choice(value: str, options, name: str) -> str:
     if value not in options:
-        raise ValueError(f"{name}: unknown option {value!r}; choose one of {sorted(options)}")
+        raise input_error(name, f"unknown option {value!r}; choose one of {sorted(options)}")
     return value

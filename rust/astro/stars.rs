@@ -165,7 +165,7 @@ pub fn check_covariances(field: &str, p: &[Mat3], n: usize) -> Result<()> {
     for (e, m) in p.iter().enumerate() {
         crate::filter::matrix::check_covariance(field, &nalgebra::DMatrix::from_column_slice(3, 3, m.as_slice()), Some(3), false)
             .map_err(|err| match err {
-                crate::error::NavError::InvalidInput { reason, .. } => invalid(field, format!("{reason} at index {e}")),
+                crate::error::NavError::InvalidInput { reason, .. } => crate::error::invalid_at(field, e, format!("{reason} at index {e}")),
                 other => other,
             })?;
     }

@@ -427,7 +427,9 @@ impl<A: Aiding> AidedIns<A> {
 /// Name the measurement in an invalid-input error of the update (NaN z, bad R, ...).
 fn at_measurement(e: NavError, name: &str, j: usize) -> NavError {
     match e {
-        NavError::InvalidInput { field, reason } => NavError::InvalidInput { field: format!("{name}[{j}] {field}"), reason },
+        NavError::InvalidInput { field, reason, .. } => {
+            NavError::InvalidInput { field: format!("{name}[{j}] {field}"), reason, index: Some(j) }
+        }
         other => other,
     }
 }
@@ -501,7 +503,7 @@ mod tests {
 
     /// A stationary record with an accelerometer bias, fixes every 0.5 s.
     fn record() -> (NavState, Vec<f64>, Vec<Vec3>, Vec<Vec3>, Vec<PositionFix>) {
-        let ell = Ellipsoid::by_name("WGS84").unwrap();
+        let ell = crate::earth::WGS84;
         let lla = Vec3::new(0.8, 0.2, 100.0);
         let loc = ell.local(lla.x, lla.z);
         let t: Vec<f64> = (0..=500).map(|k| k as f64 * 0.01).collect();
@@ -514,7 +516,7 @@ mod tests {
     fn engine(mode: LoopMode) -> AidedIns<PositionAiding> {
         let (s0, _, _, _, fixes) = record();
         let p0 = DMatrix::from_diagonal(&DVector::from_vec([1.0, 1.0, 1.0, 0.01, 0.01, 0.01, 1e-6, 1e-6, 1e-6, 1e-4, 1e-4, 1e-4, 1e-10, 1e-10, 1e-10].to_vec()));
-        let ell = Ellipsoid::by_name("WGS84").unwrap();
+        let ell = crate::earth::WGS84;
         AidedIns::new(s0, ImuKind::Rates, ell, Vec3::zeros(), Vec3::zeros(), DVector::zeros(0), p0, config(mode), PositionAiding::new(fixes).unwrap()).unwrap()
     }
 
@@ -575,7 +577,7 @@ mod tests {
     #[test]
     fn nominal_extra_blocks_follow_their_dynamics() {
         let (s0, t, g, a, _) = record();
-        let ell = Ellipsoid::by_name("WGS84").unwrap();
+        let ell = crate::earth::WGS84;
         for mode in [LoopMode::Closed, LoopMode::Open] {
             let p0 = DMatrix::identity(17, 17) * 1e-4;
             let ins = AidedIns::new(s0, ImuKind::Rates, ell, Vec3::zeros(), Vec3::zeros(), DVector::from_vec(vec![1.0, 0.5]), p0, config(mode), Drift).unwrap();

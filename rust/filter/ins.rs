@@ -199,7 +199,7 @@ mod tests {
     /// cancel and only the linearisation is tested. `damped` = (ζ, ω_v, δb_baro): both
     /// run the baro loop on the true altitude, the estimate's compensated by −δb_baro.
     fn mismatch(dr: Vec3, dv: Vec3, psi: Vec3, dba: Vec3, dbg: Vec3, damped: Option<(f64, f64, f64)>) -> [f64; 3] {
-        let ell = Ellipsoid::by_name("WGS84").unwrap();
+        let ell = crate::earth::WGS84;
         let mut spec: Vec<(String, Option<usize>)> = INS15_SPEC.iter().map(|s| (s.to_string(), None)).collect();
         if damped.is_some() {
             spec.push(("baro_bias".to_string(), Some(1)));

@@ -117,5 +117,5 @@ pub fn nominal(cfg: &ConstellationConfig) -> Result<Ephemerides> {
             }
         }
     }
-    Ephemerides::new(gps, glo, cfg.time, Helmert::by_name("identity")?)
+    Ephemerides::new(gps, glo, cfg.time, Helmert::IDENTITY)
 }

@@ -5,7 +5,6 @@ pub mod errors;
 pub mod noise;
 pub mod presets;
 
-use crate::error::{invalid, Result};
 
 /// Kind of IMU output: instantaneous (or interval-average) rates — specific force m/s²,
 /// angular rate rad/s — or increments over (t_{k−1}, t_k] — Δv m/s, Δθ rad.
@@ -15,16 +14,12 @@ pub enum ImuKind {
     Increments,
 }
 
-impl ImuKind {
-    /// "rates" or "increments".
-    pub fn parse(name: &str) -> Result<ImuKind> {
-        match name {
-            "rates" => Ok(ImuKind::Rates),
-            "increments" => Ok(ImuKind::Increments),
-            _ => Err(invalid("kind", format!("unknown IMU output kind '{name}' (known: 'rates', 'increments')"))),
-        }
-    }
+impl crate::options::Choice for ImuKind {
+    const PARAMETER: &'static str = "kind";
+    const CHOICES: &'static [(&'static str, Self)] = &[("rates", ImuKind::Rates), ("increments", ImuKind::Increments)];
+}
 
+impl ImuKind {
     /// Factor from an increment over Δt to the output sample: 1/Δt (rates) or 1.
     pub fn per_increment(self, dt: f64) -> f64 {
         match self {

@@ -339,6 +339,6 @@ mod tests {
         assert!(e.starts_with("density:"), "{e}");
         let e = gauss_markov_driving_sigma(1.0, 0.0, 0.01).unwrap_err().to_string();
         assert!(e.starts_with("tau:"), "{e}");
-        assert!(ImuKind::parse("samples").is_err());
+        assert!(<ImuKind as crate::options::Choice>::parse("samples").is_err());
     }
 }

@@ -1,6 +1,6 @@
 //! Bindings of astro/: gyro increments, star attitudes, mount calibration, scenario runs.
 
-use super::convert::{rows_to_py, vec3_rows, vec3_to_py, vector, quat_to_py};
+use super::convert::{mat_to_py, vec3_rows, vec3_to_py, vector, quat_to_py};
 use crate::astro::calibration::{self, Calibration, DiffForm, Init, Observability, Options, ResidualForm, Solver, Verdict};
 use crate::astro::increments::{self, GyroErrorMode, GyroErrorModel, ImuRecord, TaylorVariant};
 use crate::astro::scenario::{self, Run, Scenario};
@@ -36,10 +36,6 @@ fn mats<const R: usize, const C: usize>(a: &PyReadonlyArray3<'_, f64>, field: &s
 
 fn mats_to_py<'py, const R: usize, const C: usize>(py: Python<'py>, m: &[SMatrix<f64, R, C>]) -> Bound<'py, PyArray3<f64>> {
     Array3::from_shape_fn((m.len(), R, C), |(i, r, c)| m[i][(r, c)]).into_pyarray(py)
-}
-
-fn mat_to_py<'py>(py: Python<'py>, m: &Mat3) -> Bound<'py, PyArray2<f64>> {
-    rows_to_py(py, 3, 3, (0..9).map(|k| m[(k / 3, k % 3)]))
 }
 
 fn vec_to_py<'py>(py: Python<'py>, v: &Vec3) -> Bound<'py, PyArray1<f64>> {

@@ -1,7 +1,7 @@
 //! Bindings of cai: predictor, Jacobians, oracle and analytic motions, closed forms,
 //! sensitivity function, fringe tracking and ML noise identification.
 
-use super::convert::{rows, to_py_rows, vec3, vec3_rows, vec3_to_py, vec_to_py, vector};
+use super::convert::{Wrap, rows, to_py_rows, vec3, vec3_rows, vec3_to_py, vec_to_py, vector};
 use super::imu::triad_from_dict;
 use super::trajectory::Motion;
 use super::filter::{AidedSetup, PyAidedIns};
@@ -488,7 +488,7 @@ fn cai_in_shot_noise<'py>(py: Python<'py>, sensor: &CaiSensor, dt: f64, q_a: f64
         Ok((sigma, cross))
     })?;
     let flat: Vec<f64> = cross.iter().flat_map(|c| (0..15).flat_map(move |i| (0..m).map(move |j| c[(i, j)]))).collect();
-    Ok((super::filter::mat_to_py(py, &sigma), numpy::PyArray1::from_vec(py, flat).reshape([cross.len(), 15, m])?))
+    Ok((super::convert::mat_to_py(py, &sigma), numpy::PyArray1::from_vec(py, flat).reshape([cross.len(), 15, m])?))
 }
 
 /// A CAI-aided INS scenario (truth, IMU errors, CAI, filter), built once; `monte_carlo`
@@ -505,7 +505,7 @@ impl CaiHybrid {
     fn new(
         py: Python<'_>,
         motion: &Motion,
-        ellipsoid: &str,
+        ellipsoid: Wrap<Ellipsoid>,
         rate_hz: f64,
         truth_rate_hz: Option<f64>,
         imu_accel: &Bound<'_, PyDict>,
@@ -519,11 +519,11 @@ impl CaiHybrid {
         aiding: bool,
         draw_initial: bool,
     ) -> PyResult<Self> {
-        let ell = Ellipsoid::by_name(ellipsoid)?;
+        let ell = ellipsoid.0;
         let cai = sensor.with_shots(&shots)?;
         let imu_model = error_model(imu_accel, imu_gyro, "imu")?;
         let reference = reference.map(|(a, g)| error_model(&a, &g, "reference")).transpose()?;
-        let p0 = super::filter::mat(&p0, "p0")?;
+        let p0 = super::convert::mat(&p0, "p0")?;
         let m = &motion.inner;
         let scenario = py.detach(|| -> crate::Result<HybridScenario> {
             let (t, truth, f, w) = HybridScenario::imu_truth(m, &ell, rate_hz)?;

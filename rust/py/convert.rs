@@ -1,19 +1,92 @@
-//! numpy ↔ nalgebra conversion with shape and finiteness checks, and NavError → PyErr.
+//! numpy ↔ nalgebra conversion with shape and finiteness checks, options by name
+//! (`Wrap<T>`), checked integer arguments, and NavError → PyErr.
 
-use crate::error::{check_finite, invalid, NavError};
+use crate::error::{check_finite, invalid, invalid_at, NavError};
 use crate::math::{quat, Quat, Vec3};
+use crate::options::Choice;
+use nalgebra::{DMatrix, Dim, Matrix, RawStorage};
 use numpy::ndarray::Array2;
 use numpy::{IntoPyArray, PyArray1, PyArray2, PyReadonlyArray1, PyReadonlyArray2, PyUntypedArrayMethods};
-use pyo3::exceptions::PyValueError;
+use pyo3::exceptions::{PyMemoryError, PyTypeError};
 use pyo3::prelude::*;
+use pyo3::pybacked::PyBackedStr;
+use pyo3::types::{PyBool, PyDict, PyInt};
 
 impl From<NavError> for PyErr {
     fn from(e: NavError) -> PyErr {
-        match e {
-            NavError::InvalidInput { .. } => PyValueError::new_err(e.to_string()),
+        match &e {
+            NavError::InvalidInput { field, index, .. } => {
+                let err = super::InputError::new_err(e.to_string());
+                Python::attach(|py| {
+                    let value = err.value(py);
+                    // setting attributes on a fresh exception instance cannot fail
+                    let _ = value.setattr("parameter", field.as_str());
+                    let _ = value.setattr("index", *index);
+                });
+                err
+            }
+            NavError::OutOfMemory { .. } => PyMemoryError::new_err(e.to_string()),
             NavError::Numerical(_) => super::NumericalError::new_err(e.to_string()),
         }
     }
+}
+
+/// An option given by name from Python, parsed once by the core's [`Choice`] list
+/// (polars' `Wrap<T>` pattern). A non-`str` is a `TypeError` (pyo3 prefixes the argument
+/// name); an unknown name an `InputError` naming `T::PARAMETER` and the accepted names.
+pub struct Wrap<T>(pub T);
+
+impl<'a, 'py, T: Choice> FromPyObject<'a, 'py> for Wrap<T> {
+    type Error = PyErr;
+
+    fn extract(obj: Borrowed<'a, 'py, PyAny>) -> PyResult<Self> {
+        let name: PyBackedStr = obj
+            .extract()
+            .map_err(|_| PyTypeError::new_err(format!("expected a str, one of {}", T::names().join(", "))))?;
+        Ok(Wrap(T::parse(&name)?))
+    }
+}
+
+/// Publish the accepted names of option `T` in `_core.OPTIONS`, keyed by `key` (the
+/// option's type name), so Python reads the one list instead of keeping its own.
+pub fn register_choices<T: Choice>(m: &Bound<'_, PyModule>, key: &str) -> PyResult<()> {
+    m.getattr("OPTIONS")?.cast_into::<PyDict>()?.set_item(key, T::names())
+}
+
+/// An integer argument (count, size, index) checked against [min, max] before anything is
+/// sized from it: a non-integer is a `TypeError` naming `field`, an integer out of range
+/// (including one too large for 64 bits) an `InputError` naming `field`.
+pub fn count(obj: &Bound<'_, PyAny>, field: &str, min: usize, max: usize) -> PyResult<usize> {
+    if !obj.is_instance_of::<PyInt>() || obj.is_instance_of::<PyBool>() {
+        return Err(PyTypeError::new_err(format!("{field}: expected an int, got {}", type_name(obj))));
+    }
+    let n: i128 = match obj.extract::<i64>() {
+        Ok(n) => n.into(),
+        Err(_) => i128::MAX,
+    };
+    match usize::try_from(n) {
+        Ok(n) if (min..=max).contains(&n) => Ok(n),
+        _ => Err(invalid(field, format!("must be an integer in [{min}, {max}], got {obj}")).into()),
+    }
+}
+
+fn type_name(obj: &Bound<'_, PyAny>) -> String {
+    obj.get_type().name().map_or_else(|_| "object".to_string(), |n| n.to_string())
+}
+
+/// A 2-D float array as a DMatrix, checked for NaN/inf (names the first bad row).
+pub fn mat(a: &PyReadonlyArray2<'_, f64>, field: &str) -> Result<DMatrix<f64>, NavError> {
+    let s = a.shape();
+    let v = a.as_array();
+    if let Some(((i, j), x)) = v.indexed_iter().find(|(_, x)| !x.is_finite()) {
+        return Err(invalid_at(field, i, format!("non-finite value {x} at index ({i}, {j})")));
+    }
+    Ok(DMatrix::from_fn(s[0], s[1], |i, j| v[(i, j)]))
+}
+
+/// Any nalgebra matrix as a 2-D numpy array (row-major copy).
+pub fn mat_to_py<'py, R: Dim, C: Dim, S: RawStorage<f64, R, C>>(py: Python<'py>, m: &Matrix<f64, R, C, S>) -> Bound<'py, PyArray2<f64>> {
+    Array2::from_shape_fn((m.nrows(), m.ncols()), |(i, j)| m[(i, j)]).into_pyarray(py)
 }
 
 /// The rows of an (N, W) float array, checked for shape and NaN/inf.
@@ -35,7 +108,7 @@ pub fn rows<const W: usize>(a: &PyReadonlyArray2<'_, f64>, field: &str) -> Resul
                 let mut r = [0.0; W];
                 for (j, x) in row.iter().enumerate() {
                     if !x.is_finite() {
-                        return Err(invalid(field, format!("non-finite value {x} at index {i} (column {j})")));
+                        return Err(invalid_at(field, i, format!("non-finite value {x} at index {i} (column {j})")));
                     }
                     r[j] = *x;
                 }

@@ -1,6 +1,6 @@
 //! Bindings of earth.rs, vectorised over rows; every function takes an ellipsoid name.
 
-use super::convert::{rows, to_py_rows, vec3, vec3_rows, vec3_to_py};
+use super::convert::{Wrap, rows, to_py_rows, vec3, vec3_rows, vec3_to_py};
 use crate::earth::{check_latitude, dcm_ned_to_ecef, Ellipsoid};
 use crate::math::Vec3;
 use numpy::{PyArray2, PyReadonlyArray1, PyReadonlyArray2};
@@ -15,25 +15,25 @@ fn lla_rows(a: &PyReadonlyArray2<'_, f64>, field: &str) -> PyResult<Vec<Vec3>> {
 }
 
 #[pyfunction]
-#[pyo3(signature = (lla, ellipsoid="WGS84"))]
-fn lla_to_ecef_rows<'py>(py: Python<'py>, lla: PyReadonlyArray2<'py, f64>, ellipsoid: &str) -> PyResult<Bound<'py, PyArray2<f64>>> {
-    let e = Ellipsoid::by_name(ellipsoid)?;
+#[pyo3(signature = (lla, ellipsoid=Wrap(crate::earth::WGS84)))]
+fn lla_to_ecef_rows<'py>(py: Python<'py>, lla: PyReadonlyArray2<'py, f64>, ellipsoid: Wrap<Ellipsoid>) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    let e = ellipsoid.0;
     let p = lla_rows(&lla, "lla")?;
     Ok(vec3_to_py(py, &p.iter().map(|x| e.lla_to_ecef(x)).collect::<Vec<_>>()))
 }
 
 #[pyfunction]
-#[pyo3(signature = (ecef, ellipsoid="WGS84"))]
-fn ecef_to_lla_rows<'py>(py: Python<'py>, ecef: PyReadonlyArray2<'py, f64>, ellipsoid: &str) -> PyResult<Bound<'py, PyArray2<f64>>> {
-    let e = Ellipsoid::by_name(ellipsoid)?;
+#[pyo3(signature = (ecef, ellipsoid=Wrap(crate::earth::WGS84)))]
+fn ecef_to_lla_rows<'py>(py: Python<'py>, ecef: PyReadonlyArray2<'py, f64>, ellipsoid: Wrap<Ellipsoid>) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    let e = ellipsoid.0;
     let r = vec3_rows(&ecef, "ecef")?;
     Ok(vec3_to_py(py, &r.iter().map(|x| e.ecef_to_lla(x)).collect::<Vec<_>>()))
 }
 
 #[pyfunction]
-#[pyo3(signature = (ecef, origin_lla, ellipsoid="WGS84"))]
-fn ecef_to_ned_rows<'py>(py: Python<'py>, ecef: PyReadonlyArray2<'py, f64>, origin_lla: PyReadonlyArray1<'py, f64>, ellipsoid: &str) -> PyResult<Bound<'py, PyArray2<f64>>> {
-    let e = Ellipsoid::by_name(ellipsoid)?;
+#[pyo3(signature = (ecef, origin_lla, ellipsoid=Wrap(crate::earth::WGS84)))]
+fn ecef_to_ned_rows<'py>(py: Python<'py>, ecef: PyReadonlyArray2<'py, f64>, origin_lla: PyReadonlyArray1<'py, f64>, ellipsoid: Wrap<Ellipsoid>) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    let e = ellipsoid.0;
     let o = vec3(&origin_lla, "origin_lla")?;
     check_latitude("origin_lla", o.x, 0)?;
     let r = vec3_rows(&ecef, "ecef")?;
@@ -41,9 +41,9 @@ fn ecef_to_ned_rows<'py>(py: Python<'py>, ecef: PyReadonlyArray2<'py, f64>, orig
 }
 
 #[pyfunction]
-#[pyo3(signature = (ned, origin_lla, ellipsoid="WGS84"))]
-fn ned_to_ecef_rows<'py>(py: Python<'py>, ned: PyReadonlyArray2<'py, f64>, origin_lla: PyReadonlyArray1<'py, f64>, ellipsoid: &str) -> PyResult<Bound<'py, PyArray2<f64>>> {
-    let e = Ellipsoid::by_name(ellipsoid)?;
+#[pyo3(signature = (ned, origin_lla, ellipsoid=Wrap(crate::earth::WGS84)))]
+fn ned_to_ecef_rows<'py>(py: Python<'py>, ned: PyReadonlyArray2<'py, f64>, origin_lla: PyReadonlyArray1<'py, f64>, ellipsoid: Wrap<Ellipsoid>) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    let e = ellipsoid.0;
     let o = vec3(&origin_lla, "origin_lla")?;
     check_latitude("origin_lla", o.x, 0)?;
     let r = vec3_rows(&ned, "ned")?;
@@ -52,9 +52,9 @@ fn ned_to_ecef_rows<'py>(py: Python<'py>, ned: PyReadonlyArray2<'py, f64>, origi
 
 /// Per row of (lat, lon, h): [M, N, gravity γ, ∂γ/∂φ, Schuler ω_s].
 #[pyfunction]
-#[pyo3(signature = (lla, ellipsoid="WGS84"))]
-fn earth_params_rows<'py>(py: Python<'py>, lla: PyReadonlyArray2<'py, f64>, ellipsoid: &str) -> PyResult<Bound<'py, PyArray2<f64>>> {
-    let e = Ellipsoid::by_name(ellipsoid)?;
+#[pyo3(signature = (lla, ellipsoid=Wrap(crate::earth::WGS84)))]
+fn earth_params_rows<'py>(py: Python<'py>, lla: PyReadonlyArray2<'py, f64>, ellipsoid: Wrap<Ellipsoid>) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    let e = ellipsoid.0;
     let p = lla_rows(&lla, "lla")?;
     let out: Vec<[f64; 5]> = p
         .iter()
@@ -68,9 +68,9 @@ fn earth_params_rows<'py>(py: Python<'py>, lla: PyReadonlyArray2<'py, f64>, elli
 
 /// Per row of (lat, lon, h, v_N, v_E, v_D): [ω_ie^n (3), ω_en^n (3)] in rad/s.
 #[pyfunction]
-#[pyo3(signature = (lla_vel, ellipsoid="WGS84"))]
-fn nav_rates_rows<'py>(py: Python<'py>, lla_vel: PyReadonlyArray2<'py, f64>, ellipsoid: &str) -> PyResult<Bound<'py, PyArray2<f64>>> {
-    let e = Ellipsoid::by_name(ellipsoid)?;
+#[pyo3(signature = (lla_vel, ellipsoid=Wrap(crate::earth::WGS84)))]
+fn nav_rates_rows<'py>(py: Python<'py>, lla_vel: PyReadonlyArray2<'py, f64>, ellipsoid: Wrap<Ellipsoid>) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    let e = ellipsoid.0;
     let p = rows::<6>(&lla_vel, "lla_vel")?;
     let mut out = Vec::with_capacity(p.len());
     for (i, r) in p.iter().enumerate() {
@@ -93,8 +93,8 @@ fn dcm_ned_to_ecef_py<'py>(py: Python<'py>, lat: f64, lon: f64) -> PyResult<Boun
 
 /// Ellipsoid constants as a dict (a, f, gm, omega, e2, b, gamma_e, gamma_p).
 #[pyfunction]
-fn ellipsoid_constants(py: Python<'_>, name: &str) -> PyResult<Py<PyAny>> {
-    let e = Ellipsoid::by_name(name)?;
+fn ellipsoid_constants(py: Python<'_>, name: Wrap<Ellipsoid>) -> PyResult<Py<PyAny>> {
+    let e = name.0;
     let (ge, gp) = (e.gamma_e, e.gamma_p);
     let d = pyo3::types::PyDict::new(py);
     for (k, v) in [("a", e.a), ("f", e.f), ("gm", e.gm), ("omega", e.omega), ("e2", e.e2()), ("b", e.b()), ("gamma_e", ge), ("gamma_p", gp)] {

@@ -1,6 +1,6 @@
 //! Bindings of filter/: Riccati analysis, discretisation, the error-state Kalman filter.
 
-use super::convert::{quat_rows, vec3_rows, vector};
+use super::convert::{Wrap, mat, mat_to_py, quat_rows, vec3_rows, vector};
 use crate::earth::Ellipsoid;
 use crate::error::{invalid, NavError};
 use crate::filter::aided::{AidedConfig, AidedIns, AidedOutput, Aiding, PositionAiding, PositionFix};
@@ -10,27 +10,12 @@ use crate::filter::ins::{error_dynamics, BaroModel, BiasModel, InsNoise};
 use crate::filter::kf::{rts as core_rts, Kf, LoopMode, StoredStep};
 use crate::filter::layout::Layout;
 use crate::filter::riccati;
+use crate::imu::ImuKind;
 use crate::strapdown::NavState;
 use nalgebra::{DMatrix, DVector};
 use numpy::ndarray::{Array2, Array3};
 use numpy::{IntoPyArray, PyArray1, PyArray2, PyArray3, PyReadonlyArray1, PyReadonlyArray2, PyReadonlyArray3, PyUntypedArrayMethods};
 use pyo3::prelude::*;
-
-/// A 2-D float array as a DMatrix, checked for NaN/inf (names the first bad entry).
-pub fn mat(a: &PyReadonlyArray2<'_, f64>, field: &str) -> Result<DMatrix<f64>, NavError> {
-    let s = a.shape();
-    let v = a.as_array();
-    for ((i, j), x) in v.indexed_iter() {
-        if !x.is_finite() {
-            return Err(invalid(field, format!("non-finite value {x} at index ({i}, {j})")));
-        }
-    }
-    Ok(DMatrix::from_fn(s[0], s[1], |i, j| v[(i, j)]))
-}
-
-pub fn mat_to_py<'py>(py: Python<'py>, m: &DMatrix<f64>) -> Bound<'py, PyArray2<f64>> {
-    Array2::from_shape_fn((m.nrows(), m.ncols()), |(i, j)| m[(i, j)]).into_pyarray(py)
-}
 
 fn stack_to_py<'py>(py: Python<'py>, ms: &[DMatrix<f64>], n: usize) -> Bound<'py, PyArray3<f64>> {
     Array3::from_shape_fn((ms.len(), n, n), |(k, i, j)| ms[k][(i, j)]).into_pyarray(py)
@@ -142,7 +127,7 @@ fn discretize_model<'py>(
 /// Continuous INS error model (spec gnss-ins-tight Eq. 28) along a trajectory:
 /// (F, Q_c) stacks of shape (N, n, n) for the layout `blocks`.
 #[pyfunction]
-#[pyo3(signature = (blocks, lla, vel_ned, q_nb, f_b, accel_psd, gyro_psd, accel_bias, gyro_bias, ellipsoid="WGS84"))]
+#[pyo3(signature = (blocks, lla, vel_ned, q_nb, f_b, accel_psd, gyro_psd, accel_bias, gyro_bias, ellipsoid=Wrap(crate::earth::WGS84)))]
 #[allow(clippy::too_many_arguments, clippy::type_complexity)]
 fn ins_error_dynamics<'py>(
     py: Python<'py>,
@@ -155,10 +140,10 @@ fn ins_error_dynamics<'py>(
     gyro_psd: f64,
     accel_bias: (String, f64, f64),
     gyro_bias: (String, f64, f64),
-    ellipsoid: &str,
+    ellipsoid: Wrap<Ellipsoid>,
 ) -> PyResult<(Bound<'py, PyArray3<f64>>, Bound<'py, PyArray3<f64>>)> {
     let layout = blocks_of(blocks)?;
-    let ell = Ellipsoid::by_name(ellipsoid)?;
+    let ell = ellipsoid.0;
     let (lla, vel, q, fb) = (vec3_rows(&lla, "lla")?, vec3_rows(&vel_ned, "vel_ned")?, quat_rows(&q_nb, "q_nb")?, vec3_rows(&f_b, "f_b")?);
     let n = lla.len();
     for (name, len) in [("vel_ned", vel.len()), ("q_nb", q.len()), ("f_b", fb.len())] {
@@ -393,14 +378,14 @@ impl AidedSetup {
     /// bias state `baro_bias` = (model, p1, p2) as for the IMU biases with initial σ
     /// `baro_bias_sigma0` (m).
     #[new]
-    #[pyo3(signature = (t0, lla0, vel0, q0, kind, ba0, bg0, p0, accel_psd, gyro_psd, accel_bias, gyro_bias, predict_every, method, mode, sequential=false, gate=None, ellipsoid="WGS84", vertical="free", zeta=0.707, omega=0.01, baro_psd=0.0, baro_bias=None, baro_bias_sigma0=None))]
+    #[pyo3(signature = (t0, lla0, vel0, q0, kind, ba0, bg0, p0, accel_psd, gyro_psd, accel_bias, gyro_bias, predict_every, method, mode, sequential=false, gate=None, ellipsoid=Wrap(crate::earth::WGS84), vertical="free", zeta=0.707, omega=0.01, baro_psd=0.0, baro_bias=None, baro_bias_sigma0=None))]
     #[allow(clippy::too_many_arguments)]
     fn new(
         t0: f64,
         lla0: PyReadonlyArray1<'_, f64>,
         vel0: PyReadonlyArray1<'_, f64>,
         q0: PyReadonlyArray1<'_, f64>,
-        kind: &str,
+        kind: Wrap<ImuKind>,
         ba0: PyReadonlyArray1<'_, f64>,
         bg0: PyReadonlyArray1<'_, f64>,
         p0: PyReadonlyArray2<'_, f64>,
@@ -413,7 +398,7 @@ impl AidedSetup {
         mode: &str,
         sequential: bool,
         gate: Option<f64>,
-        ellipsoid: &str,
+        ellipsoid: Wrap<Ellipsoid>,
         vertical: &str,
         zeta: f64,
         omega: f64,
@@ -442,8 +427,8 @@ impl AidedSetup {
         };
         Ok(AidedSetup {
             initial,
-            kind: crate::imu::ImuKind::parse(kind)?,
-            ell: Ellipsoid::by_name(ellipsoid)?,
+            kind: kind.0,
+            ell: ellipsoid.0,
             ba0: vec3(&ba0, "ba0")?,
             bg0: vec3(&bg0, "bg0")?,
             p0: mat(&p0, "p0")?,

@@ -1,7 +1,7 @@
 //! Bindings of gnss/: broadcast ephemerides, the constellation simulator, observation
 //! simulation and single-point positioning, over numpy arrays.
 
-use super::convert::{rows, rows_to_py, vec3_rows, vector};
+use super::convert::{Wrap, rows, rows_to_py, vec3_rows, vector};
 use crate::earth::Helmert;
 use crate::error::invalid;
 use crate::gnss::atmosphere::Klobuchar;
@@ -68,8 +68,8 @@ pub(crate) fn parse_obs(sats: &[String], channel: &PyReadonlyArray1<'_, i64>, co
 #[pymethods]
 impl PyEphemerides {
     #[new]
-    #[pyo3(signature = (gps, glonass, n_leap=18.0, datum="identity"))]
-    fn new(gps: PyReadonlyArray2<'_, f64>, glonass: PyReadonlyArray2<'_, f64>, n_leap: f64, datum: &str) -> PyResult<Self> {
+    #[pyo3(signature = (gps, glonass, n_leap=18.0, datum=Wrap(Helmert::IDENTITY)))]
+    fn new(gps: PyReadonlyArray2<'_, f64>, glonass: PyReadonlyArray2<'_, f64>, n_leap: f64, datum: Wrap<Helmert>) -> PyResult<Self> {
         let g = rows::<22>(&gps, "gps")?.iter().map(gps_row).collect();
         let mut r = Vec::new();
         for (i, x) in rows::<14>(&glonass, "glonass")?.iter().enumerate() {
@@ -84,7 +84,7 @@ impl PyEphemerides {
                 gamma_n: x[13],
             });
         }
-        Ok(PyEphemerides { inner: Ephemerides::new(g, r, TimeScales { n_leap }, Helmert::by_name(datum)?)? })
+        Ok(PyEphemerides { inner: Ephemerides::new(g, r, TimeScales { n_leap }, datum.0)? })
     }
 
     /// The nominal constellations over GPS times [t_start, t_end] (spec §2.5).

@@ -1,7 +1,7 @@
 //! Bindings of imu::{errors, noise, presets}: the error-model parameters travel as one dict
 //! per triad (keys of `TRIAD_KEYS`), the IMU stream as whole (N, 3) arrays.
 
-use super::convert::{vec3_rows, vec3_to_py};
+use super::convert::{Wrap, vec3_rows, vec3_to_py};
 use crate::error::invalid;
 use crate::imu::errors::{FlickerSpec, GaussMarkovSpec, ImuErrorModel, ImuSimulator, TriadErrors};
 use crate::imu::noise;
@@ -93,9 +93,9 @@ struct ImuErrorSimulator {
 #[pymethods]
 impl ImuErrorSimulator {
     #[new]
-    fn new(accel: &Bound<'_, PyDict>, gyro: &Bound<'_, PyDict>, dt: f64, kind: &str, seed: u64) -> PyResult<Self> {
+    fn new(accel: &Bound<'_, PyDict>, gyro: &Bound<'_, PyDict>, dt: f64, kind: Wrap<ImuKind>, seed: u64) -> PyResult<Self> {
         let model = ImuErrorModel { accel: triad_from_dict(accel, "accel")?, gyro: triad_from_dict(gyro, "gyro")? };
-        Ok(Self { sim: ImuSimulator::new(&model, dt, ImuKind::parse(kind)?, seed)? })
+        Ok(Self { sim: ImuSimulator::new(&model, dt, kind.0, seed)? })
     }
 
     /// (accel measured, gyro measured, accel bias truth, gyro bias truth), each (N, 3).
@@ -114,13 +114,13 @@ impl ImuErrorSimulator {
 }
 
 #[pyfunction]
-fn imu_white_sigma(density: f64, dt: f64, kind: &str) -> PyResult<f64> {
-    Ok(noise::white_sigma(density, dt, ImuKind::parse(kind)?)?)
+fn imu_white_sigma(density: f64, dt: f64, kind: Wrap<ImuKind>) -> PyResult<f64> {
+    Ok(noise::white_sigma(density, dt, kind.0)?)
 }
 
 #[pyfunction]
-fn imu_white_density(sigma: f64, dt: f64, kind: &str) -> PyResult<f64> {
-    Ok(noise::white_density(sigma, dt, ImuKind::parse(kind)?)?)
+fn imu_white_density(sigma: f64, dt: f64, kind: Wrap<ImuKind>) -> PyResult<f64> {
+    Ok(noise::white_density(sigma, dt, kind.0)?)
 }
 
 #[pyfunction]

@@ -16,6 +16,13 @@ mod trajectory;
 
 pyo3::create_exception!(
     _core,
+    InputError,
+    pyo3::exceptions::PyValueError,
+    "An invalid argument. `parameter` names it; for array input `index` is the first offending row (None otherwise)."
+);
+
+pyo3::create_exception!(
+    _core,
     NumericalError,
     pyo3::exceptions::PyArithmeticError,
     "A computation failed on valid input (covariance lost positive definiteness, divergence)."
@@ -39,7 +46,15 @@ fn unit_constants(py: Python<'_>) -> PyResult<Py<PyAny>> {
 
 #[pymodule]
 fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    let input_error = m.py().get_type::<InputError>();
+    input_error.setattr("parameter", m.py().None())?;
+    input_error.setattr("index", m.py().None())?;
+    m.add("InputError", input_error)?;
     m.add("NumericalError", m.py().get_type::<NumericalError>())?;
+    m.add("OPTIONS", pyo3::types::PyDict::new(m.py()))?;
+    convert::register_choices::<crate::earth::Ellipsoid>(m, "Ellipsoid")?;
+    convert::register_choices::<crate::earth::Helmert>(m, "Helmert")?;
+    convert::register_choices::<crate::imu::ImuKind>(m, "ImuKind")?;
     m.add_function(wrap_pyfunction!(unit_constants, m)?)?;
     rotation::register(m)?;
     astro::register(m)?;

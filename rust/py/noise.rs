@@ -1,7 +1,7 @@
 //! Bindings of noise/: Allan family (batch, streaming, EDF, five-term fit), NNLS, ARIMA
 //! state space and the Kalman filters (batch, streaming, steady state).
 
-use super::convert::{vec_to_py, vector};
+use super::convert::{mat_to_py, vec_to_py, vector};
 use crate::error::invalid;
 use crate::noise::allan::{self, AllanResult, AllanStream, DataType, Kind, NoiseType, TauSet};
 use crate::noise::arma_filter::{self, ArimaStateSpace, FilterOutput, Kalman, NoiseForm, RMode, X0};
@@ -26,10 +26,6 @@ fn tau_set(set: &str, m: Option<Vec<usize>>) -> PyResult<TauSet> {
 
 fn result_to_py<'py>(py: Python<'py>, r: AllanResult) -> (Bound<'py, PyArray1<usize>>, Arr<'py>, Arr<'py>, Bound<'py, PyArray1<usize>>) {
     (r.m.into_pyarray(py), r.tau.into_pyarray(py), r.var.into_pyarray(py), r.n.into_pyarray(py))
-}
-
-fn mat_to_py<'py>(py: Python<'py>, m: &DMatrix<f64>) -> Bound<'py, PyArray2<f64>> {
-    Array2::from_shape_fn((m.nrows(), m.ncols()), |(i, j)| m[(i, j)]).into_pyarray(py)
 }
 
 /// Allan-family variance: returns (m, tau_s, var, n_terms).

@@ -1,6 +1,6 @@
 //! Bindings of strapdown.rs: a streaming mechanization object and attitude integration.
 
-use super::convert::{flat_to_py, quat_rows, quat_to_py, vec3, vec3_rows, vector};
+use super::convert::{Wrap, flat_to_py, quat_rows, quat_to_py, vec3, vec3_rows, vector};
 use crate::earth::Ellipsoid;
 use crate::error::{invalid, NavError};
 use crate::math::{euler_from_quat, quat, Vec3};
@@ -267,15 +267,15 @@ impl Strapdown {
     /// "rates" or "increments"; vertical "free" or "damped" (baro loop with damping ratio
     /// `zeta` and natural frequency `omega` rad/s).
     #[new]
-    #[pyo3(signature = (t0, lla, vel_ned, q_nb, kind, ellipsoid="WGS84", vertical="free", zeta=0.707, omega=0.01))]
+    #[pyo3(signature = (t0, lla, vel_ned, q_nb, kind, ellipsoid=Wrap(crate::earth::WGS84), vertical="free", zeta=0.707, omega=0.01))]
     #[allow(clippy::too_many_arguments)]
     fn new(
         t0: f64,
         lla: PyReadonlyArray1<'_, f64>,
         vel_ned: PyReadonlyArray1<'_, f64>,
         q_nb: PyReadonlyArray1<'_, f64>,
-        kind: &str,
-        ellipsoid: &str,
+        kind: Wrap<ImuKind>,
+        ellipsoid: Wrap<Ellipsoid>,
         vertical: &str,
         zeta: f64,
         omega: f64,
@@ -290,7 +290,7 @@ impl Strapdown {
             other => return Err(invalid("vertical", format!("unknown option '{other}' (known: 'free', 'damped')")).into()),
         };
         let init = NavState { t: t0, lla: vec3(&lla, "lla")?, vel: vec3(&vel_ned, "vel_ned")?, q_nb: quat(q[0], q[1], q[2], q[3]) };
-        Ok(Strapdown { inner: Core::new(init, ImuKind::parse(kind)?, Ellipsoid::by_name(ellipsoid)?, vertical)? })
+        Ok(Strapdown { inner: Core::new(init, kind.0, ellipsoid.0, vertical)? })
     }
 
     /// Integrate one chunk; returns the state after each sample as a (14, N) column table.

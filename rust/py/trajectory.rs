@@ -1,9 +1,10 @@
 //! Bindings of trajectory/ (motion models and generators) and imu::ideal.
 
-use super::convert::{quat_to_py, vec3, vec3_to_py, vec_to_py, vector};
+use super::convert::{Wrap, quat_to_py, vec3, vec3_to_py, vec_to_py, vector};
 use crate::earth::{check_latitude, Ellipsoid};
 use crate::error::invalid;
 use crate::imu::ideal::{ideal_increments, ideal_rates};
+use crate::imu::ImuKind;
 use crate::math::Vec3;
 use crate::trajectory::{generators, Motion as CoreMotion};
 use numpy::{PyReadonlyArray1, PyReadonlyArray2};
@@ -115,9 +116,9 @@ impl Motion {
 
     /// Truth at `times` (s, increasing, within [0, duration]): dict of arrays
     /// time, lla (N,3), vel_ned (N,3), acc_ned (N,3), q_nb (N,4), w_nb_b (N,3).
-    #[pyo3(signature = (times, ellipsoid="WGS84"))]
-    fn truth<'py>(&self, py: Python<'py>, times: PyReadonlyArray1<'py, f64>, ellipsoid: &str) -> PyResult<Bound<'py, PyDict>> {
-        let ell = Ellipsoid::by_name(ellipsoid)?;
+    #[pyo3(signature = (times, ellipsoid=Wrap(crate::earth::WGS84)))]
+    fn truth<'py>(&self, py: Python<'py>, times: PyReadonlyArray1<'py, f64>, ellipsoid: Wrap<Ellipsoid>) -> PyResult<Bound<'py, PyDict>> {
+        let ell = ellipsoid.0;
         let t = vector(&times, "times")?;
         let truth = py.detach(|| self.inner.truth(&ell, &t))?;
         let d = PyDict::new(py);
@@ -133,10 +134,10 @@ impl Motion {
     /// Error-free IMU output at `times`. kind "rates": gyro (rad/s), accel (m/s²) and
     /// angular acceleration (rad/s²) at each time; kind "increments": dtheta (rad), dv (m/s)
     /// over each interval (t_{k−1}, t_k], N − 1 rows.
-    #[pyo3(signature = (times, kind, ellipsoid="WGS84"))]
-    fn ideal_imu<'py>(&self, py: Python<'py>, times: PyReadonlyArray1<'py, f64>, kind: &str, ellipsoid: &str) -> PyResult<Bound<'py, PyDict>> {
-        let ell = Ellipsoid::by_name(ellipsoid)?;
-        let kind = crate::strapdown::ImuKind::parse(kind)?;
+    #[pyo3(signature = (times, kind, ellipsoid=Wrap(crate::earth::WGS84)))]
+    fn ideal_imu<'py>(&self, py: Python<'py>, times: PyReadonlyArray1<'py, f64>, kind: Wrap<ImuKind>, ellipsoid: Wrap<Ellipsoid>) -> PyResult<Bound<'py, PyDict>> {
+        let ell = ellipsoid.0;
+        let kind = kind.0;
         let t = vector(&times, "times")?;
         let d = PyDict::new(py);
         match kind {
