@@ -1,77 +1,23 @@
-//! Bindings of filter/: Riccati analysis, discretisation, the error-state Kalman filter.
+//! Bindings of filter/: state layouts, the INS error model and the aided INS (the linear
+//! Kalman machinery is bound in kalman.rs).
 
-use super::convert::{Wrap, mat, mat_to_py, quat_rows, vec3_rows, vector};
+use super::convert::{Wrap, mat, quat_rows, vec3_rows, vector};
 use crate::earth::Ellipsoid;
 use crate::error::{invalid, NavError};
 use crate::filter::aided::{AidedConfig, AidedIns, AidedOutput, Aiding, PositionAiding, PositionFix};
-use crate::filter::analysis::Scenario as CoreScenario;
-use crate::filter::discretize::{discretize, Discretization};
+use crate::filter::discretize::Discretization;
 use crate::filter::ins::{error_dynamics, BaroModel, BiasModel, InsNoise};
-use crate::filter::kf::{rts as core_rts, Kf, LoopMode, StoredStep};
+use crate::filter::kf::LoopMode;
 use crate::filter::layout::Layout;
-use crate::filter::riccati;
 use crate::imu::ImuKind;
 use crate::strapdown::NavState;
 use nalgebra::{DMatrix, DVector};
-use numpy::ndarray::{Array2, Array3};
-use numpy::{IntoPyArray, PyArray1, PyArray2, PyArray3, PyReadonlyArray1, PyReadonlyArray2, PyReadonlyArray3, PyUntypedArrayMethods};
+use numpy::ndarray::Array3;
+use numpy::{IntoPyArray, PyArray3, PyReadonlyArray1, PyReadonlyArray2, PyReadonlyArray3, PyUntypedArrayMethods};
 use pyo3::prelude::*;
 
-fn stack_to_py<'py>(py: Python<'py>, ms: &[DMatrix<f64>], n: usize) -> Bound<'py, PyArray3<f64>> {
+pub(crate) fn stack_to_py<'py>(py: Python<'py>, ms: &[DMatrix<f64>], n: usize) -> Bound<'py, PyArray3<f64>> {
     Array3::from_shape_fn((ms.len(), n, n), |(k, i, j)| ms[k][(i, j)]).into_pyarray(py)
-}
-
-/// Filter-form DARE (a-priori P⁻, a-posteriori P⁺, gain K, doubling iterations).
-#[pyfunction]
-#[allow(clippy::type_complexity)]
-fn dare<'py>(
-    py: Python<'py>,
-    phi: PyReadonlyArray2<'py, f64>,
-    q: PyReadonlyArray2<'py, f64>,
-    h: PyReadonlyArray2<'py, f64>,
-    r: PyReadonlyArray2<'py, f64>,
-) -> PyResult<(Bound<'py, PyArray2<f64>>, Bound<'py, PyArray2<f64>>, Bound<'py, PyArray2<f64>>, usize)> {
-    let (phi, q, h, r) = (mat(&phi, "phi")?, mat(&q, "q")?, mat(&h, "h")?, mat(&r, "r")?);
-    let s = py.detach(|| riccati::dare(&phi, &q, &h, &r))?;
-    Ok((mat_to_py(py, &s.p_prior), mat_to_py(py, &s.p_post), mat_to_py(py, &s.gain), s.iterations))
-}
-
-/// Scalar closed forms for Φ = 1 (seed 000 Eqs. 32–35): (P⁻, P⁺).
-#[pyfunction]
-fn riccati_scalar(q: f64, r: f64, h: f64) -> PyResult<(f64, f64)> {
-    for (name, x) in [("q", q), ("r", r), ("h", h)] {
-        if !x.is_finite() {
-            return Err(invalid(name, format!("must be finite, got {x}")).into());
-        }
-    }
-    if q < 0.0 {
-        return Err(invalid("q", format!("must be >= 0, got {q}")).into());
-    }
-    if r <= 0.0 {
-        return Err(invalid("r", format!("must be > 0, got {r}")).into());
-    }
-    if h == 0.0 {
-        return Err(invalid("h", "must be non-zero (an unobserved random walk has no steady state)").into());
-    }
-    Ok((riccati::scalar_prior(q, r, h), riccati::scalar_posterior(q, r, h)))
-}
-
-/// Kalman covariance recursion from P⁻₀: (steps, n, n) a-priori and a-posteriori stacks.
-#[pyfunction]
-#[allow(clippy::type_complexity)]
-fn kalman_recursion<'py>(
-    py: Python<'py>,
-    phi: PyReadonlyArray2<'py, f64>,
-    q: PyReadonlyArray2<'py, f64>,
-    h: PyReadonlyArray2<'py, f64>,
-    r: PyReadonlyArray2<'py, f64>,
-    p0: PyReadonlyArray2<'py, f64>,
-    steps: usize,
-) -> PyResult<(Bound<'py, PyArray3<f64>>, Bound<'py, PyArray3<f64>>)> {
-    let (phi, q, h, r, p0) = (mat(&phi, "phi")?, mat(&q, "q")?, mat(&h, "h")?, mat(&r, "r")?, mat(&p0, "p0")?);
-    let (prior, post) = py.detach(|| riccati::recursion(&phi, &q, &h, &r, &p0, steps))?;
-    let n = phi.nrows();
-    Ok((stack_to_py(py, &prior, n), stack_to_py(py, &post, n)))
 }
 
 /// A stack (N, r, c) as N matrices, checked for NaN/inf.
@@ -84,15 +30,6 @@ pub(crate) fn mats(a: &PyReadonlyArray3<'_, f64>, field: &str) -> Result<Vec<DMa
     Ok((0..s[0]).map(|k| DMatrix::from_fn(s[1], s[2], |i, j| v[(k, i, j)])).collect())
 }
 
-fn rows_mat(a: &PyReadonlyArray2<'_, f64>, field: &str) -> Result<Vec<DVector<f64>>, NavError> {
-    let m = mat(a, field)?;
-    Ok((0..m.nrows()).map(|k| m.row(k).transpose()).collect())
-}
-
-fn vecs_to_py<'py>(py: Python<'py>, v: &[DVector<f64>], n: usize) -> Bound<'py, PyArray2<f64>> {
-    Array2::from_shape_fn((v.len(), n), |(k, i)| v[k][i]).into_pyarray(py)
-}
-
 fn blocks_of(blocks: Vec<(String, Option<usize>)>) -> Result<Layout, NavError> {
     Layout::new(&blocks)
 }
@@ -102,26 +39,6 @@ fn blocks_of(blocks: Vec<(String, Option<usize>)>) -> Result<Layout, NavError> {
 fn layout_ranges(blocks: Vec<(String, Option<usize>)>) -> PyResult<Vec<(String, usize, usize)>> {
     let l = blocks_of(blocks)?;
     Ok(l.blocks().iter().map(|(n, r)| (n.clone(), r.start, r.end)).collect())
-}
-
-/// Van Loan (or first-order) discretisation: (Φ, Q_d).
-#[pyfunction]
-#[allow(clippy::type_complexity)]
-fn discretize_model<'py>(
-    py: Python<'py>,
-    f: PyReadonlyArray2<'py, f64>,
-    qc: PyReadonlyArray2<'py, f64>,
-    dt: f64,
-    method: &str,
-) -> PyResult<(Bound<'py, PyArray2<f64>>, Bound<'py, PyArray2<f64>>)> {
-    let method = Discretization::by_name(method)?;
-    let f = mat(&f, "f")?;
-    crate::filter::matrix::check_square("f", &f, None)?;
-    let qc = mat(&qc, "qc")?;
-    crate::filter::matrix::check_covariance("qc", &qc, Some(f.nrows()), false)?;
-    crate::error::check_positive("dt", dt)?;
-    let (phi, qd) = discretize(&f, &qc, dt, method);
-    Ok((mat_to_py(py, &phi), mat_to_py(py, &qd)))
 }
 
 /// Continuous INS error model (spec gnss-ins-tight Eq. 28) along a trajectory:
@@ -175,172 +92,6 @@ fn ins_error_dynamics<'py>(
     let f: Vec<_> = out.iter().map(|x| x.0.clone()).collect();
     let qc: Vec<_> = out.iter().map(|x| x.1.clone()).collect();
     Ok((stack_to_py(py, &f, m), stack_to_py(py, &qc, m)))
-}
-
-/// Error-state Kalman filter (closed or open loop), streaming one call per step.
-#[pyclass(module = "atomnav._core")]
-pub struct KalmanFilter {
-    inner: Kf,
-}
-
-#[pymethods]
-impl KalmanFilter {
-    #[new]
-    fn new(p0: PyReadonlyArray2<'_, f64>, mode: &str) -> PyResult<Self> {
-        Ok(KalmanFilter { inner: Kf::new(mat(&p0, "p0")?, LoopMode::by_name(mode)?)? })
-    }
-
-    fn predict(&mut self, phi: PyReadonlyArray2<'_, f64>, qd: PyReadonlyArray2<'_, f64>) -> PyResult<()> {
-        let (phi, qd) = (mat(&phi, "phi")?, mat(&qd, "qd")?);
-        crate::filter::matrix::check_covariance("qd", &qd, Some(self.inner.size()), false)?;
-        Ok(self.inner.predict(&phi, &qd)?)
-    }
-
-    /// `steps` predictions with the same (Φ, Q_d) in one call (the multirate / benchmark path).
-    fn predict_many(&mut self, py: Python<'_>, phi: PyReadonlyArray2<'_, f64>, qd: PyReadonlyArray2<'_, f64>, steps: usize) -> PyResult<()> {
-        let (phi, qd) = (mat(&phi, "phi")?, mat(&qd, "qd")?);
-        crate::filter::matrix::check_square("phi", &phi, Some(self.inner.size()))?;
-        crate::filter::matrix::check_covariance("qd", &qd, Some(self.inner.size()), false)?;
-        let kf = &mut self.inner;
-        py.detach(|| (0..steps).try_for_each(|_| kf.predict_unchecked(&phi, &qd)))?;
-        Ok(())
-    }
-
-    /// Returns (innovation, nis, rejected rows).
-    #[pyo3(signature = (z, h, r, sequential=false, gate=None))]
-    #[allow(clippy::type_complexity)]
-    fn update<'py>(
-        &mut self,
-        py: Python<'py>,
-        z: PyReadonlyArray1<'py, f64>,
-        h: PyReadonlyArray2<'py, f64>,
-        r: PyReadonlyArray2<'py, f64>,
-        sequential: bool,
-        gate: Option<f64>,
-    ) -> PyResult<(Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<f64>>, Vec<usize>)> {
-        let z = vector(&z, "z")?;
-        let rep = self.inner.update(&z, &mat(&h, "h")?, &mat(&r, "r")?, sequential, gate)?;
-        Ok((rep.innovation.into_pyarray(py), rep.nis.into_pyarray(py), rep.rejected))
-    }
-
-    /// Closed loop: returns δx̂ and resets it to 0; open loop: returns δx̂.
-    fn take_correction<'py>(&mut self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
-        self.inner.take_correction().as_slice().to_vec().into_pyarray(py)
-    }
-
-    #[getter]
-    fn x<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
-        self.inner.x.as_slice().to_vec().into_pyarray(py)
-    }
-
-    #[getter]
-    fn p<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
-        mat_to_py(py, &self.inner.p)
-    }
-
-    #[getter]
-    fn epoch(&self) -> usize {
-        self.inner.epoch
-    }
-}
-
-/// RTS smoother over stored steps: (x_smoothed (N, n), P_smoothed (N, n, n)).
-#[pyfunction]
-#[allow(clippy::type_complexity)]
-fn rts<'py>(
-    py: Python<'py>,
-    phi: PyReadonlyArray3<'py, f64>,
-    x_prior: PyReadonlyArray2<'py, f64>,
-    p_prior: PyReadonlyArray3<'py, f64>,
-    x_post: PyReadonlyArray2<'py, f64>,
-    p_post: PyReadonlyArray3<'py, f64>,
-) -> PyResult<(Bound<'py, PyArray2<f64>>, Bound<'py, PyArray3<f64>>)> {
-    let (phi, pp, ps) = (mats(&phi, "phi")?, mats(&p_prior, "p_prior")?, mats(&p_post, "p_post")?);
-    let (xp, xs) = (rows_mat(&x_prior, "x_prior")?, rows_mat(&x_post, "x_post")?);
-    let n_steps = phi.len();
-    for (name, len) in [("x_prior", xp.len()), ("p_prior", pp.len()), ("x_post", xs.len()), ("p_post", ps.len())] {
-        if len != n_steps {
-            return Err(invalid(name, format!("expected {n_steps} steps like phi, got {len}")).into());
-        }
-    }
-    let n = ps.first().map_or(0, |m| m.nrows());
-    let steps: Vec<StoredStep> = (0..n_steps)
-        .map(|k| StoredStep { phi: phi[k].clone(), x_prior: xp[k].clone(), p_prior: pp[k].clone(), x_post: xs[k].clone(), p_post: ps[k].clone() })
-        .collect();
-    let out = py.detach(|| core_rts(&steps))?;
-    let xs: Vec<DVector<f64>> = out.iter().map(|o| o.0.clone()).collect();
-    let ps: Vec<DMatrix<f64>> = out.into_iter().map(|o| o.1).collect();
-    Ok((vecs_to_py(py, &xs, n), stack_to_py(py, &ps, n)))
-}
-
-/// Linearised scenario: covariance analysis and Monte Carlo (see filter/analysis.rs).
-#[pyclass(module = "atomnav._core")]
-pub struct Scenario {
-    inner: CoreScenario,
-}
-
-#[pymethods]
-impl Scenario {
-    #[new]
-    #[allow(clippy::too_many_arguments)]
-    fn new(
-        py: Python<'_>,
-        f: PyReadonlyArray3<'_, f64>,
-        qc: PyReadonlyArray3<'_, f64>,
-        dt: PyReadonlyArray1<'_, f64>,
-        p0: PyReadonlyArray2<'_, f64>,
-        h: PyReadonlyArray2<'_, f64>,
-        r: PyReadonlyArray2<'_, f64>,
-        measure: Vec<bool>,
-        method: &str,
-        sequential: bool,
-    ) -> PyResult<Self> {
-        let method = Discretization::by_name(method)?;
-        let (f, qc, dt) = (mats(&f, "f")?, mats(&qc, "qc")?, vector(&dt, "dt")?);
-        let (p0, h, r) = (mat(&p0, "p0")?, mat(&h, "h")?, mat(&r, "r")?);
-        let inner = py.detach(|| CoreScenario::new(&f, &qc, &dt, p0, h, r, measure, method, sequential))?;
-        Ok(Scenario { inner })
-    }
-
-    /// σ of every state after each epoch: (epochs, n).
-    fn sigmas<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
-        let n = self.inner.size();
-        let s = py.detach(|| self.inner.sigmas())?;
-        Ok(Array2::from_shape_vec((s.len() / n, n), s).expect("epochs x n").into_pyarray(py))
-    }
-
-    /// σ of the true error of the filter as built when the measurement noise has
-    /// covariance `r_true` and cross-covariance `cross` (steps, n, m) with the process noise
-    /// of the step before each epoch (see filter/analysis.rs): (epochs, n).
-    fn true_sigmas<'py>(&self, py: Python<'py>, r_true: PyReadonlyArray2<'py, f64>, cross: PyReadonlyArray3<'py, f64>) -> PyResult<Bound<'py, PyArray2<f64>>> {
-        let n = self.inner.size();
-        let (r_true, cross) = (mat(&r_true, "r_true")?, mats(&cross, "cross")?);
-        let s = py.detach(|| self.inner.true_sigmas(&r_true, &cross))?;
-        Ok(Array2::from_shape_vec((s.len() / n, n), s).expect("epochs x n").into_pyarray(py))
-    }
-
-    /// Runs `runs` (indices under `master_seed`) on all local cores:
-    /// (error (R, E, n), sigma (R, E, n), nees (R, E), nis (R, E)).
-    #[allow(clippy::type_complexity)]
-    fn monte_carlo<'py>(
-        &self,
-        py: Python<'py>,
-        master_seed: u64,
-        runs: Vec<u64>,
-        mode: &str,
-    ) -> PyResult<(Bound<'py, PyArray3<f64>>, Bound<'py, PyArray3<f64>>, Bound<'py, PyArray2<f64>>, Bound<'py, PyArray2<f64>>)> {
-        let mode = LoopMode::by_name(mode)?;
-        let res = py.detach(|| self.inner.monte_carlo(master_seed, &runs, mode))?;
-        let (nr, ne, n) = (res.len(), self.inner.epochs(), self.inner.size());
-        let cube = |sel: fn(&crate::filter::analysis::RunResult) -> &Vec<f64>| {
-            Array3::from_shape_fn((nr, ne, n), |(a, b, c)| sel(&res[a])[b * n + c])
-        };
-        let err = cube(|r| &r.error).into_pyarray(py);
-        let sig = cube(|r| &r.sigma).into_pyarray(py);
-        let nees = Array2::from_shape_fn((nr, ne), |(a, b)| res[a].nees[b]).into_pyarray(py);
-        let nis = Array2::from_shape_fn((nr, ne), |(a, b)| res[a].nis[b]).into_pyarray(py);
-        Ok((err, sig, nees, nis))
-    }
 }
 
 /// The aided INS (filter/aided.rs) with any aiding sensor, fed chunk by chunk. Built by
@@ -572,17 +323,10 @@ fn position_aided_ins(ins: PyRef<'_, AidedSetup>, fix_t: PyReadonlyArray1<'_, f6
 }
 
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
-    m.add_function(wrap_pyfunction!(dare, m)?)?;
-    m.add_function(wrap_pyfunction!(riccati_scalar, m)?)?;
-    m.add_function(wrap_pyfunction!(kalman_recursion, m)?)?;
     m.add_function(wrap_pyfunction!(layout_ranges, m)?)?;
-    m.add_function(wrap_pyfunction!(discretize_model, m)?)?;
     m.add_function(wrap_pyfunction!(ins_error_dynamics, m)?)?;
-    m.add_function(wrap_pyfunction!(rts, m)?)?;
     m.add_function(wrap_pyfunction!(position_aided_ins, m)?)?;
     m.add_class::<PyAidedIns>()?;
     m.add_class::<AidedSetup>()?;
-    m.add_class::<KalmanFilter>()?;
-    m.add_class::<Scenario>()?;
     Ok(())
 }

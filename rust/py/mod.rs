@@ -9,6 +9,7 @@ mod earth;
 mod filter;
 mod gnss;
 mod imu;
+mod kalman;
 mod noise;
 mod rotation;
 mod strapdown;
@@ -65,6 +66,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     cai::register(m)?;
     noise::register(m)?;
     filter::register(m)?;
+    kalman::register(m)?;
     gnss::register(m)?;
     Ok(())
 }
