@@ -125,10 +125,10 @@ fn discretize_model<'py>(
     Ok((mat_to_py(py, &phi), mat_to_py(py, &qd)))
 }
 
-/// Continuous INS error model (spec gnss-ins-tight Eq. 28) along a trajectory:
+/// Continuous INS error model (Demidov 2009, Eq. 28) along a trajectory:
 /// (F, Q_c) stacks of shape (N, n, n) for the layout `blocks`.
 #[pyfunction]
-#[pyo3(signature = (blocks, lla, vel_ned, q_nb, f_b, accel_psd, gyro_psd, accel_bias, gyro_bias, ellipsoid=Wrap(crate::earth::WGS84)))]
+#[pyo3(signature = (blocks, lla, vel_ned, q_nb, f_b, *, accel_psd, gyro_psd, accel_bias, gyro_bias, ellipsoid=Wrap(crate::earth::WGS84)))]
 #[allow(clippy::too_many_arguments, clippy::type_complexity)]
 fn ins_error_dynamics<'py>(
     py: Python<'py>,
