@@ -27,7 +27,7 @@ def static_case(duration=200.0, rate=100.0, seed=4, mode="closed", chunk_s=60.0)
     fix_lla = np.c_[LAT + ned[:, 0] / rm, LON + ned[:, 1] / (rp * np.cos(LAT)), H - ned[:, 2]]
     p0 = np.diag(np.r_[[1.0] * 3, [0.01] * 3, [1e-8] * 3, [(3e-3) ** 2] * 3, [(1e-7) ** 2] * 3])
     ins = position_aided_ins(0.0, [LAT, LON, H], [0, 0, 0], [1, 0, 0, 0], "rates", fix_t, fix_lla,
-                             np.tile(np.eye(3) * sig**2, (m, 1, 1)), p0, accel_psd=1e-10, gyro_psd=1e-16,
+                             np.tile(np.eye(3) * sig**2, (m, 1, 1)), p0=p0, accel_psd=1e-10, gyro_psd=1e-16,
                              predict_every=10, mode=mode)
     res = ins.run(t, gyro + bg_true, accel + ba_true, chunk_s=chunk_s, progress=False)
     return res.nav, res.measurements, ba_true
@@ -195,7 +195,7 @@ def test_damped_channel_estimates_a_barometer_bias():
     fix_lla = np.c_[LAT + ned[:, 0] / (m_rad + H), LON + ned[:, 1] / ((n_rad + H) * np.cos(LAT)), H - ned[:, 2]]
     p0 = np.diag(np.r_[[1.0] * 3, [0.01] * 3, [1e-8] * 3, [(1e-4) ** 2] * 3, [(1e-7) ** 2] * 3])
     ins = position_aided_ins(0.0, [LAT, LON, H], [0, 0, 0], [1, 0, 0, 0], "rates", fix_t, fix_lla,
-                             np.tile(np.eye(3), (len(fix_t), 1, 1)), p0, accel_psd=1e-10, gyro_psd=1e-16,
+                             np.tile(np.eye(3), (len(fix_t), 1, 1)), p0=p0, accel_psd=1e-10, gyro_psd=1e-16,
                              predict_every=100, vertical="damped", baro_psd=1.0,
                              baro_bias=BiasModel(), baro_bias_sigma0=20.0)
     assert ins.labels[-1] == "baro_bias[0]"
@@ -261,7 +261,7 @@ def test_bad_time_order_names_the_index_in_the_record():
 
 
 def test_bad_vertical_option():
-    with pytest.raises(ValueError, match="vertical: unknown option 'baro'"):
+    with pytest.raises(ValueError, match="vertical: unknown option .baro.; choose one of free, damped"):
         position_aided_ins(**_no_fix_kwargs(vertical="baro"))
 
 

@@ -13,7 +13,8 @@ use crate::filter::aided::{AidedConfig, AidedIns, AidedOutput, Aiding};
 use crate::imu::errors::{ImuErrorModel, ImuSimulator};
 use crate::imu::ideal::ideal_rates;
 use crate::imu::ImuKind;
-use crate::math::{quat_from_rotvec, quat_mul, rotvec_from_quat, Quat, Vec3};
+use crate::filter::initial_error::draw_start;
+use crate::math::{quat_mul, rotvec_from_quat, Quat, Vec3};
 use crate::strapdown::{NavState, Strapdown, Vertical};
 use crate::trajectory::{Motion, TruthState};
 use nalgebra::{DMatrix, DVector};
@@ -153,13 +154,8 @@ impl HybridScenario {
         let n_extra: usize = aiding.extra_blocks().iter().map(|b| b.1).sum();
         let mut initial = state_at(&self.truth[0]);
         if self.draw_initial {
-            // δx = estimate − truth ~ N(0, diag P0): NED position, velocity, ψ with
-            // Ĉ = (I − [ψ×]) C ⇒ q̂ = q(−ψ) ⊗ q
-            let d: Vec<f64> = (0..9).map(|i| { let u: f64 = StandardNormal.sample(&mut rng); u * self.p0[(i, i)].sqrt() }).collect();
-            let loc = self.ell.local(initial.lla.x, initial.lla.z);
-            initial.lla += Vec3::new(d[0] / loc.rm, d[1] / (loc.rp * loc.cos), -d[2]);
-            initial.vel += Vec3::new(d[3], d[4], d[5]);
-            initial.q_nb = quat_mul(&quat_from_rotvec(&-Vec3::new(d[6], d[7], d[8])), &initial.q_nb);
+            // δx = estimate − truth ~ N(0, P0 navigation block)
+            initial = draw_start(&self.ell, &initial, &self.p0, &mut rng)?;
         }
         let mut ins = AidedIns::new(initial, ImuKind::Rates, self.ell, Vec3::zeros(), Vec3::zeros(), DVector::zeros(n_extra), self.p0.clone(), self.filter, aiding)?;
         let (t0, t1) = (self.t[0], self.t[self.t.len() - 1]);

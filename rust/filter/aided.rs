@@ -18,12 +18,14 @@
 
 use super::discretize::{discretize, Discretization};
 use super::ins::{baro_loop_dynamics, error_dynamics, BaroModel, InsNoise};
+use super::initial_error::add_nav_error;
 use super::kf::{Kf, LoopMode};
-use super::layout::{Layout, INS15};
+use super::layout::{ins_size, Layout};
 use crate::earth::Ellipsoid;
 use crate::error::{invalid, NavError, Result};
 use crate::imu::ImuKind;
-use crate::math::{quat_from_rotvec, quat_normalize, Mat3, Vec3};
+use crate::math::{Mat3, Vec3};
+use crate::options::Choice;
 use crate::strapdown::{NavState, Strapdown, Vertical};
 use nalgebra::{DMatrix, DVector};
 
@@ -105,7 +107,7 @@ impl Aiding for Box<dyn Aiding> {
     }
 }
 
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub struct AidedConfig {
     pub noise: InsNoise,
     pub predict_every: usize,
@@ -142,18 +144,127 @@ pub fn ned_diff(ell: &Ellipsoid, a: &Vec3, b: &Vec3) -> Vec3 {
     Vec3::new((a.x - b.x) * loc.rm, (a.y - b.y) * loc.rp * loc.cos, -(a.z - b.z))
 }
 
-/// X ⊖ δx for the navigation blocks: position (NED m), velocity, ψ (Ĉ = (I − [ψ×])C ⇒
-/// C = (I + [ψ×])Ĉ ≈ exp([ψ×])Ĉ).
-fn remove_error(ell: &Ellipsoid, s: &NavState, dx: &DVector<f64>) -> NavState {
-    let loc = ell.local(s.lla.x, s.lla.z);
-    let lla = s.lla - Vec3::new(dx[0] / loc.rm, dx[1] / (loc.rp * loc.cos), -dx[2]);
-    let vel = s.vel - Vec3::new(dx[3], dx[4], dx[5]);
-    let q_nb = quat_normalize(&(quat_from_rotvec(&Vec3::new(dx[6], dx[7], dx[8])) * s.q_nb));
-    NavState { t: s.t, lla, vel, q_nb }
+/// Start index of every INS block in the layout, and the number of INS states (the
+/// index of the first extra block); read once from the layout.
+#[derive(Debug, Clone, Copy)]
+struct InsIndex {
+    position: usize,
+    velocity: usize,
+    attitude: usize,
+    accel_bias: usize,
+    gyro_bias: usize,
+    n: usize,
+}
+
+impl InsIndex {
+    fn of(layout: &Layout) -> Result<InsIndex> {
+        Ok(InsIndex {
+            position: layout.range("position")?.start,
+            velocity: layout.range("velocity")?.start,
+            attitude: layout.range("attitude")?.start,
+            accel_bias: layout.range("accel_bias")?.start,
+            gyro_bias: layout.range("gyro_bias")?.start,
+            n: ins_size(),
+        })
+    }
+
+    /// X ⊖ δx for the navigation blocks: position (NED m), velocity, ψ (Ĉ = (I − [ψ×])C ⇒
+    /// C = (I + [ψ×])Ĉ ≈ exp([ψ×])Ĉ).
+    fn remove_error(&self, ell: &Ellipsoid, s: &NavState, dx: &DVector<f64>) -> NavState {
+        add_nav_error(ell, s, &-block(dx, self.position), &-block(dx, self.velocity), &-block(dx, self.attitude))
+    }
 }
 
 fn block(x: &DVector<f64>, start: usize) -> Vec3 {
     Vec3::new(x[start], x[start + 1], x[start + 2])
+}
+
+/// The vertical channel of an aided INS, chosen by name.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum VerticalMode {
+    /// Free (unstable; Schuler-free exponential divergence, Groves 2013 §5.7.2).
+    Free,
+    /// Damped by a reference (barometric) altitude per IMU sample (third-order baro loop).
+    Damped,
+}
+
+impl Choice for VerticalMode {
+    const PARAMETER: &'static str = "vertical";
+    const CHOICES: &'static [(&'static str, Self)] = &[("free", VerticalMode::Free), ("damped", VerticalMode::Damped)];
+}
+
+/// The baro loop of a damped vertical channel: damping ratio ζ, natural frequency ω_v
+/// (rad/s) and the error model of the reference altitude.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct DampedVertical {
+    pub zeta: f64,
+    pub omega: f64,
+    pub baro: BaroModel,
+}
+
+/// The INS part every aided-INS run shares (initial state, IMU kind, Earth model, initial
+/// bias estimates, P₀, noise and filter options, vertical channel), checked once by
+/// [`InsSetup::new`]; a sensor adds its measurement model ([`AidedIns::from_setup`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct InsSetup {
+    pub initial: NavState,
+    pub kind: ImuKind,
+    pub ell: Ellipsoid,
+    pub accel_bias0: Vec3,
+    pub gyro_bias0: Vec3,
+    /// P₀ over the whole layout (INS blocks, then the sensor's extra blocks), or over the
+    /// INS blocks only when the sensor supplies its own initial covariance.
+    pub p0: DMatrix<f64>,
+    pub cfg: AidedConfig,
+    pub damped: Option<DampedVertical>,
+}
+
+impl InsSetup {
+    /// Check everything that does not depend on the aiding sensor: a finite initial state
+    /// with a non-zero quaternion and latitude inside ±90°, finite bias estimates, P₀
+    /// symmetric positive definite, `predict_every` ≥ 1, the noise model, the baro loop.
+    #[allow(clippy::too_many_arguments)]
+    pub fn new(initial: NavState, kind: ImuKind, ell: Ellipsoid, accel_bias0: Vec3, gyro_bias0: Vec3, p0: DMatrix<f64>, cfg: AidedConfig, damped: Option<DampedVertical>) -> Result<InsSetup> {
+        let vertical = damped.map_or(Vertical::Free, |d| Vertical::Damped { zeta: d.zeta, omega: d.omega });
+        Strapdown::new(initial, kind, ell, vertical)?;
+        for (field, v) in [("ba0", &accel_bias0), ("bg0", &gyro_bias0)] {
+            crate::error::check_finite(field, v.as_slice(), 1)?;
+        }
+        super::matrix::check_covariance("p0", &p0, None, true)?;
+        check_config(&cfg)?;
+        if let Some(d) = damped {
+            d.baro.check()?;
+        }
+        Ok(InsSetup { initial, kind, ell, accel_bias0, gyro_bias0, p0, cfg, damped })
+    }
+
+    /// P₀ of the whole layout: this P₀ over the INS blocks and `extra_var` on the
+    /// diagonal of the extra blocks (a sensor that supplies its own initial covariance;
+    /// then this P₀ must be the INS block).
+    pub fn p0_with_extra(&self, extra_var: &[f64]) -> Result<DMatrix<f64>> {
+        let m = ins_size();
+        if self.p0.nrows() != m {
+            return Err(invalid("p0", format!("expected the {m} x {m} INS block, got {}x{}", self.p0.nrows(), self.p0.ncols())));
+        }
+        let n = m + extra_var.len();
+        let mut p = self.p0.clone().resize(n, n, 0.0);
+        for (i, v) in extra_var.iter().enumerate() {
+            p[(m + i, m + i)] = *v;
+        }
+        Ok(p)
+    }
+}
+
+/// The checks of the filter options that need no layout.
+fn check_config(cfg: &AidedConfig) -> Result<()> {
+    if cfg.predict_every == 0 {
+        return Err(invalid("predict_every", "must be >= 1"));
+    }
+    cfg.noise.check()?;
+    if let Some(g) = cfg.gate {
+        crate::error::check_positive("gate", g)?;
+    }
+    Ok(())
 }
 
 pub struct AidedIns<A: Aiding> {
@@ -175,6 +286,8 @@ pub struct AidedIns<A: Aiding> {
     samples: usize,
     /// Error model of the reference altitude (used with a damped vertical channel).
     baro: BaroModel,
+    /// Where the INS blocks sit in the layout.
+    ix: InsIndex,
 }
 
 impl<A: Aiding> AidedIns<A> {
@@ -192,18 +305,15 @@ impl<A: Aiding> AidedIns<A> {
         cfg: AidedConfig,
         aiding: A,
     ) -> Result<Self> {
-        if cfg.predict_every == 0 {
-            return Err(invalid("predict_every", "must be >= 1"));
-        }
-        let mut spec: Vec<(String, Option<usize>)> = INS15.iter().map(|s| (s.to_string(), None)).collect();
-        spec.extend(aiding.extra_blocks().into_iter().map(|(b, k)| (b, Some(k))));
-        let layout = Layout::new(&spec)?;
+        check_config(&cfg)?;
+        let layout = Layout::ins_with(&aiding.extra_blocks())?;
+        let ix = InsIndex::of(&layout)?;
         let n = layout.size();
         if p0.nrows() != n || p0.ncols() != n {
             return Err(invalid("p0", format!("expected {n}x{n}, got {}x{}", p0.nrows(), p0.ncols())));
         }
-        if extra0.len() != n - 15 {
-            return Err(invalid("extra0", format!("expected {} values for the extra blocks, got {}", n - 15, extra0.len())));
+        if extra0.len() != n - ix.n {
+            return Err(invalid("extra0", format!("expected {} values for the extra blocks, got {}", n - ix.n, extra0.len())));
         }
         crate::error::check_finite("extra0", extra0.as_slice(), 1)?;
         for (field, v) in [("accel_bias0", &accel_bias0), ("gyro_bias0", &gyro_bias0)] {
@@ -236,7 +346,19 @@ impl<A: Aiding> AidedIns<A> {
             steps_since: 0,
             samples: 0,
             baro: BaroModel { noise_psd: 0.0, bias: None },
+            ix,
         })
+    }
+
+    /// The engine of `setup` with the sensor's model, the initial estimate of its extra
+    /// blocks and `p0` over the whole layout (`setup.p0` when None).
+    pub fn from_setup(setup: &InsSetup, extra0: DVector<f64>, p0: Option<DMatrix<f64>>, aiding: A) -> Result<Self> {
+        let p0 = p0.unwrap_or_else(|| setup.p0.clone());
+        let engine = AidedIns::new(setup.initial, setup.kind, setup.ell, setup.accel_bias0, setup.gyro_bias0, extra0, p0, setup.cfg, aiding)?;
+        match setup.damped {
+            Some(d) => engine.with_damped_vertical(d.zeta, d.omega, d.baro),
+            None => Ok(engine),
+        }
     }
 
     /// Damp the vertical channel with a reference altitude h_b per IMU sample (then
@@ -250,11 +372,8 @@ impl<A: Aiding> AidedIns<A> {
             return Err(invalid("vertical", "must be set before the first sample"));
         }
         self.sd = Strapdown::new(self.sd.state, self.sd.kind(), self.ell, Vertical::Damped { zeta, omega })?;
-        if !(baro.noise_psd.is_finite() && baro.noise_psd >= 0.0) {
-            return Err(invalid("baro_psd", format!("must be finite and >= 0, got {}", baro.noise_psd)));
-        }
+        baro.check()?;
         if let Some((_, sigma0)) = baro.bias {
-            crate::error::check_positive("baro_bias_sigma0", sigma0)?;
             let mut spec: Vec<(String, Option<usize>)> = self.layout.blocks().iter().map(|(b, r)| (b.clone(), Some(r.len()))).collect();
             spec.push(("baro_bias".to_string(), Some(1)));
             self.layout = Layout::new(&spec)?;
@@ -270,6 +389,11 @@ impl<A: Aiding> AidedIns<A> {
 
     pub fn layout(&self) -> &Layout {
         &self.layout
+    }
+
+    /// Number of states in the extra blocks (the sensor's, then `baro_bias`).
+    pub fn n_extra(&self) -> usize {
+        self.extra.len()
     }
 
     pub fn aiding(&self) -> &A {
@@ -306,7 +430,7 @@ impl<A: Aiding> AidedIns<A> {
             return Ok(());
         }
         self.sd.validate(t, gyro, accel, h_ref, self.samples)?;
-        let baro_bias = self.layout.get("baro_bias").map(|r| r.start - 15);
+        let baro_bias = self.layout.extra_index("baro_bias");
         // A measurement before the first sample of the record can never be applied.
         if self.last_sample.is_none() {
             if let Some(&tm) = self.aiding.times().first().filter(|&&tm| tm < t[0]) {
@@ -369,8 +493,8 @@ impl<A: Aiding> AidedIns<A> {
         self.t_last_predict = tk;
         // nominal values of the extra blocks follow their dynamics too (δx = nominal − true)
         self.aiding.propagate_extra(&self.layout, dt, self.extra.as_mut_slice());
-        if let (Some(r), Some((model, _))) = (self.layout.get("baro_bias"), self.baro.bias) {
-            self.extra[r.start - 15] *= (model.dynamics().0 * dt).exp();
+        if let (Some(i), Some((model, _))) = (self.layout.extra_index("baro_bias"), self.baro.bias) {
+            self.extra[i] *= (model.dynamics().0 * dt).exp();
         }
         while self.next_meas < self.aiding.times().len() && self.aiding.times()[self.next_meas] <= tk {
             let j = self.next_meas;
@@ -395,24 +519,25 @@ impl<A: Aiding> AidedIns<A> {
         }
         if self.cfg.mode == LoopMode::Closed {
             let dx = self.kf.take_correction();
-            self.sd.state = remove_error(&self.ell, &self.sd.state, &dx);
-            self.accel_bias -= block(&dx, 9);
-            self.gyro_bias -= block(&dx, 12);
-            self.extra -= dx.rows(15, dx.len() - 15);
+            let ix = self.ix;
+            self.sd.state = ix.remove_error(&self.ell, &self.sd.state, &dx);
+            self.accel_bias -= block(&dx, ix.accel_bias);
+            self.gyro_bias -= block(&dx, ix.gyro_bias);
+            self.extra -= dx.rows(ix.n, dx.len() - ix.n);
         }
         self.record(out);
         Ok(())
     }
 
     fn record(&self, out: &mut AidedOutput) {
-        let x = &self.kf.x;
+        let (x, ix) = (&self.kf.x, self.ix);
         let (nav, ba, bg, extra) = match self.cfg.mode {
             LoopMode::Closed => (self.sd.state, self.accel_bias, self.gyro_bias, self.extra.clone()),
             LoopMode::Open => (
-                remove_error(&self.ell, &self.sd.state, x),
-                self.accel_bias - block(x, 9),
-                self.gyro_bias - block(x, 12),
-                &self.extra - x.rows(15, x.len() - 15),
+                ix.remove_error(&self.ell, &self.sd.state, x),
+                self.accel_bias - block(x, ix.accel_bias),
+                self.gyro_bias - block(x, ix.gyro_bias),
+                &self.extra - x.rows(ix.n, x.len() - ix.n),
             ),
         };
         out.time.push(nav.t);
@@ -461,6 +586,19 @@ pub struct PositionFix {
 pub struct PositionAiding {
     times: Vec<f64>,
     fixes: Vec<PositionFix>,
+}
+
+impl PositionFix {
+    /// Fixes from columns: times (s), (lat, lon, h) and NED covariances (3 × 3, m²).
+    pub fn table(t: &[f64], lla: &[Vec3], cov: &[DMatrix<f64>]) -> Result<Vec<PositionFix>> {
+        if lla.len() != t.len() || cov.len() != t.len() {
+            return Err(invalid("fixes", format!("fix_t has {} entries but fix_lla {} and fix_cov {}", t.len(), lla.len(), cov.len())));
+        }
+        if let Some(i) = cov.iter().position(|c| c.nrows() != 3 || c.ncols() != 3) {
+            return Err(invalid("fix_cov", format!("expected (M, 3, 3), entry {i} is {}x{}", cov[i].nrows(), cov[i].ncols())));
+        }
+        Ok((0..t.len()).map(|i| PositionFix { t: t[i], lla: lla[i], cov_ned: Mat3::from_fn(|r, c| cov[i][(r, c)]) }).collect())
+    }
 }
 
 impl PositionAiding {
@@ -569,7 +707,7 @@ mod tests {
             f[(i, i + 1)] = 1.0;
         }
         fn propagate_extra(&self, layout: &Layout, dt: f64, extra: &mut [f64]) {
-            let i = layout.get("clk").unwrap().start - 15;
+            let i = layout.extra_index("clk").unwrap();
             extra[i] += extra[i + 1] * dt;
         }
     }

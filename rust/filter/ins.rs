@@ -8,6 +8,7 @@ use super::layout::Layout;
 use crate::earth::Ellipsoid;
 use crate::error::{invalid, Result};
 use crate::math::{dcm_from_quat, skew, Mat3, Vec3};
+use crate::options::Choice;
 use crate::strapdown::NavState;
 use nalgebra::DMatrix;
 
@@ -22,9 +23,24 @@ pub enum BiasModel {
     GaussMarkov { tau: f64, sigma: f64 },
 }
 
+/// The name of a bias process (the kind of [`BiasModel`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum BiasKind {
+    RandomConstant,
+    RandomWalk,
+    GaussMarkov,
+}
+
+impl Choice for BiasKind {
+    const PARAMETER: &'static str = "kind";
+    const CHOICES: &'static [(&'static str, Self)] =
+        &[("random_constant", BiasKind::RandomConstant), ("random_walk", BiasKind::RandomWalk), ("gauss_markov", BiasKind::GaussMarkov)];
+}
+
 impl BiasModel {
     /// Parse ("random_constant" | "random_walk" | "gauss_markov", p1, p2): random walk takes
-    /// its PSD as p1; Gauss–Markov τ (s) as p1 and σ as p2.
+    /// its PSD as p1; Gauss–Markov τ (s) as p1 and σ as p2. Errors name `field` (the
+    /// argument that carries the model, e.g. "accel_bias").
     pub fn from_parts(field: &str, kind: &str, p1: f64, p2: f64) -> Result<Self> {
         let pos = |name: &str, x: f64| {
             if x.is_finite() && x >= 0.0 {
@@ -33,14 +49,16 @@ impl BiasModel {
                 Err(invalid(field, format!("{name} must be finite and >= 0, got {x}")))
             }
         };
+        let kind = BiasKind::CHOICES.iter().find(|(n, _)| *n == kind).map(|(_, k)| *k).ok_or_else(|| {
+            invalid(field, format!("unknown bias model {kind:?}; choose one of {}", BiasKind::names().join(", ")))
+        })?;
         match kind {
-            "random_constant" => Ok(Self::RandomConstant),
-            "random_walk" => Ok(Self::RandomWalk { psd: pos("psd", p1)? }),
-            "gauss_markov" => {
+            BiasKind::RandomConstant => Ok(Self::RandomConstant),
+            BiasKind::RandomWalk => Ok(Self::RandomWalk { psd: pos("psd", p1)? }),
+            BiasKind::GaussMarkov => {
                 crate::error::check_positive(&format!("{field} tau"), p1)?;
                 Ok(Self::GaussMarkov { tau: p1, sigma: pos("sigma", p2)? })
             }
-            _ => Err(invalid(field, format!("unknown bias model {kind:?} (random_constant, random_walk, gauss_markov)"))),
         }
     }
 
@@ -62,6 +80,25 @@ pub struct InsNoise {
     pub gyro_psd: f64,
     pub accel_bias: BiasModel,
     pub gyro_bias: BiasModel,
+}
+
+impl InsNoise {
+    /// The noise model, checked ([`InsNoise::check`]).
+    pub fn new(accel_psd: f64, gyro_psd: f64, accel_bias: BiasModel, gyro_bias: BiasModel) -> Result<InsNoise> {
+        let n = InsNoise { accel_psd, gyro_psd, accel_bias, gyro_bias };
+        n.check()?;
+        Ok(n)
+    }
+
+    /// White-noise PSDs finite and ≥ 0.
+    pub fn check(&self) -> Result<()> {
+        for (field, x) in [("accel_psd", self.accel_psd), ("gyro_psd", self.gyro_psd)] {
+            if !(x.is_finite() && x >= 0.0) {
+                return Err(invalid(field, format!("must be finite and >= 0, got {x}")));
+            }
+        }
+        Ok(())
+    }
 }
 
 fn put(f: &mut DMatrix<f64>, r: usize, c: usize, m: &Mat3) {
@@ -120,6 +157,23 @@ pub fn error_dynamics(layout: &Layout, ell: &Ellipsoid, nav: &NavState, f_b: &Ve
     Ok((f, qc))
 }
 
+/// [`error_dynamics`] at every sample of a trajectory (geodetic position, NED velocity,
+/// attitude, compensated specific force; equal lengths, latitude inside ±90°).
+pub fn error_dynamics_along(layout: &Layout, ell: &Ellipsoid, lla: &[Vec3], vel: &[Vec3], q_nb: &[crate::math::Quat], f_b: &[Vec3], noise: &InsNoise) -> Result<Vec<(DMatrix<f64>, DMatrix<f64>)>> {
+    noise.check()?;
+    let n = lla.len();
+    if let Some((name, len)) = [("vel_ned", vel.len()), ("q_nb", q_nb.len()), ("f_b", f_b.len())].into_iter().find(|x| x.1 != n) {
+        return Err(invalid(name, format!("expected {n} rows like lla, got {len}")));
+    }
+    (0..n)
+        .map(|k| {
+            crate::earth::check_latitude("lla", lla[k].x, k)?;
+            let nav = NavState { t: 0.0, lla: lla[k], vel: vel[k], q_nb: q_nb[k] };
+            error_dynamics(layout, ell, &nav, &f_b[k], noise)
+        })
+        .collect()
+}
+
 /// Gains of the baro loop (spec gnss-ins-tight Eq. 26, as in `strapdown.rs`):
 /// K_v1 = 2ζω_v, K_v2 = ω_v² + 2γ/R₀ with R₀ = √(R_M R_P) at (lat, h).
 pub fn baro_gains(ell: &Ellipsoid, lat: f64, h: f64, zeta: f64, omega: f64) -> (f64, f64) {
@@ -137,6 +191,19 @@ pub fn baro_gains(ell: &Ellipsoid, lat: f64, h: f64, zeta: f64, omega: f64) -> (
 pub struct BaroModel {
     pub noise_psd: f64,
     pub bias: Option<(BiasModel, f64)>,
+}
+
+impl BaroModel {
+    /// White-noise PSD finite and ≥ 0, initial σ of the bias state > 0.
+    pub fn check(&self) -> Result<()> {
+        if !(self.noise_psd.is_finite() && self.noise_psd >= 0.0) {
+            return Err(invalid("baro_psd", format!("must be finite and >= 0, got {}", self.noise_psd)));
+        }
+        if let Some((_, sigma0)) = self.bias {
+            crate::error::check_positive("baro_bias_sigma0", sigma0)?;
+        }
+        Ok(())
+    }
 }
 
 /// Add the baro-loop terms of a damped vertical channel to F and Q_c (spec gnss-ins-tight

@@ -3,24 +3,36 @@
 use crate::error::{invalid, Result};
 use std::ops::Range;
 
-/// Size of the standard blocks (navigation errors and IMU error blocks).
-pub fn standard_size(name: &str) -> Option<usize> {
-    match name {
-        "position" | "velocity" | "attitude" | "accel_bias" | "gyro_bias" | "accel_scale" | "gyro_scale" => Some(3),
-        // Off-diagonal small-angle misalignment terms: (xy, xz, yx, yz, zx, zy).
-        "accel_misalignment" | "gyro_misalignment" => Some(6),
-        _ => None,
-    }
-}
-
-/// Names of the standard blocks, for error messages and documentation.
-pub const STANDARD_BLOCKS: [&str; 9] = [
-    "position", "velocity", "attitude", "accel_bias", "gyro_bias", "accel_scale", "gyro_scale", "accel_misalignment", "gyro_misalignment",
+/// The standard blocks and their sizes (navigation errors and IMU error blocks), in the
+/// order the documentation lists them; misalignment blocks carry the off-diagonal
+/// small-angle terms (xy, xz, yx, yz, zx, zy). Python reads this table
+/// (`_core.STATE_BLOCKS`).
+pub const STANDARD_BLOCKS: [(&str, usize); 9] = [
+    ("position", 3),
+    ("velocity", 3),
+    ("attitude", 3),
+    ("accel_bias", 3),
+    ("gyro_bias", 3),
+    ("accel_scale", 3),
+    ("gyro_scale", 3),
+    ("accel_misalignment", 6),
+    ("gyro_misalignment", 6),
 ];
 
-/// The 15-state layout of spec gnss-ins-tight §2.9 / atom-strapdown E22 (block order as in
-/// the project: accelerometer bias before gyro bias).
+/// Size of a standard block, or None for an extra block (lever arm, clock, ...).
+pub fn standard_size(name: &str) -> Option<usize> {
+    STANDARD_BLOCKS.iter().find(|(b, _)| *b == name).map(|(_, k)| *k)
+}
+
+/// The 15-state INS layout (Groves 2013, §14.2.1; block order as in the project:
+/// accelerometer bias before gyro bias). Aided-INS layouts are these blocks followed by
+/// the aiding sensor's extra blocks.
 pub const INS15: [&str; 5] = ["position", "velocity", "attitude", "accel_bias", "gyro_bias"];
+
+/// Number of states of [`INS15`]: the index of the first extra block of an aided-INS layout.
+pub fn ins_size() -> usize {
+    INS15.iter().filter_map(|b| standard_size(b)).sum()
+}
 
 #[derive(Debug, Clone, PartialEq)]
 pub struct Layout {
@@ -49,7 +61,10 @@ impl Layout {
                 (None, None) => {
                     return Err(invalid(
                         "blocks",
-                        format!("unknown block name {name:?} at index {i}: a non-standard block needs a size (standard: {})", STANDARD_BLOCKS.join(", ")),
+                        format!(
+                            "unknown block name {name:?} at index {i}: a non-standard block needs a size (standard: {})",
+                            STANDARD_BLOCKS.map(|b| b.0).join(", ")
+                        ),
                     ))
                 }
             };
@@ -61,7 +76,20 @@ impl Layout {
 
     /// The 15-state INS layout.
     pub fn ins15() -> Layout {
-        Layout::new(&INS15.map(|s| (s.to_string(), None))).expect("standard blocks")
+        Layout::ins_with(&[]).expect("standard blocks")
+    }
+
+    /// [`INS15`] followed by the extra blocks (name, size) of an aiding sensor.
+    pub fn ins_with(extra: &[(String, usize)]) -> Result<Layout> {
+        let mut spec: Vec<(String, Option<usize>)> = INS15.iter().map(|s| (s.to_string(), None)).collect();
+        spec.extend(extra.iter().map(|(b, k)| (b.clone(), Some(*k))));
+        Layout::new(&spec)
+    }
+
+    /// Index of block `name` within the extra blocks of an aided-INS layout (its start
+    /// minus [`ins_size`]), or None when the layout has no such extra block.
+    pub fn extra_index(&self, name: &str) -> Option<usize> {
+        self.get(name).and_then(|r| r.start.checked_sub(ins_size()))
     }
 
     /// Total state size.
@@ -105,5 +133,18 @@ mod tests {
         assert_eq!(l.size(), 11);
         assert!(l.range("velocity").is_err());
         assert_eq!(Layout::ins15().range("gyro_bias").unwrap(), 12..15);
+    }
+
+    #[test]
+    fn ins_layout_and_extra_blocks() {
+        // Groves 2013 §14.2.1: 3 position, 3 velocity, 3 attitude, 3 + 3 bias states
+        assert_eq!(ins_size(), 15);
+        assert_eq!(Layout::ins15().size(), ins_size());
+        let l = Layout::ins_with(&[("c_tau_gps".into(), 1), ("clock".into(), 2)]).unwrap();
+        assert_eq!(l.range("clock").unwrap(), 16..18);
+        assert_eq!(l.extra_index("clock"), Some(1));
+        assert_eq!(l.extra_index("c_tau_gps"), Some(0));
+        assert_eq!(l.extra_index("position"), None);
+        assert_eq!(l.extra_index("lever_arm"), None);
     }
 }

@@ -10,3 +10,4 @@ pub mod kf;
 pub mod ins;
 pub mod analysis;
 pub mod aided;
+pub mod initial_error;

@@ -99,6 +99,18 @@ impl Ephemerides {
         invalid("ephemeris", format!("{} at t = {t} s: nearest set is {age:.0} s away (validity ±{max} s)", sat.name()))
     }
 
+    /// Rows [x, y, z, vx, vy, vz (WGS-84 ECEF m, m/s), clock s, clock rate s/s] of `sat`
+    /// at each GPS time of `t` ([`Ephemerides::state`]).
+    pub fn state_rows(&self, sat: SatId, t: &[f64], tau_gps: f64) -> Result<Vec<[f64; 8]>> {
+        crate::error::check_finite("t", t, 1)?;
+        t.iter()
+            .map(|&tk| {
+                let s = self.state(sat, tk, tau_gps)?;
+                Ok([s.pos.x, s.pos.y, s.pos.z, s.vel.x, s.vel.y, s.vel.z, s.clock, s.clock_rate])
+            })
+            .collect()
+    }
+
     /// State of `sat` at GPS time t. GLONASS sets are evaluated at GLONASS time
     /// t − ΔT_leap − τ_GPS (Eq. 7) with the caller's τ_GPS estimate `tau_gps` (s).
     pub fn state(&self, sat: SatId, t: f64, tau_gps: f64) -> Result<SatState> {

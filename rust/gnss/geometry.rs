@@ -37,6 +37,20 @@ fn r3(theta: f64) -> (Mat3, Mat3) {
 /// Light time iterated t_tx = t − ρ/c until |Δρ| < 1e-9 m (Eq. 13). The rate is the exact
 /// derivative of the range model: ρ̇ = uᵀ(R₃v_s − v)/(1 − uᵀ(ΩR₃′r_s − R₃v_s)/c).
 #[allow(clippy::too_many_arguments)]
+/// Rows [elevation, azimuth] (rad) of `sat` seen from the geodetic position `lla` (WGS-84,
+/// at rest) at each GPS time of `t`.
+pub fn look_angles(eph: &Ephemerides, sat: SatId, t: &[f64], lla: &Vec3) -> Result<Vec<[f64; 2]>> {
+    crate::earth::check_latitude("lla", lla.x, 0)?;
+    crate::error::check_finite("t", t, 1)?;
+    let (r, _) = super::observation::receiver_ecef(lla, &Vec3::zeros());
+    t.iter()
+        .map(|&tk| {
+            let g = geometry(eph, sat, tk, &r, &Vec3::zeros(), lla.x, lla.y, 0.0)?;
+            Ok([g.elevation, g.azimuth])
+        })
+        .collect()
+}
+
 pub fn geometry(eph: &Ephemerides, sat: SatId, t: f64, r: &Vec3, v: &Vec3, lat: f64, lon: f64, tau_gps: f64) -> Result<Geometry> {
     let mut rho = 0.0;
     let mut st = eph.state(sat, t, tau_gps)?;

@@ -30,6 +30,29 @@ pub struct GloEphemeris {
     pub gamma_n: f64,
 }
 
+impl GloEphemeris {
+    /// From a row: slot, channel, tb, x, y, z, vx, vy, vz, ax, ay, az, tau_n, gamma_n;
+    /// the channel is checked (row `index` named on error).
+    pub fn from_row(x: &[f64; 14], index: usize) -> Result<GloEphemeris> {
+        Ok(GloEphemeris {
+            slot: x[0] as u8,
+            channel: super::check_channel("glonass", x[1] as i64, index)?,
+            tb: x[2],
+            pos: Vec3::new(x[3], x[4], x[5]),
+            vel: Vec3::new(x[6], x[7], x[8]),
+            acc: Vec3::new(x[9], x[10], x[11]),
+            tau_n: x[12],
+            gamma_n: x[13],
+        })
+    }
+
+    /// The set as a row in the order of [`GloEphemeris::from_row`].
+    pub fn to_row(&self) -> [f64; 14] {
+        let e = self;
+        [e.slot as f64, e.channel as f64, e.tb, e.pos.x, e.pos.y, e.pos.z, e.vel.x, e.vel.y, e.vel.z, e.acc.x, e.acc.y, e.acc.z, e.tau_n, e.gamma_n]
+    }
+}
+
 /// Right-hand side of Eq. 10 (J₂, centrifugal and Coriolis terms in the rotating frame).
 pub fn acceleration(pos: &Vec3, vel: &Vec3, acc_ls: &Vec3, j2: f64) -> Vec3 {
     let r = pos.norm();
@@ -43,6 +66,18 @@ pub fn acceleration(pos: &Vec3, vel: &Vec3, acc_ls: &Vec3, j2: f64) -> Vec3 {
         -mu_bar * yb - k * yb * (1.0 - 5.0 * zb * zb) + w2 * pos.y - 2.0 * OMEGA_GLO * vel.x + acc_ls.y,
         -mu_bar * zb - k * zb * (3.0 - 5.0 * zb * zb) + acc_ls.z,
     )
+}
+
+/// [`propagate`] with the step checked (finite, > 0) and the inputs finite.
+pub fn propagate_checked(pos: Vec3, vel: Vec3, acc_ls: &Vec3, dt: f64, max_step: f64, j2: f64) -> Result<(Vec3, Vec3)> {
+    crate::error::check_positive("step", max_step)?;
+    for (field, v) in [("pos", &pos), ("vel", &vel), ("acc", acc_ls)] {
+        crate::error::check_finite(field, v.as_slice(), 1)?;
+    }
+    for (field, x) in [("dt", dt), ("j2", j2)] {
+        crate::error::check_finite(field, &[x], 1)?;
+    }
+    Ok(propagate(pos, vel, acc_ls, dt, max_step, j2))
 }
 
 /// Classical RK4 of (r, v) over `dt` seconds in equal steps no longer than `max_step`.

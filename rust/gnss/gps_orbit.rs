@@ -40,6 +40,28 @@ pub struct GpsEphemeris {
     pub tgd: f64,
 }
 
+impl GpsEphemeris {
+    /// Width of [`GpsEphemeris::to_row`]: prn, toe, sqrt_a, e, m0, delta_n, omega0, i0,
+    /// omega, omega_dot, idot, cuc, cus, crc, crs, cic, cis, toc, af0, af1, af2, tgd.
+    pub const ROW: usize = 22;
+
+    /// From a row in the order of [`GpsEphemeris::ROW`] (the PRN is checked by
+    /// `Ephemerides::new`).
+    pub fn from_row(r: &[f64; 22]) -> GpsEphemeris {
+        GpsEphemeris {
+            prn: r[0] as u8, toe: r[1], sqrt_a: r[2], e: r[3], m0: r[4], delta_n: r[5], omega0: r[6], i0: r[7], omega: r[8],
+            omega_dot: r[9], idot: r[10], cuc: r[11], cus: r[12], crc: r[13], crs: r[14], cic: r[15], cis: r[16], toc: r[17],
+            af0: r[18], af1: r[19], af2: r[20], tgd: r[21],
+        }
+    }
+
+    /// The set as a row in the order of [`GpsEphemeris::ROW`].
+    pub fn to_row(&self) -> [f64; 22] {
+        let e = self;
+        [e.prn as f64, e.toe, e.sqrt_a, e.e, e.m0, e.delta_n, e.omega0, e.i0, e.omega, e.omega_dot, e.idot, e.cuc, e.cus, e.crc, e.crs, e.cic, e.cis, e.toc, e.af0, e.af1, e.af2, e.tgd]
+    }
+}
+
 /// t − t_ref wrapped to ±302400 s (week crossover, IS-GPS-200 20.3.3.4.3).
 fn wrap_half_week(dt: f64) -> f64 {
     if dt > HALF_WEEK {

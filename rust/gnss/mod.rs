@@ -14,6 +14,7 @@ pub mod geometry;
 pub mod glonass_orbit;
 pub mod gps_orbit;
 pub mod observation;
+pub mod options;
 pub mod spp;
 pub mod tight;
 
@@ -58,6 +59,19 @@ impl SatId {
         }
         Ok(SatId { system: sys, prn: prn as u8 })
     }
+    /// From a RINEX-style name "G05", "R12" (entry `index` of `field` named on error).
+    pub fn from_name(name: &str, field: &str, index: usize) -> Result<SatId> {
+        let mut chars = name.chars();
+        let system = chars.next().unwrap_or('?');
+        let prn: i64 = chars.as_str().trim().parse().map_err(|_| invalid(field, format!("malformed satellite '{name}' at index {index}")))?;
+        SatId::parse(system, prn, field, index)
+    }
+
+    /// Satellites from their names ([`SatId::from_name`]).
+    pub fn from_names(names: &[String], field: &str) -> Result<Vec<SatId>> {
+        names.iter().enumerate().map(|(i, s)| SatId::from_name(s, field, i)).collect()
+    }
+
     /// RINEX-style name "G05", "R12".
     pub fn name(&self) -> String {
         let c = if self.system == System::Gps { 'G' } else { 'R' };

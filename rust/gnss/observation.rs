@@ -35,6 +35,12 @@ pub struct Atmosphere {
 }
 
 impl Atmosphere {
+    /// The broadcast models: Klobuchar with the fixed coefficient set of
+    /// [`Klobuchar::default`] when `iono`, Saastamoinen when `tropo`.
+    pub fn broadcast(iono: bool, tropo: bool) -> Atmosphere {
+        Atmosphere { iono: iono.then(Klobuchar::default), tropo }
+    }
+
     /// Ionosphere + troposphere delay (m) of one signal; 0 below the horizon.
     pub fn delay(&self, sat: SatId, channel: i8, lla: &Vec3, g: &Geometry, t: f64) -> f64 {
         if g.elevation <= 0.0 {
@@ -127,6 +133,53 @@ pub fn simulate(eph: &Ephemerides, t: &[f64], lla: &[Vec3], vel_ned: &[Vec3], cf
             epoch.push((Observation { sat, channel, code, rate }, g.elevation));
         }
         out.push(epoch);
+    }
+    Ok(out)
+}
+
+/// Observations from the columns of a flat table (satellite names, GLONASS channels,
+/// code m, rate m/s); the channels of GLONASS rows are checked (GPS rows get 0).
+pub fn observations(sat: &[String], channel: &[i64], code: &[f64], rate: &[f64]) -> Result<Vec<Observation>> {
+    let ids = SatId::from_names(sat, "sat")?;
+    if channel.len() != ids.len() || code.len() != ids.len() || rate.len() != ids.len() {
+        return Err(invalid("sat", format!("{} satellites, {} channels, {} codes, {} rates", ids.len(), channel.len(), code.len(), rate.len())));
+    }
+    ids.iter()
+        .enumerate()
+        .map(|(i, &sat)| {
+            let channel = if sat.system == System::Glonass { super::check_channel("channel", channel[i], i)? } else { 0 };
+            Ok(Observation { sat, channel, code: code[i], rate: rate[i] })
+        })
+        .collect()
+}
+
+/// Simulated observations as a flat table, one row per satellite and epoch.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct ObservationTable {
+    pub sat: Vec<String>,
+    pub channel: Vec<i64>,
+    pub time: Vec<f64>,
+    pub code: Vec<f64>,
+    pub rate: Vec<f64>,
+    /// True elevation (rad).
+    pub elevation: Vec<f64>,
+}
+
+/// [`simulate`] flattened into an [`ObservationTable`] (epochs in time order, satellites
+/// in the order of `Ephemerides::satellites`).
+pub fn simulate_table(eph: &Ephemerides, t: &[f64], lla: &[Vec3], vel_ned: &[Vec3], cfg: &SimConfig, vis: &Visibility) -> Result<ObservationTable> {
+    crate::error::check_increasing("t", t)?;
+    let epochs = simulate(eph, t, lla, vel_ned, cfg, vis)?;
+    let mut out = ObservationTable::default();
+    for (k, ep) in epochs.iter().enumerate() {
+        for (o, e) in ep {
+            out.sat.push(o.sat.name());
+            out.channel.push(o.channel as i64);
+            out.time.push(t[k]);
+            out.code.push(o.code);
+            out.rate.push(o.rate);
+            out.elevation.push(*e);
+        }
     }
     Ok(out)
 }

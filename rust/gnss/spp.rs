@@ -151,6 +151,42 @@ pub fn solve_position(eph: &Ephemerides, t: f64, obs: &[Observation], cfg: &SppC
     }
 }
 
+/// Columns of a [`solve_epochs`] row: time, ECEF and geodetic antenna position, c·δt_r,
+/// τ_GPS and its σ (s; NaN when not estimated), the residual metric, satellites and
+/// unknowns, DOP values, Doppler velocity (ECEF m/s) and c·δṫ_r (m/s; NaN with fewer than
+/// four rates).
+pub const SPP_COLUMNS: [&str; 22] = [
+    "time_s", "x_m", "y_m", "z_m", "lat_rad", "lon_rad", "h_m", "clock_m", "tau_gps_s", "sigma_tau_gps_s", "residual_metric_m", "n_sats",
+    "n_unknowns", "gdop", "pdop", "hdop", "vdop", "tdop", "vx_mps", "vy_mps", "vz_mps", "clock_drift_mps",
+];
+
+/// Single-point positioning epoch by epoch: each position solution starts from the
+/// previous epoch's (the first from the Earth's centre); the Doppler velocity
+/// ([`solve_velocity`], rate σ `sigma_rate` m/s) when at least four rates are finite.
+/// One row per epoch, columns [`SPP_COLUMNS`].
+pub fn solve_epochs(eph: &Ephemerides, epochs: &[(f64, Vec<Observation>)], cfg: &SppConfig, sigma_rate: f64) -> Result<Vec<[f64; 22]>> {
+    crate::error::check_positive("sigma_rate", sigma_rate)?;
+    let mut x0 = None;
+    epochs
+        .iter()
+        .map(|(t, ob)| {
+            let s = solve_position(eph, *t, ob, cfg, x0)?;
+            x0 = Some(s.pos);
+            let (v, d) = if ob.iter().filter(|o| o.rate.is_finite()).count() >= 4 {
+                let (v, d, _) = solve_velocity(eph, *t, ob, &s.pos, sigma_rate)?;
+                (v, d)
+            } else {
+                (Vec3::repeat(f64::NAN), f64::NAN)
+            };
+            let (tau, st) = s.tau.map_or((f64::NAN, f64::NAN), |x| (x, s.cov[(4, 4)].sqrt()));
+            Ok([
+                *t, s.pos.x, s.pos.y, s.pos.z, s.lla.x, s.lla.y, s.lla.z, s.clock_m, tau, st, s.residual_metric, ob.len() as f64,
+                s.n_unknowns as f64, s.dop.gdop, s.dop.pdop, s.dop.hdop, s.dop.vdop, s.dop.tdop, v.x, v.y, v.z, d,
+            ])
+        })
+        .collect()
+}
+
 /// DOP from the design matrix rotated into local NED (position columns).
 fn dop(h: &DMatrix<f64>, lla: &Vec3, n: usize) -> Result<Dop> {
     let cne = dcm_ned_to_ecef(lla.x, lla.y);
@@ -269,6 +305,27 @@ mod tests {
             let fm = geometry(&eph, o.sat, 600.0 - h, &(r - v * h), &v, lla.x, lla.y, 0.0).unwrap().range;
             assert!(((fp - fm) / (2.0 * h) - gv.rate).abs() < 1e-4, "{}", (fp - fm) / (2.0 * h) - gv.rate);
         }
+    }
+
+    /// Noiseless epochs: every row recovers the truth; τ columns NaN without GLONASS,
+    /// velocity columns NaN when fewer than four rates are given.
+    #[test]
+    fn solve_epochs_rows_follow_the_rules() {
+        let (eph, lla, obs, sim) = setup(-340e-9, 0.0);
+        let cfg = SppConfig { use_tau: true, atm: sim.atm, sigma_gps: 3.0, sigma_glo: 3.0, elevation_weight: false };
+        let gps: Vec<Observation> = obs.iter().filter(|o| o.sat.system == System::Gps).copied().collect();
+        let mut few_rates = obs.clone();
+        few_rates.iter_mut().skip(3).for_each(|o| o.rate = f64::NAN);
+        let rows = solve_epochs(&eph, &[(600.0, obs.clone()), (600.0, gps.clone()), (600.0, few_rates)], &cfg, 0.05).unwrap();
+        let truth = WGS84.lla_to_ecef(&lla);
+        let col = |name: &str| SPP_COLUMNS.iter().position(|c| *c == name).unwrap();
+        for r in &rows {
+            assert!((Vec3::new(r[col("x_m")], r[col("y_m")], r[col("z_m")]) - truth).norm() < 1e-4);
+        }
+        assert!((rows[0][col("tau_gps_s")] + 340e-9).abs() < 1e-13 && rows[0][col("n_unknowns")] == 5.0);
+        assert!(rows[1][col("tau_gps_s")].is_nan() && rows[1][col("n_unknowns")] == 4.0 && rows[1][col("n_sats")] == gps.len() as f64);
+        assert!(rows[0][col("vx_mps")].is_finite() && rows[2][col("vx_mps")].is_nan() && rows[2][col("clock_drift_mps")].is_nan());
+        assert!(solve_epochs(&eph, &[], &cfg, 0.0).unwrap_err().to_string().starts_with("sigma_rate:"));
     }
 
     #[test]

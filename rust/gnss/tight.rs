@@ -30,14 +30,9 @@ pub enum Formulation {
     ClockStates,
 }
 
-impl Formulation {
-    pub fn by_name(name: &str) -> Result<Formulation> {
-        match name {
-            "first_difference" => Ok(Formulation::FirstDifference),
-            "clock_states" => Ok(Formulation::ClockStates),
-            _ => Err(invalid("formulation", format!("unknown '{name}' (known: first_difference, clock_states)"))),
-        }
-    }
+impl crate::options::Choice for Formulation {
+    const PARAMETER: &'static str = "formulation";
+    const CHOICES: &'static [(&'static str, Self)] = &[("first_difference", Formulation::FirstDifference), ("clock_states", Formulation::ClockStates)];
 }
 
 #[derive(Debug, Clone, Copy)]
@@ -116,7 +111,11 @@ impl TightAiding {
         let v_a = cne * (nav.vel + cnb * self.omega_b.cross(&self.cfg.lever_arm));
         let lla_a = ctx.ell.ecef_to_lla(&r_a);
         let (ip, iv, ipsi) = (ctx.layout.range("position")?.start, ctx.layout.range("velocity")?.start, ctx.layout.range("attitude")?.start);
-        let extra = |name: &str| ctx.layout.get(name).map(|r| (r.start, ctx.extra[r.start - 15]));
+        // (state index, nominal value, nominal value of the next component) of an extra block
+        let extra = |name: &str| {
+            let (r, e) = (ctx.layout.get(name)?, ctx.layout.extra_index(name)?);
+            Some((r.start, ctx.extra[e], ctx.extra.get(e + 1).copied().unwrap_or(0.0)))
+        };
         let tau = extra("c_tau_gps");
         let clock = extra("clock");
         let lever_skew = skew(&lever_n);
@@ -156,15 +155,15 @@ impl TightAiding {
                 h_rate[ipsi + k] = gpsi[k];
             }
             let mut pred_rate = g.rate;
-            if let Some((i, ct)) = tau {
+            if let Some((i, ct, _)) = tau {
                 if glo {
                     pred += ct;
                     h_code[i] = 1.0 - g.kappa * g.los.dot(&g.sat.vel) / C_LIGHT;
                 }
             }
-            if let Some((i, cb)) = clock {
+            if let Some((i, cb, drift)) = clock {
                 pred += cb;
-                pred_rate += ctx.extra[i - 15 + 1];
+                pred_rate += drift;
                 h_code[i] = 1.0;
                 h_rate[i + 1] = 1.0;
             }
@@ -295,8 +294,7 @@ impl Aiding for TightAiding {
 
     fn propagate_extra(&self, layout: &Layout, dt: f64, extra: &mut [f64]) {
         // nominal clock bias follows the drift (the F block above): c·δt_r += c·δṫ_r·Δt
-        if let Some(r) = layout.get("clock") {
-            let i = r.start - 15;
+        if let Some(i) = layout.extra_index("clock") {
             extra[i] += extra[i + 1] * dt;
         }
     }
@@ -309,7 +307,6 @@ mod tests {
     use super::super::TimeScales;
     use super::*;
     use crate::earth::WGS84;
-    use crate::filter::layout::INS15;
     use crate::math::{quat_from_euler, quat_from_rotvec};
     use nalgebra::DVector;
 
@@ -329,9 +326,7 @@ mod tests {
             use_rate: true, atm, tau_psd: 0.0, clock_h0: 0.0, clock_hm2: 0.0, kind: ImuKind::Rates,
         };
         let mut aiding = TightAiding::new(eph, vec![(100.0, obs)], tc).unwrap();
-        let mut spec: Vec<(String, Option<usize>)> = INS15.iter().map(|s| (s.to_string(), None)).collect();
-        spec.extend(aiding.extra_blocks().into_iter().map(|(b, k)| (b, Some(k))));
-        let layout = Layout::new(&spec).unwrap();
+        let layout = Layout::ins_with(&aiding.extra_blocks()).unwrap();
         let (x, extra) = (DVector::zeros(layout.size()), DVector::zeros(3));
         let q = quat_from_euler(0.1, -0.05, 1.2);
         let z_of = |a: &mut TightAiding, nav: &NavState| {

@@ -1,14 +1,15 @@
 //! Bindings of filter/: state layouts, the INS error model and the aided INS (the linear
 //! Kalman machinery is bound in kalman.rs).
 
-use super::convert::{Wrap, mat, quat_rows, vec3_rows, vector};
+use super::convert::{register_choices, Wrap, mat, mat_to_py, quat_rows, vec3_rows, vector};
 use crate::earth::Ellipsoid;
 use crate::error::{invalid, NavError};
-use crate::filter::aided::{AidedConfig, AidedIns, AidedOutput, Aiding, PositionAiding, PositionFix};
+use crate::filter::aided::{AidedConfig, AidedIns, AidedOutput, Aiding, DampedVertical, InsSetup, PositionAiding, PositionFix, VerticalMode};
 use crate::filter::discretize::Discretization;
-use crate::filter::ins::{error_dynamics, BaroModel, BiasModel, InsNoise};
+use crate::filter::initial_error::perturbed_start;
+use crate::filter::ins::{error_dynamics_along, BaroModel, BiasKind, BiasModel, InsNoise};
 use crate::filter::kf::LoopMode;
-use crate::filter::layout::Layout;
+use crate::filter::layout::{Layout, INS15, STANDARD_BLOCKS};
 use crate::imu::ImuKind;
 use crate::strapdown::NavState;
 use nalgebra::{DMatrix, DVector};
@@ -41,10 +42,10 @@ fn layout_ranges(blocks: Vec<(String, Option<usize>)>) -> PyResult<Vec<(String, 
     Ok(l.blocks().iter().map(|(n, r)| (n.clone(), r.start, r.end)).collect())
 }
 
-/// Continuous INS error model (spec gnss-ins-tight Eq. 28) along a trajectory:
+/// Continuous INS error model (Demidov 2009, Eq. 28) along a trajectory:
 /// (F, Q_c) stacks of shape (N, n, n) for the layout `blocks`.
 #[pyfunction]
-#[pyo3(signature = (blocks, lla, vel_ned, q_nb, f_b, accel_psd, gyro_psd, accel_bias, gyro_bias, ellipsoid=Wrap(crate::earth::WGS84)))]
+#[pyo3(signature = (blocks, lla, vel_ned, q_nb, f_b, *, accel_psd, gyro_psd, accel_bias, gyro_bias, ellipsoid=Wrap(crate::earth::WGS84)))]
 #[allow(clippy::too_many_arguments, clippy::type_complexity)]
 fn ins_error_dynamics<'py>(
     py: Python<'py>,
@@ -62,32 +63,8 @@ fn ins_error_dynamics<'py>(
     let layout = blocks_of(blocks)?;
     let ell = ellipsoid.0;
     let (lla, vel, q, fb) = (vec3_rows(&lla, "lla")?, vec3_rows(&vel_ned, "vel_ned")?, quat_rows(&q_nb, "q_nb")?, vec3_rows(&f_b, "f_b")?);
-    let n = lla.len();
-    for (name, len) in [("vel_ned", vel.len()), ("q_nb", q.len()), ("f_b", fb.len())] {
-        if len != n {
-            return Err(invalid(name, format!("expected {n} rows like lla, got {len}")).into());
-        }
-    }
-    for (name, x) in [("accel_psd", accel_psd), ("gyro_psd", gyro_psd)] {
-        if !(x.is_finite() && x >= 0.0) {
-            return Err(invalid(name, format!("must be finite and >= 0, got {x}")).into());
-        }
-    }
-    let noise = InsNoise {
-        accel_psd,
-        gyro_psd,
-        accel_bias: BiasModel::from_parts("accel_bias", &accel_bias.0, accel_bias.1, accel_bias.2)?,
-        gyro_bias: BiasModel::from_parts("gyro_bias", &gyro_bias.0, gyro_bias.1, gyro_bias.2)?,
-    };
-    let out = py.detach(|| -> Result<Vec<_>, NavError> {
-        (0..n)
-            .map(|k| {
-                crate::earth::check_latitude("lla", lla[k].x, k)?;
-                let nav = NavState { t: 0.0, lla: lla[k], vel: vel[k], q_nb: q[k] };
-                error_dynamics(&layout, &ell, &nav, &fb[k], &noise)
-            })
-            .collect()
-    })?;
+    let noise = ins_noise(accel_psd, gyro_psd, &accel_bias, &gyro_bias)?;
+    let out = py.detach(|| error_dynamics_along(&layout, &ell, &lla, &vel, &q, &fb, &noise))?;
     let m = layout.size();
     let f: Vec<_> = out.iter().map(|x| x.0.clone()).collect();
     let qc: Vec<_> = out.iter().map(|x| x.1.clone()).collect();
@@ -107,19 +84,13 @@ pub struct PyAidedIns {
 type OutputTuple<'py> = Bound<'py, pyo3::types::PyTuple>;
 
 /// The INS part every aided-INS factory shares (initial state, IMU kind, Earth model,
-/// initial bias estimates, P₀, noise and filter options), parsed and checked once; each
-/// sensor's factory takes it as `ins` and adds its own measurement model.
+/// initial bias estimates, P₀, noise and filter options, vertical channel; the core's
+/// `InsSetup`), checked once; each sensor's factory takes it as `ins` and adds its own
+/// measurement model. Keyword-only.
 #[pyclass(name = "AidedSetup", module = "atomnav._core", frozen)]
 pub struct AidedSetup {
-    initial: NavState,
+    pub(crate) setup: InsSetup,
     pub(crate) kind: crate::imu::ImuKind,
-    ell: Ellipsoid,
-    ba0: crate::math::Vec3,
-    bg0: crate::math::Vec3,
-    p0: DMatrix<f64>,
-    cfg: AidedConfig,
-    /// Damped vertical channel: (ζ, ω_v rad/s, reference-altitude error model).
-    damped: Option<(f64, f64, BaroModel)>,
 }
 
 #[pymethods]
@@ -129,40 +100,35 @@ impl AidedSetup {
     /// bias state `baro_bias` = (model, p1, p2) as for the IMU biases with initial σ
     /// `baro_bias_sigma0` (m).
     #[new]
-    #[pyo3(signature = (t0, lla0, vel0, q0, kind, ba0, bg0, p0, accel_psd, gyro_psd, accel_bias, gyro_bias, predict_every, method, mode, sequential=false, gate=None, ellipsoid=Wrap(crate::earth::WGS84), vertical="free", zeta=0.707, omega=0.01, baro_psd=0.0, baro_bias=None, baro_bias_sigma0=None))]
+    #[pyo3(signature = (*, t0, lla0, vel0, q0, kind, p0, accel_psd, gyro_psd, accel_bias, gyro_bias, ba0, bg0, predict_every, method, mode, sequential=false, gate=None, ellipsoid=Wrap(crate::earth::WGS84), vertical=Wrap(VerticalMode::Free), zeta=0.707, omega=0.01, baro_psd=0.0, baro_bias=None, baro_bias_sigma0=None))]
     #[allow(clippy::too_many_arguments)]
     fn new(
         t0: f64,
-        lla0: PyReadonlyArray1<'_, f64>,
-        vel0: PyReadonlyArray1<'_, f64>,
-        q0: PyReadonlyArray1<'_, f64>,
+        lla0: [f64; 3],
+        vel0: [f64; 3],
+        q0: [f64; 4],
         kind: Wrap<ImuKind>,
-        ba0: PyReadonlyArray1<'_, f64>,
-        bg0: PyReadonlyArray1<'_, f64>,
         p0: PyReadonlyArray2<'_, f64>,
         accel_psd: f64,
         gyro_psd: f64,
         accel_bias: (String, f64, f64),
         gyro_bias: (String, f64, f64),
+        ba0: [f64; 3],
+        bg0: [f64; 3],
         predict_every: usize,
         method: &str,
         mode: &str,
         sequential: bool,
         gate: Option<f64>,
         ellipsoid: Wrap<Ellipsoid>,
-        vertical: &str,
+        vertical: Wrap<VerticalMode>,
         zeta: f64,
         omega: f64,
         baro_psd: f64,
         baro_bias: Option<(String, f64, f64)>,
         baro_bias_sigma0: Option<f64>,
     ) -> PyResult<Self> {
-        use super::convert::vec3;
-        let q = vector(&q0, "q0")?;
-        if q.len() != 4 {
-            return Err(invalid("q0", format!("expected 4 elements, got {}", q.len())).into());
-        }
-        let initial = NavState { t: t0, lla: vec3(&lla0, "lla0")?, vel: vec3(&vel0, "vel0")?, q_nb: crate::math::quat(q[0], q[1], q[2], q[3]) };
+        let initial = NavState { t: t0, lla: lla0.into(), vel: vel0.into(), q_nb: crate::math::quat(q0[0], q0[1], q0[2], q0[3]) };
         let noise = ins_noise(accel_psd, gyro_psd, &accel_bias, &gyro_bias)?;
         let cfg = AidedConfig { noise, predict_every, method: Discretization::by_name(method)?, mode: LoopMode::by_name(mode)?, sequential, gate };
         let bias = match (baro_bias, baro_bias_sigma0) {
@@ -171,21 +137,9 @@ impl AidedSetup {
             (Some(_), None) => return Err(invalid("baro_bias_sigma0", "required with baro_bias (initial σ of the bias state, m)").into()),
             (None, Some(_)) => return Err(invalid("baro_bias_sigma0", "given without baro_bias").into()),
         };
-        let damped = match vertical {
-            "free" => None,
-            "damped" => Some((zeta, omega, BaroModel { noise_psd: baro_psd, bias })),
-            _ => return Err(invalid("vertical", format!("unknown {vertical:?} (free, damped)")).into()),
-        };
-        Ok(AidedSetup {
-            initial,
-            kind: kind.0,
-            ell: ellipsoid.0,
-            ba0: vec3(&ba0, "ba0")?,
-            bg0: vec3(&bg0, "bg0")?,
-            p0: mat(&p0, "p0")?,
-            cfg,
-            damped,
-        })
+        let damped = (vertical.0 == VerticalMode::Damped).then_some(DampedVertical { zeta, omega, baro: BaroModel { noise_psd: baro_psd, bias } });
+        let setup = InsSetup::new(initial, kind.0, ellipsoid.0, ba0.into(), bg0.into(), mat(&p0, "p0")?, cfg, damped)?;
+        Ok(AidedSetup { setup, kind: kind.0 })
     }
 }
 
@@ -193,21 +147,23 @@ impl PyAidedIns {
     /// The aided INS of `ins` with the sensor's model and the initial estimate of its
     /// extra blocks.
     pub(crate) fn from_aiding(ins: &AidedSetup, extra0: DVector<f64>, aiding: Box<dyn Aiding>) -> PyResult<Self> {
-        let mut engine = AidedIns::new(ins.initial, ins.kind, ins.ell, ins.ba0, ins.bg0, extra0, ins.p0.clone(), ins.cfg, aiding)?;
-        if let Some((zeta, omega, baro)) = ins.damped {
-            engine = engine.with_damped_vertical(zeta, omega, baro)?;
-        }
+        Self::from_aiding_with(ins, extra0, None, aiding)
+    }
+
+    /// [`Self::from_aiding`] with P₀ over the whole layout when the sensor assembles it.
+    pub(crate) fn from_aiding_with(ins: &AidedSetup, extra0: DVector<f64>, p0: Option<DMatrix<f64>>, aiding: Box<dyn Aiding>) -> PyResult<Self> {
+        let engine = AidedIns::from_setup(&ins.setup, extra0, p0, aiding)?;
         Ok(PyAidedIns { inner: std::sync::Mutex::new(engine) })
     }
 
-    fn output<'py>(py: Python<'py>, o: AidedOutput, n: usize) -> PyResult<OutputTuple<'py>> {
+    fn output<'py>(py: Python<'py>, o: AidedOutput, n: usize, n_extra: usize) -> PyResult<OutputTuple<'py>> {
         use super::convert::{flat_to_py, vec3_to_py};
         let ne = o.time.len();
         let items: Vec<Bound<'py, PyAny>> = vec![
             super::strapdown::states_to_columns(py, &o.nav).into_any(),
             vec3_to_py(py, &o.accel_bias).into_any(),
             vec3_to_py(py, &o.gyro_bias).into_any(),
-            flat_to_py(py, ne, n - 15, o.extra).into_any(),
+            flat_to_py(py, ne, n_extra, o.extra).into_any(),
             flat_to_py(py, ne, n, o.sigma).into_any(),
             o.meas_time.into_pyarray(py).into_any(),
             o.meas_rows.into_pyarray(py).into_any(),
@@ -222,12 +178,12 @@ impl PyAidedIns {
     /// computed before it are not lost: the raised exception carries them as `partial`.
     fn call<'py>(&self, py: Python<'py>, f: impl FnOnce(&mut AidedIns<Box<dyn Aiding>>, &mut AidedOutput) -> crate::error::Result<()> + Send) -> PyResult<OutputTuple<'py>> {
         let mut guard = self.inner.lock().map_err(|_| pyo3::exceptions::PyRuntimeError::new_err("AidedIns: a previous call panicked"))?;
-        let n = guard.layout().size();
+        let (n, n_extra) = (guard.layout().size(), guard.n_extra());
         let mut out = AidedOutput::default();
         let ins: &mut AidedIns<Box<dyn Aiding>> = &mut guard;
         let res = py.detach(|| f(ins, &mut out));
         drop(guard);
-        let table = Self::output(py, out, n)?;
+        let table = Self::output(py, out, n, n_extra)?;
         match res {
             Ok(()) => Ok(table),
             Err(e) => {
@@ -292,40 +248,45 @@ fn unchecked_vec3_rows(a: &PyReadonlyArray2<'_, f64>, field: &str) -> Result<Vec
     Ok(v.outer_iter().map(|r| crate::math::Vec3::new(r[0], r[1], r[2])).collect())
 }
 
-/// INS noise model from the Python arguments.
+/// INS noise model from the Python arguments (bias models as (kind, p1, p2)).
 pub(crate) fn ins_noise(accel_psd: f64, gyro_psd: f64, accel_bias: &(String, f64, f64), gyro_bias: &(String, f64, f64)) -> PyResult<InsNoise> {
-    for (field, x) in [("accel_psd", accel_psd), ("gyro_psd", gyro_psd)] {
-        if !(x.is_finite() && x >= 0.0) {
-            return Err(invalid(field, format!("must be finite and >= 0, got {x}")).into());
-        }
-    }
-    Ok(InsNoise {
-        accel_psd,
-        gyro_psd,
-        accel_bias: BiasModel::from_parts("accel_bias", &accel_bias.0, accel_bias.1, accel_bias.2)?,
-        gyro_bias: BiasModel::from_parts("gyro_bias", &gyro_bias.0, gyro_bias.1, gyro_bias.2)?,
-    })
+    let ba = BiasModel::from_parts("accel_bias", &accel_bias.0, accel_bias.1, accel_bias.2)?;
+    let bg = BiasModel::from_parts("gyro_bias", &gyro_bias.0, gyro_bias.1, gyro_bias.2)?;
+    Ok(InsNoise::new(accel_psd, gyro_psd, ba, bg)?)
 }
 
 /// Position-aided INS: fixes at `fix_t` (M,) with (lat, lon, h) `fix_lla` (M, 3) and NED
 /// covariance `fix_cov` (M, 3, 3) m².
 #[pyfunction]
 fn position_aided_ins(ins: PyRef<'_, AidedSetup>, fix_t: PyReadonlyArray1<'_, f64>, fix_lla: PyReadonlyArray2<'_, f64>, fix_cov: PyReadonlyArray3<'_, f64>) -> PyResult<PyAidedIns> {
-    let (ft, fl, fc) = (vector(&fix_t, "fix_t")?, vec3_rows(&fix_lla, "fix_lla")?, mats(&fix_cov, "fix_cov")?);
-    if fl.len() != ft.len() || fc.len() != ft.len() {
-        return Err(invalid("fixes", format!("fix_t has {} entries but fix_lla {} and fix_cov {}", ft.len(), fl.len(), fc.len())).into());
-    }
-    if let Some(i) = fc.iter().position(|c| c.nrows() != 3 || c.ncols() != 3) {
-        return Err(invalid("fix_cov", format!("expected (M, 3, 3), entry {i} is {}x{}", fc[i].nrows(), fc[i].ncols())).into());
-    }
-    let fixes: Vec<PositionFix> = (0..ft.len()).map(|i| PositionFix { t: ft[i], lla: fl[i], cov_ned: crate::math::Mat3::from_fn(|r, c| fc[i][(r, c)]) }).collect();
+    let fixes = PositionFix::table(&vector(&fix_t, "fix_t")?, &vec3_rows(&fix_lla, "fix_lla")?, &mats(&fix_cov, "fix_cov")?)?;
     PyAidedIns::from_aiding(&ins, DVector::zeros(0), Box::new(PositionAiding::new(fixes)?))
+}
+
+/// The estimate at the start of a run whose truth is (`lla` rad/rad/m, `vel_ned` m/s,
+/// `q_nb`): the truth ⊕ δx with δx = L u drawn from the navigation block of `p0` and the
+/// standard normals `normals` (9,) (filter/initial_error.rs). Returns (lla, vel_ned, q_nb).
+#[pyfunction]
+#[pyo3(signature = (lla, vel_ned, q_nb, p0, normals, ellipsoid=Wrap(crate::earth::WGS84)))]
+#[allow(clippy::type_complexity)]
+fn initial_error<'py>(
+    py: Python<'py>, lla: [f64; 3], vel_ned: [f64; 3], q_nb: [f64; 4], p0: PyReadonlyArray2<'py, f64>, normals: PyReadonlyArray1<'py, f64>, ellipsoid: Wrap<Ellipsoid>,
+) -> PyResult<(Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<f64>>)> {
+    let truth = NavState { t: 0.0, lla: lla.into(), vel: vel_ned.into(), q_nb: crate::math::quat(q_nb[0], q_nb[1], q_nb[2], q_nb[3]) };
+    let s = perturbed_start(&ellipsoid.0, &truth, &mat(&p0, "p0")?, &vector(&normals, "normals")?)?;
+    let q = [s.q_nb.w, s.q_nb.i, s.q_nb.j, s.q_nb.k];
+    Ok((s.lla.as_slice().to_vec().into_pyarray(py), s.vel.as_slice().to_vec().into_pyarray(py), q.to_vec().into_pyarray(py)))
 }
 
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(layout_ranges, m)?)?;
     m.add_function(wrap_pyfunction!(ins_error_dynamics, m)?)?;
     m.add_function(wrap_pyfunction!(position_aided_ins, m)?)?;
+    m.add_function(wrap_pyfunction!(initial_error, m)?)?;
+    m.add("STATE_BLOCKS", STANDARD_BLOCKS.to_vec())?;
+    m.add("INS15", INS15.to_vec())?;
+    register_choices::<VerticalMode>(m, "VerticalMode")?;
+    register_choices::<BiasKind>(m, "BiasKind")?;
     m.add_class::<PyAidedIns>()?;
     m.add_class::<AidedSetup>()?;
     Ok(())

@@ -4,8 +4,10 @@ factories of their packages) builds an :class:`AidedIns`; :meth:`AidedIns.run` f
 whole IMU record in chunks with a progress bar, :meth:`AidedIns.process` /
 :meth:`AidedIns.finish` stream it yourself. Closed loop (feedback) or open loop
 (estimation) is chosen at construction, and so is the vertical channel: free, or
-damped by a reference (barometric) altitude per IMU sample (``vertical="damped"``, spec
-gnss-ins-tight decision 13), which :meth:`AidedIns.run` then takes as ``h_ref``."""
+damped by a reference (barometric) altitude per IMU sample (``vertical="damped"``, the
+third-order baro loop of Demidov 2009, Eq. 26), which :meth:`AidedIns.run` then takes as
+``h_ref``. The INS part of every factory is one frozen configuration, :class:`InsSetup`,
+checked by the core when it is built and convertible to and from dict and JSON."""
 
 from __future__ import annotations
 
@@ -16,10 +18,95 @@ import pandas as pd
 from tqdm.auto import tqdm
 
 from .. import _core
-from .._validate import choice, positive, rows, vector
+from .._validate import input_error, positive, rows
 from ..strapdown import _table
-from .engine import BiasModel
+from .engine import BiasModel, Config, _floats
 from .riccati import _mat
+
+#: Names of the vertical-channel options (from the core).
+VERTICAL = tuple(_core.OPTIONS["VerticalMode"])
+
+
+@dataclass(frozen=True, kw_only=True)
+class InsSetup(Config):
+    """The INS part every aided-INS factory shares (Rust ``filter::aided::InsSetup``),
+    checked once by the core when built (an invalid field raises
+    :class:`atomnav.InputError` naming it).
+
+    Initial state ``t0`` (s), ``lla0`` (rad, rad, m), ``vel0`` NED (m/s), ``q0`` = q_nb;
+    IMU output ``kind`` "rates" or "increments"; ``p0`` the initial covariance (in the
+    order of :data:`atomnav.filter.INS15`, then the sensor's extra states where the
+    sensor does not supply them); white-noise PSDs ``accel_psd`` ((m/s²)²/Hz) and
+    ``gyro_psd`` (rad²/s); bias processes; initial bias estimates ``ba0`` (m/s²), ``bg0``
+    (rad/s); the filter predicts every ``predict_every`` IMU steps and at every
+    measurement; ``method`` "van_loan" or "first_order"; ``mode`` "closed" or "open";
+    ``sequential`` scalar updates; ``gate`` χ² threshold; ``ellipsoid``.
+
+    Vertical channel: ``vertical`` one of :data:`VERTICAL` — "free" (default) or
+    "damped", then :meth:`AidedIns.run` needs ``h_ref``, the reference (barometric)
+    altitude (m) per IMU sample; ``zeta``, ``omega`` (rad/s) of the baro loop
+    (K_v1 = 2ζω, K_v2 = ω² + 2γ/R₀; Demidov 2009, Eq. 26); the reference-altitude error
+    h_b − h = b + n: ``baro_psd`` the PSD of the white part n (m²·s; σ²Δt for independent
+    samples of σ every Δt), ``baro_bias`` a :class:`BiasModel` of b carried as the state
+    ``baro_bias`` (m, after the sensor's extra states) with initial σ
+    ``baro_bias_sigma0`` (m); without it the filter assumes b = 0.
+
+    >>> s = InsSetup(t0=0.0, lla0=(0.8, 0.2, 100.0), vel0=(0, 0, 0), q0=(1, 0, 0, 0),
+    ...              kind="rates", p0=np.eye(15), accel_psd=1e-8, gyro_psd=1e-12)  # doctest: +SKIP
+    >>> InsSetup.from_json(s.to_json()) == s                                      # doctest: +SKIP
+    True
+    """
+
+    _NESTED = {"accel_bias": BiasModel, "gyro_bias": BiasModel, "baro_bias": BiasModel}
+
+    t0: float
+    lla0: tuple
+    vel0: tuple
+    q0: tuple
+    kind: str
+    p0: tuple
+    accel_psd: float
+    gyro_psd: float
+    accel_bias: BiasModel = BiasModel()
+    gyro_bias: BiasModel = BiasModel()
+    ba0: tuple = (0.0, 0.0, 0.0)
+    bg0: tuple = (0.0, 0.0, 0.0)
+    predict_every: int = 1
+    method: str = "van_loan"
+    mode: str = "closed"
+    sequential: bool = False
+    gate: float | None = None
+    ellipsoid: str = "WGS84"
+    vertical: str = "free"
+    zeta: float = 0.707
+    omega: float = 0.01
+    baro_psd: float = 0.0
+    baro_bias: BiasModel | None = None
+    baro_bias_sigma0: float | None = None
+
+    def __post_init__(self):
+        for name, n in (("lla0", 3), ("vel0", 3), ("q0", 4), ("ba0", 3), ("bg0", 3)):
+            v = np.asarray(getattr(self, name), dtype=float)
+            if v.shape != (n,):
+                raise input_error(name, f"expected shape ({n},), got {v.shape}")
+            object.__setattr__(self, name, _floats(v))
+        p0 = _mat(self.p0, "p0")
+        object.__setattr__(self, "p0", _floats(p0))
+        native = _core.AidedSetup(
+            t0=float(self.t0), lla0=list(self.lla0), vel0=list(self.vel0), q0=list(self.q0), kind=self.kind, p0=p0,
+            accel_psd=float(self.accel_psd), gyro_psd=float(self.gyro_psd), accel_bias=self.accel_bias._parts(),
+            gyro_bias=self.gyro_bias._parts(), ba0=list(self.ba0), bg0=list(self.bg0), predict_every=int(self.predict_every),
+            method=self.method, mode=self.mode, sequential=bool(self.sequential),
+            gate=None if self.gate is None else float(self.gate), ellipsoid=self.ellipsoid, vertical=self.vertical,
+            zeta=float(self.zeta), omega=float(self.omega), baro_psd=float(self.baro_psd),
+            baro_bias=None if self.baro_bias is None else self.baro_bias._parts(),
+            baro_bias_sigma0=None if self.baro_bias_sigma0 is None else float(self.baro_bias_sigma0))
+        object.__setattr__(self, "_native", native)
+
+    @property
+    def native(self) -> _core.AidedSetup:
+        """The checked core object the sensor factories take."""
+        return self._native
 
 _AXES = "xyz"
 
@@ -45,9 +132,11 @@ class AidedResult:
 class AidedIns:
     """A running aided INS; build it with a sensor's factory function."""
 
-    def __init__(self, core: _core.AidedIns, kind: str):
+    def __init__(self, core: _core.AidedIns, setup: InsSetup):
         self._core = core
-        self.kind = kind
+        #: The INS configuration (save it beside the results: ``setup.to_json()``).
+        self.setup = setup
+        self.kind = setup.kind
         #: Labels of the state components in filter order, e.g. ``velocity[2]``.
         self.labels: list[str] = list(core.labels)
 
@@ -105,7 +194,7 @@ class AidedIns:
         positive(chunk_s, "chunk_s")
         n = len(t)
         if n < 2:
-            raise ValueError(f"time: need >= 2 samples, got {n}")
+            raise input_error("time", f"need >= 2 samples, got {n}")
         mt = np.asarray(self._core.measurement_times)
         outside = np.nonzero((mt < t[0]) | (mt > t[-1]))[0]
         if outside.size:
@@ -153,54 +242,24 @@ def _concat(parts: list[AidedResult]) -> AidedResult:
                        np.concatenate([p.innovation for p in parts]))
 
 
-def ins_setup(t0, lla0, vel0, q0, kind, p0, accel_psd, gyro_psd, accel_bias: BiasModel, gyro_bias: BiasModel,
-              ba0, bg0, predict_every, method, mode, sequential, gate, ellipsoid, vertical: str = "free",
-              zeta: float = 0.707, omega: float = 0.01, baro_psd: float = 0.0, baro_bias: BiasModel | None = None,
-              baro_bias_sigma0: float | None = None) -> _core.AidedSetup:
-    """The INS part every sensor factory shares, checked once (see
-    :func:`position_aided_ins` for the meaning of the arguments)."""
-    choice(kind, ("rates", "increments"), "kind")
-    choice(vertical, ("free", "damped"), "vertical")
-    return _core.AidedSetup(float(t0), vector(lla0, 3, "lla0"), vector(vel0, 3, "vel0"), vector(q0, 4, "q0"), kind,
-                            vector(ba0, 3, "ba0"), vector(bg0, 3, "bg0"), _mat(p0, "p0"), float(accel_psd),
-                            float(gyro_psd), accel_bias._parts(), gyro_bias._parts(), int(predict_every), method, mode,
-                            bool(sequential), None if gate is None else float(gate), ellipsoid, vertical, float(zeta),
-                            float(omega), float(baro_psd), None if baro_bias is None else baro_bias._parts(),
-                            None if baro_bias_sigma0 is None else float(baro_bias_sigma0))
-
-
-def position_aided_ins(t0: float, lla0, vel0, q0, kind: str, fix_time, fix_lla, fix_cov, p0, accel_psd: float,
-                       gyro_psd: float, accel_bias: BiasModel = BiasModel(), gyro_bias: BiasModel = BiasModel(),
-                       ba0=(0, 0, 0), bg0=(0, 0, 0), predict_every: int = 1, method: str = "van_loan",
-                       mode: str = "closed", sequential: bool = False, gate: float | None = None,
-                       ellipsoid: str = "WGS84", **vertical) -> AidedIns:
+def position_aided_ins(t0: float, lla0, vel0, q0, kind: str, fix_time, fix_lla, fix_cov, *, p0, accel_psd: float,
+                       gyro_psd: float, **options) -> AidedIns:
     """A position-aided 15-state INS.
 
-    Initial state t0 (s), lla0 (rad, rad, m), vel0 NED (m/s), q0 = q_nb; IMU output
-    ``kind`` "rates" or "increments"; fixes at ``fix_time`` (M,) s with ``fix_lla``
-    (M, 3) and NED covariance ``fix_cov`` (M, 3, 3) m², applied at the first IMU epoch at
-    or after their time; p0 (15, 15) in the order of :data:`INS15`; white-noise PSDs
-    accel_psd ((m/s²)²/Hz) and gyro_psd (rad²/s); bias processes; initial bias estimates
-    ba0 (m/s²), bg0 (rad/s); the filter predicts every ``predict_every`` IMU steps and at
-    every fix; ``method`` "van_loan" or "first_order"; ``mode`` "closed" or "open";
-    ``sequential`` scalar updates; ``gate`` χ² threshold.
-
-    Vertical channel (keywords of :func:`ins_setup`): ``vertical`` "free" (default) or
-    "damped", then :meth:`AidedIns.run` needs ``h_ref``, the reference (barometric)
-    altitude (m) per IMU sample; ``zeta``, ``omega`` (rad/s) of the baro loop
-    (K_v1 = 2ζω, K_v2 = ω² + 2γ/R₀; spec gnss-ins-tight Eq. 26); the reference-altitude
-    error h_b − h = b + n: ``baro_psd`` the PSD of the white part n (m²·s; σ²Δt for
-    independent samples of σ every Δt), ``baro_bias`` a :class:`BiasModel` of b carried as
-    the state ``baro_bias`` (m, after the sensor's extra states) with initial σ
-    ``baro_bias_sigma0`` (m); without it the filter assumes b = 0.
+    Fixes at ``fix_time`` (M,) s with ``fix_lla`` (M, 3) and NED covariance ``fix_cov``
+    (M, 3, 3) m², applied at the first IMU epoch at or after their time. The INS
+    arguments (initial state ``t0``, ``lla0``, ``vel0``, ``q0``, IMU ``kind``, ``p0``
+    (15, 15), noise PSDs and the keyword ``options``: bias models, ``ba0``/``bg0``,
+    ``predict_every``, ``method``, ``mode``, ``sequential``, ``gate``, ``ellipsoid`` and the
+    vertical channel) are the fields of :class:`InsSetup`.
 
     >>> ins = position_aided_ins(...)              # doctest: +SKIP
     >>> result = ins.run(time, gyro, accel)        # doctest: +SKIP
     >>> truth.errors(result.nav)                   # doctest: +SKIP
     """
-    ins = ins_setup(t0, lla0, vel0, q0, kind, p0, accel_psd, gyro_psd, accel_bias, gyro_bias, ba0, bg0,
-                    predict_every, method, mode, sequential, gate, ellipsoid, **vertical)
+    setup = InsSetup(t0=t0, lla0=lla0, vel0=vel0, q0=q0, kind=kind, p0=p0, accel_psd=accel_psd, gyro_psd=gyro_psd,
+                     **options)
     core = _core.position_aided_ins(
-        ins, np.ascontiguousarray(np.asarray(fix_time, float).ravel()), rows(fix_lla, 3, "fix_lla"),
+        setup.native, np.ascontiguousarray(np.asarray(fix_time, float).ravel()), rows(fix_lla, 3, "fix_lla"),
         np.ascontiguousarray(np.asarray(fix_cov, float).reshape(-1, 3, 3)))
-    return AidedIns(core, kind)
+    return AidedIns(core, setup)

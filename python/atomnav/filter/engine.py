@@ -7,21 +7,73 @@ z = predicted − measured ≈ H δx + v. SI units throughout.
 
 from __future__ import annotations
 
+import dataclasses
+import json
 from dataclasses import dataclass
 
 import numpy as np
 
 from .. import _core
-from .._validate import rows
+from .._validate import input_error, rows
 from .riccati import _mat
 
-#: Standard blocks and their sizes; extra blocks (lever arm, clock, ...) give their size.
-STANDARD_BLOCKS = {
-    "position": 3, "velocity": 3, "attitude": 3, "accel_bias": 3, "gyro_bias": 3,
-    "accel_scale": 3, "gyro_scale": 3, "accel_misalignment": 6, "gyro_misalignment": 6,
-}
-#: The 15-state INS layout (spec gnss-ins-tight §2.9, atom-strapdown E22).
-INS15 = ("position", "velocity", "attitude", "accel_bias", "gyro_bias")
+#: Standard blocks and their sizes (read from the core, ``rust/filter/layout.rs``); extra
+#: blocks (lever arm, clock, ...) give their size.
+STANDARD_BLOCKS = dict(_core.STATE_BLOCKS)
+#: The 15-state INS layout (Groves 2013, §14.2.1; from the core).
+INS15 = tuple(_core.INS15)
+#: Bias process names (from the core).
+BIAS_KINDS = tuple(_core.OPTIONS["BiasKind"])
+
+
+def _plain(x):
+    """A config value as JSON-ready Python (configs as dicts, arrays and tuples as lists)."""
+    if isinstance(x, Config):
+        return x.to_dict()
+    if isinstance(x, (tuple, list, np.ndarray)):
+        return [_plain(v) for v in x]
+    if isinstance(x, np.generic):
+        return x.item()
+    return x
+
+
+class Config:
+    """Mixin of the frozen configuration dataclasses (:class:`BiasModel`,
+    :class:`atomnav.filter.aided.InsSetup`, :class:`atomnav.gnss.GnssOptions`): save a run's
+    configuration beside its results and rebuild it. ``_NESTED`` maps a field to the
+    config class its dict is rebuilt with."""
+
+    _NESTED: dict = {}
+
+    def to_dict(self) -> dict:
+        """Every field as plain Python (nested configs as dicts, arrays as lists)."""
+        return {f.name: _plain(getattr(self, f.name)) for f in dataclasses.fields(self)}
+
+    @classmethod
+    def from_dict(cls, d: dict):
+        """The configuration of :meth:`to_dict`'s dict; an unknown key is an
+        :class:`atomnav.InputError` naming it."""
+        names = {f.name for f in dataclasses.fields(cls)}
+        unknown = sorted(set(d) - names)
+        if unknown:
+            raise input_error(unknown[0], f"not a field of {cls.__name__} (fields: {', '.join(sorted(names))})")
+        kw = {k: cls._NESTED[k].from_dict(v) if k in cls._NESTED and isinstance(v, dict) else v for k, v in d.items()}
+        return cls(**kw)
+
+    def to_json(self, **kwargs) -> str:
+        """:meth:`to_dict` as JSON (``kwargs`` go to :func:`json.dumps`)."""
+        return json.dumps(self.to_dict(), **kwargs)
+
+    @classmethod
+    def from_json(cls, text: str):
+        """The configuration of :meth:`to_json`'s text."""
+        return cls.from_dict(json.loads(text))
+
+
+def _floats(x) -> tuple:
+    """A vector or matrix as (nested) tuples of floats: hashable, comparable, JSON-ready."""
+    a = np.asarray(x, dtype=float)
+    return tuple(map(float, a)) if a.ndim <= 1 else tuple(_floats(r) for r in a)
 
 
 def _block_spec(blocks) -> list[tuple[str, int | None]]:
@@ -74,9 +126,11 @@ def discretize(f, qc, dt: float, method: str = "van_loan") -> tuple[np.ndarray, 
 
 
 @dataclass(frozen=True)
-class BiasModel:
-    """Per-axis bias process: ``random_constant``, ``random_walk`` (psd in units²/s) or
-    ``gauss_markov`` (tau in s, sigma = steady-state σ in the bias unit)."""
+class BiasModel(Config):
+    """Per-axis bias process: ``kind`` one of :data:`BIAS_KINDS` — ``random_constant``,
+    ``random_walk`` (psd in units²/s) or ``gauss_markov`` (tau in s, sigma = steady-state σ
+    in the bias unit). The core checks the kind where the model is used and names that
+    argument (e.g. ``accel_bias``)."""
 
     kind: str = "random_constant"
     psd: float = 0.0
@@ -90,7 +144,7 @@ class BiasModel:
 
 
 def ins_error_model(lla, vel_ned, q_nb, f_b, accel_psd: float, gyro_psd: float,
-                    accel_bias: BiasModel = BiasModel(), gyro_bias: BiasModel = BiasModel(),
+                    accel_bias: BiasModel = BiasModel(), gyro_bias: BiasModel = BiasModel(), *,
                     layout: Layout | None = None, ellipsoid: str = "WGS84") -> tuple[np.ndarray, np.ndarray]:
     """Continuous INS error model F, Q_c (spec gnss-ins-tight Eq. 28) along a trajectory.
 
@@ -100,8 +154,9 @@ def ins_error_model(lla, vel_ned, q_nb, f_b, accel_psd: float, gyro_psd: float,
     """
     layout = layout or Layout()
     return _core.ins_error_dynamics(layout.spec, rows(lla, 3, "lla"), rows(vel_ned, 3, "vel_ned"),
-                                    rows(q_nb, 4, "q_nb"), rows(f_b, 3, "f_b"), float(accel_psd), float(gyro_psd),
-                                    accel_bias._parts(), gyro_bias._parts(), ellipsoid)
+                                    rows(q_nb, 4, "q_nb"), rows(f_b, 3, "f_b"), accel_psd=float(accel_psd),
+                                    gyro_psd=float(gyro_psd), accel_bias=accel_bias._parts(),
+                                    gyro_bias=gyro_bias._parts(), ellipsoid=ellipsoid)
 
 
 class KalmanFilter:

@@ -10,30 +10,34 @@ import pandas as pd
 from .. import _core
 from .._validate import rows, vector
 from .ephemeris import Ephemerides
+from .options import GnssOptions, split_options
 
 C_LIGHT = 299792458.0
 OBS_COLUMNS = ["time_s", "sat", "channel", "code_m", "rate_mps"]
 
 
-def simulate(eph: Ephemerides, time, lla, vel_ned, sigma_code: float = 3.0, sigma_code_glonass: float | None = None,
-             sigma_rate: float = 0.05, tau_gps: float = 0.0, clock_bias: float = 0.0, clock_drift: float = 0.0,
-             iono: bool = True, tropo: bool = True, mask_deg: float = 10.0, only: list[str] | None = None,
-             outages=(), sat_outages=(), seed: int = 0) -> pd.DataFrame:
+def simulate(eph: Ephemerides, time, lla, vel_ned, options: GnssOptions | None = None, *, tau_gps: float = 0.0,
+             clock_bias: float = 0.0, clock_drift: float = 0.0, mask_deg: float = 10.0, only: list[str] | None = None,
+             outages=(), sat_outages=(), seed: int = 0, **option_fields) -> pd.DataFrame:
     """Observations of a receiver at ``lla`` (N, 3) rad/rad/m with NED velocity ``vel_ned``
     (N, 3) m/s at GPS times ``time`` (N,) s.
 
-    Code σ ``sigma_code`` m (GLONASS ``sigma_code_glonass``, default the same), rate σ
-    ``sigma_rate`` m/s, true ``tau_gps`` (s) on GLONASS code, receiver clock
-    δt_r = clock_bias + clock_drift·t (s), Klobuchar ``iono`` and Saastamoinen ``tropo``,
-    elevation mask ``mask_deg``; visibility: ``only`` a fixed satellite subset, ``outages``
-    [(start, end)] s of all satellites, ``sat_outages`` [(sat, start, end)]. Seeded. The table also carries the true ``elevation_rad``."""
+    Noise and atmosphere from ``options`` (:class:`GnssOptions`; its fields may also be
+    given as keywords, e.g. ``sigma_code=1.0, iono=False``): code σ, rate σ, Klobuchar
+    and Saastamoinen. Truth: ``tau_gps`` (s) on GLONASS code, receiver clock
+    δt_r = clock_bias + clock_drift·t (s). Visibility: elevation mask ``mask_deg``,
+    ``only`` a fixed satellite subset, ``outages`` [(start, end)] s of all satellites,
+    ``sat_outages`` [(sat, start, end)]. Seeded. The table also carries the true
+    ``elevation_rad``."""
+    opts, rest = split_options(options, option_fields)
+    if rest:
+        raise TypeError(f"simulate() got an unexpected keyword argument {sorted(rest)[0]!r}")
     t = vector(time, None, "time")
     out = np.asarray(outages, float).reshape(-1, 2)
-    d = _core.gnss_simulate(eph._core, t, rows(lla, 3, "lla"), rows(vel_ned, 3, "vel_ned"), float(sigma_code),
-                            float(sigma_code if sigma_code_glonass is None else sigma_code_glonass), float(sigma_rate),
-                            float(tau_gps), float(clock_bias), float(clock_drift), bool(iono), bool(tropo),
-                            np.radians(mask_deg), only, np.ascontiguousarray(out),
-                            [(str(s), float(a), float(b)) for s, a, b in sat_outages], int(seed))
+    d = _core.gnss_simulate(eph._core, t, rows(lla, 3, "lla"), rows(vel_ned, 3, "vel_ned"), opts.native,
+                            tau_gps=float(tau_gps), clock_bias=float(clock_bias), clock_drift=float(clock_drift),
+                            mask=float(np.radians(mask_deg)), only=only, outages=np.ascontiguousarray(out),
+                            sat_outages=[(str(s), float(a), float(b)) for s, a, b in sat_outages], seed=int(seed))
     return pd.DataFrame({c: d[c] for c in OBS_COLUMNS + ["elevation_rad"]})
 
 

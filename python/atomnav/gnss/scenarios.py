@@ -1,12 +1,12 @@
-"""Named, seeded experiments of the thesis (spec gnss-ins-tight §4): INS accuracy class ×
+"""Named, seeded experiments of the thesis (Demidov 2009, §4): INS accuracy class ×
 satellite count, GNSS outages, open- vs closed-loop, all on the tightly coupled filter.
 
 ``STAT``: stationary at 55.75°N, 37.6°E, 200 m, heading 30°. ``MOVE``: level drive at
 100 m/s whose heading swings with yaw rate 3 °/s·sin(2πt/600 s) (turns of up to 3 °/s, the
 manoeuvres that make heading observable; a smooth stand-in for the spec's legs and 180°
 turns). GPS nominal constellation, 10° mask, code/rate σ 3 m / 0.05 m/s, ΔT = 1 s.
-The INS's vertical channel is baro-damped (spec decision 13, Eq. 26: ζ = 0.707,
-ω_v = 0.01 rad/s): a barometric altitude at 1 Hz with white error σ = 1 m (spec §3), held
+The INS's vertical channel is baro-damped (Demidov 2009, Eq. 26: ζ = 0.707,
+ω_v = 0.01 rad/s): a barometric altitude at 1 Hz with white error σ = 1 m (Demidov 2009, §3), held
 over each second to the IMU rate, is the loop's reference; the filter models it as white
 noise of PSD σ²·1 s = 1 m²·s (the loop's time constants, ~100 s, are far longer than the
 1 s hold) and no bias, as simulated.
@@ -19,20 +19,21 @@ from dataclasses import dataclass, replace
 import numpy as np
 import pandas as pd
 
-from .. import imu, rotation, trajectory, units
+from .. import _core, imu, trajectory, units
+from .._validate import input_error
 from ..filter.engine import BiasModel
 from .ephemeris import Ephemerides
 from .observations import simulate
 from .tight import tight_ins
 
-#: Initial attitude σ (tilt, heading) of each class (spec §3), rad.
+#: Initial attitude σ (tilt, heading) of each class (Demidov 2009, §3), rad.
 INITIAL_ATTITUDE = {
     "precise": (20 * units.ARCSEC, 0.05 * units.DEG),
     "medium": (units.ARCMIN, 0.5 * units.DEG),
     "coarse": (0.3 * units.DEG, 3.0 * units.DEG),
 }
 ORIGIN = np.array(trajectory.MOSCOW)
-#: Baro loop (spec §3): damping ratio, natural frequency (rad/s), white altitude error σ (m).
+#: Baro loop (Demidov 2009, §3): damping ratio, natural frequency (rad/s), white altitude error σ (m).
 BARO_ZETA, BARO_OMEGA, BARO_SIGMA = 0.707, 0.01, 1.0
 
 
@@ -73,7 +74,7 @@ def _trajectory(sc: Scenario) -> trajectory.Trajectory:
     if sc.motion == "MOVE":
         return trajectory.drive_with_yaw(sc.rate_hz, origin=ORIGIN, speed=100.0, yaw_rate_amp=np.radians(3.0),
                                          period=600.0, duration=sc.duration_s)
-    raise ValueError(f"motion: unknown {sc.motion!r} (known: 'STAT', 'MOVE')")
+    raise input_error("motion", f"unknown {sc.motion!r} (known: 'STAT', 'MOVE')")
 
 
 def build(sc: Scenario | str, clock=(0.0, 0.0)) -> dict:
@@ -101,18 +102,16 @@ def build(sc: Scenario | str, clock=(0.0, 0.0)) -> dict:
     a, g = errors.accel, errors.gyro
     p0 = np.diag(np.r_[[10.0 ** 2] * 3, [0.1 ** 2] * 3, [tilt ** 2, tilt ** 2, heading ** 2],
                        [a.bias_sigma ** 2] * 3, [g.bias_sigma ** 2] * 3])
-    dx = rng.standard_normal(9) * np.sqrt(np.diag(p0)[:9])
+    # initial error δx ~ N(0, P0) of the navigation states (core: filter/initial_error.rs)
     s0 = traj.initial_state()
-    from ..earth import radii
-    m, n = radii(s0["lla"][0])
-    lla0 = s0["lla"] + np.array([dx[0] / (m + s0["lla"][2]), dx[1] / ((n + s0["lla"][2]) * np.cos(s0["lla"][0])), -dx[2]])
-    q0 = rotation.quat_multiply(rotation.quat_from_rotvec(-dx[6:9]), s0["q_nb"])
-    args = dict(t0=s0["t0"], lla0=lla0, vel0=s0["vel_ned"] + dx[3:6], q0=q0, kind="increments", p0_ins=p0,
+    lla0, vel0, q0 = _core.initial_error(np.asarray(s0["lla"], float).tolist(), np.asarray(s0["vel_ned"], float).tolist(),
+                                         np.asarray(s0["q_nb"], float).tolist(), p0, rng.standard_normal(9))
+    args = dict(t0=s0["t0"], lla0=lla0, vel0=vel0, q0=q0, kind="increments", p0_ins=p0,
                 accel_psd=a.white ** 2, gyro_psd=g.white ** 2,
                 accel_bias=BiasModel("random_walk", psd=a.bias_rw ** 2), gyro_bias=BiasModel("random_walk", psd=g.bias_rw ** 2),
                 predict_every=int(round(sc.rate_hz)), mode=sc.mode, formulation=sc.formulation,
                 vertical=sc.vertical, zeta=BARO_ZETA, omega=BARO_OMEGA, baro_psd=BARO_SIGMA ** 2 * 1.0)
-    # barometric altimeter at 1 Hz, white error σ 1 m (spec §3), held to the IMU samples
+    # barometric altimeter at 1 Hz, white error σ 1 m (Demidov 2009, §3), held to the IMU samples
     # (sample k covers (t_k − dt, t_k]: the reading of the second it ends in)
     t_imu = meas["time_s"].to_numpy()
     noise = BARO_SIGMA * rng.standard_normal(int(np.ceil(sc.duration_s)) + 1)

@@ -1,5 +1,6 @@
-"""Single-point positioning (spec gnss-ins-tight §2.7): least squares for position,
-receiver clock and τ_GPS per epoch, the thesis's residual metric, DOP, Doppler velocity."""
+"""Single-point positioning (Demidov 2009, §2.7; Rust ``gnss/spp.rs``): least squares for
+position, receiver clock and τ_GPS per epoch, the thesis's residual metric, DOP, Doppler
+velocity."""
 
 from __future__ import annotations
 
@@ -8,24 +9,23 @@ import pandas as pd
 from .. import _core
 from .ephemeris import Ephemerides
 from .observations import obs_arrays
+from .options import GnssOptions, split_options
 
-SPP_COLUMNS = ["time_s", "x_m", "y_m", "z_m", "lat_rad", "lon_rad", "h_m", "clock_m", "tau_gps_s", "sigma_tau_gps_s",
-               "residual_metric_m", "n_sats", "n_unknowns", "gdop", "pdop", "hdop", "vdop", "tdop",
-               "vx_mps", "vy_mps", "vz_mps", "clock_drift_mps"]
+#: Columns of :func:`solve` (from the core).
+SPP_COLUMNS = list(_core.SPP_COLUMNS)
 
 
-def solve(eph: Ephemerides, obs: pd.DataFrame, use_tau: bool = True, iono: bool = True, tropo: bool = True,
-          sigma_code: float = 3.0, sigma_code_glonass: float | None = None, sigma_rate: float = 0.05,
-          elevation_weight: bool = False) -> pd.DataFrame:
+def solve(eph: Ephemerides, obs: pd.DataFrame, options: GnssOptions | None = None, **option_fields) -> pd.DataFrame:
     """One solution per epoch of the observation table (see :func:`simulate`).
 
-    ``use_tau``: estimate τ_GPS (5 unknowns when GLONASS is present; False gives the
-    thesis's "no-τ" diagnostic); corrections ``iono``/``tropo``; weights 1/σ² with
-    ``sigma_code`` (GLONASS ``sigma_code_glonass``), optionally σ/sin E. Columns
+    ``options`` (:class:`GnssOptions`; its fields may also be given as keywords, e.g.
+    ``use_tau=False``): ``use_tau`` estimates τ_GPS, corrections ``iono``/``tropo``,
+    weights 1/σ² with ``sigma_code`` (GLONASS ``sigma_code_glonass``), optionally σ/sin E
+    (``elevation_weight``), Doppler velocity with ``sigma_rate``. Columns
     :data:`SPP_COLUMNS`: ECEF and geodetic antenna position, ``clock_m`` = c·δt_r,
     τ_GPS and its σ (s, NaN when not estimated), the residual metric Σ|r_i|/(N − n) (m),
     DOP values, Doppler velocity (ECEF m/s) and c·δṫ_r (m/s)."""
-    s = _core.gnss_spp(eph._core, *obs_arrays(obs), bool(use_tau), bool(iono), bool(tropo), float(sigma_code),
-                       float(sigma_code if sigma_code_glonass is None else sigma_code_glonass), float(sigma_rate),
-                       bool(elevation_weight))
-    return pd.DataFrame(s, columns=SPP_COLUMNS)
+    opts, rest = split_options(options, option_fields)
+    if rest:
+        raise TypeError(f"solve() got an unexpected keyword argument {sorted(rest)[0]!r}")
+    return pd.DataFrame(_core.gnss_spp(eph._core, *obs_arrays(obs), opts.native), columns=SPP_COLUMNS)

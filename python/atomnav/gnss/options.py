@@ -1,0 +1,72 @@
+"""One set of GNSS processing options (Rust ``gnss/options.rs``, the role of RTKLIB's
+``prcopt_t``; Takasu 2013): measurement noise, atmosphere corrections, single-point
+options and the tightly coupled filter's formulation, lever arm and clock models. Every
+GNSS function takes one (:func:`atomnav.gnss.simulate`, :func:`atomnav.gnss.solve`,
+:func:`atomnav.gnss.tight_ins`); the core checks it when it is built."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from .. import _core
+from ..filter.engine import Config, _floats
+
+#: Names of the tight-coupling formulations (from the core).
+FORMULATIONS = tuple(_core.OPTIONS["Formulation"])
+
+
+@dataclass(frozen=True, kw_only=True)
+class GnssOptions(Config):
+    """GNSS processing options; an invalid field raises :class:`atomnav.InputError` naming it.
+
+    Noise: code σ ``sigma_code`` (m; GLONASS ``sigma_code_glonass``, None = the same),
+    pseudorange-rate σ ``sigma_rate`` (m/s). Corrections: Klobuchar ``iono`` (broadcast
+    coefficients of 2009-01-01) and Saastamoinen ``tropo``. Single-point positioning:
+    ``use_tau`` estimates τ_GPS (5 unknowns when GLONASS is present; False gives the
+    thesis's "no-τ" diagnostic), ``elevation_weight`` σ/sin E. Tight coupling:
+    ``formulation`` one of :data:`FORMULATIONS` ("first_difference": between-satellite
+    differences with c·τ_GPS as an extra state; "clock_states": undifferenced rows with
+    the receiver clock states), ``lever_arm`` IMU → antenna in body axes (m), ``use_rate``;
+    τ_GPS initial value ``tau0`` ± ``sigma_tau0`` (s) and random-walk PSD ``tau_psd``
+    (s²/s; Demidov 2009, Eq. 42: (0.1 ns)²/h); clock states (c·δt_r m, c·δṫ_r m/s)
+    ``clock0`` ± ``sigma_clock0`` with oscillator h₀ ``clock_h0`` (s), h₋₂ ``clock_hm2``
+    (1/s) (Brown & Hwang 2012, Table 9.1: a TCXO)."""
+
+    sigma_code: float = 3.0
+    sigma_code_glonass: float | None = None
+    sigma_rate: float = 0.05
+    iono: bool = True
+    tropo: bool = True
+    use_tau: bool = True
+    elevation_weight: bool = False
+    formulation: str = "first_difference"
+    lever_arm: tuple = (0.0, 0.0, 0.0)
+    use_rate: bool = True
+    tau0: float = 0.0
+    sigma_tau0: float = 1e-6
+    tau_psd: float = (0.1e-9) ** 2 / 3600.0
+    clock0: tuple = (0.0, 0.0)
+    sigma_clock0: tuple = (3e5, 300.0)
+    clock_h0: float = 2e-19
+    clock_hm2: float = 2e-20
+
+    def __post_init__(self):
+        for name in ("lever_arm", "clock0", "sigma_clock0"):
+            object.__setattr__(self, name, _floats(getattr(self, name)))
+        kw = {k: getattr(self, k) for k in self.to_dict()}
+        kw["lever_arm"], kw["clock0"], kw["sigma_clock0"] = list(self.lever_arm), list(self.clock0), list(self.sigma_clock0)
+        object.__setattr__(self, "_native", _core.GnssOptions(**kw))
+
+    @property
+    def native(self) -> _core.GnssOptions:
+        """The checked core object."""
+        return self._native
+
+
+def split_options(options: GnssOptions | None, kw: dict) -> tuple[GnssOptions, dict]:
+    """``options`` with the fields among the keywords ``kw`` replaced, and the other keywords."""
+    names = set(GnssOptions.__dataclass_fields__)
+    mine = {k: v for k, v in kw.items() if k in names}
+    rest = {k: v for k, v in kw.items() if k not in names}
+    base = options or GnssOptions()
+    return (GnssOptions.from_dict({**base.to_dict(), **mine}) if mine else base), rest
