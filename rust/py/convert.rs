@@ -197,7 +197,7 @@ pub fn seed(obj: &Bound<'_, PyAny>, field: &str) -> PyResult<u64> {
     if !obj.is_instance_of::<PyInt>() || obj.is_instance_of::<PyBool>() {
         return Err(PyTypeError::new_err(format!("{field}: expected an int, got {}", type_name(obj))));
     }
-    obj.extract::<u64>().map_err(|_| invalid(field, format!("a seed must be an integer in [0, 2**64 - 1], got {obj}")).into())
+    obj.extract::<u64>().map_err(|_| invalid(field, format!("must be an integer in [0, 2**64), got {obj}")).into())
 }
 
 /// Named numbers (constants, fitted parameters) into a dict.
