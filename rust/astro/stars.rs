@@ -225,11 +225,6 @@ pub fn star_attitudes(
     p_avu: Option<&[Mat3]>,
 ) -> Result<StarAttitudes> {
     let m = obs.s_cf.len();
-    // every epoch needs three stars: more epochs than m/3 cannot be solved (and n_epochs
-    // sizes the allocations below)
-    if n_epochs == 0 || n_epochs > m / 3 {
-        return Err(invalid("n_epochs", format!("must be in [1, {}] (at least 3 of the {m} star observations per epoch), got {n_epochs}", m / 3)));
-    }
     if let Some(p) = p_avu {
         check_covariances("p_avu", p, n_epochs)?;
     }
@@ -255,12 +250,19 @@ pub fn star_attitudes(
         }
         check_unit("up_gcrs", up)?;
     }
+    // Every epoch needs three stars, checked on the m observations before anything is
+    // sized by n_epochs: the search stops within m/3 + 1 epochs, however large n_epochs is.
+    let mut stars_at = std::collections::BTreeMap::<usize, usize>::new();
+    for &e in &obs.epoch {
+        *stars_at.entry(e).or_default() += 1;
+    }
+    if let Some(e) = (0..n_epochs).find(|e| stars_at.get(e).is_none_or(|&k| k < 3)) {
+        let k = stars_at.get(&e).copied().unwrap_or(0);
+        return Err(invalid("star_directions", format!("epoch at index {e} has {k} stars, need at least 3")));
+    }
     let mut rows: Vec<Vec<usize>> = vec![Vec::new(); n_epochs];
     for (r, &e) in obs.epoch.iter().enumerate() {
         rows[e].push(r);
-    }
-    if let Some(e) = rows.iter().position(|r| r.len() < 3) {
-        return Err(invalid("star_directions", format!("epoch at index {e} has {} stars, need at least 3", rows[e].len())));
     }
     let d1s: Vec<Mat3> = cameras.iter().map(|c| d1(&euler_from_dcm(&c.c_vf_cf))).collect();
     let mut out = StarAttitudes { s: Vec::with_capacity(n_epochs), p: Vec::with_capacity(n_epochs), stars: Vec::with_capacity(n_epochs) };
@@ -423,5 +425,20 @@ mod tests {
         assert!(c.mags.iter().all(|&m| m <= 5.6));
         assert_eq!(c.dirs[17], Catalog::synthetic(5.6, 7).unwrap().dirs[17]);
         assert!((c.dirs.iter().sum::<Vec3>() / c.dirs.len() as f64).norm() < 0.05);
+    }
+
+    #[test]
+    fn huge_epoch_count_is_an_error_not_an_allocation() {
+        let g = [Vec3::x(), Vec3::y(), Vec3::z()];
+        let obs = Observations { epoch: vec![0, 0, 0], camera: vec![0; 3], s_cf: g.to_vec(), g: g.to_vec() };
+        let cams = [Camera { c_vf_cf: Mat3::identity(), p_alpha: Mat3::zeros() }];
+        assert_eq!(star_attitudes(&obs, 1, &cams, 1e-5, None, None).unwrap().s.len(), 1);
+        match star_attitudes(&obs, usize::MAX, &cams, 1e-5, None, None) {
+            Err(crate::error::NavError::InvalidInput { field, reason, .. }) => {
+                assert_eq!(field, "star_directions");
+                assert!(reason.starts_with("epoch at index 1 has 0 stars"), "{reason}");
+            }
+            other => panic!("{other:?}"),
+        }
     }
 }

@@ -1,6 +1,6 @@
 //! Bindings of astro/: gyro increments, star attitudes, mount calibration, scenario runs.
 
-use super::convert::{count, mat_to_py, mats, mats_to_py, quat_to_py, register_choices, seed, vec3_rows, vec3_to_py, vector, Wrap};
+use super::convert::{index_count, mat_to_py, mats, mats_to_py, quat_to_py, register_choices, seed, vec3_rows, vec3_to_py, vector, Wrap};
 use crate::astro::calibration::{self, Calibration, DiffForm, Init, Observability, Options, ResidualForm, Solver, Start, Verdict};
 use crate::astro::increments::{self, GyroErrorMode, GyroErrorModel, ImuRecord, TaylorVariant};
 use crate::astro::scenario::{self, Run, Scenario};
@@ -174,7 +174,7 @@ fn astro_calibrate<'py>(
 ) -> PyResult<Bound<'py, PyDict>> {
     let (a, b) = (mats::<3, 3>(&ds_imu, "ds_imu")?, mats::<3, 3>(&ds_avu, "ds_avu")?);
     let c0 = c0.map(|c| mat3_arg(&c, "c0")).transpose()?;
-    let max_iter = max_iter.map(|n| count(&n, "max_iter", 1, usize::MAX)).transpose()?.unwrap_or(Options::default().max_iter);
+    let max_iter = max_iter.map(|n| index_count(&n, "max_iter", 1, usize::MAX)).transpose()?.unwrap_or(Options::default().max_iter);
     let opt = Options::new(Init::new(init.0, c0)?, solver.0, max_iter, tol, residual_form.0)?;
     let cal = py.detach(|| calibration::calibrate(&a, &b, &opt))?;
     calibration_dict(py, &cal)
@@ -220,7 +220,7 @@ fn astro_star_attitudes<'py>(
     p_avu: Option<PyReadonlyArray3<'py, f64>>,
 ) -> PyResult<(Arr3<'py>, Arr3<'py>, Bound<'py, PyArray1<i64>>)> {
     let obs = Observations { epoch: indices(&epoch, "epoch")?, camera: indices(&camera, "camera")?, s_cf: vec3_rows(&s_cf, "star_directions")?, g: vec3_rows(&g, "catalog_directions")? };
-    let n_epochs = count(n_epochs, "n_epochs", 1, usize::MAX)?;
+    let n_epochs = index_count(n_epochs, "n_epochs", 1, usize::MAX)?;
     let cams = cameras_arg(&cameras, &p_alpha)?;
     let up = up_gcrs.map(|u| vec3_rows(&u, "up_gcrs")).transpose()?;
     let p_avu = p_avu.map(|p| mats::<3, 3>(&p, "p_avu")).transpose()?;
@@ -420,7 +420,7 @@ impl PyScenario {
     /// mean χ² of θ^diff, Gauss–Newton iterations.
     #[pyo3(signature = (runs, seed0=None, p_diff=Wrap(DiffForm::Full)))]
     fn monte_carlo<'py>(&self, py: Python<'py>, runs: &Bound<'py, PyAny>, seed0: Option<Bound<'py, PyAny>>, p_diff: Wrap<DiffForm>) -> PyResult<Bound<'py, PyDict>> {
-        let runs = count(runs, "runs", 1, usize::MAX)?;
+        let runs = index_count(runs, "runs", 1, usize::MAX)?;
         let seed0 = seed0.map(|s| seed(&s, "seed0")).transpose()?.unwrap_or(0);
         let s = py.detach(|| scenario::monte_carlo(&self.inner, runs, seed0, &Options::default(), p_diff.0))?;
         let d = PyDict::new(py);

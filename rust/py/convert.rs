@@ -183,12 +183,24 @@ pub fn counts(obj: &Bound<'_, PyAny>, field: &str, min: usize, max: usize) -> Py
         .iter()
         .enumerate()
         .map(|(i, x)| {
-            count(x, field, min, max).map_err(|e| match e.is_instance_of::<PyTypeError>(x.py()) {
+            index_count(x, field, min, max).map_err(|e| match e.is_instance_of::<PyTypeError>(x.py()) {
                 true => e,
                 false => invalid_at(field, i, format!("element {i} must be an integer in [{min}, {max}], got {x}")).into(),
             })
         })
         .collect()
+}
+
+/// [`count`] of any integer-like object (`int`, numpy integers: whatever has
+/// `__index__`, but not `bool`).
+pub fn index_count(obj: &Bound<'_, PyAny>, field: &str, min: usize, max: usize) -> PyResult<usize> {
+    match obj.is_instance_of::<PyBool>() {
+        true => count(obj, field, min, max),
+        false => match obj.call_method0("__index__") {
+            Ok(i) => count(&i, field, min, max),
+            Err(_) => count(obj, field, min, max),
+        },
+    }
 }
 
 /// A random seed: any integer in [0, 2⁶⁴ − 1]; others are an `InputError` naming `field`

@@ -1,7 +1,7 @@
 //! Bindings of noise/: Allan family (batch, streaming, EDF, five-term fit), NNLS, ARIMA
 //! state space and the Kalman filters (batch, streaming, steady state).
 
-use super::convert::{count, counts, flat_to_py, mat, mat_to_py, register_choices, set_floats, vec_to_py, vector, Wrap};
+use super::convert::{counts, index_count, flat_to_py, mat, mat_to_py, register_choices, set_floats, vec_to_py, vector, Wrap};
 use crate::error::invalid;
 use crate::noise::allan::{self, AllanResult, AllanStream, DataType, Kind, NoiseType, TauGrid, TauSet};
 use crate::noise::arma_filter::{self, Adaptive, ArimaStateSpace, ArmaFilterConfig, FilterOutput, Kalman, NoiseForm, X0, MAX_DIM};
@@ -43,7 +43,7 @@ fn allan_var<'py>(
 /// Equivalent degrees of freedom per averaging factor (`np` phase points).
 #[pyfunction]
 fn allan_edf<'py>(py: Python<'py>, kind: Wrap<Kind>, noise: Wrap<NoiseType>, np: &Bound<'py, PyAny>, m: &Bound<'py, PyAny>) -> PyResult<Arr<'py>> {
-    let np = count(np, "np", 2, usize::MAX)?;
+    let np = index_count(np, "np", 2, usize::MAX)?;
     Ok(vec_to_py(py, allan::edf(kind.0, noise.0, np, &counts(m, "m", 1, usize::MAX)?)?))
 }
 
@@ -64,7 +64,7 @@ fn allan_fit<'py>(
     let m = counts(m, "m", 1, usize::MAX)?;
     let n = vec![0; m.len()];
     let res = AllanResult { m, tau: vector(&tau, "tau")?, var: vector(&var, "var")?, n };
-    let f = allan::fit(&res, count(n_samples, "n_samples", 1, usize::MAX)?, terms, tau_min, tau_max)?;
+    let f = allan::fit(&res, index_count(n_samples, "n_samples", 1, usize::MAX)?, terms, tau_min, tau_max)?;
     let d = PyDict::new(py);
     d.set_item("coeffs", f.coeffs.to_vec())?;
     set_floats(&d, &f.parameters())?;
@@ -108,7 +108,7 @@ impl PyAllanStream {
 
 /// The differencing order (1 when not given), at most the filter's largest state.
 fn order(d: Option<Bound<'_, PyAny>>) -> PyResult<usize> {
-    Ok(d.map(|d| count(&d, "d", 0, MAX_DIM)).transpose()?.unwrap_or(1))
+    Ok(d.map(|d| index_count(&d, "d", 0, MAX_DIM)).transpose()?.unwrap_or(1))
 }
 
 /// Φ, B, Q and BQBᵀ of an ARIMA(p,d,q) state-space model.
