@@ -1,5 +1,5 @@
 //! Gyro attitude increments between asynchronous camera epochs and their covariance
-//! (seed 001 §2.2; spec E1–E8).
+//! (Vasilyuk et al. 2024 §2.2; spec E1–E8).
 //!
 //! IMU record: increment `rho[j]` (rad, MF axes) covers [t_start + jT, t_start + (j+1)T].
 //! Interval n runs from epoch t_{E,n−1} to t_{E,n}; its increment q_n maps MF at t_{E,n}

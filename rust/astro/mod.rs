@@ -1,5 +1,5 @@
 //! Astro-inertial calibration of the star-camera (virtual camera VF) to IMU (MF) mount from
-//! attitude increments (seed 001, Vasilyuk et al. 2024; spec astro-calibration-vasilyuk2024).
+//! attitude increments (Vasilyuk et al. 2024, Vasilyuk et al. 2024; spec astro-calibration-vasilyuk2024).
 //!
 //! Internally everything is in the paper's conventions (spec §2): ENU navigation frame,
 //! right-forward-up body axes, right-multiplicative body-frame small errors
@@ -39,7 +39,7 @@ pub fn euler_from_dcm(c: &Mat3) -> Vec3 {
     Vec3::new(psi, th, g)
 }
 
-/// D1(β): θ^clb = D1 δβ with C(β + δβ) ≈ C(β)(I + [θ^clb×]) (seed 001, Eq. 8; spec E19).
+/// D1(β): θ^clb = D1 δβ with C(β + δβ) ≈ C(β)(I + [θ^clb×]) (Vasilyuk et al. 2024, Eq. 8; spec E19).
 pub fn d1(b: &Vec3) -> Mat3 {
     let (st, ct) = b.y.sin_cos();
     let (sg, cg) = b.z.sin_cos();

@@ -1,4 +1,4 @@
-//! Star-camera front end (seed 001 §2.1; spec E9–E13, D4, D13): a deterministic synthetic
+//! Star-camera front end (Vasilyuk et al. 2024 §2.1; spec E9–E13, D4, D13): a deterministic synthetic
 //! catalog, a camera simulator, refraction, bundle merging into the virtual camera VF,
 //! Wahba/SVD attitudes with their covariance, and the astro increments.
 

@@ -1,6 +1,6 @@
 //! Allan family: overlapping Allan, modified Allan and overlapping Hadamard variance of
 //! rate or phase (angle) data, batch and streaming; equivalent degrees of freedom; the
-//! five-term IEEE Std 952 fit (seed 002 Eqs. 19–21, spec E14–E16, D15).
+//! five-term IEEE Std 952 fit (Niu et al. 2025 Eqs. 19–21, spec E14–E16, D15).
 //!
 //! Everything works on phase x (the integral of the rate): rate data y become
 //! x₀ = 0, x_{i+1} = x_i + (y_i − ȳ) in units of rate·τ₀, so that all three statistics
@@ -534,7 +534,7 @@ pub fn edf_non_overlapping(kind: Kind, np: usize, m: usize) -> f64 {
     (((np - 1) / m) as f64 - d as f64 + 1.0).max(1.0)
 }
 
-/// Result of the five-term fit σ²(τ) = Σ_{k=−2}^{2} A_k τ^k (seed 002 Eq. 19).
+/// Result of the five-term fit σ²(τ) = Σ_{k=−2}^{2} A_k τ^k (Niu et al. 2025 Eq. 19).
 #[derive(Debug, Clone, PartialEq)]
 pub struct AllanFit {
     /// A₋₂, A₋₁, A₀, A₁, A₂ in (rate)²·s^k.

@@ -1,4 +1,4 @@
-//! ARIMA(p,d,q) state-space form and the scalar-measurement Kalman filters of seed 002:
+//! ARIMA(p,d,q) state-space form and the scalar-measurement Kalman filters of Niu et al. 2025:
 //! fixed R, the measurement-noise-adaptive R of Eq. 17 (both readings of y_k), and
 //! Sage–Husa (standard form, not from the paper; spec E11, D12). Batch and streaming.
 //!
@@ -12,7 +12,7 @@ use nalgebra::{DMatrix, SMatrix, SVector};
 /// How the ARMA innovations enter the state (spec D5).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum NoiseForm {
-    /// Seed 002 Eq. 16: X = [ω_k … ω_{k−n+1}], B first row [1, β₁ … β_q, 0 …], Q = σ²I_n.
+    /// Niu et al. 2025 Eq. 16: X = [ω_k … ω_{k−n+1}], B first row [1, β₁ … β_q, 0 …], Q = σ²I_n.
     /// Treats a_{k−j} in W_k as fresh noise (doubles the process noise for β₁ ≈ −1).
     Paper,
     /// X = [ω_k … ω_{k−r+1}, a_k … a_{k−q+1}], G = e₀ + e_r, scalar Q = σ² (exact).
@@ -24,7 +24,7 @@ impl Choice for NoiseForm {
     const CHOICES: &'static [(&'static str, Self)] = &[("paper", NoiseForm::Paper), ("exact", NoiseForm::Exact)];
 }
 
-/// X_k = Φ X_{k−1} + B W_{k−1}, Y_k = H X_k + V_k (seed 002 Eq. 14).
+/// X_k = Φ X_{k−1} + B W_{k−1}, Y_k = H X_k + V_k (Niu et al. 2025 Eq. 14).
 #[derive(Debug, Clone, PartialEq)]
 pub struct ArimaStateSpace {
     /// Transition matrix Φ (n×n), companion form of the AR polynomial on ω.
@@ -40,7 +40,7 @@ pub struct ArimaStateSpace {
 }
 
 /// Coefficients c of ω_k = Σ c_i ω_{k−i} + …: (1 − Σφ_i Lⁱ)(1 − L)^d = 1 − Σ c_i Lⁱ.
-/// For (2,1): [1+φ₁, φ₂−φ₁, −φ₂] (seed 002 Eq. 12).
+/// For (2,1): [1+φ₁, φ₂−φ₁, −φ₂] (Niu et al. 2025 Eq. 12).
 pub fn integrated_ar(ar: &[f64], d: usize) -> Vec<f64> {
     // Polynomial in L with constant term first.
     let mut poly: Vec<f64> = std::iter::once(1.0).chain(ar.iter().map(|a| -a)).collect();
@@ -177,7 +177,7 @@ impl RunningAllanR {
         self.count += 1;
         let c = self.count as f64;
         let dy = y - prev;
-        // seed 002, Eq. 17 (recursive form)
+        // Niu et al. 2025, Eq. 17 (recursive form)
         self.r = (1.0 - 1.0 / c) * self.r + dy * dy / (2.0 * c);
         Some(self.r)
     }
@@ -330,7 +330,7 @@ impl<const N: usize> Core<N> {
         Ok(())
     }
 
-    /// One step of seed 002 Eq. 15 with R_k chosen by `rs`.
+    /// One step of Niu et al. 2025 Eq. 15 with R_k chosen by `rs`.
     #[inline(always)]
     fn step(&mut self, z: f64, rs: &mut RState) -> Result<f64> {
         rs.k += 1;
@@ -439,7 +439,7 @@ macro_rules! cores {
 
 cores!(D1 = 1, D2 = 2, D3 = 3, D4 = 4, D5 = 5, D6 = 6, D7 = 7, D8 = 8);
 
-/// Stateful Kalman filter on an ARIMA state-space model (seed 002 Eq. 15); feed chunks
+/// Stateful Kalman filter on an ARIMA state-space model (Niu et al. 2025 Eq. 15); feed chunks
 /// with [`Kalman::update`] for streaming, or use [`kalman`] for a whole series.
 #[derive(Debug, Clone)]
 pub struct Kalman {

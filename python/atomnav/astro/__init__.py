@@ -1,5 +1,5 @@
 """Astro-inertial calibration: star-camera (virtual camera VF) to IMU (MF) mount from
-attitude increments (Vasilyuk et al. 2024, seed 001; spec astro-calibration-vasilyuk2024).
+attitude increments (Vasilyuk et al. 2024; spec astro-calibration-vasilyuk2024).
 
 Conventions of this module (the paper's, spec §2): ENU navigation frame, body axes
 right-forward-up (MF), ``S_X2^X1`` maps X1 coordinates into X2, small errors are
@@ -67,12 +67,12 @@ def euler_from_dcm(c) -> np.ndarray:
 
 
 def d1(beta) -> np.ndarray:
-    """D1(β): θ^clb = D1 δβ (seed 001 Eq. 8)."""
+    """D1(β): θ^clb = D1 δβ (Vasilyuk et al. 2024 Eq. 8)."""
     return _single(lambda b: _core.astro_d1_d2(b)[0], beta)
 
 
 def d2(beta) -> np.ndarray:
-    """D2(β) = C(β) D1(β): θ^mfa = Cθ^avu − D2 δβ (seed 001 Eq. 8)."""
+    """D2(β) = C(β) D1(β): θ^mfa = Cθ^avu − D2 δβ (Vasilyuk et al. 2024 Eq. 8)."""
     return _single(lambda b: _core.astro_d1_d2(b)[1], beta)
 
 

@@ -1,4 +1,4 @@
-"""Allan family and the metrics of seed 002 (spec E14–E18, D15–D17).
+"""Allan family and the metrics of Niu et al. 2025 (spec E14–E18, D15–D17).
 
 All functions are unit-agnostic: a rate series in some unit U sampled every ``tau0``
 seconds gives variances in U², fit coefficients A_k in U²·s^k, ARW in U·√s, bias
@@ -21,7 +21,7 @@ KINDS = tuple(_core.OPTIONS["AllanKind"])
 DATA_TYPES = tuple(_core.OPTIONS["DataType"])
 TAU_SETS = tuple(_core.OPTIONS["TauGrid"])
 NOISE_TYPES = tuple(_core.OPTIONS["NoiseType"])
-#: Names of the five-term coefficients A₋₂ … A₂ (seed 002 Eq. 19).
+#: Names of the five-term coefficients A₋₂ … A₂ (Niu et al. 2025 Eq. 19).
 TERMS = ("quantization", "arw", "bias_instability", "rrw", "ramp")
 
 
@@ -124,7 +124,7 @@ class AllanStream:
 
 @dataclass(kw_only=True)
 class AllanFit:
-    """Five-term fit σ²(τ) = Σ_{k=−2}^{2} A_k τ^k (seed 002 Eq. 19, IEEE Std 952).
+    """Five-term fit σ²(τ) = Σ_{k=−2}^{2} A_k τ^k (Niu et al. 2025 Eq. 19, IEEE Std 952).
 
     With rate unit U and τ in s: ``coeffs`` A₋₂…A₂ in U²·s^k; ``quantization`` Q_q =
     √(A₋₂/3) (U·s); ``arw`` N = √A₋₁ (U·√s), the paper's SS (Eq. 20);
@@ -178,13 +178,13 @@ def fit_allan(omega, tau0: float, terms=TERMS, tau_min: float | None = None, tau
 
 
 def short_term_sensitivity(omega, tau0: float, **fit_kw) -> float:
-    """SS = √A₋₁ (seed 002 Eq. 20) in U·√s; divide by 60 for °/√h when U = °/h and τ in s
+    """SS = √A₋₁ (Niu et al. 2025 Eq. 20) in U·√s; divide by 60 for °/√h when U = °/h and τ in s
     (or use :meth:`AllanFit.arw_in`)."""
     return fit_allan(omega, tau0, **fit_kw).arw
 
 
 def long_term_stability(omega, tau0: float, **fit_kw) -> float:
-    """LS = √(π A₀ / (2 ln 2)) (seed 002 Eq. 21) in the rate unit."""
+    """LS = √(π A₀ / (2 ln 2)) (Niu et al. 2025 Eq. 21) in the rate unit."""
     return fit_allan(omega, tau0, **fit_kw).bias_instability
 
 
@@ -211,7 +211,7 @@ def bias_stability(omega, window: int = 1) -> float:
 
 
 def improvement_ratio(before, after, absolute: bool = False):
-    """Improvement ratio in percent (seed 002 Eq. 18): (M_raw − M_filt)/M_raw·100, signed
+    """Improvement ratio in percent (Niu et al. 2025 Eq. 18): (M_raw − M_filt)/M_raw·100, signed
     by default (spec D11: negative means the filter made the metric worse);
     ``absolute=True`` gives the paper's |M_raw − M_filt|/M_raw·100."""
     b = np.asarray(before, dtype=float)

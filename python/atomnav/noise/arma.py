@@ -175,7 +175,7 @@ def fit_arma(omega, order=(2, 1), differenced: bool = False, lags: int = 10) -> 
 
 
 def durbin_watson(e) -> float:
-    """DW = Σ(e_k − e_{k−1})² / Σe_k² (seed 002 Eq. 13); 2 for white residuals, 0 for a
+    """DW = Σ(e_k − e_{k−1})² / Σe_k² (Niu et al. 2025 Eq. 13); 2 for white residuals, 0 for a
     constant series."""
     from statsmodels.stats.stattools import durbin_watson as dw
 

@@ -1,4 +1,4 @@
-"""ARIMA state-space form and Kalman filters of seed 002 (spec E7–E11, D5–D12); the
+"""ARIMA state-space form and Kalman filters of Niu et al. 2025 (spec E7–E11, D5–D12); the
 numerical work runs in Rust.
 
 Eq. 17 has two readings (spec E10, D7): ``"literal"`` takes y = ω (the raw rate);
@@ -22,7 +22,7 @@ from .._validate import finite, input_error, positive, vector
 #: The default reading of Eq. 17 (spec D7, binding).
 DEFAULT_READING = "differenced"
 READINGS = ("differenced", "literal")
-#: Seed 002 Eq. 10 (spec E5): φ₁, φ₂, β₁, σ_a² (°/h)².
+#: Niu et al. 2025 Eq. 10 (spec E5): φ₁, φ₂, β₁, σ_a² (°/h)².
 PAPER_AR = (-0.018, 0.029)
 PAPER_MA = (-0.99,)
 PAPER_SIGMA2 = 0.035
@@ -31,7 +31,7 @@ PAPER_SIGMA2 = 0.035
 @dataclass(frozen=True)
 class ArimaStateSpace:
     """ARIMA(p,d,q) in state-space form X_k = Φ X_{k−1} + B W_{k−1}, Y_k = H X_k + V_k
-    (seed 002 Eqs. 14, 16) with H = [1 0 … 0].
+    (Niu et al. 2025 Eqs. 14, 16) with H = [1 0 … 0].
 
     ``ar`` = φ, ``ma`` = β (statsmodels' sign convention, spec E4), ``sigma2`` = σ_a² in
     the rate unit squared. ``noise_form="paper"``: the paper's B with Q = σ²I
