@@ -3,7 +3,7 @@
 //!
 //! Positions are (latitude rad, longitude rad, ellipsoidal height m).
 
-use crate::error::{invalid, Result};
+use crate::error::{invalid, NavError, Result};
 use crate::math::{Mat3, Vec3};
 
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -330,7 +330,55 @@ pub fn check_latitude(field: &str, lat: f64, index: usize) -> Result<()> {
     }
 }
 
+/// [`check_latitude`] of row `index` of an array (the error carries the row).
+fn check_latitude_row(field: &str, lat: f64, index: usize) -> Result<()> {
+    check_latitude(field, lat, index).map_err(|e| match e {
+        NavError::InvalidInput { field, reason, .. } => NavError::InvalidInput { field, reason, index: Some(index) },
+        other => other,
+    })
+}
+
+/// [`check_latitude`] for every row of (lat, lon, h) positions (names the first bad row).
+pub fn check_latitudes(field: &str, lla: &[Vec3]) -> Result<()> {
+    lla.iter().enumerate().try_for_each(|(i, p)| check_latitude_row(field, p.x, i))
+}
+
 impl Ellipsoid {
+    /// [`Ellipsoid::ecef_to_lla`] of each row; a position whose geodetic coordinates are
+    /// undefined (the Earth's centre, where the iteration divides N − N) is an
+    /// `InvalidInput` naming `field` and the row instead of a NaN row.
+    pub fn ecef_to_lla_rows(&self, field: &str, r: &[Vec3]) -> Result<Vec<Vec3>> {
+        r.iter()
+            .enumerate()
+            .map(|(i, r)| {
+                let lla = self.ecef_to_lla(r);
+                match lla.iter().all(|x| x.is_finite()) {
+                    true => Ok(lla),
+                    false => Err(crate::error::invalid_at(field, i, format!("position {:?} m at index {i} is at the Earth's centre: latitude and height are undefined", [r.x, r.y, r.z]))),
+                }
+            })
+            .collect()
+    }
+
+    /// Per row of (lat, lon, h, v_N, v_E, v_D): [ω_ie^n (3), ω_en^n (3)] in rad/s; a
+    /// latitude outside [−π/2, π/2] names `field` and the row.
+    pub fn nav_rates_rows(&self, field: &str, rows: &[[f64; 6]]) -> Result<Vec<[f64; 6]>> {
+        rows.iter()
+            .enumerate()
+            .map(|(i, r)| {
+                check_latitude_row(field, r[0], i)?;
+                let wie = self.earth_rate_ned(r[0]);
+                let wen = self.transport_rate_ned(r[0], r[2], &Vec3::new(r[3], r[4], r[5]));
+                Ok([wie.x, wie.y, wie.z, wen.x, wen.y, wen.z])
+            })
+            .collect()
+    }
+
+    /// The defining and derived constants by name (a, f, gm, omega, e2, b, gamma_e, gamma_p).
+    pub fn constants(&self) -> [(&'static str, f64); 8] {
+        [("a", self.a), ("f", self.f), ("gm", self.gm), ("omega", self.omega), ("e2", self.e2()), ("b", self.b()), ("gamma_e", self.gamma_e), ("gamma_p", self.gamma_p)]
+    }
+
     /// Everything the mechanization needs at one position (see `LocalModel::at`).
     pub fn local(&self, lat: f64, h: f64) -> Local {
         self.local_model().at(lat, h)
@@ -447,7 +495,7 @@ mod tests {
     /// Kinematic mode: no gravity, no gradient, no Earth rate; WGS-84 geometry.
     #[test]
     fn kinematic_model_has_no_gravity_and_no_rotation() {
-        let k = Ellipsoid::by_name("kinematic").unwrap();
+        let k = <Ellipsoid as crate::options::Choice>::parse("kinematic").unwrap();
         for (lat, h) in [(0.0, 0.0), (0.9, 300.0), (-1.2, -50.0)] {
             assert_eq!(k.gravity(lat, h), 0.0);
             assert_eq!(k.gravity_dlat(lat, h), 0.0);
@@ -502,9 +550,21 @@ mod tests {
         let h = Helmert { translation: Vec3::new(-0.36, 0.08, 0.18), rotation: Vec3::new(1e-8, -2e-8, 3e-9), scale: 2e-9 };
         let r = Vec3::new(2.1e7, -1.3e7, 9.0e6);
         assert!((h.inverse(&h.forward(&r)) - r).norm() < 1e-7);
-        let p = Helmert::by_name("pz90_02_to_wgs84").unwrap();
+        let p = <Helmert as crate::options::Choice>::parse("pz90_02_to_wgs84").unwrap();
         assert!(((p.forward(&r) - r) - Vec3::new(-0.36, 0.08, 0.18)).norm() < 1e-9);
-        assert_eq!(Helmert::by_name("identity").unwrap().forward(&r), r);
-        assert!(Helmert::by_name("itrf").is_err());
+        assert_eq!(<Helmert as crate::options::Choice>::parse("identity").unwrap().forward(&r), r);
+        assert!(<Helmert as crate::options::Choice>::parse("itrf").is_err());
+    }
+
+    #[test]
+    fn centre_of_the_earth_is_rejected_not_nan() {
+        let r = [WGS84.lla_to_ecef(&Vec3::new(0.5, 0.2, 100.0)), Vec3::zeros()];
+        match WGS84.ecef_to_lla_rows("ecef", &r) {
+            Err(crate::error::NavError::InvalidInput { field, index, .. }) => assert_eq!((field.as_str(), index), ("ecef", Some(1))),
+            other => panic!("{other:?}"),
+        }
+        let lla = WGS84.ecef_to_lla_rows("ecef", &r[..1]).unwrap();
+        assert!((lla[0] - Vec3::new(0.5, 0.2, 100.0)).abs().max() < 1e-8);
+        assert!(WGS84.nav_rates_rows("lla_vel", &[[0.1, 0.0, 0.0, 1.0, 2.0, 3.0], [2.0, 0.0, 0.0, 0.0, 0.0, 0.0]]).is_err());
     }
 }

@@ -23,3 +23,19 @@ pub const MICRO_G_PER_SQRT_HZ: f64 = 1e-6 * G0;
 pub const MPS_PER_SQRT_HOUR: f64 = 1.0 / 60.0;
 /// parts per million → dimensionless.
 pub const PPM: f64 = 1e-6;
+
+/// Every factor above by name (read by `atomnav.units`, so Python has no second copy).
+pub const UNITS: [(&str, f64); 12] = [
+    ("G0", G0),
+    ("DEG", DEG),
+    ("ARCSEC", ARCSEC),
+    ("ARCMIN", ARCMIN),
+    ("HOUR", HOUR),
+    ("DEG_PER_HOUR", DEG_PER_HOUR),
+    ("DEG_PER_SQRT_HOUR", DEG_PER_SQRT_HOUR),
+    ("MICRO_G", MICRO_G),
+    ("MILLI_G", MILLI_G),
+    ("MICRO_G_PER_SQRT_HZ", MICRO_G_PER_SQRT_HZ),
+    ("MPS_PER_SQRT_HOUR", MPS_PER_SQRT_HOUR),
+    ("PPM", PPM),
+];

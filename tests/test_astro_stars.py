@@ -16,8 +16,9 @@ def scn():
 
 def _simulate(tr, sigma, seed, n_refr=None):
     cat = astro.Catalog(tr["catalog_dirs"], tr["catalog_mags"], np.arange(len(tr["catalog_mags"])))
-    return astro.simulate_observations(cat, tr["s_gcrs_vf"], tr["up_gcrs"], tr["cameras"], tr["fov_half"], tr["m_lim"],
-                                       sigma, tr["n_refr"] if n_refr is None else n_refr, seed)
+    return astro.simulate_observations(cat, tr["s_gcrs_vf"], tr["up_gcrs"], tr["cameras"], fov_half_rad=tr["fov_half"],
+                                       m_lim=tr["m_lim"], sigma_s_rad=sigma, n_refr=tr["n_refr"] if n_refr is None else n_refr,
+                                       seed=seed)
 
 
 def test_catalog_is_deterministic_with_the_d4_count():

@@ -475,7 +475,7 @@ def test_bad_negative_seed():
 
 
 def test_bad_register_builtin_name():
-    _raises(r"preset: 'mems' is a built-in preset", imu.register_preset, "mems", imu.ImuErrors())
+    _raises(r"name: .mems. is a built-in preset", imu.register_preset, "mems", imu.ImuErrors())
 
 
 def test_bad_conversion_zero_dt():

@@ -147,7 +147,8 @@ def test_arw_unit_conversion():
     # spec §4a.10: 0.015 °/√h at τ₀ = 52 s ↔ per-sample σ 0.1248075 °/h.
     from atomnav import units
 
-    f = allan.AllanFit(np.array([0, (0.1248075 * np.sqrt(52.0)) ** 2, 0, 0, 0]), 0, 0.1248075 * np.sqrt(52.0), 0, 0, 0, 1, 0, np.inf, None)
+    f = allan.AllanFit(coeffs=np.array([0, (0.1248075 * np.sqrt(52.0)) ** 2, 0, 0, 0]), quantization=0, arw=0.1248075 * np.sqrt(52.0),
+                       bias_instability=0, rrw=0, ramp=0, points=1, tau_min=0, tau_max=np.inf, table=None)
     assert allan.ss_deg_per_sqrt_hour(f) == pytest.approx(0.015, rel=1e-6)
     assert f.arw_in(units.DEG_PER_HOUR, 1.0) == pytest.approx(0.015 * units.DEG_PER_SQRT_HOUR, rel=1e-6)
 

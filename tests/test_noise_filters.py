@@ -175,7 +175,7 @@ def test_streaming_equals_batch():
     w = synth.model_b(seed=3)
     m = ArimaStateSpace.paper()
     for mode in ("fixed", "differenced", "literal", "sage_husa"):
-        s = filters.KalmanStream(m, mode=mode)
+        s = filters.KalmanStream(m, adaptive=mode)
         parts = [s.update(c) for c in np.array_split(w, 7)]
         got = np.concatenate([p.omega_hat for p in parts])
         ref = filters.sage_husa(w, m) if mode == "sage_husa" else filters.kalman(w, m, adaptive=None if mode == "fixed" else mode)

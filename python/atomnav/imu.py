@@ -40,16 +40,15 @@ sample interval, in rate units for both kinds.
 from __future__ import annotations
 
 import copy
-import operator
 from dataclasses import dataclass, field
 
 import numpy as np
 import pandas as pd
 
 from . import _core, units
-from ._validate import choice, rows, vector
+from ._validate import choice, input_error, rows, vector
 
-KINDS = ("rates", "increments")
+KINDS = tuple(_core.OPTIONS["ImuKind"])
 _AXES = ("x", "y", "z")
 COLUMNS = {
     "rates": ([f"accel_{a}_mps2" for a in _AXES], [f"gyro_{a}_rad_s" for a in _AXES]),
@@ -99,7 +98,7 @@ class TriadErrors:
     def _to_core(self, name: str) -> dict:
         m = np.asarray(self.misalignment, dtype=float)
         if m.shape != (3, 3):
-            raise ValueError(f"{name}.misalignment: expected shape (3, 3), got {m.shape}")
+            raise input_error(f"{name}.misalignment", f"expected shape (3, 3), got {m.shape}")
         gm, fl = self.gauss_markov, self.flicker
         return {
             "bias": vector(self.bias, 3, f"{name}.bias").tolist(),
@@ -189,18 +188,8 @@ def preset_names() -> list[str]:
 def register_preset(name: str, errors: ImuErrors) -> None:
     """Add a named user preset (validated; a built-in name cannot be replaced)."""
     if name in _core.imu_preset_names():
-        raise ValueError(f"preset: {name!r} is a built-in preset and cannot be replaced")
+        raise input_error("name", f"{name!r} is a built-in preset and cannot be replaced")
     _USER_PRESETS[str(name)] = copy.deepcopy(errors.validate())
-
-
-def _seed(seed) -> int:
-    try:
-        s = operator.index(seed)
-    except TypeError:
-        raise ValueError(f"seed: must be an integer in [0, 2**64), got {seed!r}") from None
-    if not 0 <= s < 2**64:
-        raise ValueError(f"seed: must be an integer in [0, 2**64), got {s}")
-    return s
 
 
 class ImuSimulator:
@@ -211,10 +200,10 @@ class ImuSimulator:
     def __init__(self, errors: ImuErrors | str, dt: float, kind: str = "rates", seed: int = 0):
         if isinstance(errors, str):
             errors = ImuErrors.preset(errors)
-        self.kind = choice(kind, KINDS, "kind")
+        self.kind = kind
         self.dt = float(dt)
         self.errors = copy.deepcopy(errors)
-        self._sim = _core.ImuErrorSimulator(*errors._to_core(), self.dt, self.kind, _seed(seed))
+        self._sim = _core.ImuErrorSimulator(*errors._to_core(), self.dt, self.kind, seed)
         self._k = 0
 
     def corrupt(self, accel, gyro=None) -> pd.DataFrame:
@@ -227,17 +216,17 @@ class ImuSimulator:
         t = None
         if isinstance(accel, pd.DataFrame):
             if gyro is not None:
-                raise ValueError("gyro: must be None when accel is a DataFrame")
+                raise input_error("gyro", "must be None when accel is a DataFrame")
             missing = [c for c in fcols + wcols if c not in accel.columns]
             if missing:
-                raise ValueError(f"accel: DataFrame lacks columns {missing} for kind {self.kind!r}")
+                raise input_error("accel", f"DataFrame lacks columns {missing} for kind {self.kind!r}")
             t = accel["time_s"].to_numpy() if "time_s" in accel.columns else None
             accel, gyro = accel[fcols].to_numpy(), accel[wcols].to_numpy()
         elif gyro is None:
-            raise ValueError("gyro: required when accel is an array")
+            raise input_error("gyro", "required when accel is an array")
         f, w = rows(accel, 3, "accel"), rows(gyro, 3, "gyro")
         if len(w) != len(f):
-            raise ValueError(f"gyro: expected {len(f)} rows like accel, got {len(w)}")
+            raise input_error("gyro", f"expected {len(f)} rows like accel, got {len(w)}")
         fm, wm, fb, wb = self._sim.corrupt(f, w)
         index = pd.RangeIndex(self._k, self._k + len(f), name="sample")
         self._k += len(f)

@@ -11,7 +11,7 @@ from __future__ import annotations
 import numpy as np
 
 from . import _core
-from ._validate import rows
+from ._validate import input_error, rows
 
 
 def _single(x, width):
@@ -45,7 +45,7 @@ def quat_from_dcm(dcm):
     single = m.shape == (3, 3)
     m = np.ascontiguousarray(m[None] if single else m)
     if m.ndim != 3 or m.shape[1:] != (3, 3):
-        raise ValueError(f"dcm: expected shape (N, 3, 3), got {np.shape(dcm)}")
+        raise input_error("dcm", f"expected shape (N, 3, 3), got {np.shape(dcm)}")
     r = _core.quat_from_dcm_rows(m)
     return r[0] if single else r
 
@@ -84,7 +84,8 @@ def quat_multiply(a, b):
 
 
 def quat_normalize(q):
-    """Unit quaternion(s); a zero quaternion raises ValueError."""
+    """Unit quaternion(s); a zero (or non-finite-norm) quaternion raises
+    :class:`atomnav.InputError` naming ``q`` and its row."""
     return _wrap(_core.quat_normalize_rows, q, 4, "q", True)
 
 

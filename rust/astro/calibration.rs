@@ -1,9 +1,10 @@
-//! Mount calibration C = C_MF^VF from pairs of attitude increments (seed 001 §3; spec
+//! Mount calibration C = C_MF^VF from pairs of attitude increments (Vasilyuk et al. 2024 §3; spec
 //! E14–E20): identifiability, closed-form start, Gauss–Newton on SO(3), the sandwich
 //! covariance P_β, P^clb, P^mfa and the dead-reckoning consistency check.
 
 use super::{d1, d2, euler_dcm, euler_from_dcm, nearest_rotation, rotation_angle, vee};
-use crate::error::{invalid, NavError, Result};
+use crate::error::{check_positive, invalid, NavError, Result};
+use crate::options::Choice;
 use crate::math::{dcm_from_rotvec, rotvec_from_dcm, skew, Mat3, Vec3};
 use super::increments::Mat39;
 use nalgebra::{SMatrix, SymmetricEigen};
@@ -23,6 +24,11 @@ pub enum Verdict {
     Ok,
     Warn,
     Reject,
+}
+
+impl Choice for Verdict {
+    const PARAMETER: &'static str = "verdict";
+    const CHOICES: &'static [(&'static str, Self)] = &[("ok", Verdict::Ok), ("warn", Verdict::Warn), ("reject", Verdict::Reject)];
 }
 
 /// E15: how well a set of astro increments determines the mount.
@@ -133,11 +139,42 @@ pub enum Init {
     Given(Mat3),
 }
 
+/// The name of an [`Init`] (`init="axes"`); "given" takes its rotation from `c0`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Start {
+    Axes,
+    Zero,
+    Given,
+}
+
+impl Choice for Start {
+    const PARAMETER: &'static str = "init";
+    const CHOICES: &'static [(&'static str, Self)] = &[("axes", Start::Axes), ("zero", Start::Zero), ("given", Start::Given)];
+}
+
+impl Init {
+    /// The start named `start`; `c0` (a rotation) is required by "given" and refused otherwise.
+    pub fn new(start: Start, c0: Option<Mat3>) -> Result<Init> {
+        match (start, c0) {
+            (Start::Axes, None) => Ok(Init::Axes),
+            (Start::Zero, None) => Ok(Init::Zero),
+            (Start::Given, Some(c)) => Ok(Init::Given(c)),
+            (Start::Given, None) => Err(invalid("c0", "init='given' needs the starting rotation c0")),
+            (_, Some(_)) => Err(invalid("c0", format!("c0 is only used with init='given', got init={:?}", start.name()))),
+        }
+    }
+}
+
 /// Residual covariance P_S of E18: the full 3×3 (default) or its diagonal (D6).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum ResidualForm {
     Full,
     Diagonal,
+}
+
+impl Choice for ResidualForm {
+    const PARAMETER: &'static str = "residual_form";
+    const CHOICES: &'static [(&'static str, Self)] = &[("full", ResidualForm::Full), ("diagonal", ResidualForm::Diagonal)];
 }
 
 /// Gauss–Newton parametrisation (spec E17, D3, D8).
@@ -147,6 +184,11 @@ pub enum Solver {
     So3,
     /// The paper's β_j = β_{j−1} − (HᵀH)⁻¹Hᵀf with a central-difference Jacobian in β.
     PaperEuler,
+}
+
+impl Choice for Solver {
+    const PARAMETER: &'static str = "solver";
+    const CHOICES: &'static [(&'static str, Self)] = &[("so3", Solver::So3), ("paper_euler", Solver::PaperEuler)];
 }
 
 #[derive(Debug, Clone, Copy)]
@@ -162,6 +204,17 @@ pub struct Options {
 impl Default for Options {
     fn default() -> Self {
         Self { init: Init::Axes, solver: Solver::So3, max_iter: 50, tol: 1e-9, residual_form: ResidualForm::Full }
+    }
+}
+
+impl Options {
+    /// Checked options: at least one iteration, a finite positive tolerance (rad).
+    pub fn new(init: Init, solver: Solver, max_iter: usize, tol: f64, residual_form: ResidualForm) -> Result<Options> {
+        if max_iter == 0 {
+            return Err(invalid("max_iter", "must be ≥ 1"));
+        }
+        check_positive("tol", tol)?;
+        Ok(Options { init, solver, max_iter, tol, residual_form })
     }
 }
 
@@ -234,7 +287,7 @@ fn normal_equations_euler_fd(beta: &Vec3, ds_imu: &[Mat3], ds_avu: &[Mat3]) -> (
 }
 
 /// Gauss–Newton on SO(3): C_j = C_{j−1} exp([Δθ×]), Δθ = −(HᵀH)⁻¹Hᵀf, stop at ‖Δθ‖ ≤ tol
-/// (seed 001 §3, spec E17), then the sandwich covariance (E18).
+/// (Vasilyuk et al. 2024 §3, spec E17), then the sandwich covariance (E18).
 ///
 /// Errors: an unobservable trajectory (κ < 1e-12, the null direction named) is
 /// `InvalidInput`; no convergence within `max_iter`, or convergence to a point whose
@@ -242,7 +295,7 @@ fn normal_equations_euler_fd(beta: &Vec3, ds_imu: &[Mat3], ds_avu: &[Mat3]) -> (
 pub fn calibrate(ds_imu: &[Mat3], ds_avu: &[Mat3], opt: &Options) -> Result<Calibration> {
     check_increments(ds_imu, ds_avu)?;
     if let Init::Given(c) = opt.init {
-        super::check_rotation("init", 0, &c)?;
+        super::check_rotation("c0", 0, &c)?;
     }
     let obs = observability(ds_avu);
     if obs.verdict == Verdict::Reject {
@@ -404,6 +457,11 @@ pub enum DiffForm {
     Full,
     /// P_n^imu + P_n^mfa as in the paper.
     Paper,
+}
+
+impl Choice for DiffForm {
+    const PARAMETER: &'static str = "p_diff";
+    const CHOICES: &'static [(&'static str, Self)] = &[("full", DiffForm::Full), ("paper", DiffForm::Paper)];
 }
 
 /// Dead-reckoning check (E20): S_1^MF = S_1^VF Cᵀ (D9), S_n^MF = S_{n−1}^MF ΔS_n^imu,

@@ -1,11 +1,12 @@
 //! Gyro attitude increments between asynchronous camera epochs and their covariance
-//! (seed 001 §2.2; spec E1–E8).
+//! (Vasilyuk et al. 2024 §2.2; spec E1–E8).
 //!
 //! IMU record: increment `rho[j]` (rad, MF axes) covers [t_start + jT, t_start + (j+1)T].
 //! Interval n runs from epoch t_{E,n−1} to t_{E,n}; its increment q_n maps MF at t_{E,n}
 //! into MF at t_{E,n−1}: R(q_n) = ΔS_n^imu = S_{MF,n−1}^{MF,n} (spec E6).
 
 use crate::error::{check_increasing, check_positive, invalid, Result};
+use crate::options::Choice;
 use crate::math::{dcm_from_quat, quat, quat_normalize, skew, Mat3, Quat, Vec3};
 use nalgebra::SMatrix;
 use rayon::prelude::*;
@@ -19,14 +20,12 @@ pub enum TaylorVariant {
     PaperLiteral,
 }
 
+impl Choice for TaylorVariant {
+    const PARAMETER: &'static str = "taylor_variant";
+    const CHOICES: &'static [(&'static str, Self)] = &[("corrected", Self::Corrected), ("paper_literal", Self::PaperLiteral)];
+}
+
 impl TaylorVariant {
-    pub fn parse(s: &str) -> Result<Self> {
-        match s {
-            "corrected" => Ok(Self::Corrected),
-            "paper_literal" => Ok(Self::PaperLiteral),
-            _ => Err(invalid("taylor_variant", format!("expected 'corrected' or 'paper_literal', got '{s}'"))),
-        }
-    }
     fn c(self) -> f64 {
         match self {
             Self::Corrected => 0.125,
@@ -44,14 +43,9 @@ pub enum GyroErrorMode {
     Consistent,
 }
 
-impl GyroErrorMode {
-    pub fn parse(s: &str) -> Result<Self> {
-        match s {
-            "paper" => Ok(Self::Paper),
-            "consistent" => Ok(Self::Consistent),
-            _ => Err(invalid("gyro_error_model", format!("expected 'paper' or 'consistent', got '{s}'"))),
-        }
-    }
+impl Choice for GyroErrorMode {
+    const PARAMETER: &'static str = "gyro_error_model";
+    const CHOICES: &'static [(&'static str, Self)] = &[("paper", Self::Paper), ("consistent", Self::Consistent)];
 }
 
 /// Gyro error budget of E1: σ_φG misalignment (rad), σ_kG scale factor (–), σ_wG angle

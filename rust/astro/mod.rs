@@ -1,5 +1,5 @@
 //! Astro-inertial calibration of the star-camera (virtual camera VF) to IMU (MF) mount from
-//! attitude increments (seed 001, Vasilyuk et al. 2024; spec astro-calibration-vasilyuk2024).
+//! attitude increments (Vasilyuk et al. 2024, Vasilyuk et al. 2024; spec astro-calibration-vasilyuk2024).
 //!
 //! Internally everything is in the paper's conventions (spec §2): ENU navigation frame,
 //! right-forward-up body axes, right-multiplicative body-frame small errors
@@ -39,7 +39,7 @@ pub fn euler_from_dcm(c: &Mat3) -> Vec3 {
     Vec3::new(psi, th, g)
 }
 
-/// D1(β): θ^clb = D1 δβ with C(β + δβ) ≈ C(β)(I + [θ^clb×]) (seed 001, Eq. 8; spec E19).
+/// D1(β): θ^clb = D1 δβ with C(β + δβ) ≈ C(β)(I + [θ^clb×]) (Vasilyuk et al. 2024, Eq. 8; spec E19).
 pub fn d1(b: &Vec3) -> Mat3 {
     let (st, ct) = b.y.sin_cos();
     let (sg, cg) = b.z.sin_cos();
@@ -51,6 +51,11 @@ pub fn d2(b: &Vec3) -> Mat3 {
     let (sp, cp) = b.x.sin_cos();
     let (st, ct) = b.y.sin_cos();
     Mat3::new(0.0, cp, ct * sp, 0.0, -sp, ct * cp, -1.0, 0.0, st)
+}
+
+/// [`check_rotation`] of every matrix of a series (names the first that is not a rotation).
+pub fn check_rotations(field: &str, r: &[Mat3]) -> crate::Result<()> {
+    r.iter().enumerate().try_for_each(|(i, m)| check_rotation(field, i, m))
 }
 
 /// Rotation angle of a rotation matrix by atan2 (spec E20, D15): accurate for small angles.
@@ -70,8 +75,9 @@ pub fn nearest_rotation(b: &Mat3) -> Mat3 {
 pub fn check_rotation(field: &str, index: usize, r: &Mat3) -> crate::Result<()> {
     let orth = (r.transpose() * r - Mat3::identity()).abs().max();
     if !orth.is_finite() || orth > 1e-9 || r.determinant() <= 0.0 {
-        return Err(crate::error::invalid(
+        return Err(crate::error::invalid_at(
             field,
+            index,
             format!("not a rotation matrix at index {index} (‖RᵀR − I‖ = {orth:.3e}, det = {:.6})", r.determinant()),
         ));
     }

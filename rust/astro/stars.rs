@@ -1,9 +1,9 @@
-//! Star-camera front end (seed 001 §2.1; spec E9–E13, D4, D13): a deterministic synthetic
+//! Star-camera front end (Vasilyuk et al. 2024 §2.1; spec E9–E13, D4, D13): a deterministic synthetic
 //! catalog, a camera simulator, refraction, bundle merging into the virtual camera VF,
 //! Wahba/SVD attitudes with their covariance, and the astro increments.
 
-use super::{check_rotation, d1, euler_from_dcm, nearest_rotation};
-use crate::error::{invalid, Result};
+use super::{check_rotation, check_rotations, d1, euler_from_dcm, nearest_rotation};
+use crate::error::{invalid, invalid_at, Result};
 use crate::math::{Mat3, Vec3};
 use rand::Rng;
 use rand_distr::StandardNormal;
@@ -96,8 +96,47 @@ pub fn check_unit(field: &str, v: &[Vec3]) -> Result<()> {
     // NaN norms fail too: `is_nan() ||` keeps them out of the accepted set
     match v.iter().position(|s| (s.norm() - 1.0).is_nan() || (s.norm() - 1.0).abs() > UNIT_TOLERANCE) {
         None => Ok(()),
-        Some(i) => Err(invalid(field, format!("not a unit vector at index {i} (norm {})", v[i].norm()))),
+        Some(i) => Err(invalid_at(field, i, format!("not a unit vector at index {i} (norm {})", v[i].norm()))),
     }
+}
+
+/// Largest observer speed of the first-order aberration formula: above 1e-3 c the
+/// neglected second-order term exceeds ~1e-6 rad (0.2″).
+pub const ABERRATION_MAX_SPEED: f64 = 1e-3 * crate::gnss::C_LIGHT;
+
+/// [`aberration`] of unit directions `s` (N) for one velocity or one per direction,
+/// checked: unit directions, 1 or N velocities, each below [`ABERRATION_MAX_SPEED`].
+pub fn aberration_rows(s: &[Vec3], v: &[Vec3]) -> Result<Vec<Vec3>> {
+    if v.len() != s.len() && v.len() != 1 {
+        return Err(invalid("velocity", format!("expected 1 or {} rows like directions, got {}", s.len(), v.len())));
+    }
+    check_unit("directions", s)?;
+    if let Some(i) = v.iter().position(|v| v.norm() >= ABERRATION_MAX_SPEED) {
+        return Err(invalid_at("velocity", i, format!("|v| = {} m/s at index {i}: the first-order formula needs |v| < 1e-3 c", v[i].norm())));
+    }
+    Ok(s.iter().enumerate().map(|(i, s)| aberration(s, &v[if v.len() == 1 { 0 } else { i }])).collect())
+}
+
+fn check_cameras(cameras: &[Camera]) -> Result<()> {
+    cameras.iter().enumerate().try_for_each(|(i, c)| check_rotation("cameras", i, &c.c_vf_cf))
+}
+
+fn check_refractive_index(n: f64) -> Result<()> {
+    match n.is_finite() && n >= 1.0 {
+        true => Ok(()),
+        false => Err(invalid("n_refr", format!("refractive index must be finite and ≥ 1, got {n}"))),
+    }
+}
+
+/// [`refraction_apply`] (`apply`) or [`refraction_correct`] of each direction `s` about
+/// the vertical `u` of the same row, with refractive index `n` ≥ 1.
+pub fn refraction_rows(s: &[Vec3], u: &[Vec3], n: f64, apply: bool) -> Result<Vec<Vec3>> {
+    if s.len() != u.len() {
+        return Err(invalid("up", format!("expected {} rows like directions, got {}", s.len(), u.len())));
+    }
+    check_refractive_index(n)?;
+    let f = if apply { refraction_apply } else { refraction_correct };
+    Ok(s.iter().zip(u).map(|(s, u)| f(s, u, n)).collect())
 }
 
 /// n(H) = 1 + 2.7783e-4 (1 − 2.25577e-5 H)^4.25588 (spec D13; H in m).
@@ -185,13 +224,11 @@ pub fn star_attitudes(
     refraction: Option<(&[Vec3], f64)>,
     p_avu: Option<&[Mat3]>,
 ) -> Result<StarAttitudes> {
+    let m = obs.s_cf.len();
     if let Some(p) = p_avu {
         check_covariances("p_avu", p, n_epochs)?;
     }
-    for (i, c) in cameras.iter().enumerate() {
-        check_rotation("cameras", i, &c.c_vf_cf)?;
-    }
-    let m = obs.s_cf.len();
+    check_cameras(cameras)?;
     if obs.epoch.len() != m || obs.camera.len() != m || obs.g.len() != m {
         return Err(invalid("observations", "epoch, camera, star and catalog arrays differ in length"));
     }
@@ -207,20 +244,25 @@ pub fn star_attitudes(
         return Err(invalid("epoch", format!("epoch index {} at index {i} but {n_epochs} epochs", obs.epoch[i])));
     }
     if let Some((up, n)) = refraction {
-        if !(n.is_finite() && n >= 1.0) {
-            return Err(invalid("n_refr", format!("refractive index must be finite and ≥ 1, got {n}")));
-        }
+        check_refractive_index(n)?;
         if up.len() != n_epochs {
             return Err(invalid("up_gcrs", format!("expected {n_epochs} rows, got {}", up.len())));
         }
         check_unit("up_gcrs", up)?;
     }
+    // Every epoch needs three stars, checked on the m observations before anything is
+    // sized by n_epochs: the search stops within m/3 + 1 epochs, however large n_epochs is.
+    let mut stars_at = std::collections::BTreeMap::<usize, usize>::new();
+    for &e in &obs.epoch {
+        *stars_at.entry(e).or_default() += 1;
+    }
+    if let Some(e) = (0..n_epochs).find(|e| stars_at.get(e).is_none_or(|&k| k < 3)) {
+        let k = stars_at.get(&e).copied().unwrap_or(0);
+        return Err(invalid("star_directions", format!("epoch at index {e} has {k} stars, need at least 3")));
+    }
     let mut rows: Vec<Vec<usize>> = vec![Vec::new(); n_epochs];
     for (r, &e) in obs.epoch.iter().enumerate() {
         rows[e].push(r);
-    }
-    if let Some(e) = rows.iter().position(|r| r.len() < 3) {
-        return Err(invalid("star_directions", format!("epoch at index {e} has {} stars, need at least 3", rows[e].len())));
     }
     let d1s: Vec<Mat3> = cameras.iter().map(|c| d1(&euler_from_dcm(&c.c_vf_cf))).collect();
     let mut out = StarAttitudes { s: Vec::with_capacity(n_epochs), p: Vec::with_capacity(n_epochs), stars: Vec::with_capacity(n_epochs) };
@@ -291,7 +333,18 @@ pub fn simulate_observations<R: Rng>(
     sigma_s: f64,
     n_refr: f64,
     rng: &mut R,
-) -> Observations {
+) -> Result<Observations> {
+    check_rotations("s_gcrs_vf", s_gcrs_vf)?;
+    if up_gcrs.len() != s_gcrs_vf.len() {
+        return Err(invalid("up_gcrs", format!("expected {} rows, got {}", s_gcrs_vf.len(), up_gcrs.len())));
+    }
+    check_cameras(cameras)?;
+    for (name, v) in [("fov_half", fov_half), ("sigma_s", sigma_s)] {
+        if !(v.is_finite() && v >= 0.0) {
+            return Err(invalid(name, format!("must be finite and ≥ 0, got {v}")));
+        }
+    }
+    check_refractive_index(n_refr)?;
     let cos_fov = fov_half.cos();
     let mut obs = Observations::default();
     for (e, (s, up)) in s_gcrs_vf.iter().zip(up_gcrs).enumerate() {
@@ -319,7 +372,7 @@ pub fn simulate_observations<R: Rng>(
             }
         }
     }
-    obs
+    Ok(obs)
 }
 
 #[cfg(test)]
@@ -372,5 +425,20 @@ mod tests {
         assert!(c.mags.iter().all(|&m| m <= 5.6));
         assert_eq!(c.dirs[17], Catalog::synthetic(5.6, 7).unwrap().dirs[17]);
         assert!((c.dirs.iter().sum::<Vec3>() / c.dirs.len() as f64).norm() < 0.05);
+    }
+
+    #[test]
+    fn huge_epoch_count_is_an_error_not_an_allocation() {
+        let g = [Vec3::x(), Vec3::y(), Vec3::z()];
+        let obs = Observations { epoch: vec![0, 0, 0], camera: vec![0; 3], s_cf: g.to_vec(), g: g.to_vec() };
+        let cams = [Camera { c_vf_cf: Mat3::identity(), p_alpha: Mat3::zeros() }];
+        assert_eq!(star_attitudes(&obs, 1, &cams, 1e-5, None, None).unwrap().s.len(), 1);
+        match star_attitudes(&obs, usize::MAX, &cams, 1e-5, None, None) {
+            Err(crate::error::NavError::InvalidInput { field, reason, .. }) => {
+                assert_eq!(field, "star_directions");
+                assert!(reason.starts_with("epoch at index 1 has 0 stars"), "{reason}");
+            }
+            other => panic!("{other:?}"),
+        }
     }
 }

@@ -5,6 +5,7 @@
 //! Euler angles are the aerospace z-y-x sequence: C_nb = Rz(yaw) Ry(pitch) Rx(roll).
 //! Composition: C(q_a ⊗ q_b) = C(q_a) C(q_b).
 
+use crate::error::{invalid_at, Result};
 use nalgebra::{Matrix3, Quaternion, Vector3};
 
 pub type Vec3 = Vector3<f64>;
@@ -30,6 +31,21 @@ pub fn quat_to_array(q: &Quat) -> [f64; 4] {
 pub fn quat_normalize(q: &Quat) -> Quat {
     let n = q.norm();
     q / n
+}
+
+/// Rows `q` that stand for rotations, scaled to unit norm. A row whose norm is zero or not
+/// finite names no rotation: `InvalidInput` naming `field` and that row (never a NaN row).
+pub fn unit_quats(field: &str, q: &[Quat]) -> Result<Vec<Quat>> {
+    q.iter()
+        .enumerate()
+        .map(|(i, q)| {
+            let u = quat_normalize(q);
+            match u.coords.iter().all(|x| x.is_finite()) {
+                true => Ok(u),
+                false => Err(invalid_at(field, i, format!("quaternion {:?} at index {i} has norm {}, not a rotation", quat_to_array(q), q.norm()))),
+            }
+        })
+        .collect()
 }
 
 /// Hamilton product a ⊗ b.
@@ -217,5 +233,18 @@ mod tests {
         let v = Vec3::new(1.0, -2.0, 0.5);
         assert!((dcm_from_quat(&quat_mul(&a, &b)) - dcm_from_quat(&a) * dcm_from_quat(&b)).abs().max() < 1e-15);
         assert!((quat_rotate(&a, &v) - dcm_from_quat(&a) * v).norm() < 1e-15);
+    }
+
+    #[test]
+    fn unit_quats_rejects_what_names_no_rotation() {
+        let good = [quat(2.0, 0.0, 0.0, 0.0), quat(0.0, 0.0, 3.0, 4.0)];
+        let u = unit_quats("q", &good).unwrap();
+        assert_eq!(quat_to_array(&u[1]), [0.0, 0.0, 0.6, 0.8]);
+        for bad in [quat(0.0, 0.0, 0.0, 0.0), quat(1e300, 1e300, 0.0, 0.0), quat(f64::NAN, 1.0, 0.0, 0.0)] {
+            match unit_quats("q", &[good[0], bad]) {
+                Err(crate::error::NavError::InvalidInput { field, index, .. }) => assert_eq!((field.as_str(), index), ("q", Some(1))),
+                other => panic!("{other:?}"),
+            }
+        }
     }
 }

@@ -1,6 +1,6 @@
 //! Allan family: overlapping Allan, modified Allan and overlapping Hadamard variance of
 //! rate or phase (angle) data, batch and streaming; equivalent degrees of freedom; the
-//! five-term IEEE Std 952 fit (seed 002 Eqs. 19–21, spec E14–E16, D15).
+//! five-term IEEE Std 952 fit (Niu et al. 2025 Eqs. 19–21, spec E14–E16, D15).
 //!
 //! Everything works on phase x (the integral of the rate): rate data y become
 //! x₀ = 0, x_{i+1} = x_i + (y_i − ȳ) in units of rate·τ₀, so that all three statistics
@@ -10,8 +10,9 @@
 //!   HVAR(mτ₀)  = Σ_{i<Np−3m} (x_{i+3m} − 3x_{i+2m} + 3x_{i+m} − x_i)² / (6 m² τ₀² (Np−3m)),
 //! with Np phase points. τ₀ cancels for rate data (x in rate·τ₀ units).
 
-use crate::error::{check_finite, check_positive, invalid, Result};
+use crate::error::{check_finite, check_positive, invalid, invalid_at, NavError, Result};
 use crate::noise::nnls::nnls;
+use crate::options::Choice;
 use nalgebra::{DMatrix, DVector};
 
 /// Which variance of the Allan family.
@@ -25,16 +26,12 @@ pub enum Kind {
     Hadamard,
 }
 
-impl Kind {
-    pub fn by_name(name: &str) -> Result<Kind> {
-        match name {
-            "allan" => Ok(Kind::Allan),
-            "modified" => Ok(Kind::Modified),
-            "hadamard" => Ok(Kind::Hadamard),
-            _ => Err(invalid("kind", format!("unknown {name:?}; choose allan, modified or hadamard"))),
-        }
-    }
+impl Choice for Kind {
+    const PARAMETER: &'static str = "kind";
+    const CHOICES: &'static [(&'static str, Self)] = &[("allan", Kind::Allan), ("modified", Kind::Modified), ("hadamard", Kind::Hadamard)];
+}
 
+impl Kind {
     /// Number of terms in the sum at averaging factor m with `np` phase points.
     pub fn terms(self, np: usize, m: usize) -> usize {
         match self {
@@ -52,14 +49,9 @@ pub enum DataType {
     Phase,
 }
 
-impl DataType {
-    pub fn by_name(name: &str) -> Result<DataType> {
-        match name {
-            "rate" => Ok(DataType::Rate),
-            "phase" => Ok(DataType::Phase),
-            _ => Err(invalid("data_type", format!("unknown {name:?}; choose rate or phase"))),
-        }
-    }
+impl Choice for DataType {
+    const PARAMETER: &'static str = "data_type";
+    const CHOICES: &'static [(&'static str, Self)] = &[("rate", DataType::Rate), ("phase", DataType::Phase)];
 }
 
 /// Averaging factors m (τ = mτ₀).
@@ -73,6 +65,29 @@ pub enum TauSet {
     All,
     /// User-given factors; each must leave at least two terms.
     List(Vec<usize>),
+}
+
+/// A generated set of averaging factors, chosen by name (`m="octave"`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum TauGrid {
+    Octave,
+    Decade,
+    All,
+}
+
+impl Choice for TauGrid {
+    const PARAMETER: &'static str = "m";
+    const CHOICES: &'static [(&'static str, Self)] = &[("octave", TauGrid::Octave), ("decade", TauGrid::Decade), ("all", TauGrid::All)];
+}
+
+impl From<TauGrid> for TauSet {
+    fn from(g: TauGrid) -> TauSet {
+        match g {
+            TauGrid::Octave => TauSet::Octave,
+            TauGrid::Decade => TauSet::Decade,
+            TauGrid::All => TauSet::All,
+        }
+    }
 }
 
 /// One statistic at each averaging factor.
@@ -100,13 +115,17 @@ pub fn resolve_m(set: &TauSet, kind: Kind, np: usize) -> Result<Vec<usize>> {
         TauSet::All => gen(&|k| k + 1),
         TauSet::Decade => gen(&|k| [1, 2, 4][k % 3] * 10usize.pow((k / 3) as u32)),
         TauSet::List(ms) => {
+            if ms.is_empty() {
+                return Err(invalid("m", "no averaging factors given"));
+            }
             for (i, &m) in ms.iter().enumerate() {
                 if m == 0 {
-                    return Err(invalid("m", format!("averaging factor 0 at index {i}; τ must be ≥ τ₀")));
+                    return Err(invalid_at("m", i, format!("averaging factor 0 at index {i}; τ must be ≥ τ₀")));
                 }
                 if !ok(m) {
-                    return Err(invalid(
+                    return Err(invalid_at(
                         "m",
+                        i,
                         format!(
                             "averaging factor {m} at index {i} leaves {} terms (< {MIN_TERMS}) in a record of {np} phase points: τ is too large for the record (larger than about half the record for the Allan variance, a third for modified/Hadamard)",
                             kind.terms(np, m)
@@ -348,24 +367,31 @@ pub struct AllanStream {
 }
 
 impl AllanStream {
+    /// A stream at the averaging factors `ms` (each ≥ 1; the ring of 3·max(m)+1 phase
+    /// points must fit in memory: `OutOfMemory` names its size otherwise).
     pub fn new(ms: &[usize], tau0: f64, data_type: DataType) -> Result<AllanStream> {
         check_positive("tau0", tau0)?;
-        if ms.is_empty() {
-            return Err(invalid("m", "no averaging factors given"));
-        }
         if let Some(i) = ms.iter().position(|&m| m == 0) {
-            return Err(invalid("m", format!("averaging factor 0 at index {i}")));
+            return Err(invalid_at("m", i, format!("averaging factor 0 at index {i}")));
         }
+        let (i, &m_max) = ms.iter().enumerate().max_by_key(|(_, m)| **m).ok_or_else(|| invalid("m", "no averaging factors given"))?;
+        let cap = m_max
+            .checked_mul(3)
+            .and_then(|n| n.checked_add(1))
+            .and_then(usize::checked_next_power_of_two)
+            .ok_or_else(|| invalid_at("m", i, format!("averaging factor {m_max} at index {i} needs a ring of 3m+1 phase points, more than any address space holds")))?;
+        // reserved, not touched: the pages fill as the stream runs
+        let mut ring = Vec::new();
+        ring.try_reserve_exact(cap).map_err(|_| NavError::OutOfMemory { field: "m".into(), bytes: cap as u128 * 8 })?;
         let mut ms = ms.to_vec();
         ms.sort_unstable();
         ms.dedup();
-        let cap = (3 * ms[ms.len() - 1] + 1).next_power_of_two();
         let k = ms.len();
         Ok(AllanStream {
             ms,
             tau0,
             data_type,
-            ring: vec![0.0; cap],
+            ring,
             mask: cap - 1,
             np: 0,
             phase: 0.0,
@@ -379,7 +405,11 @@ impl AllanStream {
 
     fn push_phase(&mut self, x: f64) {
         let n = self.np;
-        self.ring[n & self.mask] = x;
+        if self.ring.len() > self.mask {
+            self.ring[n & self.mask] = x;
+        } else {
+            self.ring.push(x); // first pass: n == ring.len() == n & mask
+        }
         let r = |i: usize| self.ring[i & self.mask];
         for (j, &m) in self.ms.iter().enumerate() {
             if n < 2 * m {
@@ -453,17 +483,27 @@ pub enum NoiseType {
     RandomWalkFm,
 }
 
-impl NoiseType {
-    pub fn by_name(name: &str) -> Result<NoiseType> {
-        match name {
-            "white_pm" => Ok(NoiseType::WhitePm),
-            "flicker_pm" => Ok(NoiseType::FlickerPm),
-            "white_fm" => Ok(NoiseType::WhiteFm),
-            "flicker_fm" => Ok(NoiseType::FlickerFm),
-            "random_walk_fm" => Ok(NoiseType::RandomWalkFm),
-            _ => Err(invalid("noise", format!("unknown {name:?}; choose white_pm, flicker_pm, white_fm, flicker_fm or random_walk_fm"))),
-        }
+impl Choice for NoiseType {
+    const PARAMETER: &'static str = "noise";
+    const CHOICES: &'static [(&'static str, Self)] = &[
+        ("white_pm", NoiseType::WhitePm),
+        ("flicker_pm", NoiseType::FlickerPm),
+        ("white_fm", NoiseType::WhiteFm),
+        ("flicker_fm", NoiseType::FlickerFm),
+        ("random_walk_fm", NoiseType::RandomWalkFm),
+    ];
+}
+
+/// Equivalent degrees of freedom of `kind` at each averaging factor of `m` for a record
+/// of `np` phase points: [`edf_overlapping_allan`] for the Allan variance, the
+/// non-overlapping count [`edf_non_overlapping`] otherwise.
+pub fn edf(kind: Kind, noise: NoiseType, np: usize, m: &[usize]) -> Result<Vec<f64>> {
+    if let Some(i) = m.iter().position(|&mj| mj == 0 || mj >= np) {
+        return Err(invalid_at("m", i, format!("averaging factor {} at index {i} outside [1, {np}) for {np} phase points", m[i])));
     }
+    Ok(m.iter()
+        .map(|&mj| if kind == Kind::Allan { edf_overlapping_allan(noise, np, mj) } else { edf_non_overlapping(kind, np, mj) })
+        .collect())
 }
 
 /// Equivalent degrees of freedom of the overlapping Allan variance with `np` phase
@@ -494,7 +534,7 @@ pub fn edf_non_overlapping(kind: Kind, np: usize, m: usize) -> f64 {
     (((np - 1) / m) as f64 - d as f64 + 1.0).max(1.0)
 }
 
-/// Result of the five-term fit σ²(τ) = Σ_{k=−2}^{2} A_k τ^k (seed 002 Eq. 19).
+/// Result of the five-term fit σ²(τ) = Σ_{k=−2}^{2} A_k τ^k (Niu et al. 2025 Eq. 19).
 #[derive(Debug, Clone, PartialEq)]
 pub struct AllanFit {
     /// A₋₂, A₋₁, A₀, A₁, A₂ in (rate)²·s^k.
@@ -513,11 +553,27 @@ pub struct AllanFit {
     pub points: usize,
 }
 
+impl AllanFit {
+    /// The derived noise parameters by name (the fields after `coeffs`).
+    pub fn parameters(&self) -> [(&'static str, f64); 5] {
+        [("quantization", self.quantization), ("arw", self.arw), ("bias_instability", self.bias_instability), ("rrw", self.rrw), ("ramp", self.ramp)]
+    }
+}
+
 /// Weighted non-negative least-squares fit of the five-term model to AVAR points (spec D15):
 /// weights 1/σ_j², σ_j = AVAR_j/√max(1, ⌊N/m_j⌋ − 1), columns normalised, Lawson–Hanson.
 /// `terms` selects which of A₋₂…A₂ are free (the others are 0); only points with
 /// `tau_min ≤ τ ≤ tau_max` and positive variance are used. `n_samples` is the record length.
 pub fn fit(res: &AllanResult, n_samples: usize, terms: [bool; 5], tau_min: f64, tau_max: f64) -> Result<AllanFit> {
+    let k = res.m.len();
+    if res.tau.len() != k || res.var.len() != k {
+        return Err(invalid("var", format!("m, tau and var must have equal lengths ({k}, {}, {})", res.tau.len(), res.var.len())));
+    }
+    if let Some(i) = res.m.iter().position(|&m| m == 0) {
+        return Err(invalid_at("m", i, format!("averaging factor 0 at index {i}")));
+    }
+    check_finite("tau", &res.tau, 1)?;
+    check_finite("var", &res.var, 1)?;
     let idx: Vec<usize> = (0..res.tau.len()).filter(|&j| res.tau[j] >= tau_min && res.tau[j] <= tau_max && res.var[j] > 0.0).collect();
     let cols: Vec<i32> = (-2..=2).filter(|k| terms[(k + 2) as usize]).collect();
     if cols.is_empty() {
@@ -619,5 +675,30 @@ mod tests {
         for k in 0..5 {
             assert!((f.coeffs[k] - coeffs[k]).abs() < 1e-9 * (1.0 + coeffs[k]), "{k}: {:?}", f.coeffs);
         }
+    }
+
+    #[test]
+    fn sizes_from_input_are_checked() {
+        let y: Vec<f64> = (0..64).map(|k| ((k * 37 % 11) as f64).sin()).collect();
+        let field = |e: NavError| match e {
+            NavError::InvalidInput { field, .. } | NavError::OutOfMemory { field, .. } => field,
+            NavError::Numerical(m) => m,
+        };
+        assert_eq!(field(variance(&y, 1.0, DataType::Rate, Kind::Allan, &TauSet::List(vec![])).unwrap_err()), "m");
+        assert_eq!(field(AllanStream::new(&[], 1.0, DataType::Rate).unwrap_err()), "m");
+        assert_eq!(field(AllanStream::new(&[4, 1 << 62], 1.0, DataType::Rate).unwrap_err()), "m");
+        assert_eq!(field(AllanStream::new(&[usize::MAX / 4], 1.0, DataType::Rate).unwrap_err()), "m");
+        assert_eq!(field(edf(Kind::Modified, NoiseType::WhiteFm, 64, &[1, 0]).unwrap_err()), "m");
+        let r = AllanResult { m: vec![1, 0], tau: vec![1.0, 2.0], var: vec![1.0, 0.5], n: vec![0, 0] };
+        assert_eq!(field(fit(&r, 100, [true; 5], 0.0, 10.0).unwrap_err()), "m");
+        assert_eq!(field(fit(&AllanResult { m: vec![1], ..r }, 100, [true; 5], 0.0, 10.0).unwrap_err()), "var");
+    }
+
+    #[test]
+    fn edf_picks_the_formula_of_the_kind() {
+        let e = edf(Kind::Allan, NoiseType::WhiteFm, 1001, &[1, 10]).unwrap();
+        assert_eq!(e, vec![edf_overlapping_allan(NoiseType::WhiteFm, 1001, 1), edf_overlapping_allan(NoiseType::WhiteFm, 1001, 10)]);
+        // non-overlapping count ⌊(Np−1)/m⌋ − 2 for the Hadamard variance
+        assert_eq!(edf(Kind::Hadamard, NoiseType::WhiteFm, 1001, &[10]).unwrap(), vec![98.0]);
     }
 }

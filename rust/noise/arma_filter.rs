@@ -1,4 +1,4 @@
-//! ARIMA(p,d,q) state-space form and the scalar-measurement Kalman filters of seed 002:
+//! ARIMA(p,d,q) state-space form and the scalar-measurement Kalman filters of Niu et al. 2025:
 //! fixed R, the measurement-noise-adaptive R of Eq. 17 (both readings of y_k), and
 //! Sage–Husa (standard form, not from the paper; spec E11, D12). Batch and streaming.
 //!
@@ -6,29 +6,25 @@
 //! d = (1−L)^D ω. Measurement H = [1 0 … 0]: the filter observes ω_k directly.
 
 use crate::error::{check_finite, check_positive, invalid, NavError, Result};
+use crate::options::Choice;
 use nalgebra::{DMatrix, SMatrix, SVector};
 
 /// How the ARMA innovations enter the state (spec D5).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum NoiseForm {
-    /// Seed 002 Eq. 16: X = [ω_k … ω_{k−n+1}], B first row [1, β₁ … β_q, 0 …], Q = σ²I_n.
+    /// Niu et al. 2025 Eq. 16: X = [ω_k … ω_{k−n+1}], B first row [1, β₁ … β_q, 0 …], Q = σ²I_n.
     /// Treats a_{k−j} in W_k as fresh noise (doubles the process noise for β₁ ≈ −1).
     Paper,
     /// X = [ω_k … ω_{k−r+1}, a_k … a_{k−q+1}], G = e₀ + e_r, scalar Q = σ² (exact).
     Exact,
 }
 
-impl NoiseForm {
-    pub fn by_name(name: &str) -> Result<NoiseForm> {
-        match name {
-            "paper" => Ok(NoiseForm::Paper),
-            "exact" => Ok(NoiseForm::Exact),
-            _ => Err(invalid("noise_form", format!("unknown {name:?}; choose paper or exact"))),
-        }
-    }
+impl Choice for NoiseForm {
+    const PARAMETER: &'static str = "noise_form";
+    const CHOICES: &'static [(&'static str, Self)] = &[("paper", NoiseForm::Paper), ("exact", NoiseForm::Exact)];
 }
 
-/// X_k = Φ X_{k−1} + B W_{k−1}, Y_k = H X_k + V_k (seed 002 Eq. 14).
+/// X_k = Φ X_{k−1} + B W_{k−1}, Y_k = H X_k + V_k (Niu et al. 2025 Eq. 14).
 #[derive(Debug, Clone, PartialEq)]
 pub struct ArimaStateSpace {
     /// Transition matrix Φ (n×n), companion form of the AR polynomial on ω.
@@ -44,7 +40,7 @@ pub struct ArimaStateSpace {
 }
 
 /// Coefficients c of ω_k = Σ c_i ω_{k−i} + …: (1 − Σφ_i Lⁱ)(1 − L)^d = 1 − Σ c_i Lⁱ.
-/// For (2,1): [1+φ₁, φ₂−φ₁, −φ₂] (seed 002 Eq. 12).
+/// For (2,1): [1+φ₁, φ₂−φ₁, −φ₂] (Niu et al. 2025 Eq. 12).
 pub fn integrated_ar(ar: &[f64], d: usize) -> Vec<f64> {
     // Polynomial in L with constant term first.
     let mut poly: Vec<f64> = std::iter::once(1.0).chain(ar.iter().map(|a| -a)).collect();
@@ -129,19 +125,38 @@ pub enum RMode {
     SageHusa { b: f64, adapt_q: bool, fading: bool },
 }
 
+/// The name of an [`RMode`] (`adaptive="differenced"`); Sage–Husa's numbers travel beside it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Adaptive {
+    Fixed,
+    Literal,
+    Differenced,
+    SageHusa,
+}
+
+impl Choice for Adaptive {
+    const PARAMETER: &'static str = "adaptive";
+    const CHOICES: &'static [(&'static str, Self)] = &[
+        ("fixed", Adaptive::Fixed),
+        ("literal", Adaptive::Literal),
+        ("differenced", Adaptive::Differenced),
+        ("sage_husa", Adaptive::SageHusa),
+    ];
+}
+
 impl RMode {
-    pub fn by_name(name: &str, b: f64, adapt_q: bool, fading: bool) -> Result<RMode> {
-        match name {
-            "fixed" => Ok(RMode::Fixed),
-            "literal" => Ok(RMode::Literal),
-            "differenced" => Ok(RMode::Differenced),
-            "sage_husa" => {
+    /// The mode named `adaptive`; `b`, `adapt_q` and `fading` are used by Sage–Husa only.
+    pub fn new(adaptive: Adaptive, b: f64, adapt_q: bool, fading: bool) -> Result<RMode> {
+        match adaptive {
+            Adaptive::Fixed => Ok(RMode::Fixed),
+            Adaptive::Literal => Ok(RMode::Literal),
+            Adaptive::Differenced => Ok(RMode::Differenced),
+            Adaptive::SageHusa => {
                 if !(b > 0.0 && b < 1.0) {
                     return Err(invalid("b", format!("forgetting factor must be in (0, 1), got {b}")));
                 }
                 Ok(RMode::SageHusa { b, adapt_q, fading })
             }
-            _ => Err(invalid("adaptive", format!("unknown {name:?}; choose fixed, literal, differenced or sage_husa"))),
         }
     }
 }
@@ -162,7 +177,7 @@ impl RunningAllanR {
         self.count += 1;
         let c = self.count as f64;
         let dy = y - prev;
-        // seed 002, Eq. 17 (recursive form)
+        // Niu et al. 2025, Eq. 17 (recursive form)
         self.r = (1.0 - 1.0 / c) * self.r + dy * dy / (2.0 * c);
         Some(self.r)
     }
@@ -174,6 +189,57 @@ pub enum X0 {
     Zeros,
     /// All ω-slots start at the first measurement (removes the start-up transient).
     First,
+}
+
+impl Choice for X0 {
+    const PARAMETER: &'static str = "x0";
+    const CHOICES: &'static [(&'static str, Self)] = &[("zeros", X0::Zeros), ("first", X0::First)];
+}
+
+/// Everything that defines an ARMA Kalman filter run (model, measurement-noise mode,
+/// initial state), frozen: the binding builds it once, Python mirrors it as
+/// `atomnav.noise.filters.ArmaFilterConfig` (to/from dict and JSON).
+#[derive(Debug, Clone, PartialEq)]
+pub struct ArmaFilterConfig {
+    /// AR coefficients φ of the differenced series.
+    pub ar: Vec<f64>,
+    /// MA coefficients β.
+    pub ma: Vec<f64>,
+    /// Innovation variance σ_a².
+    pub sigma2: f64,
+    /// Differencing order.
+    pub d: usize,
+    pub noise_form: NoiseForm,
+    /// Initial (and fixed) measurement variance; σ_a² when None.
+    pub r0: Option<f64>,
+    pub adaptive: Adaptive,
+    /// Sage–Husa forgetting factor, Q adaptation and fading.
+    pub b: f64,
+    pub adapt_q: bool,
+    pub fading: bool,
+    pub x0: X0,
+    /// P₀ = p0·I.
+    pub p0: f64,
+}
+
+impl ArmaFilterConfig {
+    /// The filter this configuration describes (checks every field).
+    pub fn build(&self, record: bool) -> Result<Kalman> {
+        let model = ArimaStateSpace::from_arma(&self.ar, &self.ma, self.sigma2, self.d, self.noise_form)?;
+        let mode = RMode::new(self.adaptive, self.b, self.adapt_q, self.fading)?;
+        Kalman::new(&model, self.r0.unwrap_or(self.sigma2), mode, self.x0, self.p0, record)
+    }
+
+    /// Batch filter of a whole series; also returns the state dimension.
+    pub fn filter(&self, omega: &[f64], record: bool) -> Result<(FilterOutput, usize)> {
+        if omega.is_empty() {
+            return Err(invalid("omega", "empty series"));
+        }
+        let mut f = self.build(record)?;
+        let mut out = FilterOutput::default();
+        f.update(omega, &mut out)?;
+        Ok((out, f.dim()))
+    }
 }
 
 /// Filter output; the R and gain histories only when requested.
@@ -264,7 +330,7 @@ impl<const N: usize> Core<N> {
         Ok(())
     }
 
-    /// One step of seed 002 Eq. 15 with R_k chosen by `rs`.
+    /// One step of Niu et al. 2025 Eq. 15 with R_k chosen by `rs`.
     #[inline(always)]
     fn step(&mut self, z: f64, rs: &mut RState) -> Result<f64> {
         rs.k += 1;
@@ -360,6 +426,10 @@ macro_rules! cores {
                 }
             }
 
+            fn dim(&self) -> usize {
+                match self { $(AnyCore::$v(_) => $n,)* }
+            }
+
             fn run(&mut self, z: &[f64], rs: &mut RState, out: &mut FilterOutput, record: bool) -> Result<()> {
                 match self { $(AnyCore::$v(c) => c.run(z, rs, out, record),)* }
             }
@@ -369,7 +439,7 @@ macro_rules! cores {
 
 cores!(D1 = 1, D2 = 2, D3 = 3, D4 = 4, D5 = 5, D6 = 6, D7 = 7, D8 = 8);
 
-/// Stateful Kalman filter on an ARIMA state-space model (seed 002 Eq. 15); feed chunks
+/// Stateful Kalman filter on an ARIMA state-space model (Niu et al. 2025 Eq. 15); feed chunks
 /// with [`Kalman::update`] for streaming, or use [`kalman`] for a whole series.
 #[derive(Debug, Clone)]
 pub struct Kalman {
@@ -385,6 +455,11 @@ impl Kalman {
         check_positive("p0", p0)?;
         let rs = RState { mode, r: r0, r_floor: 1e-12 * model.sigma2, k: 0, allan: RunningAllanR::default(), last: None, bk: 1.0, v: 0.0 };
         Ok(Kalman { core: AnyCore::new(model, p0, x0 == X0::First)?, rs, record })
+    }
+
+    /// State dimension n (the width of a gain row).
+    pub fn dim(&self) -> usize {
+        self.core.dim()
     }
 
     /// Filter the next chunk of measurements, appending to `out`.
@@ -494,6 +569,35 @@ mod tests {
                 f.update(c, &mut out).unwrap();
             }
             assert_eq!(batch, out);
+        }
+    }
+
+    #[test]
+    fn config_builds_the_named_filter() {
+        let w: Vec<f64> = (0..300).map(|k| 0.7 + 0.1 * ((k * 7919 % 101) as f64 / 50.0 - 1.0)).collect();
+        let cfg = ArmaFilterConfig {
+            ar: vec![-0.018, 0.029],
+            ma: vec![-0.99],
+            sigma2: 0.035,
+            d: 1,
+            noise_form: NoiseForm::parse("paper").unwrap(),
+            r0: None,
+            adaptive: Adaptive::parse("sage_husa").unwrap(),
+            b: 0.98,
+            adapt_q: true,
+            fading: false,
+            x0: X0::parse("first").unwrap(),
+            p0: 1.0,
+        };
+        let (out, n) = cfg.filter(&w, true).unwrap();
+        let mode = RMode::SageHusa { b: 0.98, adapt_q: true, fading: false };
+        assert_eq!(out, kalman(&w, &paper(), 0.035, mode, X0::First, 1.0, true).unwrap());
+        assert_eq!(n, 3);
+        let bad = ArmaFilterConfig { b: 1.0, ..cfg.clone() };
+        assert!(matches!(bad.build(false), Err(NavError::InvalidInput { ref field, .. }) if field == "b"));
+        assert!(matches!(cfg.filter(&[], false), Err(NavError::InvalidInput { ref field, .. }) if field == "omega"));
+        for (e, p) in [(Adaptive::parse("eq17").unwrap_err(), "adaptive"), (X0::parse("last").unwrap_err(), "x0"), (NoiseForm::parse("x").unwrap_err(), "noise_form")] {
+            assert!(matches!(e, NavError::InvalidInput { ref field, .. } if field == p), "{e}");
         }
     }
 }

@@ -1,6 +1,6 @@
 //! Sensor noise analysis (spec aig-noise-arma-niu2025): the Allan family with the
 //! five-term IEEE-952 fit, and ARIMA state-space Kalman filters (fixed, adaptive-R of
-//! seed 002 Eq. 17, Sage–Husa).
+//! Niu et al. 2025 Eq. 17, Sage–Husa).
 
 pub mod allan;
 pub mod arma_filter;

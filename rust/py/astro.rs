@@ -1,15 +1,14 @@
 //! Bindings of astro/: gyro increments, star attitudes, mount calibration, scenario runs.
 
-use super::convert::{mat_to_py, vec3_rows, vec3_to_py, vector, quat_to_py};
-use crate::astro::calibration::{self, Calibration, DiffForm, Init, Observability, Options, ResidualForm, Solver, Verdict};
+use super::convert::{index_count, mat_to_py, mats, mats_to_py, quat_to_py, register_choices, seed, vec3_rows, vec3_to_py, vector, Wrap};
+use crate::astro::calibration::{self, Calibration, DiffForm, Init, Observability, Options, ResidualForm, Solver, Start, Verdict};
 use crate::astro::increments::{self, GyroErrorMode, GyroErrorModel, ImuRecord, TaylorVariant};
 use crate::astro::scenario::{self, Run, Scenario};
 use crate::astro::stars::{self, Camera, Catalog, Observations};
-use crate::astro::{d1, d2, euler_dcm, euler_from_dcm};
+use crate::astro::{check_rotations, d1, d2, euler_dcm, euler_from_dcm};
 use crate::error::{invalid, NavError};
 use crate::math::{Mat3, Vec3};
-use nalgebra::SMatrix;
-use numpy::ndarray::Array3;
+use crate::options::Choice;
 use numpy::{IntoPyArray, PyArray1, PyArray2, PyArray3, PyReadonlyArray1, PyReadonlyArray2, PyReadonlyArray3, PyUntypedArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
@@ -19,23 +18,11 @@ use rand_chacha::ChaCha8Rng;
 
 type Arr3<'py> = Bound<'py, PyArray3<f64>>;
 
-/// The (R, C) blocks of an (N, R, C) array, checked for shape and NaN/inf.
-fn mats<const R: usize, const C: usize>(a: &PyReadonlyArray3<'_, f64>, field: &str) -> Result<Vec<SMatrix<f64, R, C>>, NavError> {
-    let s = a.shape();
-    if s[1] != R || s[2] != C {
-        return Err(invalid(field, format!("expected shape (N, {R}, {C}), got ({}, {}, {})", s[0], s[1], s[2])));
-    }
-    let v = a.as_array();
-    (0..s[0])
-        .map(|i| {
-            let m = SMatrix::<f64, R, C>::from_fn(|r, c| v[[i, r, c]]);
-            if m.iter().all(|x| x.is_finite()) { Ok(m) } else { Err(invalid(field, format!("non-finite value at index {i}"))) }
-        })
-        .collect()
-}
-
-fn mats_to_py<'py, const R: usize, const C: usize>(py: Python<'py>, m: &[SMatrix<f64, R, C>]) -> Bound<'py, PyArray3<f64>> {
-    Array3::from_shape_fn((m.len(), R, C), |(i, r, c)| m[i][(r, c)]).into_pyarray(py)
+/// A series of rotation matrices (N, 3, 3), each checked to be a rotation.
+fn rotations(a: &PyReadonlyArray3<'_, f64>, field: &str) -> Result<Vec<Mat3>, NavError> {
+    let m = mats::<3, 3>(a, field)?;
+    check_rotations(field, &m)?;
+    Ok(m)
 }
 
 fn vec_to_py<'py>(py: Python<'py>, v: &Vec3) -> Bound<'py, PyArray1<f64>> {
@@ -50,8 +37,8 @@ fn mat3_arg(a: &PyReadonlyArray2<'_, f64>, field: &str) -> Result<Mat3, NavError
     Ok(Mat3::from_fn(|i, j| r[i][j]))
 }
 
-fn gyro_model(sigmas: (f64, f64, f64, f64), mode: &str) -> Result<GyroErrorModel, NavError> {
-    let m = GyroErrorModel { sigma_phi: sigmas.0, sigma_k: sigmas.1, sigma_w: sigmas.2, sigma_b: sigmas.3, mode: GyroErrorMode::parse(mode)? };
+fn gyro_model(sigmas: (f64, f64, f64, f64), mode: GyroErrorMode) -> Result<GyroErrorModel, NavError> {
+    let m = GyroErrorModel { sigma_phi: sigmas.0, sigma_k: sigmas.1, sigma_w: sigmas.2, sigma_b: sigmas.3, mode };
     m.validate()?;
     Ok(m)
 }
@@ -64,10 +51,7 @@ fn astro_euler_dcm<'py>(py: Python<'py>, beta: PyReadonlyArray2<'py, f64>) -> Py
 
 #[pyfunction]
 fn astro_euler_from_dcm<'py>(py: Python<'py>, c: PyReadonlyArray3<'py, f64>) -> PyResult<Bound<'py, PyArray2<f64>>> {
-    let c = mats::<3, 3>(&c, "c")?;
-    for (i, m) in c.iter().enumerate() {
-        crate::astro::check_rotation("c", i, m)?;
-    }
+    let c = rotations(&c, "c")?;
     Ok(vec3_to_py(py, &c.iter().map(euler_from_dcm).collect::<Vec<_>>()))
 }
 
@@ -95,7 +79,7 @@ fn gyro_record<'a>(
     rho: &'a PyReadonlyArray2<'_, f64>,
     epochs: &PyReadonlyArray1<'_, f64>,
     sigmas: (f64, f64, f64, f64),
-    mode: &str,
+    mode: GyroErrorMode,
 ) -> PyResult<(Cow<'a, [[f64; 3]]>, Vec<f64>, GyroErrorModel)> {
     Ok((rows3(rho, "gyro_increments")?, vector(epochs, "epochs")?, gyro_model(sigmas, mode)?))
 }
@@ -111,11 +95,11 @@ fn astro_increments<'py>(
     rho: PyReadonlyArray2<'py, f64>,
     epochs: PyReadonlyArray1<'py, f64>,
     sigmas: (f64, f64, f64, f64),
-    mode: &str,
-    taylor_variant: &str,
+    mode: Wrap<GyroErrorMode>,
+    taylor_variant: Wrap<TaylorVariant>,
 ) -> PyResult<IncrementArrays<'py>> {
-    let (rho, epochs, model) = gyro_record(&rho, &epochs, sigmas, mode)?;
-    let variant = TaylorVariant::parse(taylor_variant)?;
+    let (rho, epochs, model) = gyro_record(&rho, &epochs, sigmas, mode.0)?;
+    let variant = taylor_variant.0;
     let inc = py.detach(|| increments::integrate_increments(&ImuRecord { t_start, period, rho: &rho[..] }, &epochs, &model, variant))?;
     let q: Vec<_> = inc.iter().map(|i| i.q).collect();
     let cov: Vec<Mat3> = inc.iter().map(|i| i.cov).collect();
@@ -134,9 +118,9 @@ fn astro_dead_reckoning_cov<'py>(
     rho: PyReadonlyArray2<'py, f64>,
     epochs: PyReadonlyArray1<'py, f64>,
     sigmas: (f64, f64, f64, f64),
-    mode: &str,
+    mode: Wrap<GyroErrorMode>,
 ) -> PyResult<Bound<'py, PyArray3<f64>>> {
-    let (rho, epochs, model) = gyro_record(&rho, &epochs, sigmas, mode)?;
+    let (rho, epochs, model) = gyro_record(&rho, &epochs, sigmas, mode.0)?;
     let p = py.detach(|| increments::dead_reckoning_cov(&ImuRecord { t_start, period, rho: &rho[..] }, &epochs, &model))?;
     Ok(mats_to_py(py, &p))
 }
@@ -151,11 +135,7 @@ fn observability_dict<'py>(py: Python<'py>, o: &Observability) -> PyResult<Bound
     d.set_item("eigenvectors", mat_to_py(py, &o.eigenvectors))?;
     d.set_item("kappa", o.kappa)?;
     d.set_item("weak_axis_vf", vec_to_py(py, &o.weak_axis_vf()))?;
-    d.set_item("verdict", match o.verdict {
-        Verdict::Ok => "ok",
-        Verdict::Warn => "warn",
-        Verdict::Reject => "reject",
-    })?;
+    d.set_item("verdict", o.verdict.name())?;
     Ok(d)
 }
 
@@ -178,64 +158,31 @@ fn calibration_dict<'py>(py: Python<'py>, c: &Calibration) -> PyResult<Bound<'py
     Ok(d)
 }
 
-fn options(init: &str, c0: Option<PyReadonlyArray2<'_, f64>>, solver: &str, max_iter: usize, tol: f64, residual_form: &str) -> Result<Options, NavError> {
-    let init = match (init, c0) {
-        ("axes", None) => Init::Axes,
-        ("zero", None) => Init::Zero,
-        ("given", Some(c)) => Init::Given(mat3_arg(&c, "c0")?),
-        _ => return Err(invalid("init", format!("expected 'axes', 'zero', or 'given' with c0, got '{init}'"))),
-    };
-    let residual_form = match residual_form {
-        "full" => ResidualForm::Full,
-        "diagonal" => ResidualForm::Diagonal,
-        _ => return Err(invalid("residual_form", format!("expected 'full' or 'diagonal', got '{residual_form}'"))),
-    };
-    let solver = match solver {
-        "so3" => Solver::So3,
-        "paper_euler" => Solver::PaperEuler,
-        _ => return Err(invalid("solver", format!("expected 'so3' or 'paper_euler', got '{solver}'"))),
-    };
-    if max_iter == 0 {
-        return Err(invalid("max_iter", "must be ≥ 1"));
-    }
-    crate::error::check_positive("tol", tol)?;
-    Ok(Options { init, solver, max_iter, tol, residual_form })
-}
-
-fn diff_form(s: &str) -> Result<DiffForm, NavError> {
-    match s {
-        "full" => Ok(DiffForm::Full),
-        "paper" => Ok(DiffForm::Paper),
-        _ => Err(invalid("p_diff", format!("expected 'full' or 'paper', got '{s}'"))),
-    }
-}
-
 #[pyfunction]
-#[pyo3(signature = (ds_imu, ds_avu, init="axes", c0=None, solver="so3", max_iter=50, tol=1e-9, residual_form="full"))]
+#[pyo3(signature = (ds_imu, ds_avu, *, init=Wrap(Start::Axes), c0=None, solver=Wrap(Solver::So3), max_iter=None, tol=1e-9, residual_form=Wrap(ResidualForm::Full)))]
 #[allow(clippy::too_many_arguments)]
 fn astro_calibrate<'py>(
     py: Python<'py>,
     ds_imu: PyReadonlyArray3<'py, f64>,
     ds_avu: PyReadonlyArray3<'py, f64>,
-    init: &str,
+    init: Wrap<Start>,
     c0: Option<PyReadonlyArray2<'py, f64>>,
-    solver: &str,
-    max_iter: usize,
+    solver: Wrap<Solver>,
+    max_iter: Option<Bound<'py, PyAny>>,
     tol: f64,
-    residual_form: &str,
+    residual_form: Wrap<ResidualForm>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let (a, b) = (mats::<3, 3>(&ds_imu, "ds_imu")?, mats::<3, 3>(&ds_avu, "ds_avu")?);
-    let opt = options(init, c0, solver, max_iter, tol, residual_form)?;
+    let c0 = c0.map(|c| mat3_arg(&c, "c0")).transpose()?;
+    let max_iter = max_iter.map(|n| index_count(&n, "max_iter", 1, usize::MAX)).transpose()?.unwrap_or(Options::default().max_iter);
+    let opt = Options::new(Init::new(init.0, c0)?, solver.0, max_iter, tol, residual_form.0)?;
     let cal = py.detach(|| calibration::calibrate(&a, &b, &opt))?;
     calibration_dict(py, &cal)
 }
 
 #[pyfunction]
 fn astro_observability<'py>(py: Python<'py>, ds_avu: PyReadonlyArray3<'py, f64>) -> PyResult<Bound<'py, PyDict>> {
-    let b = mats::<3, 3>(&ds_avu, "ds_avu")?;
-    for (i, m) in b.iter().enumerate() {
-        crate::astro::check_rotation("ds_avu", i, m)?;
-    }
+    let b = rotations(&ds_avu, "ds_avu")?;
     observability_dict(py, &calibration::observability(&b))
 }
 
@@ -256,7 +203,7 @@ fn indices(a: &PyReadonlyArray1<'_, i64>, field: &str) -> Result<Vec<usize>, Nav
 }
 
 #[pyfunction]
-#[pyo3(signature = (epoch, camera, s_cf, g, n_epochs, cameras, p_alpha, sigma_s, up_gcrs=None, n_refr=1.0, p_avu=None))]
+#[pyo3(signature = (epoch, camera, s_cf, g, n_epochs, *, cameras, p_alpha, sigma_s, up_gcrs=None, n_refr=1.0, p_avu=None))]
 #[allow(clippy::too_many_arguments)]
 fn astro_star_attitudes<'py>(
     py: Python<'py>,
@@ -264,7 +211,7 @@ fn astro_star_attitudes<'py>(
     camera: PyReadonlyArray1<'py, i64>,
     s_cf: PyReadonlyArray2<'py, f64>,
     g: PyReadonlyArray2<'py, f64>,
-    n_epochs: usize,
+    n_epochs: &Bound<'py, PyAny>,
     cameras: PyReadonlyArray3<'py, f64>,
     p_alpha: PyReadonlyArray3<'py, f64>,
     sigma_s: f64,
@@ -273,6 +220,7 @@ fn astro_star_attitudes<'py>(
     p_avu: Option<PyReadonlyArray3<'py, f64>>,
 ) -> PyResult<(Arr3<'py>, Arr3<'py>, Bound<'py, PyArray1<i64>>)> {
     let obs = Observations { epoch: indices(&epoch, "epoch")?, camera: indices(&camera, "camera")?, s_cf: vec3_rows(&s_cf, "star_directions")?, g: vec3_rows(&g, "catalog_directions")? };
+    let n_epochs = index_count(n_epochs, "n_epochs", 1, usize::MAX)?;
     let cams = cameras_arg(&cameras, &p_alpha)?;
     let up = up_gcrs.map(|u| vec3_rows(&u, "up_gcrs")).transpose()?;
     let p_avu = p_avu.map(|p| mats::<3, 3>(&p, "p_avu")).transpose()?;
@@ -287,9 +235,7 @@ fn astro_astro_increments<'py>(py: Python<'py>, s: PyReadonlyArray3<'py, f64>, p
     if s.len() != p.len() {
         return Err(invalid("p_avu", format!("expected {} covariances, got {}", s.len(), p.len())).into());
     }
-    for (i, m) in s.iter().enumerate() {
-        crate::astro::check_rotation("s_vf", i, m)?;
-    }
+    check_rotations("s_vf", &s)?;
     let (ds, e) = stars::astro_increments(&s, &p);
     Ok((mats_to_py(py, &ds), mats_to_py(py, &e)))
 }
@@ -325,7 +271,7 @@ fn astro_model_covariance<'py>(
             if jm.len() != a.len() || jb.len() != a.len() {
                 return Err(invalid("j_m", format!("expected {} sensitivities, got {} and {}", a.len(), jm.len(), jb.len())).into());
             }
-            Some((jm.into_iter().zip(jb).collect(), gyro_model(sg, "consistent")?))
+            Some((jm.into_iter().zip(jb).collect(), gyro_model(sg, GyroErrorMode::Consistent)?))
         }
         _ => return Err(invalid("j_m", "give j_m, j_b and sigmas together (consistent gyro mode) or none of them").into()),
     };
@@ -337,37 +283,21 @@ fn astro_model_covariance<'py>(
 #[pyfunction]
 fn astro_aberration<'py>(py: Python<'py>, s: PyReadonlyArray2<'py, f64>, v: PyReadonlyArray2<'py, f64>) -> PyResult<Bound<'py, PyArray2<f64>>> {
     let (s, v) = (vec3_rows(&s, "directions")?, vec3_rows(&v, "velocity")?);
-    if v.len() != s.len() && v.len() != 1 {
-        return Err(invalid("velocity", format!("expected 1 or {} rows like directions, got {}", s.len(), v.len())).into());
-    }
-    stars::check_unit("directions", &s)?;
-    // above 1e-3 c the neglected second-order term exceeds ~1e-6 rad (0.2″)
-    if let Some(i) = v.iter().position(|v| v.norm() >= 1e-3 * crate::gnss::C_LIGHT) {
-        return Err(invalid("velocity", format!("|v| = {} m/s at index {i}: the first-order formula needs |v| < 1e-3 c", v[i].norm())).into());
-    }
-    let out: Vec<Vec3> = s.iter().enumerate().map(|(i, s)| stars::aberration(s, &v[if v.len() == 1 { 0 } else { i }])).collect();
-    Ok(vec3_to_py(py, &out))
+    Ok(vec3_to_py(py, &stars::aberration_rows(&s, &v)?))
 }
 
 type CatalogArrays<'py> = (Bound<'py, PyArray2<f64>>, Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<u64>>);
 
 #[pyfunction]
-fn astro_synthetic_catalog<'py>(py: Python<'py>, m_lim: f64, seed: u64) -> PyResult<CatalogArrays<'py>> {
-    let c = Catalog::synthetic(m_lim, seed)?;
+fn astro_synthetic_catalog<'py>(py: Python<'py>, m_lim: f64, seed: &Bound<'py, PyAny>) -> PyResult<CatalogArrays<'py>> {
+    let c = Catalog::synthetic(m_lim, super::convert::seed(seed, "seed")?)?;
     Ok((vec3_to_py(py, &c.dirs), c.mags.into_pyarray(py), c.ids.into_pyarray(py)))
 }
 
 #[pyfunction]
 fn astro_refraction<'py>(py: Python<'py>, s: PyReadonlyArray2<'py, f64>, u: PyReadonlyArray2<'py, f64>, n_refr: f64, apply: bool) -> PyResult<Bound<'py, PyArray2<f64>>> {
     let (s, u) = (vec3_rows(&s, "directions")?, vec3_rows(&u, "up")?);
-    if s.len() != u.len() {
-        return Err(invalid("up", format!("expected {} rows like directions, got {}", s.len(), u.len())).into());
-    }
-    if !(n_refr.is_finite() && n_refr >= 1.0) {
-        return Err(invalid("n_refr", format!("refractive index must be finite and ≥ 1, got {n_refr}")).into());
-    }
-    let f = if apply { stars::refraction_apply } else { stars::refraction_correct };
-    Ok(vec3_to_py(py, &s.iter().zip(&u).map(|(s, u)| f(s, u, n_refr)).collect::<Vec<_>>()))
+    Ok(vec3_to_py(py, &stars::refraction_rows(&s, &u, n_refr, apply)?))
 }
 
 #[pyfunction]
@@ -376,6 +306,7 @@ fn astro_refractive_index(height_m: f64) -> f64 {
 }
 
 #[pyfunction]
+#[pyo3(signature = (catalog_dirs, catalog_mags, s_gcrs_vf, up_gcrs, cameras, *, fov_half, m_lim, sigma_s, n_refr, seed))]
 #[allow(clippy::too_many_arguments)]
 fn astro_simulate_observations<'py>(
     py: Python<'py>,
@@ -388,30 +319,17 @@ fn astro_simulate_observations<'py>(
     m_lim: f64,
     sigma_s: f64,
     n_refr: f64,
-    seed: u64,
+    seed: &Bound<'py, PyAny>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let dirs = vec3_rows(&catalog_dirs, "catalog_directions")?;
     let mags = vector(&catalog_mags, "magnitudes")?;
     let ids = (0..dirs.len() as u64).collect();
     let cat = Catalog::new(dirs, mags, ids)?;
     let s = mats::<3, 3>(&s_gcrs_vf, "s_gcrs_vf")?;
-    for (i, m) in s.iter().enumerate() {
-        crate::astro::check_rotation("s_gcrs_vf", i, m)?;
-    }
     let up = vec3_rows(&up_gcrs, "up_gcrs")?;
-    if up.len() != s.len() {
-        return Err(invalid("up_gcrs", format!("expected {} rows, got {}", s.len(), up.len())).into());
-    }
     let cams: Vec<Camera> = mats::<3, 3>(&cameras, "cameras")?.into_iter().map(|c| Camera { c_vf_cf: c, p_alpha: Mat3::zeros() }).collect();
-    for (i, c) in cams.iter().enumerate() {
-        crate::astro::check_rotation("cameras", i, &c.c_vf_cf)?;
-    }
-    for (name, v) in [("fov_half", fov_half), ("sigma_s", sigma_s)] {
-        if !(v.is_finite() && v >= 0.0) {
-            return Err(invalid(name, format!("must be finite and ≥ 0, got {v}")).into());
-        }
-    }
-    let obs = py.detach(|| stars::simulate_observations(&cat, &s, &up, &cams, fov_half, m_lim, sigma_s, n_refr, &mut ChaCha8Rng::seed_from_u64(seed)));
+    let mut rng = ChaCha8Rng::seed_from_u64(super::convert::seed(seed, "seed")?);
+    let obs = py.detach(|| stars::simulate_observations(&cat, &s, &up, &cams, fov_half, m_lim, sigma_s, n_refr, &mut rng))?;
     observations_dict(py, &obs)
 }
 
@@ -480,30 +398,31 @@ fn run_dict<'py>(py: Python<'py>, r: &Run) -> PyResult<Bound<'py, PyDict>> {
 impl PyScenario {
     /// `vasilyuk2024_like` (spec §5.1) with catalog seed and gyro truth "paper" | "consistent".
     #[new]
-    #[pyo3(signature = (catalog_seed=3, gyro_error_model="paper"))]
-    fn new(py: Python<'_>, catalog_seed: u64, gyro_error_model: &str) -> PyResult<Self> {
-        let mode = GyroErrorMode::parse(gyro_error_model)?;
-        Ok(Self { inner: py.detach(|| scenario::vasilyuk2024_like(catalog_seed, mode))? })
+    #[pyo3(signature = (catalog_seed=None, gyro_error_model=Wrap(GyroErrorMode::Paper)))]
+    fn new(py: Python<'_>, catalog_seed: Option<Bound<'_, PyAny>>, gyro_error_model: Wrap<GyroErrorMode>) -> PyResult<Self> {
+        let catalog_seed = catalog_seed.map(|s| seed(&s, "catalog_seed")).transpose()?.unwrap_or(scenario::CATALOG_SEED);
+        Ok(Self { inner: py.detach(|| scenario::vasilyuk2024_like(catalog_seed, gyro_error_model.0))? })
     }
 
     fn truth<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
         scenario_dict(py, &self.inner)
     }
 
-    #[pyo3(signature = (seed, init="axes", p_diff="full"))]
-    fn run<'py>(&self, py: Python<'py>, seed: u64, init: &str, p_diff: &str) -> PyResult<Bound<'py, PyDict>> {
-        let opt = options(init, None, "so3", 50, 1e-9, "full")?;
-        let form = diff_form(p_diff)?;
-        let r = py.detach(|| scenario::run(&self.inner, seed, &opt, form))?;
+    #[pyo3(signature = (seed, init=Wrap(Start::Axes), p_diff=Wrap(DiffForm::Full)))]
+    fn run<'py>(&self, py: Python<'py>, seed: &Bound<'py, PyAny>, init: Wrap<Start>, p_diff: Wrap<DiffForm>) -> PyResult<Bound<'py, PyDict>> {
+        let seed = super::convert::seed(seed, "seed")?;
+        let opt = Options { init: Init::new(init.0, None)?, ..Options::default() };
+        let r = py.detach(|| scenario::run(&self.inner, seed, &opt, p_diff.0))?;
         run_dict(py, &r)
     }
 
     /// Per run: β̂ − β̆ (rad), √diag P_β and √diag P_β^model (rad), fraction of θ^diff components within ±3σ,
     /// mean χ² of θ^diff, Gauss–Newton iterations.
-    #[pyo3(signature = (runs, seed0=0, p_diff="full"))]
-    fn monte_carlo<'py>(&self, py: Python<'py>, runs: usize, seed0: u64, p_diff: &str) -> PyResult<Bound<'py, PyDict>> {
-        let form = diff_form(p_diff)?;
-        let s = py.detach(|| scenario::monte_carlo(&self.inner, runs, seed0, &Options::default(), form))?;
+    #[pyo3(signature = (runs, seed0=None, p_diff=Wrap(DiffForm::Full)))]
+    fn monte_carlo<'py>(&self, py: Python<'py>, runs: &Bound<'py, PyAny>, seed0: Option<Bound<'py, PyAny>>, p_diff: Wrap<DiffForm>) -> PyResult<Bound<'py, PyDict>> {
+        let runs = index_count(runs, "runs", 1, usize::MAX)?;
+        let seed0 = seed0.map(|s| seed(&s, "seed0")).transpose()?.unwrap_or(0);
+        let s = py.detach(|| scenario::monte_carlo(&self.inner, runs, seed0, &Options::default(), p_diff.0))?;
         let d = PyDict::new(py);
         d.set_item("beta_error", vec3_to_py(py, &s.iter().map(|r| r.beta_error).collect::<Vec<_>>()))?;
         d.set_item("sigma_beta", vec3_to_py(py, &s.iter().map(|r| r.sigma_beta).collect::<Vec<_>>()))?;
@@ -516,6 +435,13 @@ impl PyScenario {
 }
 
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    register_choices::<Start>(m, "CalibrationInit")?;
+    register_choices::<Solver>(m, "CalibrationSolver")?;
+    register_choices::<ResidualForm>(m, "ResidualForm")?;
+    register_choices::<DiffForm>(m, "DiffForm")?;
+    register_choices::<GyroErrorMode>(m, "GyroErrorMode")?;
+    register_choices::<TaylorVariant>(m, "TaylorVariant")?;
+    register_choices::<Verdict>(m, "Verdict")?;
     m.add_class::<PyScenario>()?;
     m.add_function(wrap_pyfunction!(astro_euler_dcm, m)?)?;
     m.add_function(wrap_pyfunction!(astro_euler_from_dcm, m)?)?;

@@ -172,3 +172,81 @@ pub fn quat_to_py<'py>(py: Python<'py>, q: &[Quat]) -> Bound<'py, PyArray2<f64>>
 pub fn vec_to_py<'py>(py: Python<'py>, v: Vec<f64>) -> Bound<'py, PyArray1<f64>> {
     v.into_pyarray(py)
 }
+
+/// A sequence of counts (averaging factors, sizes), each checked like [`count`]: an
+/// element out of [min, max] (including -1 or 2**64) is an `InputError` naming `field`
+/// and its index; a non-integer a `TypeError`.
+pub fn counts(obj: &Bound<'_, PyAny>, field: &str, min: usize, max: usize) -> PyResult<Vec<usize>> {
+    let items: Vec<Bound<'_, PyAny>> =
+        obj.extract().map_err(|_| PyTypeError::new_err(format!("{field}: expected a sequence of ints, got {}", type_name(obj))))?;
+    items
+        .iter()
+        .enumerate()
+        .map(|(i, x)| {
+            index_count(x, field, min, max).map_err(|e| match e.is_instance_of::<PyTypeError>(x.py()) {
+                true => e,
+                false => invalid_at(field, i, format!("element {i} must be an integer in [{min}, {max}], got {x}")).into(),
+            })
+        })
+        .collect()
+}
+
+/// [`count`] of any integer-like object (`int`, numpy integers: whatever has
+/// `__index__`, but not `bool`).
+pub fn index_count(obj: &Bound<'_, PyAny>, field: &str, min: usize, max: usize) -> PyResult<usize> {
+    match obj.is_instance_of::<PyBool>() {
+        true => count(obj, field, min, max),
+        false => match obj.call_method0("__index__") {
+            Ok(i) => count(&i, field, min, max),
+            Err(_) => count(obj, field, min, max),
+        },
+    }
+}
+
+/// A random seed: any integer in [0, 2⁶⁴ − 1]; others are an `InputError` naming `field`
+/// (not an `OverflowError`), a non-integer a `TypeError`.
+pub fn seed(obj: &Bound<'_, PyAny>, field: &str) -> PyResult<u64> {
+    if !obj.is_instance_of::<PyInt>() || obj.is_instance_of::<PyBool>() {
+        return Err(PyTypeError::new_err(format!("{field}: expected an int, got {}", type_name(obj))));
+    }
+    obj.extract::<u64>().map_err(|_| invalid(field, format!("must be an integer in [0, 2**64), got {obj}")).into())
+}
+
+/// Named numbers (constants, fitted parameters) into a dict.
+pub fn set_floats(d: &Bound<'_, PyDict>, items: &[(&str, f64)]) -> PyResult<()> {
+    items.iter().try_for_each(|(k, v)| d.set_item(*k, *v))
+}
+
+/// Call `f(key, value)` for every item of a dict with `str` keys (a non-str key is a
+/// `TypeError` naming `field`).
+pub fn each_item<'py>(d: &Bound<'py, PyDict>, field: &str, mut f: impl FnMut(&str, Bound<'py, PyAny>) -> PyResult<()>) -> PyResult<()> {
+    for (k, v) in d.iter() {
+        let key: PyBackedStr = k.extract().map_err(|_| PyTypeError::new_err(format!("{field}: keys must be str, got {}", type_name(&k))))?;
+        f(&key, v)?;
+    }
+    Ok(())
+}
+
+/// The (R, C) blocks of an (N, R, C) array, checked for shape and NaN/inf (naming the
+/// first bad block).
+pub fn mats<const R: usize, const C: usize>(a: &numpy::PyReadonlyArray3<'_, f64>, field: &str) -> Result<Vec<nalgebra::SMatrix<f64, R, C>>, NavError> {
+    let s = a.shape();
+    if s[1] != R || s[2] != C {
+        return Err(invalid(field, format!("expected shape (N, {R}, {C}), got ({}, {}, {})", s[0], s[1], s[2])));
+    }
+    let v = a.as_array();
+    (0..s[0])
+        .map(|i| {
+            let m = nalgebra::SMatrix::<f64, R, C>::from_fn(|r, c| v[[i, r, c]]);
+            match m.iter().find(|x| !x.is_finite()) {
+                None => Ok(m),
+                Some(x) => Err(invalid_at(field, i, format!("non-finite value {x} at index {i}"))),
+            }
+        })
+        .collect()
+}
+
+/// A stack of (R, C) matrices as an (N, R, C) array.
+pub fn mats_to_py<'py, const R: usize, const C: usize>(py: Python<'py>, m: &[nalgebra::SMatrix<f64, R, C>]) -> Bound<'py, numpy::PyArray3<f64>> {
+    numpy::ndarray::Array3::from_shape_fn((m.len(), R, C), |(i, r, c)| m[i][(r, c)]).into_pyarray(py)
+}

@@ -1,17 +1,21 @@
 //! Bindings of earth.rs, vectorised over rows; every function takes an ellipsoid name.
 
-use super::convert::{Wrap, rows, to_py_rows, vec3, vec3_rows, vec3_to_py};
-use crate::earth::{check_latitude, dcm_ned_to_ecef, Ellipsoid};
+use super::convert::{mat_to_py, rows, set_floats, to_py_rows, vec3, vec3_rows, vec3_to_py, Wrap};
+use crate::earth::{check_latitude, check_latitudes, dcm_ned_to_ecef, Ellipsoid};
 use crate::math::Vec3;
 use numpy::{PyArray2, PyReadonlyArray1, PyReadonlyArray2};
 use pyo3::prelude::*;
 
 fn lla_rows(a: &PyReadonlyArray2<'_, f64>, field: &str) -> PyResult<Vec<Vec3>> {
     let v = vec3_rows(a, field)?;
-    for (i, p) in v.iter().enumerate() {
-        check_latitude(field, p.x, i)?;
-    }
+    check_latitudes(field, &v)?;
     Ok(v)
+}
+
+fn origin(a: &PyReadonlyArray1<'_, f64>) -> PyResult<Vec3> {
+    let o = vec3(a, "origin_lla")?;
+    check_latitude("origin_lla", o.x, 0)?;
+    Ok(o)
 }
 
 #[pyfunction]
@@ -25,17 +29,14 @@ fn lla_to_ecef_rows<'py>(py: Python<'py>, lla: PyReadonlyArray2<'py, f64>, ellip
 #[pyfunction]
 #[pyo3(signature = (ecef, ellipsoid=Wrap(crate::earth::WGS84)))]
 fn ecef_to_lla_rows<'py>(py: Python<'py>, ecef: PyReadonlyArray2<'py, f64>, ellipsoid: Wrap<Ellipsoid>) -> PyResult<Bound<'py, PyArray2<f64>>> {
-    let e = ellipsoid.0;
     let r = vec3_rows(&ecef, "ecef")?;
-    Ok(vec3_to_py(py, &r.iter().map(|x| e.ecef_to_lla(x)).collect::<Vec<_>>()))
+    Ok(vec3_to_py(py, &ellipsoid.0.ecef_to_lla_rows("ecef", &r)?))
 }
 
 #[pyfunction]
 #[pyo3(signature = (ecef, origin_lla, ellipsoid=Wrap(crate::earth::WGS84)))]
 fn ecef_to_ned_rows<'py>(py: Python<'py>, ecef: PyReadonlyArray2<'py, f64>, origin_lla: PyReadonlyArray1<'py, f64>, ellipsoid: Wrap<Ellipsoid>) -> PyResult<Bound<'py, PyArray2<f64>>> {
-    let e = ellipsoid.0;
-    let o = vec3(&origin_lla, "origin_lla")?;
-    check_latitude("origin_lla", o.x, 0)?;
+    let (e, o) = (ellipsoid.0, origin(&origin_lla)?);
     let r = vec3_rows(&ecef, "ecef")?;
     Ok(vec3_to_py(py, &r.iter().map(|x| e.ecef_to_ned(x, &o)).collect::<Vec<_>>()))
 }
@@ -43,9 +44,7 @@ fn ecef_to_ned_rows<'py>(py: Python<'py>, ecef: PyReadonlyArray2<'py, f64>, orig
 #[pyfunction]
 #[pyo3(signature = (ned, origin_lla, ellipsoid=Wrap(crate::earth::WGS84)))]
 fn ned_to_ecef_rows<'py>(py: Python<'py>, ned: PyReadonlyArray2<'py, f64>, origin_lla: PyReadonlyArray1<'py, f64>, ellipsoid: Wrap<Ellipsoid>) -> PyResult<Bound<'py, PyArray2<f64>>> {
-    let e = ellipsoid.0;
-    let o = vec3(&origin_lla, "origin_lla")?;
-    check_latitude("origin_lla", o.x, 0)?;
+    let (e, o) = (ellipsoid.0, origin(&origin_lla)?);
     let r = vec3_rows(&ned, "ned")?;
     Ok(vec3_to_py(py, &r.iter().map(|x| e.ned_to_ecef(x, &o)).collect::<Vec<_>>()))
 }
@@ -70,37 +69,23 @@ fn earth_params_rows<'py>(py: Python<'py>, lla: PyReadonlyArray2<'py, f64>, elli
 #[pyfunction]
 #[pyo3(signature = (lla_vel, ellipsoid=Wrap(crate::earth::WGS84)))]
 fn nav_rates_rows<'py>(py: Python<'py>, lla_vel: PyReadonlyArray2<'py, f64>, ellipsoid: Wrap<Ellipsoid>) -> PyResult<Bound<'py, PyArray2<f64>>> {
-    let e = ellipsoid.0;
     let p = rows::<6>(&lla_vel, "lla_vel")?;
-    let mut out = Vec::with_capacity(p.len());
-    for (i, r) in p.iter().enumerate() {
-        check_latitude("lla_vel", r[0], i)?;
-        let wie = e.earth_rate_ned(r[0]);
-        let wen = e.transport_rate_ned(r[0], r[2], &Vec3::new(r[3], r[4], r[5]));
-        out.push([wie.x, wie.y, wie.z, wen.x, wen.y, wen.z]);
-    }
-    Ok(to_py_rows(py, &out))
+    Ok(to_py_rows(py, &ellipsoid.0.nav_rates_rows("lla_vel", &p)?))
 }
 
 /// C_n^e for one (lat, lon) as a (3, 3) array.
 #[pyfunction]
 fn dcm_ned_to_ecef_py<'py>(py: Python<'py>, lat: f64, lon: f64) -> PyResult<Bound<'py, PyArray2<f64>>> {
     check_latitude("lat", lat, 0)?;
-    let c = dcm_ned_to_ecef(lat, lon);
-    let r: Vec<[f64; 3]> = (0..3).map(|i| [c[(i, 0)], c[(i, 1)], c[(i, 2)]]).collect();
-    Ok(to_py_rows(py, &r))
+    Ok(mat_to_py(py, &dcm_ned_to_ecef(lat, lon)))
 }
 
 /// Ellipsoid constants as a dict (a, f, gm, omega, e2, b, gamma_e, gamma_p).
 #[pyfunction]
 fn ellipsoid_constants(py: Python<'_>, name: Wrap<Ellipsoid>) -> PyResult<Py<PyAny>> {
-    let e = name.0;
-    let (ge, gp) = (e.gamma_e, e.gamma_p);
     let d = pyo3::types::PyDict::new(py);
-    for (k, v) in [("a", e.a), ("f", e.f), ("gm", e.gm), ("omega", e.omega), ("e2", e.e2()), ("b", e.b()), ("gamma_e", ge), ("gamma_p", gp)] {
-        d.set_item(k, v)?;
-    }
-    d.set_item("name", e.name)?;
+    set_floats(&d, &name.0.constants())?;
+    d.set_item("name", name.0.name)?;
     Ok(d.into_any().unbind())
 }
 

@@ -1,7 +1,7 @@
 //! Bindings of imu::{errors, noise, presets}: the error-model parameters travel as one dict
 //! per triad (keys of `TRIAD_KEYS`), the IMU stream as whole (N, 3) arrays.
 
-use super::convert::{Wrap, vec3_rows, vec3_to_py};
+use super::convert::{each_item, vec3_rows, vec3_to_py, Wrap};
 use crate::error::invalid;
 use crate::imu::errors::{FlickerSpec, GaussMarkovSpec, ImuErrorModel, ImuSimulator, TriadErrors};
 use crate::imu::noise;
@@ -24,10 +24,9 @@ fn floats(v: &Bound<'_, PyAny>, field: &str, len: usize) -> PyResult<Vec<f64>> {
 
 pub(super) fn triad_from_dict(d: &Bound<'_, PyDict>, name: &str) -> PyResult<TriadErrors> {
     let mut t = TriadErrors::default();
-    for (k, v) in d.iter() {
-        let key: String = k.extract()?;
+    each_item(d, name, |key, v| {
         let field = format!("{name}.{key}");
-        match key.as_str() {
+        match key {
             "bias" => t.bias = Vec3::from_vec(floats(&v, &field, 3)?),
             "scale" => t.scale = Vec3::from_vec(floats(&v, &field, 3)?),
             "misalignment" => t.misalignment = Mat3::from_row_slice(&floats(&v, &field, 9)?),
@@ -46,7 +45,8 @@ pub(super) fn triad_from_dict(d: &Bound<'_, PyDict>, name: &str) -> PyResult<Tri
             }
             _ => return Err(invalid(&field, format!("unknown parameter; choose from {TRIAD_KEYS:?}")).into()),
         }
-    }
+        Ok(())
+    })?;
     Ok(t)
 }
 
@@ -93,9 +93,9 @@ struct ImuErrorSimulator {
 #[pymethods]
 impl ImuErrorSimulator {
     #[new]
-    fn new(accel: &Bound<'_, PyDict>, gyro: &Bound<'_, PyDict>, dt: f64, kind: Wrap<ImuKind>, seed: u64) -> PyResult<Self> {
+    fn new(accel: &Bound<'_, PyDict>, gyro: &Bound<'_, PyDict>, dt: f64, kind: Wrap<ImuKind>, seed: &Bound<'_, PyAny>) -> PyResult<Self> {
         let model = ImuErrorModel { accel: triad_from_dict(accel, "accel")?, gyro: triad_from_dict(gyro, "gyro")? };
-        Ok(Self { sim: ImuSimulator::new(&model, dt, kind.0, seed)? })
+        Ok(Self { sim: ImuSimulator::new(&model, dt, kind.0, super::convert::seed(seed, "seed")?)? })
     }
 
     /// (accel measured, gyro measured, accel bias truth, gyro bias truth), each (N, 3).

@@ -32,16 +32,9 @@ pyo3::create_exception!(
 /// The unit factors of `units.rs` as a dict, so Python has no second copy of them.
 #[pyfunction]
 fn unit_constants(py: Python<'_>) -> PyResult<Py<PyAny>> {
-    use crate::units::*;
+    use crate::units::UNITS;
     let d = pyo3::types::PyDict::new(py);
-    for (k, v) in [
-        ("G0", G0), ("DEG", DEG), ("ARCSEC", ARCSEC), ("ARCMIN", ARCMIN), ("HOUR", HOUR),
-        ("DEG_PER_HOUR", DEG_PER_HOUR), ("DEG_PER_SQRT_HOUR", DEG_PER_SQRT_HOUR),
-        ("MICRO_G", MICRO_G), ("MILLI_G", MILLI_G), ("MICRO_G_PER_SQRT_HZ", MICRO_G_PER_SQRT_HZ),
-        ("MPS_PER_SQRT_HOUR", MPS_PER_SQRT_HOUR), ("PPM", PPM),
-    ] {
-        d.set_item(k, v)?;
-    }
+    convert::set_floats(&d, &UNITS)?;
     Ok(d.into_any().unbind())
 }
 

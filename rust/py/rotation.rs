@@ -1,38 +1,13 @@
 //! Bindings of math::rotation, vectorised over rows.
 
-use super::convert::{quat_rows, quat_to_py, to_py_rows, vec3_rows, vec3_to_py};
+use super::convert::{mats, mats_to_py, quat_rows, quat_to_py, to_py_rows, vec3_rows, vec3_to_py};
 use crate::math::*;
-use numpy::ndarray::Array3;
-use numpy::{IntoPyArray, PyArray2, PyArray3, PyReadonlyArray2, PyReadonlyArray3, PyUntypedArrayMethods};
+use numpy::{PyArray2, PyArray3, PyReadonlyArray2, PyReadonlyArray3};
 use pyo3::prelude::*;
 
-fn dcm_rows(a: &PyReadonlyArray3<'_, f64>) -> PyResult<Vec<Mat3>> {
-    let s = a.shape();
-    if s[1] != 3 || s[2] != 3 {
-        return Err(crate::error::invalid("dcm", format!("expected shape (N, 3, 3), got ({}, {}, {})", s[0], s[1], s[2])).into());
-    }
-    let v = a.as_array();
-    let mut out = Vec::with_capacity(s[0]);
-    for i in 0..s[0] {
-        let m = Mat3::from_fn(|r, c| v[[i, r, c]]);
-        if m.iter().any(|x| !x.is_finite()) {
-            return Err(crate::error::invalid("dcm", format!("non-finite value at index {i}")).into());
-        }
-        out.push(m);
-    }
-    Ok(out)
-}
-
-fn dcm_to_py<'py>(py: Python<'py>, m: &[Mat3]) -> Bound<'py, PyArray3<f64>> {
-    let mut a = Array3::<f64>::zeros((m.len(), 3, 3));
-    for (i, c) in m.iter().enumerate() {
-        for r in 0..3 {
-            for k in 0..3 {
-                a[[i, r, k]] = c[(r, k)];
-            }
-        }
-    }
-    a.into_pyarray(py)
+/// Quaternion rows scaled to unit norm; a zero or non-finite row is an `InputError`.
+fn unit_rows(q: &PyReadonlyArray2<'_, f64>, field: &str) -> PyResult<Vec<Quat>> {
+    Ok(unit_quats(field, &quat_rows(q, field)?)?)
 }
 
 #[pyfunction]
@@ -43,19 +18,17 @@ fn quat_from_euler_rows<'py>(py: Python<'py>, euler: PyReadonlyArray2<'py, f64>)
 
 #[pyfunction]
 fn euler_from_quat_rows<'py>(py: Python<'py>, q: PyReadonlyArray2<'py, f64>) -> PyResult<Bound<'py, PyArray2<f64>>> {
-    let q = quat_rows(&q, "q")?;
-    Ok(vec3_to_py(py, &q.iter().map(|q| euler_from_quat(&quat_normalize(q))).collect::<Vec<_>>()))
+    Ok(vec3_to_py(py, &unit_rows(&q, "q")?.iter().map(euler_from_quat).collect::<Vec<_>>()))
 }
 
 #[pyfunction]
 fn dcm_from_quat_rows<'py>(py: Python<'py>, q: PyReadonlyArray2<'py, f64>) -> PyResult<Bound<'py, PyArray3<f64>>> {
-    let q = quat_rows(&q, "q")?;
-    Ok(dcm_to_py(py, &q.iter().map(|q| dcm_from_quat(&quat_normalize(q))).collect::<Vec<_>>()))
+    Ok(mats_to_py(py, &unit_rows(&q, "q")?.iter().map(dcm_from_quat).collect::<Vec<_>>()))
 }
 
 #[pyfunction]
 fn quat_from_dcm_rows<'py>(py: Python<'py>, dcm: PyReadonlyArray3<'py, f64>) -> PyResult<Bound<'py, PyArray2<f64>>> {
-    let m = dcm_rows(&dcm)?;
+    let m = mats::<3, 3>(&dcm, "dcm")?;
     Ok(quat_to_py(py, &m.iter().map(quat_from_dcm).collect::<Vec<_>>()))
 }
 
@@ -67,42 +40,41 @@ fn quat_from_rotvec_rows<'py>(py: Python<'py>, rv: PyReadonlyArray2<'py, f64>) -
 
 #[pyfunction]
 fn rotvec_from_quat_rows<'py>(py: Python<'py>, q: PyReadonlyArray2<'py, f64>) -> PyResult<Bound<'py, PyArray2<f64>>> {
-    let q = quat_rows(&q, "q")?;
-    Ok(vec3_to_py(py, &q.iter().map(|q| rotvec_from_quat(&quat_normalize(q))).collect::<Vec<_>>()))
+    Ok(vec3_to_py(py, &unit_rows(&q, "q")?.iter().map(rotvec_from_quat).collect::<Vec<_>>()))
+}
+
+/// Two quaternion series of equal length named `na`, `nb` (`nb` is named when they differ).
+fn pair(a: &PyReadonlyArray2<'_, f64>, b: &PyReadonlyArray2<'_, f64>, na: &str, nb: &str) -> PyResult<(Vec<Quat>, Vec<Quat>)> {
+    let (a, b) = (quat_rows(a, na)?, quat_rows(b, nb)?);
+    if a.len() != b.len() {
+        return Err(crate::error::invalid(nb, format!("expected {} rows like {na}, got {}", a.len(), b.len())).into());
+    }
+    Ok((a, b))
 }
 
 #[pyfunction]
 fn quat_mul_rows<'py>(py: Python<'py>, a: PyReadonlyArray2<'py, f64>, b: PyReadonlyArray2<'py, f64>) -> PyResult<Bound<'py, PyArray2<f64>>> {
-    let (a, b) = (quat_rows(&a, "a")?, quat_rows(&b, "b")?);
-    if a.len() != b.len() {
-        return Err(crate::error::invalid("b", format!("expected {} rows like a, got {}", a.len(), b.len())).into());
-    }
+    let (a, b) = pair(&a, &b, "a", "b")?;
     Ok(quat_to_py(py, &a.iter().zip(&b).map(|(x, y)| quat_mul(x, y)).collect::<Vec<_>>()))
 }
 
 #[pyfunction]
 fn quat_normalize_rows<'py>(py: Python<'py>, q: PyReadonlyArray2<'py, f64>) -> PyResult<Bound<'py, PyArray2<f64>>> {
-    let q = quat_rows(&q, "q")?;
-    if let Some(i) = q.iter().position(|x| x.norm() == 0.0) {
-        return Err(crate::error::invalid("q", format!("zero quaternion at index {i}")).into());
-    }
-    Ok(quat_to_py(py, &q.iter().map(quat_normalize).collect::<Vec<_>>()))
+    Ok(quat_to_py(py, &unit_rows(&q, "q")?))
 }
 
 #[pyfunction]
 fn skew_rows<'py>(py: Python<'py>, v: PyReadonlyArray2<'py, f64>) -> PyResult<Bound<'py, PyArray3<f64>>> {
     let v = vec3_rows(&v, "v")?;
-    Ok(dcm_to_py(py, &v.iter().map(skew).collect::<Vec<_>>()))
+    Ok(mats_to_py(py, &v.iter().map(skew).collect::<Vec<_>>()))
 }
 
 /// Attitude difference angle (rad) per row between two quaternion series.
 #[pyfunction]
-fn quat_angle_rows<'py>(py: Python<'py>, a: PyReadonlyArray2<'py, f64>, b: PyReadonlyArray2<'py, f64>) -> PyResult<Bound<'py, PyArray2<f64>>> {
-    let (a, b) = (quat_rows(&a, "a")?, quat_rows(&b, "b")?);
-    if a.len() != b.len() {
-        return Err(crate::error::invalid("b", format!("expected {} rows like a, got {}", a.len(), b.len())).into());
-    }
-    let r: Vec<[f64; 1]> = a.iter().zip(&b).map(|(x, y)| [quat_angle_between(&quat_normalize(x), &quat_normalize(y))]).collect();
+fn quat_angle_rows<'py>(py: Python<'py>, q_a: PyReadonlyArray2<'py, f64>, q_b: PyReadonlyArray2<'py, f64>) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    let (a, b) = pair(&q_a, &q_b, "q_a", "q_b")?;
+    let (a, b) = (unit_quats("q_a", &a)?, unit_quats("q_b", &b)?);
+    let r: Vec<[f64; 1]> = a.iter().zip(&b).map(|(x, y)| [quat_angle_between(x, y)]).collect();
     Ok(to_py_rows(py, &r))
 }
 

@@ -1,5 +1,5 @@
 """Astro-inertial calibration: star-camera (virtual camera VF) to IMU (MF) mount from
-attitude increments (Vasilyuk et al. 2024, seed 001; spec astro-calibration-vasilyuk2024).
+attitude increments (Vasilyuk et al. 2024; spec astro-calibration-vasilyuk2024).
 
 Conventions of this module (the paper's, spec §2): ENU navigation frame, body axes
 right-forward-up (MF), ``S_X2^X1`` maps X1 coordinates into X2, small errors are
@@ -23,21 +23,19 @@ from pathlib import Path
 import numpy as np
 
 from .. import _core
-from .._validate import choice, positive, rows, vector
+from .._validate import input_error, positive, rows, vector
+from .results import D17_CAVEAT, Calibration, Observations
+from .scenario import Vasilyuk2024
 
 NED_TO_ENU = np.array([[0.0, 1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, -1.0]])
 """T: NED→ENU and FRD→right-forward-up (T = Tᵀ = T⁻¹)."""
-
-D17_CAVEAT = ("P_beta is precision conditional on the IMU calibration: a constant rotation of the gyro "
-              "triad is indistinguishable from a mount error (accuracy vs the nominal MF >= ~sigma_phiG/sqrt(2)).")
-
 
 def _mats(x, name: str) -> np.ndarray:
     a = np.asarray(x, dtype=float)
     if a.ndim == 2:
         a = a[None]
     if a.ndim != 3 or a.shape[1:] != (3, 3):
-        raise ValueError(f"{name}: expected shape (N, 3, 3), got {a.shape}")
+        raise input_error(name, f"expected shape (N, 3, 3), got {a.shape}")
     return np.ascontiguousarray(a)
 
 
@@ -46,7 +44,7 @@ def _rows3_unchecked(x, name: str) -> np.ndarray:
     rejects NaN/inf naming the first bad row, so no second numpy pass over long records."""
     a = np.ascontiguousarray(x, dtype=float)
     if a.ndim != 2 or a.shape[1] != 3:
-        raise ValueError(f"{name}: expected shape (N, 3), got {a.shape}")
+        raise input_error(name, f"expected shape (N, 3), got {a.shape}")
     return a
 
 
@@ -69,12 +67,12 @@ def euler_from_dcm(c) -> np.ndarray:
 
 
 def d1(beta) -> np.ndarray:
-    """D1(β): θ^clb = D1 δβ (seed 001 Eq. 8)."""
+    """D1(β): θ^clb = D1 δβ (Vasilyuk et al. 2024 Eq. 8)."""
     return _single(lambda b: _core.astro_d1_d2(b)[0], beta)
 
 
 def d2(beta) -> np.ndarray:
-    """D2(β) = C(β) D1(β): θ^mfa = Cθ^avu − D2 δβ (seed 001 Eq. 8)."""
+    """D2(β) = C(β) D1(β): θ^mfa = Cθ^avu − D2 δβ (Vasilyuk et al. 2024 Eq. 8)."""
     return _single(lambda b: _core.astro_d1_d2(b)[1], beta)
 
 
@@ -93,7 +91,7 @@ class GyroErrorModel:
     @classmethod
     def vasilyuk2024(cls, mode: str = "paper") -> "GyroErrorModel":
         """The paper's budget: 3″, 1e-5, 0.0012 °/√h, 0.007 °/h."""
-        return cls(*_core.astro_vasilyuk2024_gyro_budget(), mode=choice(mode, {"paper", "consistent"}, "mode"))
+        return cls(*_core.astro_vasilyuk2024_gyro_budget(), mode=mode)
 
     def _sigmas(self):
         return (self.sigma_phi_rad, self.sigma_k, self.sigma_w_rad_sqrt_s, self.sigma_b_rad_s)
@@ -125,7 +123,6 @@ def gyro_increments(t_start: float, period: float, rho, epochs, model: GyroError
     with T = ``period`` (s); ``epochs`` (N,) s strictly increasing inside the record.
     ``taylor_variant`` "corrected" (c = 1/8, default) or "paper_literal" (c = 1/4) (D1).
     """
-    choice(taylor_variant, {"corrected", "paper_literal"}, "taylor_variant")
     q, cov, sens = _core.astro_increments(float(t_start), positive(period, "period"), _rows3_unchecked(rho, "gyro_increments"),
                                             vector(epochs, None, "epochs"), model._sigmas(), model.mode, taylor_variant)
     jm, jb = sens if sens is not None else (None, None)
@@ -146,79 +143,24 @@ def observability(ds_avu) -> dict:
     return _core.astro_observability(_mats(ds_avu, "ds_avu"))
 
 
-_RESULT_ARRAYS = ("c", "beta", "residuals", "p_s", "p_theta", "p_beta", "p_clb", "singular_values", "weak_axis_mf")
-
-
-@dataclass
-class Calibration:
-    """Calibrated mount C = C_MF^VF with β (rad), Gauss–Newton iterations, residuals f_n
-    (rad), P_S, P_θ (VF), P_β, P^clb (MF) (rad²), singular values and condition number
-    of the stacked Jacobian, the weakest direction in MF with σ_weak = σ̂_f/√λ_min (rad),
-    the identifiability report (E15) and the gyro-model provenance."""
-
-    c: np.ndarray
-    beta: np.ndarray
-    iterations: int
-    residuals: np.ndarray
-    relative_misfit: float
-    p_s: np.ndarray
-    p_theta: np.ndarray
-    p_beta: np.ndarray
-    p_clb: np.ndarray
-    singular_values: np.ndarray
-    condition_number: float
-    weak_axis_mf: np.ndarray
-    sigma_weak: float
-    observability: dict
-    gyro_error_model: str = "unspecified"
-    caveat: str = D17_CAVEAT
-
-    @property
-    def sigma_beta_rad(self) -> np.ndarray:
-        return np.sqrt(np.diag(self.p_beta))
-
-    def p_mfa(self, p_avu) -> np.ndarray:
-        """P^mfa = C P^avu Cᵀ + P^clb (rad²) of IMU attitude from a new star fix (Eq. 8)."""
-        p = np.asarray(p_avu, dtype=float)
-        return self.c @ p @ self.c.T + self.p_clb
-
-    def save(self, path) -> None:
-        """Save as .npz (arrays, scalars, observability, provenance, caveat)."""
-        obs = {f"obs_{k}": np.asarray(v) for k, v in self.observability.items()}
-        np.savez(path, **{k: getattr(self, k) for k in _RESULT_ARRAYS}, iterations=self.iterations,
-                 relative_misfit=self.relative_misfit, condition_number=self.condition_number, sigma_weak=self.sigma_weak,
-                 gyro_error_model=self.gyro_error_model, caveat=self.caveat, **obs)
-
-    @classmethod
-    def load(cls, path) -> "Calibration":
-        with np.load(path, allow_pickle=False) as z:
-            kw = {k: z[k] for k in _RESULT_ARRAYS}
-            obs = {k[4:]: (z[k].item() if z[k].ndim == 0 else z[k]) for k in z.files if k.startswith("obs_")}
-            return cls(**kw, iterations=int(z["iterations"]), relative_misfit=float(z["relative_misfit"]),
-                       condition_number=float(z["condition_number"]), sigma_weak=float(z["sigma_weak"]),
-                       observability=obs,
-                       gyro_error_model=str(z["gyro_error_model"]), caveat=str(z["caveat"]))
-
-
-def calibrate(ds_imu, ds_avu, init: str = "axes", c0=None, solver: str = "so3", max_iter: int = 50,
+def calibrate(ds_imu, ds_avu, *, init: str = "axes", c0=None, solver: str = "so3", max_iter: int = 50,
               tol: float = 1e-9, residual_form: str = "full", gyro_error_model: str = "unspecified") -> Calibration:
-    """Mount C_MF^VF from increment pairs ΔS^avu = Cᵀ ΔS^imu C (seed 001 §3; spec E16–E18).
+    """Mount C_MF^VF from increment pairs ΔS^avu = Cᵀ ΔS^imu C (Vasilyuk et al. 2024, §3).
 
     Gauss–Newton from ``init`` "axes" (closed-form alignment of rotation axes, default),
     "zero" (paper's β0 = 0) or "given" (``c0``); ``solver`` "so3" (C ← C exp([Δθ×]),
     analytic Jacobian, default) or "paper_euler" (β ← β + Δβ, central differences with
     dx = 1e-6); stops at a step ≤ ``tol`` rad, at most ``max_iter`` iterations. P_β is the paper's
-    residual sandwich with P_S "full" (default) or "diagonal".
+    residual sandwich with P_S "full" (default) or "diagonal". The option names are
+    ``_core.OPTIONS["CalibrationInit"]``, ``["CalibrationSolver"]`` and ``["ResidualForm"]``.
 
-    Raises ValueError when the trajectory cannot determine the mount (κ < 1e-12; the
-    message names the null direction) and atomnav.NumericalError when Gauss–Newton does
-    not converge or stops at a wrong stationary point; warns when κ < 1e-4.
+    Raises :class:`atomnav.InputError` when the trajectory cannot determine the mount
+    (κ < 1e-12; the message names the null direction) and atomnav.NumericalError when
+    Gauss–Newton does not converge or stops at a wrong stationary point; warns when κ < 1e-4.
     """
-    choice(init, {"axes", "zero", "given"}, "init")
     c0 = None if c0 is None else rows(c0, 3, "c0")
-    choice(solver, {"so3", "paper_euler"}, "solver")
-    d = _core.astro_calibrate(_mats(ds_imu, "ds_imu"), _mats(ds_avu, "ds_avu"), init, c0, solver, int(max_iter),
-                              float(tol), choice(residual_form, {"full", "diagonal"}, "residual_form"))
+    d = _core.astro_calibrate(_mats(ds_imu, "ds_imu"), _mats(ds_avu, "ds_avu"), init=init, c0=c0, solver=solver,
+                              max_iter=max_iter, tol=float(tol), residual_form=residual_form)
     if d["observability"]["verdict"] == "warn":
         k = d["observability"]["weak_axis_vf"]
         warnings.warn(f"weakly observable mount: kappa = {d['observability']['kappa']:.3e} < 1e-4, "
@@ -240,7 +182,7 @@ class Catalog:
 def synthetic_catalog(m_lim: float = 5.6, seed: int = 1) -> Catalog:
     """Deterministic uniform sky (spec D4): round(10^(0.985 + 0.455 m_lim)) stars,
     xoshiro256** seeded through SplitMix64 (identical on every platform)."""
-    return Catalog(*_core.astro_synthetic_catalog(float(m_lim), int(seed)))
+    return Catalog(*_core.astro_synthetic_catalog(float(m_lim), seed))
 
 
 def load_catalog(path) -> Catalog:
@@ -254,12 +196,12 @@ def load_catalog(path) -> Catalog:
     elif {"x", "y", "z"} <= names:
         dirs = np.column_stack([data["x"], data["y"], data["z"]])
     else:
-        raise ValueError(f"catalog: expected columns id,ra_deg,dec_deg,mag or id,x,y,z,mag in {path}, got {sorted(names)}")
+        raise input_error("catalog", f"expected columns id,ra_deg,dec_deg,mag or id,x,y,z,mag in {path}, got {sorted(names)}")
     dirs = rows(dirs, 3, "catalog_directions")
     norm = np.linalg.norm(dirs, axis=1)
     bad = np.nonzero(np.abs(norm - 1.0) > 1e-9)[0]
     if bad.size:
-        raise ValueError(f"catalog_directions: not a unit vector at index {bad[0]} (norm {norm[bad[0]]})")
+        raise input_error("catalog_directions", f"not a unit vector at index {bad[0]} (norm {norm[bad[0]]})", bad[0])
     return Catalog(dirs=dirs, mags=vector(data["mag"], None, "mag"), ids=np.asarray(data["id"], dtype=np.int64))
 
 
@@ -279,17 +221,6 @@ def refraction_apply(s, up, n: float) -> np.ndarray:
     return _core.astro_refraction(rows(s, 3, "directions"), rows(up, 3, "up"), float(n), True)
 
 
-@dataclass(frozen=True)
-class Observations:
-    """Star observations, one row per star: epoch index, camera index, measured unit
-    direction in the camera frame (N, 3), catalog direction in GCRS (N, 3)."""
-
-    epoch: np.ndarray
-    camera: np.ndarray
-    s_cf: np.ndarray
-    g: np.ndarray
-
-
 def star_attitudes(obs: Observations, n_epochs: int, cameras, sigma_s_rad: float, p_alpha=None,
                    up_gcrs=None, n_refr: float = 1.0, p_avu=None):
     """Merge the cameras into VF (``cameras`` (I, 3, 3) = C_VF^CFⁱ, camera 0 = identity), remove
@@ -307,8 +238,8 @@ def star_attitudes(obs: Observations, n_epochs: int, cameras, sigma_s_rad: float
     return _core.astro_star_attitudes(np.ascontiguousarray(obs.epoch, dtype=np.int64),
                                       np.ascontiguousarray(obs.camera, dtype=np.int64),
                                       rows(obs.s_cf, 3, "star_directions"), rows(obs.g, 3, "catalog_directions"),
-                                      int(n_epochs), cams, pa, float(sigma_s_rad), up, float(n_refr),
-                                      None if p_avu is None else _mats(p_avu, "p_avu"))
+                                      n_epochs, cameras=cams, p_alpha=pa, sigma_s=float(sigma_s_rad), up_gcrs=up,
+                                      n_refr=float(n_refr), p_avu=None if p_avu is None else _mats(p_avu, "p_avu"))
 
 
 def astro_increments(s_vf, p_avu):
@@ -326,7 +257,7 @@ def model_covariance(cal: Calibration, ds_imu, ds_avu, e_imu, p_avu, increments:
     ``increments.j_m``/``j_b``; P_β^sys is their part (zero otherwise)."""
     consistent = model is not None and model.mode == "consistent"
     if consistent and (increments is None or increments.j_m is None):
-        raise ValueError("increments: the consistent gyro mode needs the Increments with j_m, j_b")
+        raise input_error("increments", "the consistent gyro mode needs the Increments with j_m, j_b")
     extra = (increments.j_m, increments.j_b, model._sigmas()) if consistent else (None, None, None)
     return _core.astro_model_covariance(rows(cal.c, 3, "c"), _mats(ds_imu, "ds_imu"), _mats(ds_avu, "ds_avu"),
                                         _mats(e_imu, "e_imu"), _mats(p_avu, "p_avu"), *extra)
@@ -340,18 +271,17 @@ def aberration(directions, velocity_mps) -> np.ndarray:
     return _core.astro_aberration(rows(directions, 3, "directions"), rows(velocity_mps, 3, "velocity"))
 
 
-def simulate_observations(catalog: Catalog, s_gcrs_vf, up_gcrs, cameras, fov_half_rad: float, m_lim: float,
+def simulate_observations(catalog: Catalog, s_gcrs_vf, up_gcrs, cameras, *, fov_half_rad: float, m_lim: float,
                           sigma_s_rad: float, n_refr: float, seed: int) -> Observations:
     """Camera simulator: stars brighter than ``m_lim``, above the horizon, within
-    ``fov_half_rad`` of each camera's +z after refraction, with isotropic tangent noise."""
+    ``fov_half_rad`` of each camera's +z after refraction (index ``n_refr`` ≥ 1), with
+    isotropic tangent noise ``sigma_s_rad``; ``seed`` any integer in [0, 2**64)."""
     d = _core.astro_simulate_observations(rows(catalog.dirs, 3, "catalog_directions"),
                                           vector(catalog.mags, None, "magnitudes"), _mats(s_gcrs_vf, "s_gcrs_vf"),
-                                          rows(up_gcrs, 3, "up_gcrs"), _mats(cameras, "cameras"), float(fov_half_rad),
-                                          float(m_lim), float(sigma_s_rad), float(n_refr), int(seed))
+                                          rows(up_gcrs, 3, "up_gcrs"), _mats(cameras, "cameras"), fov_half=float(fov_half_rad),
+                                          m_lim=float(m_lim), sigma_s=float(sigma_s_rad), n_refr=float(n_refr), seed=seed)
     return Observations(**d)
 
-
-from .scenario import Vasilyuk2024  # noqa: E402
 
 __all__ = [
     "NED_TO_ENU", "D17_CAVEAT", "euler_dcm", "euler_from_dcm", "d1", "d2", "GyroErrorModel", "Increments",

@@ -1,4 +1,4 @@
-"""Allan family and the metrics of seed 002 (spec E14–E18, D15–D17).
+"""Allan family and the metrics of Niu et al. 2025 (spec E14–E18, D15–D17).
 
 All functions are unit-agnostic: a rate series in some unit U sampled every ``tau0``
 seconds gives variances in U², fit coefficients A_k in U²·s^k, ARW in U·√s, bias
@@ -14,13 +14,14 @@ import numpy as np
 import pandas as pd
 
 from .. import _core, units
-from .._validate import choice, positive, vector
+from .._validate import input_error, positive, vector
 
-KINDS = ("allan", "modified", "hadamard")
-DATA_TYPES = ("rate", "phase")
-TAU_SETS = ("octave", "decade", "all")
-NOISE_TYPES = ("white_pm", "flicker_pm", "white_fm", "flicker_fm", "random_walk_fm")
-#: Names of the five-term coefficients A₋₂ … A₂ (seed 002 Eq. 19).
+#: Option names, listed (and checked) by the Rust core.
+KINDS = tuple(_core.OPTIONS["AllanKind"])
+DATA_TYPES = tuple(_core.OPTIONS["DataType"])
+TAU_SETS = tuple(_core.OPTIONS["TauGrid"])
+NOISE_TYPES = tuple(_core.OPTIONS["NoiseType"])
+#: Names of the five-term coefficients A₋₂ … A₂ (Niu et al. 2025 Eq. 19).
 TERMS = ("quantization", "arw", "bias_instability", "rrw", "ramp")
 
 
@@ -32,36 +33,30 @@ def _series(x, name: str, min_len: int = 1, check_finite: bool = True) -> np.nda
     else:
         a = np.ascontiguousarray(np.asarray(x, dtype=float))
         if a.ndim != 1:
-            raise ValueError(f"{name}: expected shape (N,), got {a.shape}")
+            raise input_error(name, f"expected shape (N,), got {a.shape}")
     if a.size < min_len:
-        raise ValueError(f"{name}: series of {a.size} samples is too short; at least {min_len} are needed")
+        raise input_error(name, f"series of {a.size} samples is too short; at least {min_len} are needed")
     return a
 
 
 def _m_list(m, taus, tau0: float):
-    """Averaging factors from ``m`` (a set name or integers) or ``taus`` (seconds)."""
+    """Averaging factors from ``m`` (integers) or ``taus`` (seconds); None when ``m`` is
+    the name of a set (which the core resolves)."""
     if taus is not None:
         t = vector(taus, None, "taus")
         mm = np.rint(t / tau0)
         bad = np.nonzero((mm < 1) | (np.abs(mm * tau0 - t) > 1e-9 * np.maximum(t, tau0)))[0]
         if bad.size:
-            raise ValueError(f"taus: τ = {t[bad[0]]} s at index {bad[0]} is not a positive multiple of tau0 = {tau0} s")
-        return "list", [int(v) for v in mm]
-    if isinstance(m, str):
-        return choice(m, TAU_SETS, "m"), None
-    mm = np.asarray(m)
-    if mm.ndim != 1 or not np.issubdtype(mm.dtype, np.integer):
-        raise ValueError(f"m: expected 'octave', 'decade', 'all' or a 1-D sequence of integers, got {m!r}")
-    bad = np.nonzero(mm < 1)[0]
-    if bad.size:
-        raise ValueError(f"m: averaging factor {mm[bad[0]]} at index {bad[0]} must be ≥ 1")
-    return "list", [int(v) for v in mm]
+            raise input_error("taus", f"τ = {t[bad[0]]} s at index {bad[0]} is not a positive multiple of tau0 = {tau0} s", bad[0])
+        return [int(v) for v in mm]
+    # a set name or a sequence of integers, both checked by the core (which names the index)
+    return None if isinstance(m, str) else m
 
 
 def _table(m, tau, var, n, kind: str, n_phase: int, noise: str, confidence: float) -> pd.DataFrame:
     from scipy.stats import chi2
 
-    edf = _core.allan_edf(kind, noise, n_phase, [int(v) for v in m])
+    edf = _core.allan_edf(kind, noise, n_phase, m.tolist())
     alpha = 1.0 - confidence
     lo = var * edf / chi2.ppf(1.0 - alpha / 2.0, edf)
     hi = var * edf / chi2.ppf(alpha / 2.0, edf)
@@ -76,7 +71,7 @@ def allan_variance(data, tau0: float, m="octave", kind: str = "allan", data_type
     ``m``: "octave" (1, 2, 4, …), "decade" (1, 2, 4, 10, 20, 40, …), "all", or a list of
     averaging factors; alternatively ``taus`` in seconds (multiples of tau0). Factors
     that leave fewer than two terms are dropped from the named sets and rejected (with
-    ValueError) in a user list.
+    :class:`atomnav.InputError` naming ``m`` and the index) in a user list.
     ``data_type="phase"``: data are the integral of the rate (e.g. angle in rad), the
     variance is then of the rate (rad/s)².
 
@@ -87,12 +82,9 @@ def allan_variance(data, tau0: float, m="octave", kind: str = "allan", data_type
     ``confidence``.
     """
     tau0 = positive(tau0, "tau0")
-    kind = choice(kind, KINDS, "kind")
-    data_type = choice(data_type, DATA_TYPES, "data_type")
-    noise = choice(noise, NOISE_TYPES, "noise")
     x = _series(data, "data", check_finite=False)
-    set_name, ms = _m_list(m, taus, tau0)
-    mm, tau, var, n = _core.allan_var(x, tau0, data_type, kind, set_name, ms)
+    ms = _m_list(m, taus, tau0)
+    mm, tau, var, n = _core.allan_var(x, tau0, data_type, kind, **({"set": m} if ms is None else {"m": ms}))
     n_phase = x.size + 1 if data_type == "rate" else x.size
     return _table(mm, tau, var, n, kind, n_phase, noise, confidence)
 
@@ -108,12 +100,12 @@ class AllanStream:
 
     def __init__(self, m, tau0: float, data_type: str = "rate", noise: str = "white_fm", confidence: float = 0.683):
         self.tau0 = positive(tau0, "tau0")
-        self.data_type = choice(data_type, DATA_TYPES, "data_type")
-        self.noise = choice(noise, NOISE_TYPES, "noise")
+        self.data_type = data_type
+        self.noise = noise
         self.confidence = confidence
-        _, ms = _m_list(m, None, self.tau0)
+        ms = _m_list(m, None, self.tau0)
         if ms is None:
-            raise ValueError("m: give explicit averaging factors for a stream (the record length is unknown)")
+            raise input_error("m", "give explicit averaging factors for a stream (the record length is unknown)")
         self._s = _core.AllanStream(ms, self.tau0, self.data_type)
         self.n_samples = 0
 
@@ -125,15 +117,14 @@ class AllanStream:
 
     def result(self, kind: str = "allan") -> pd.DataFrame:
         """The table of :func:`allan_variance` for the samples seen so far."""
-        kind = choice(kind, KINDS, "kind")
         mm, tau, var, n = self._s.result(kind)
         n_phase = self.n_samples + 1 if self.data_type == "rate" else self.n_samples
         return _table(mm, tau, var, n, kind, n_phase, self.noise, self.confidence)
 
 
-@dataclass
+@dataclass(kw_only=True)
 class AllanFit:
-    """Five-term fit σ²(τ) = Σ_{k=−2}^{2} A_k τ^k (seed 002 Eq. 19, IEEE Std 952).
+    """Five-term fit σ²(τ) = Σ_{k=−2}^{2} A_k τ^k (Niu et al. 2025 Eq. 19, IEEE Std 952).
 
     With rate unit U and τ in s: ``coeffs`` A₋₂…A₂ in U²·s^k; ``quantization`` Q_q =
     √(A₋₂/3) (U·s); ``arw`` N = √A₋₁ (U·√s), the paper's SS (Eq. 20);
@@ -170,12 +161,13 @@ def fit_allan_table(table: pd.DataFrame, n_samples: int, terms=TERMS, tau_min: f
     variance are used."""
     bad = [t for t in terms if t not in TERMS]
     if bad:
-        raise ValueError(f"terms: unknown term {bad[0]!r}; choose from {TERMS}")
+        raise input_error("terms", f"unknown term {bad[0]!r}; choose from {TERMS}")
     mask = [t in terms for t in TERMS]
     lo = 0.0 if tau_min is None else float(tau_min)
     hi = np.inf if tau_max is None else float(tau_max)
-    d = _core.allan_fit([int(v) for v in table["m"]], np.ascontiguousarray(table["tau_s"], dtype=float), np.ascontiguousarray(table["var"], dtype=float), int(n_samples), mask, lo, hi)
-    return AllanFit(np.asarray(d["coeffs"]), d["quantization"], d["arw"], d["bias_instability"], d["rrw"], d["ramp"], d["points"], lo, hi, table)
+    d = _core.allan_fit(table["m"].to_numpy().tolist(), np.ascontiguousarray(table["tau_s"], dtype=float), np.ascontiguousarray(table["var"], dtype=float), n_samples, mask, lo, hi)
+    return AllanFit(coeffs=np.asarray(d["coeffs"]), quantization=d["quantization"], arw=d["arw"], bias_instability=d["bias_instability"],
+                    rrw=d["rrw"], ramp=d["ramp"], points=d["points"], tau_min=lo, tau_max=hi, table=table)
 
 
 def fit_allan(omega, tau0: float, terms=TERMS, tau_min: float | None = None, tau_max: float | None = None, m="octave") -> AllanFit:
@@ -186,13 +178,13 @@ def fit_allan(omega, tau0: float, terms=TERMS, tau_min: float | None = None, tau
 
 
 def short_term_sensitivity(omega, tau0: float, **fit_kw) -> float:
-    """SS = √A₋₁ (seed 002 Eq. 20) in U·√s; divide by 60 for °/√h when U = °/h and τ in s
+    """SS = √A₋₁ (Niu et al. 2025 Eq. 20) in U·√s; divide by 60 for °/√h when U = °/h and τ in s
     (or use :meth:`AllanFit.arw_in`)."""
     return fit_allan(omega, tau0, **fit_kw).arw
 
 
 def long_term_stability(omega, tau0: float, **fit_kw) -> float:
-    """LS = √(π A₀ / (2 ln 2)) (seed 002 Eq. 21) in the rate unit."""
+    """LS = √(π A₀ / (2 ln 2)) (Niu et al. 2025 Eq. 21) in the rate unit."""
     return fit_allan(omega, tau0, **fit_kw).bias_instability
 
 
@@ -211,7 +203,7 @@ def bias_stability(omega, window: int = 1) -> float:
     non-overlapping means of ``window`` samples (incomplete tail dropped), in the rate
     unit. Report ``window`` with the value."""
     if int(window) != window or window < 1:
-        raise ValueError(f"window: must be an integer ≥ 1, got {window}")
+        raise input_error("window", f"must be an integer ≥ 1, got {window}")
     w = int(window)
     x = _series(omega, "omega", min_len=2 * w)
     k = x.size // w
@@ -219,12 +211,12 @@ def bias_stability(omega, window: int = 1) -> float:
 
 
 def improvement_ratio(before, after, absolute: bool = False):
-    """Improvement ratio in percent (seed 002 Eq. 18): (M_raw − M_filt)/M_raw·100, signed
+    """Improvement ratio in percent (Niu et al. 2025 Eq. 18): (M_raw − M_filt)/M_raw·100, signed
     by default (spec D11: negative means the filter made the metric worse);
     ``absolute=True`` gives the paper's |M_raw − M_filt|/M_raw·100."""
     b = np.asarray(before, dtype=float)
     a = np.asarray(after, dtype=float)
     if np.any(b == 0):
-        raise ValueError("before: metric is zero, the ratio is undefined")
+        raise input_error("before", "metric is zero, the ratio is undefined")
     r = (b - a) / b * 100.0
     return np.abs(r) if absolute else r

@@ -10,25 +10,25 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
-from .._validate import choice, vector
+from .._validate import choice, input_error, vector
 
 
 def _series(x, name: str, min_len: int) -> np.ndarray:
     a = vector(x, None, name)
     if a.size < min_len:
-        raise ValueError(f"{name}: series of {a.size} samples is too short; at least {min_len} are needed")
+        raise input_error(name, f"series of {a.size} samples is too short; at least {min_len} are needed")
     if np.all(a == a[0]):
-        raise ValueError(f"{name}: constant series (every value is {a[0]}); nothing to model")
+        raise input_error(name, f"constant series (every value is {a[0]}); nothing to model")
     return a
 
 
 def difference(omega, d: int = 1) -> np.ndarray:
     """d-th difference (spec E2, D1): d_k = ω_k − ω_{k−1}, length N − d."""
     if int(d) != d or d < 0:
-        raise ValueError(f"d: must be an integer ≥ 0, got {d}")
+        raise input_error("d", f"must be an integer ≥ 0, got {d}")
     x = vector(omega, None, "omega")
     if x.size <= d:
-        raise ValueError(f"omega: series of {x.size} samples is too short to difference {d} times")
+        raise input_error("omega", f"series of {x.size} samples is too short to difference {d} times")
     return np.diff(x, n=int(d))
 
 
@@ -124,7 +124,7 @@ def select_arma(d, max_p: int = 3, max_q: int = 3) -> pd.DataFrame:
     return pd.DataFrame(rows).sort_values("bic", ignore_index=True)
 
 
-@dataclass
+@dataclass(kw_only=True)
 class ArmaFit:
     """Exact-ML ARMA(p, q) fit of d (statsmodels). ``ar`` φ, ``ma`` β, ``sigma2`` σ_a²;
     ``se`` standard errors by parameter name (``ar.L1``, ``ma.L1``, ``sigma2``);
@@ -149,39 +149,39 @@ def fit_arma(omega, order=(2, 1), differenced: bool = False, lags: int = 10) -> 
     ``ARIMA(d, order=(p,0,q), trend='n')`` (spec D2)."""
     p, q = (int(v) for v in order)
     if p < 0 or q < 0:
-        raise ValueError(f"order: p and q must be ≥ 0, got {order}")
+        raise input_error("order", f"p and q must be ≥ 0, got {order}")
     need = _min_len(p, q) + (0 if differenced else 1)
     w = _series(omega, "omega", need)
     d = w if differenced else np.diff(w)
     if np.all(d == d[0]):
-        raise ValueError("omega: the differenced series is constant (a pure ramp); nothing to model")
+        raise input_error("omega", "the differenced series is constant (a pure ramp); nothing to model")
     r = _arima(d, p, q)
     names = list(r.model.param_names)
     par = dict(zip(names, np.asarray(r.params)))
     se = dict(zip(names, np.asarray(r.bse)))
     res = np.asarray(r.resid)
     return ArmaFit(
-        (p, q),
-        np.array([par[f"ar.L{i}"] for i in range(1, p + 1)]),
-        np.array([par[f"ma.L{i}"] for i in range(1, q + 1)]),
-        float(par["sigma2"]),
-        se,
-        res,
-        durbin_watson(res),
-        ljung_box(res, lags),
-        float(r.aic),
-        float(r.bic),
+        order=(p, q),
+        ar=np.array([par[f"ar.L{i}"] for i in range(1, p + 1)]),
+        ma=np.array([par[f"ma.L{i}"] for i in range(1, q + 1)]),
+        sigma2=float(par["sigma2"]),
+        se=se,
+        residuals=res,
+        dw=durbin_watson(res),
+        ljung_box=ljung_box(res, lags),
+        aic=float(r.aic),
+        bic=float(r.bic),
     )
 
 
 def durbin_watson(e) -> float:
-    """DW = Σ(e_k − e_{k−1})² / Σe_k² (seed 002 Eq. 13); 2 for white residuals, 0 for a
+    """DW = Σ(e_k − e_{k−1})² / Σe_k² (Niu et al. 2025 Eq. 13); 2 for white residuals, 0 for a
     constant series."""
     from statsmodels.stats.stattools import durbin_watson as dw
 
     x = vector(e, None, "e")
     if x.size < 2:
-        raise ValueError(f"e: series of {x.size} samples is too short; at least 2 are needed")
+        raise input_error("e", f"series of {x.size} samples is too short; at least 2 are needed")
     return float(dw(x))
 
 
@@ -191,5 +191,5 @@ def ljung_box(e, lags: int = 10) -> pd.DataFrame:
 
     x = vector(e, None, "e")
     if x.size <= lags + 1:
-        raise ValueError(f"e: series of {x.size} samples is too short for {lags} lags")
+        raise input_error("e", f"series of {x.size} samples is too short for {lags} lags")
     return acorr_ljungbox(x, lags=lags)

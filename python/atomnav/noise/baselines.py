@@ -1,10 +1,10 @@
-"""Non-model baselines of seed 002 §5.2 with the spec's settings (D13, D14)."""
+"""Non-model baselines of Niu et al. 2025 §5.2 with the spec's settings (D13, D14)."""
 
 from __future__ import annotations
 
 import numpy as np
 
-from .._validate import choice, positive, vector
+from .._validate import choice, input_error, positive, vector
 
 
 def butterworth_lowpass(omega, tau0: float, fc: float = 0.002, order: int = 2, zero_phase: bool = True) -> np.ndarray:
@@ -17,12 +17,12 @@ def butterworth_lowpass(omega, tau0: float, fc: float = 0.002, order: int = 2, z
     fs = 1.0 / positive(tau0, "tau0")
     fc = positive(fc, "fc")
     if fc >= fs / 2:
-        raise ValueError(f"fc: cutoff {fc} Hz must be below the Nyquist frequency {fs / 2} Hz")
+        raise input_error("fc", f"cutoff {fc} Hz must be below the Nyquist frequency {fs / 2} Hz")
     sos = butter(int(order), fc, fs=fs, output="sos")
     if zero_phase:
         need = 3 * (2 * sos.shape[0] + 1)
         if x.size <= need:
-            raise ValueError(f"omega: series of {x.size} samples is too short for zero-phase filtering (needs > {need})")
+            raise input_error("omega", f"series of {x.size} samples is too short for zero-phase filtering (needs > {need})")
         return sosfiltfilt(sos, x)
     y, _ = sosfilt(sos, x, zi=sosfilt_zi(sos) * x[0])
     return y
@@ -40,7 +40,7 @@ def wavelet_denoise(omega, wavelet: str = "db4", level: int = 5, threshold: str 
     choice(mode, ("soft", "hard"), "mode")
     max_level = pywt.dwt_max_level(x.size, pywt.Wavelet(wavelet).dec_len)
     if level > max_level:
-        raise ValueError(f"omega: series of {x.size} samples is too short for a {level}-level {wavelet} decomposition (max {max_level})")
+        raise input_error("omega", f"series of {x.size} samples is too short for a {level}-level {wavelet} decomposition (max {max_level})")
     coeffs = pywt.wavedec(x, wavelet, level=level, mode="symmetric")
     sigma = np.median(np.abs(coeffs[-1])) / 0.6745
     lam = sigma * np.sqrt(2.0 * np.log(x.size))

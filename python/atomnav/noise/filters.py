@@ -1,4 +1,4 @@
-"""ARIMA state-space form and Kalman filters of seed 002 (spec E7–E11, D5–D12); the
+"""ARIMA state-space form and Kalman filters of Niu et al. 2025 (spec E7–E11, D5–D12); the
 numerical work runs in Rust.
 
 Eq. 17 has two readings (spec E10, D7): ``"literal"`` takes y = ω (the raw rate);
@@ -11,17 +11,18 @@ Sage–Husa is the standard form (spec E11) — the paper gives no equations for
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+import json
+from dataclasses import KW_ONLY, dataclass, field, fields
 
 import numpy as np
 
 from .. import _core
-from .._validate import choice, finite, positive, vector
+from .._validate import finite, input_error, positive, vector
 
 #: The default reading of Eq. 17 (spec D7, binding).
 DEFAULT_READING = "differenced"
 READINGS = ("differenced", "literal")
-#: Seed 002 Eq. 10 (spec E5): φ₁, φ₂, β₁, σ_a² (°/h)².
+#: Niu et al. 2025 Eq. 10 (spec E5): φ₁, φ₂, β₁, σ_a² (°/h)².
 PAPER_AR = (-0.018, 0.029)
 PAPER_MA = (-0.99,)
 PAPER_SIGMA2 = 0.035
@@ -30,7 +31,7 @@ PAPER_SIGMA2 = 0.035
 @dataclass(frozen=True)
 class ArimaStateSpace:
     """ARIMA(p,d,q) in state-space form X_k = Φ X_{k−1} + B W_{k−1}, Y_k = H X_k + V_k
-    (seed 002 Eqs. 14, 16) with H = [1 0 … 0].
+    (Niu et al. 2025 Eqs. 14, 16) with H = [1 0 … 0].
 
     ``ar`` = φ, ``ma`` = β (statsmodels' sign convention, spec E4), ``sigma2`` = σ_a² in
     the rate unit squared. ``noise_form="paper"``: the paper's B with Q = σ²I
@@ -48,10 +49,7 @@ class ArimaStateSpace:
             v = np.asarray(getattr(self, name), dtype=float).reshape(-1)
             finite(v, name)
             object.__setattr__(self, name, tuple(float(c) for c in v))
-        choice(self.noise_form, ("paper", "exact"), "noise_form")
-        if int(self.d) != self.d or self.d < 0:
-            raise ValueError(f"d: differencing order must be an integer ≥ 0, got {self.d}")
-        object.__setattr__(self, "_m", _core.arima_state_space(list(self.ar), list(self.ma), positive(self.sigma2, "sigma2"), int(self.d), self.noise_form))
+        object.__setattr__(self, "_m", _core.arima_state_space(list(self.ar), list(self.ma), positive(self.sigma2, "sigma2"), self.d, self.noise_form))
 
     @classmethod
     def from_arma(cls, ar, ma, sigma2: float, d: int = 1, noise_form: str = "paper") -> "ArimaStateSpace":
@@ -99,6 +97,61 @@ class ArimaStateSpace:
         return (list(self.ar), list(self.ma), self.sigma2, int(self.d), self.noise_form)
 
 
+@dataclass(frozen=True)
+class ArmaFilterConfig:
+    """Everything that defines a Kalman filter run on an ARIMA model, frozen, checked by
+    the Rust core when created (mirror of ``noise::arma_filter::ArmaFilterConfig``); save
+    it beside the results with :meth:`to_json`.
+
+    ``ar``, ``ma``, ``sigma2``, ``d``, ``noise_form`` as in :class:`ArimaStateSpace`;
+    ``r0`` the initial (and fixed) measurement variance (None: ``sigma2``, the paper's
+    R₀ = Q); ``adaptive`` one of ``_core.OPTIONS["Adaptive"]`` ("fixed", "literal",
+    "differenced" — Niu et al. 2025, Eq. 17 — or "sage_husa" with forgetting factor ``b``,
+    optional Q adaptation ``adapt_q`` and fading ``fading``); ``x0`` "zeros" or "first";
+    P₀ = ``p0``·I."""
+
+    ar: tuple
+    ma: tuple
+    sigma2: float
+    _: KW_ONLY
+    d: int = 1
+    noise_form: str = "paper"
+    r0: float | None = None
+    adaptive: str = "fixed"
+    b: float = 0.98
+    adapt_q: bool = False
+    fading: bool = False
+    x0: str = "zeros"
+    p0: float = 1.0
+    _core: object = field(init=False, repr=False, compare=False)
+
+    def __post_init__(self):
+        for name in ("ar", "ma"):
+            object.__setattr__(self, name, tuple(float(c) for c in np.asarray(getattr(self, name), dtype=float).reshape(-1)))
+        object.__setattr__(self, "_core", _core.ArmaFilterConfig(**self.to_dict()))
+
+    @classmethod
+    def for_model(cls, model: ArimaStateSpace, **options) -> "ArmaFilterConfig":
+        """The configuration of a filter on ``model`` with the given filter ``options``."""
+        return cls(model.ar, model.ma, model.sigma2, d=model.d, noise_form=model.noise_form, **options)
+
+    def to_dict(self) -> dict:
+        """The fields as plain Python values (lists for ``ar`` and ``ma``)."""
+        d = {f.name: getattr(self, f.name) for f in fields(self) if f.init}
+        return {**d, "ar": list(self.ar), "ma": list(self.ma)}
+
+    @classmethod
+    def from_dict(cls, d: dict) -> "ArmaFilterConfig":
+        return cls(**d)
+
+    def to_json(self) -> str:
+        return json.dumps(self.to_dict())
+
+    @classmethod
+    def from_json(cls, text: str) -> "ArmaFilterConfig":
+        return cls.from_dict(json.loads(text))
+
+
 @dataclass
 class KalmanResult:
     """Filtered rate ``omega_hat`` (N,), the measurement variance ``r`` used at each step
@@ -114,37 +167,34 @@ def _mode(adaptive) -> str:
         return "fixed"
     if adaptive is True:
         return DEFAULT_READING
-    return choice(adaptive, READINGS, "adaptive")
+    return adaptive
 
 
-def _check_x0(x0: str) -> str:
-    return choice(x0, ("zeros", "first"), "x0")
+def filter_series(omega, config: ArmaFilterConfig, *, record: bool = True) -> KalmanResult:
+    """Kalman filter of the rate series ``omega`` as ``config`` describes (Niu et al.
+    2025, Eq. 15); the R and gain histories only when ``record``."""
+    w = vector(omega, None, "omega")
+    if w.size == 0:
+        raise input_error("omega", "empty series")
+    return KalmanResult(*_core.kalman_filter(w, config._core, record=record))
 
 
 def kalman(omega, model: ArimaStateSpace, r0: float | None = None, adaptive=None, x0: str = "zeros", p0: float = 1.0, record: bool = True) -> KalmanResult:
-    """Kalman filter of the rate series ``omega`` on ``model`` (seed 002 Eq. 15).
+    """Kalman filter of the rate series ``omega`` on ``model`` (Niu et al. 2025, Eq. 15).
 
     ``adaptive``: None (fixed R ≡ r0), ``"differenced"`` (default reading of Eq. 17, also
     selected by ``True``) or ``"literal"``. ``r0`` defaults to model.sigma2 (the paper's
     R₀ = Q); ``x0="zeros"`` (paper) or ``"first"`` (start at ω₁); P₀ = p0·I."""
-    w = vector(omega, None, "omega")
-    if w.size == 0:
-        raise ValueError("omega: empty series")
-    r0 = model.sigma2 if r0 is None else positive(r0, "r0")
-    xh, r, g = _core.kalman_filter(w, *model._args(), r0=r0, mode=_mode(adaptive), x0=_check_x0(x0), p0=positive(p0, "p0"), record=record)
-    return KalmanResult(xh, r, g)
+    cfg = ArmaFilterConfig.for_model(model, r0=r0, adaptive=_mode(adaptive), x0=x0, p0=p0)
+    return filter_series(omega, cfg, record=record)
 
 
-def sage_husa(omega, model: ArimaStateSpace, b: float = 0.98, adapt_q: bool = False, fading: bool = False, r0: float | None = None, x0: str = "zeros", p0: float = 1.0, record: bool = True) -> KalmanResult:
-    """Sage–Husa adaptive filter (standard form, spec E11/D12 — not from the paper):
+def sage_husa(omega, model: ArimaStateSpace, b: float = 0.98, *, adapt_q: bool = False, fading: bool = False, r0: float | None = None, x0: str = "zeros", p0: float = 1.0, record: bool = True) -> KalmanResult:
+    """Sage–Husa adaptive filter (the standard form; Niu et al. 2025 give no equations for it):
     R̂_k = (1−d_k)R̂_{k−1} + d_k(ε_k² − HP⁻Hᵀ), d_k = (1−b)/(1−b^k); optional Q
     adaptation and strong-tracking fading factor (ρ = 0.95)."""
-    w = vector(omega, None, "omega")
-    if w.size == 0:
-        raise ValueError("omega: empty series")
-    r0 = model.sigma2 if r0 is None else positive(r0, "r0")
-    xh, r, g = _core.kalman_filter(w, *model._args(), r0=r0, mode="sage_husa", b=float(b), adapt_q=adapt_q, fading=fading, x0=_check_x0(x0), p0=positive(p0, "p0"), record=record)
-    return KalmanResult(xh, r, g)
+    cfg = ArmaFilterConfig.for_model(model, r0=r0, adaptive="sage_husa", b=b, adapt_q=adapt_q, fading=fading, x0=x0, p0=p0)
+    return filter_series(omega, cfg, record=record)
 
 
 def steady_state_gain(model: ArimaStateSpace, r: float):
@@ -156,12 +206,19 @@ def steady_state_gain(model: ArimaStateSpace, r: float):
 class KalmanStream:
     """Streaming form of :func:`kalman` / :func:`sage_husa`: ``update(chunk)`` returns the
     :class:`KalmanResult` of that chunk; the state carries over between chunks.
-    ``mode``: "fixed", "differenced", "literal" or "sage_husa"."""
+    ``adaptive`` as in :class:`ArmaFilterConfig` (None or False: "fixed", True: the
+    default reading of Eq. 17); :meth:`from_config` takes a saved configuration."""
 
-    def __init__(self, model: ArimaStateSpace, mode: str = "fixed", r0: float | None = None, b: float = 0.98, adapt_q: bool = False, fading: bool = False, x0: str = "zeros", p0: float = 1.0, record: bool = True):
-        mode = choice(mode, ("fixed", "sage_husa") + READINGS, "mode")
-        r0 = model.sigma2 if r0 is None else positive(r0, "r0")
-        self._f = _core.KalmanStream(*model._args(), r0=r0, mode=mode, b=float(b), adapt_q=adapt_q, fading=fading, x0=_check_x0(x0), p0=positive(p0, "p0"), record=record)
+    def __init__(self, model: ArimaStateSpace, adaptive="fixed", *, r0: float | None = None, b: float = 0.98, adapt_q: bool = False, fading: bool = False, x0: str = "zeros", p0: float = 1.0, record: bool = True):
+        cfg = ArmaFilterConfig.for_model(model, r0=r0, adaptive=_mode(adaptive), b=b, adapt_q=adapt_q, fading=fading, x0=x0, p0=p0)
+        self._f = _core.KalmanStream(cfg._core, record=record)
+        self.config = cfg
+
+    @classmethod
+    def from_config(cls, config: ArmaFilterConfig, *, record: bool = True) -> "KalmanStream":
+        s = cls.__new__(cls)
+        s._f, s.config = _core.KalmanStream(config._core, record=record), config
+        return s
 
     def update(self, chunk) -> KalmanResult:
         return KalmanResult(*self._f.update(vector(chunk, None, "chunk")))

@@ -1,4 +1,4 @@
-"""The paper's comparison (seed 002 Tables 2–4) on any rate series: ARMA(2,1) fit of the
+"""The paper's comparison (Niu et al. 2025 Tables 2–4) on any rate series: ARMA(2,1) fit of the
 differenced data, fixed and adaptive Kalman filters, Sage–Husa, low-pass and wavelet
 baselines; bias, bias stability, SS, LS and improvement ratios; Allan and PSD plots.
 
@@ -31,7 +31,7 @@ METHODS = ("raw", "fixed KF", "adaptive KF (literal)", "adaptive KF (differenced
 
 
 def paper_tables() -> pd.DataFrame:
-    """Seed 002 Tables 2–4 (spec §4c). Table 4's BS entries for LPF and WD (0.7020,
+    """Niu et al. 2025 Tables 2–4 (spec §4c). Table 4's BS entries for LPF and WD (0.7020,
     0.6970) equal the bias, not BS (spec D18): kept in ``bs_table4_misprint`` and NaN
     in ``bs_dph``."""
     return pd.DataFrame(

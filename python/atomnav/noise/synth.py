@@ -8,9 +8,10 @@ from __future__ import annotations
 
 import numpy as np
 from .. import units
+from .._validate import input_error
 from .filters import PAPER_AR, PAPER_MA, PAPER_SIGMA2
 
-#: Seed 002: sample interval (s), record length, Table 2 raw mean (°/h, spec D20).
+#: Niu et al. 2025: sample interval (s), record length, Table 2 raw mean (°/h, spec D20).
 TAU0 = 52.0
 N_SAMPLES = 900
 MEAN = 0.6851
@@ -18,7 +19,7 @@ MEAN = 0.6851
 
 def _n(n: int) -> int:
     if int(n) != n or n < 1:
-        raise ValueError(f"n: must be an integer ≥ 1, got {n}")
+        raise input_error("n", f"must be an integer ≥ 1, got {n}")
     return int(n)
 
 

@@ -1,4 +1,4 @@
-"""Vasilyuk et al. 2024 (seed 001): astro-inertial mount calibration on a two-axis stand.
+"""Vasilyuk et al. 2024: astro-inertial mount calibration on a two-axis stand.
 
 Monte Carlo of the synthetic scenario ``vasilyuk2024_like`` (spec §5.1): mount accuracy
 σ_β beside the paper's 6.0″ / 0.6″ / 0.6″, the consistency of P_β with the spread of β̂,

@@ -1,4 +1,4 @@
-"""Niu et al. 2025 (seed 002): ARMA-model Kalman filtering of atom-interferometer-gyro
+"""Niu et al. 2025: ARMA-model Kalman filtering of atom-interferometer-gyro
 noise. Deterministic oracles of the paper's model, then the paper's Tables 2–4 beside
 atomnav's values on model-B data (spec §5; the paper's data are not public), the
 paper's directional claims over seeds, and the Allan / PSD plots."""

@@ -1,0 +1,76 @@
+"""Result types of the astro-inertial calibration (shared by :mod:`atomnav.astro` and its
+scenario runner, which both import them from here)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+D17_CAVEAT = ("P_beta is precision conditional on the IMU calibration: a constant rotation of the gyro "
+              "triad is indistinguishable from a mount error (accuracy vs the nominal MF >= ~sigma_phiG/sqrt(2)).")
+
+
+_RESULT_ARRAYS = ("c", "beta", "residuals", "p_s", "p_theta", "p_beta", "p_clb", "singular_values", "weak_axis_mf")
+
+
+@dataclass(kw_only=True)
+class Calibration:
+    """Calibrated mount C = C_MF^VF with β (rad), Gauss–Newton iterations, residuals f_n
+    (rad), P_S, P_θ (VF), P_β, P^clb (MF) (rad²), singular values and condition number
+    of the stacked Jacobian, the weakest direction in MF with σ_weak = σ̂_f/√λ_min (rad),
+    the identifiability report (E15) and the gyro-model provenance."""
+
+    c: np.ndarray
+    beta: np.ndarray
+    iterations: int
+    residuals: np.ndarray
+    relative_misfit: float
+    p_s: np.ndarray
+    p_theta: np.ndarray
+    p_beta: np.ndarray
+    p_clb: np.ndarray
+    singular_values: np.ndarray
+    condition_number: float
+    weak_axis_mf: np.ndarray
+    sigma_weak: float
+    observability: dict
+    gyro_error_model: str = "unspecified"
+    caveat: str = D17_CAVEAT
+
+    @property
+    def sigma_beta_rad(self) -> np.ndarray:
+        return np.sqrt(np.diag(self.p_beta))
+
+    def p_mfa(self, p_avu) -> np.ndarray:
+        """P^mfa = C P^avu Cᵀ + P^clb (rad²) of IMU attitude from a new star fix (Eq. 8)."""
+        p = np.asarray(p_avu, dtype=float)
+        return self.c @ p @ self.c.T + self.p_clb
+
+    def save(self, path) -> None:
+        """Save as .npz (arrays, scalars, observability, provenance, caveat)."""
+        obs = {f"obs_{k}": np.asarray(v) for k, v in self.observability.items()}
+        np.savez(path, **{k: getattr(self, k) for k in _RESULT_ARRAYS}, iterations=self.iterations,
+                 relative_misfit=self.relative_misfit, condition_number=self.condition_number, sigma_weak=self.sigma_weak,
+                 gyro_error_model=self.gyro_error_model, caveat=self.caveat, **obs)
+
+    @classmethod
+    def load(cls, path) -> "Calibration":
+        with np.load(path, allow_pickle=False) as z:
+            kw = {k: z[k] for k in _RESULT_ARRAYS}
+            obs = {k[4:]: (z[k].item() if z[k].ndim == 0 else z[k]) for k in z.files if k.startswith("obs_")}
+            return cls(**kw, iterations=int(z["iterations"]), relative_misfit=float(z["relative_misfit"]),
+                       condition_number=float(z["condition_number"]), sigma_weak=float(z["sigma_weak"]),
+                       observability=obs,
+                       gyro_error_model=str(z["gyro_error_model"]), caveat=str(z["caveat"]))
+
+
+@dataclass(frozen=True)
+class Observations:
+    """Star observations, one row per star: epoch index, camera index, measured unit
+    direction in the camera frame (N, 3), catalog direction in GCRS (N, 3)."""
+
+    epoch: np.ndarray
+    camera: np.ndarray
+    s_cf: np.ndarray
+    g: np.ndarray
