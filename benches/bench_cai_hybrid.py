@@ -8,7 +8,7 @@ piecewise-linear gyro), mid-fringe steering, nonlinear innovation, stacked 6-row
 (Joseph form), Van Loan prediction of the 15-state model, closed-loop feedback. The numpy
 side is lighter where that is easy (flat strapdown without coning/sculling, forward
 differences for H vectorised with the predictor), so the ratio is a lower bound. Then the
-100-run Monte Carlo (``atomnav.cai.hybrid.car_mc``) on this machine's cores, against 100 ×
+100-run Monte Carlo (``atomnav.cai.car_mc``) on this machine's cores, against 100 ×
 the numpy run (extrapolated: running it would take minutes).
 
     python benches/bench_cai_hybrid.py [--runs 100]
@@ -25,7 +25,8 @@ import numpy as np
 from scipy.linalg import expm
 
 import atomnav as an
-from atomnav.cai import hybrid, predict_phase
+from atomnav import cai
+from atomnav.cai import predict_phase
 
 sys.path.insert(0, os.path.dirname(__file__))
 from timing import best_of  # noqa: E402
@@ -82,7 +83,7 @@ def numpy_run(t, gyro, accel, shots, phase, noise, sensor, setup, p0, vel0, q0):
     P = p0.copy()
     half = 0.5 * sensor.contrast
     # the in-shot noise covariance from the predictor's sample sensitivities, as the Rust aiding
-    R = sensor.sigma_p**2 * np.eye(6) + half**2 * hybrid.in_shot_noise(sensor, DT, *sensor.inflation)[0]
+    R = sensor.sigma_p**2 * np.eye(6) + half**2 * cai.in_shot_noise(sensor, DT, *sensor.inflation)[0]
     qc = np.zeros((15, 15))
     qc[3:6, 3:6] = setup.accel_psd * np.eye(3)
     qc[6:9, 6:9] = setup.gyro_psd * np.eye(3)
@@ -142,7 +143,7 @@ def main() -> None:
     ap = argparse.ArgumentParser()
     ap.add_argument("--runs", type=int, default=100)
     args = ap.parse_args()
-    traj = an.trajectory.car(rate_hz=200.0, origin=hybrid.HANNOVER, ellipsoid="kinematic")
+    traj = an.trajectory.car(rate_hz=200.0, origin=cai.HANNOVER, ellipsoid="kinematic")
     n = 35 * 200 + 1
     df = traj.df.iloc[:n]
     ideal = traj.ideal_imu("rates").iloc[:n]
@@ -150,8 +151,8 @@ def main() -> None:
     meas = an.imu.corrupt(ideal, errors="navigation", dt=DT, kind="rates", seed=1)
     t = ideal["time_s"].to_numpy()
     gyro, accel = meas[gcols].to_numpy(), meas[acols].to_numpy()
-    sensor = hybrid.seed003_sensor((0.0, 0.0, 0.0), interpolation="linear", omega_dot="pwl")
-    setup = hybrid.seed003_filter()
+    sensor = cai.seed003_sensor((0.0, 0.0, 0.0), interpolation="linear", omega_dot="pwl")
+    setup = cai.seed003_filter()
     shots = sensor.shots(0.0, t[-1])
     phase = predict_phase(t, ideal[acols].to_numpy(), ideal[gcols].to_numpy(), shots, T, sensor.channels, omega_dot="pwl").total
     noise = np.random.default_rng(2).normal(0.0, sensor.sigma_p, phase.shape)
@@ -159,7 +160,7 @@ def main() -> None:
     lla0, vel0, q0 = s0[["lat_rad", "lon_rad", "h_m"]].to_numpy(float), s0[["vn_mps", "ve_mps", "vd_mps"]].to_numpy(float), s0[["qw", "qx", "qy", "qz"]].to_numpy(float)
 
     def rust():
-        ins = hybrid.cai_aided_ins(0.0, lla0, vel0, q0, sensor, shots, phase=phase, noise=noise, setup=setup, ellipsoid="kinematic")
+        ins = cai.cai_aided_ins(0.0, lla0, vel0, q0, sensor, shots, phase=phase, noise=noise, setup=setup, ellipsoid="kinematic")
         return ins.run(t, gyro, accel, progress=False)
 
     t_rust, res = best_of(rust, 3)
@@ -177,7 +178,7 @@ def main() -> None:
     print(f"  numpy reference loop:               {t_np:8.3f} s")
     print(f"  ratio numpy / atomnav:              {t_np / t_rust:8.1f}x   (target >= 30x)")
     t0 = time.perf_counter()
-    hybrid.car_mc(args.runs, progress=False)
+    cai.car_mc(args.runs, progress=False)
     t_mc = time.perf_counter() - t0
     print(f"{args.runs}-run car Monte Carlo (40 s runs incl. truth and IMU simulation) on {os.cpu_count()} cores: {t_mc:.2f} s")
     print(f"  numpy reference, {args.runs} x one run (extrapolated): {args.runs * t_np * 40 / 35:.1f} s")

@@ -23,7 +23,7 @@ fn bench(c: &mut Criterion) {
     let (f, w, _) = ideal_rates(&motion, &KINEMATIC, &truth);
     let channels: Vec<Channel> =
         (0..6).map(|c| Channel { k: Vec3::ith(c / 2, 1.610576e7), lever: Vec3::zeros(), c_sb: Mat3::identity(), v0: Vec3::ith((c / 2 + 1) % 3, if c % 2 == 0 { 2.8 } else { -2.8 }) }).collect();
-    let shots = shot_times(0.0, 35.0, 0.025, 0.0).unwrap();
+    let shots = shot_times(0.0, 35.0, 0.025, 0.05).unwrap();
     let pcfg = PredictorConfig { t_sep: 0.025, substeps: 1, gradient: None, bias_a: Vec3::zeros(), bias_g: Vec3::zeros(), omega_dot: OmegaDot::Pwl, interpolation: Interpolation::Cubic };
     let phase: Vec<f64> = predict(Imu { t: &t, f: &f, w: &w }, &shots, &channels, &pcfg).unwrap().iter().map(|r| r[0]).collect();
     let noise = vec![0.0; phase.len()];

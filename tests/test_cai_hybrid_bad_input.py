@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 import atomnav as an
-from atomnav.cai import hybrid
+from atomnav import cai
 
 T = 0.025
 
@@ -21,9 +21,9 @@ def record():
 
 def _ins(record, shots, n_channels=6, **kw):
     init, _ = record
-    sensor = hybrid.seed003_sensor()
+    sensor = cai.seed003_sensor()
     data = np.zeros((len(shots), n_channels))
-    return hybrid.cai_aided_ins(*init, sensor, shots, phase=data, noise=data, ellipsoid="kinematic", **kw)
+    return cai.cai_aided_ins(*init, sensor, shots, phase=data, noise=data, ellipsoid="kinematic", **kw)
 
 
 def _run(ins, record):
@@ -60,17 +60,17 @@ def test_mismatched_number_of_interferometers(record):
 def test_mismatched_number_of_shots(record):
     init, _ = record
     with pytest.raises(ValueError, match=r"noise: expected 2 shots"):
-        hybrid.cai_aided_ins(*init, hybrid.seed003_sensor(), [0.1, 0.2], phase=np.zeros((2, 6)), noise=np.zeros((3, 6)))
+        cai.cai_aided_ins(*init, cai.seed003_sensor(), [0.1, 0.2], phase=np.zeros((2, 6)), noise=np.zeros((3, 6)))
 
 
 def test_recorded_and_emulated_data_are_exclusive(record):
     init, _ = record
     with pytest.raises(ValueError, match=r"data: give either"):
-        hybrid.cai_aided_ins(*init, hybrid.seed003_sensor(), [0.1], phase=np.zeros((1, 6)), noise=np.zeros((1, 6)), population=np.zeros((1, 6)))
+        cai.cai_aided_ins(*init, cai.seed003_sensor(), [0.1], phase=np.zeros((1, 6)), noise=np.zeros((1, 6)), population=np.zeros((1, 6)))
 
 
 def test_shot_period_shorter_than_the_shot():
-    s = hybrid.seed003_sensor()
+    s = cai.seed003_sensor()
     s.shot_period = 0.04
     with pytest.raises(ValueError, match=r"shot_period: must be >= 2T"):
         s.shots(0.0, 10.0)
@@ -78,17 +78,17 @@ def test_shot_period_shorter_than_the_shot():
 
 def test_zero_runs():
     with pytest.raises(ValueError, match=r"runs: must be >= 1"):
-        hybrid.slalom(0, progress=False)
+        cai.slalom(0, progress=False)
 
 
 def test_in_shot_noise_rejects_a_non_positive_sample_interval():
     with pytest.raises(ValueError, match="dt"):
-        hybrid.in_shot_noise(hybrid.seed003_sensor(), 0.0, 1e-11, 1e-12)
+        cai.in_shot_noise(cai.seed003_sensor(), 0.0, 1e-11, 1e-12)
 
 
 def test_in_shot_noise_rejects_a_model_that_is_not_15_by_15():
     with pytest.raises(ValueError, match="f:.*15 × 15"):
-        hybrid.in_shot_noise(hybrid.seed003_sensor(), 0.005, 1e-11, 1e-12, np.zeros((2, 9, 9)))
+        cai.in_shot_noise(cai.seed003_sensor(), 0.005, 1e-11, 1e-12, np.zeros((2, 9, 9)))
 
 
 def test_true_error_analysis_rejects_a_cross_covariance_of_the_wrong_shape():

@@ -3,12 +3,12 @@
 import numpy as np
 import pytest
 
-from atomnav.cai import hybrid
+from atomnav import cai
 
 
 @pytest.fixture(scope="module", params=[pytest.param(8, id="8-runs"), pytest.param(100, id="100-runs", marks=pytest.mark.slow)])
 def car(request):
-    return hybrid.car_mc(request.param, progress=False)
+    return cai.car_mc(request.param, progress=False)
 
 
 def test_velocity_gain_at_25s_is_at_least_30(car):

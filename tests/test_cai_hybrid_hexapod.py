@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from atomnav.cai import hybrid
+from atomnav import cai
 
 
 def _inside(res, t):
@@ -13,7 +13,7 @@ def _inside(res, t):
 
 
 def test_one_run_all_six_biases_within_3_sigma_after_60s():
-    res = hybrid.hexapod(1, progress=False)
+    res = cai.hexapod(1, progress=False)
     assert _inside(res, 60.0).all() and _inside(res, 170.0).all()
     # the injected MEMS biases are large compared with the filter's final σ
     assert np.all(np.abs(res.bias_true[:, -1]) > 3 * res.sigma[:, -1, 9:15])
@@ -21,7 +21,7 @@ def test_one_run_all_six_biases_within_3_sigma_after_60s():
 
 @pytest.fixture(scope="module")
 def hexapod20():
-    return hybrid.hexapod(20, progress=False)
+    return cai.hexapod(20, progress=False)
 
 
 @pytest.mark.slow

@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from atomnav.cai import hybrid
+from atomnav import cai
 from atomnav.filter import riccati_scalar
 
 TABLE1_A = 4.82e-20  # seed 000 Table 1, case A, (m/s²)²
@@ -11,18 +11,18 @@ TABLE1_A = 4.82e-20  # seed 000 Table 1, case A, (m/s²)²
 
 @pytest.fixture(scope="module", params=[pytest.param(0.5, id="12-hours"), pytest.param(4.0, id="4-days", marks=pytest.mark.slow)])
 def sat(request):
-    return hybrid.satellite(request.param, progress=False)
+    return cai.satellite(request.param, progress=False)
 
 
 def test_steady_state_bias_variance_matches_table1(sat):
-    st = hybrid.satellite_steady_state(sat)
+    st = cai.satellite_steady_state(sat)
     assert 0.5 <= st["filter_p_post"] / TABLE1_A <= 2.0, st
     # same Q, R, H as the paper's case A: the scalar Riccati root is the printed value
     assert abs(riccati_scalar(1e-20, 1.024e-3, st["H"])[1] / TABLE1_A - 1) < 0.01
 
 
 def test_filtered_psd_equals_imu_above_0p1_hz_and_is_flattened_below(sat):
-    psd = hybrid.satellite_psd(sat, nperseg=2**14)
+    psd = cai.satellite_psd(sat, nperseg=2**14)
     f = psd["frequency_hz"].to_numpy()
     ratio = (psd["filtered_asd"] / psd["imu_asd"]).to_numpy() ** 2
     hi = f > 0.1

@@ -151,18 +151,10 @@ class Trajectory:
         if off.size:
             raise ValueError(f"nav: time stamp {tn[off[0]]} at index {off[0]} is not a time stamp of the trajectory")
         truth, est = self.df.iloc[idx], nav
-        from .earth import lla_to_ecef
-        from .rotation import quat_multiply, rotvec_from_quat
-
-        lla_t = truth[["lat_rad", "lon_rad", "h_m"]].to_numpy()
-        d_ecef = lla_to_ecef(est[["lat_rad", "lon_rad", "h_m"]].to_numpy(), self.ellipsoid) - lla_to_ecef(lla_t, self.ellipsoid)
-        d_ned = np.einsum("nji,nj->ni", _dcm_ned_to_ecef_vec(lla_t), d_ecef.reshape(-1, 3))
-        dv = est[["vn_mps", "ve_mps", "vd_mps"]].to_numpy() - truth[["vn_mps", "ve_mps", "vd_mps"]].to_numpy()
-        # C_est C_trueᵀ = I − [ψ×]  ⇒  ψ = −rotvec(q_est ⊗ q_true*)
-        qt = truth[["qw", "qx", "qy", "qz"]].to_numpy() * np.array([1, -1, -1, -1])
-        psi = -np.reshape(rotvec_from_quat(quat_multiply(est[["qw", "qx", "qy", "qz"]].to_numpy(), qt)), (-1, 3))
-        cols = ["time_s", "dpos_n_m", "dpos_e_m", "dpos_d_m", "dvel_n_mps", "dvel_e_mps", "dvel_d_mps", "psi_n_rad", "psi_e_rad", "psi_d_rad"]
-        return pd.DataFrame(np.column_stack([tn, d_ned, dv, psi]), columns=cols)
+        lla, vel, q = (["lat_rad", "lon_rad", "h_m"], ["vn_mps", "ve_mps", "vd_mps"], ["qw", "qx", "qy", "qz"])
+        arrays = [np.ascontiguousarray(df[c].to_numpy(float)) for df in (est, truth) for c in (lla, vel, q)]
+        err = _core.nav_errors(*arrays, ellipsoid=self.ellipsoid)
+        return pd.DataFrame(np.column_stack([tn, err]), columns=["time_s", *_core.NAV_ERROR_COLUMNS])
 
     def plot(self, ax=None):
         """Ground track (east vs north, m, relative to the start) coloured by time."""
@@ -178,14 +170,6 @@ class Trajectory:
         ax.set_aspect("equal", adjustable="datalim")
         ax.figure.colorbar(sc, ax=ax, label="time (s)")
         return ax
-
-
-def _dcm_ned_to_ecef_vec(lla: np.ndarray) -> np.ndarray:
-    """C_n^e for every row of (lat, lon, h): (N, 3, 3), spec gnss-ins-tight Eq. 2."""
-    sl, cl = np.sin(lla[:, 0]), np.cos(lla[:, 0])
-    so, co = np.sin(lla[:, 1]), np.cos(lla[:, 1])
-    z = np.zeros_like(sl)
-    return np.stack([np.stack([-sl * co, -so, -cl * co], -1), np.stack([-sl * so, co, -cl * so], -1), np.stack([cl, z, -sl], -1)], 1)
 
 
 # ---- generators -----------------------------------------------------------------------

@@ -23,15 +23,16 @@
 //! the same convention (δl = l̂ − l, δγ = γ̂ − γ, C_sb = exp(−[γ×]) C_sb,0).
 
 use super::in_shot;
-use super::predictor::{jacobian, predict, Channel, Imu, Interpolation, OmegaDot, PredictorConfig};
+use super::predictor::{jacobian, predict, Channel, Imu, Interpolation, OmegaDot, PredictorConfig, MAX_SUBSTEPS};
+use super::readout::{population, slope, steer_mid_fringe};
 use crate::error::{check_finite, check_positive, invalid, Result};
 use crate::filter::aided::{Aiding, AidingContext, Measurement};
 use crate::filter::layout::Layout;
 use crate::imu::ImuKind;
 use crate::math::{dcm_from_quat, dcm_from_rotvec, Mat3, Vec3};
+use crate::options::Choice;
 use crate::strapdown::NavState;
 use nalgebra::{DMatrix, DVector};
-use std::f64::consts::{FRAC_PI_2, TAU};
 
 /// Names of the optional extra state blocks (after the 15 INS states).
 pub const MISALIGNMENT_BLOCK: &str = "cai_misalignment";
@@ -49,6 +50,57 @@ pub enum CaiData {
     Recorded { population: Vec<f64>, laser_phase: Vec<f64> },
 }
 
+/// The kind of the shots' data (option `data_kind`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum DataKind {
+    Emulated,
+    Recorded,
+}
+
+impl Choice for DataKind {
+    const PARAMETER: &'static str = "data_kind";
+    const CHOICES: &'static [(&'static str, Self)] = &[("emulated", DataKind::Emulated), ("recorded", DataKind::Recorded)];
+}
+
+impl DataKind {
+    /// Parameter names of the two (shots × channels) tables of this kind.
+    pub fn tables(self) -> (&'static str, &'static str) {
+        match self {
+            DataKind::Emulated => ("phase", "noise"),
+            DataKind::Recorded => ("population", "laser_phase"),
+        }
+    }
+}
+
+impl CaiData {
+    /// The data of `kind` from its two row-major tables `a`, `b` of `width_a`, `width_b`
+    /// columns, checked against the `channels` interferometers of the configuration (the
+    /// number of shots is checked by [`CaiAiding::new`]).
+    pub fn new(kind: DataKind, a: Vec<f64>, b: Vec<f64>, (width_a, width_b): (usize, usize), channels: usize) -> Result<Self> {
+        let (na, nb) = kind.tables();
+        if let Some((name, w)) = [(na, width_a), (nb, width_b)].into_iter().find(|&(_, w)| w != channels) {
+            return Err(invalid(name, format!("has {w} interferometers per shot, but the configuration has {channels}")));
+        }
+        Ok(match kind {
+            DataKind::Emulated => CaiData::Emulated { phase: a, noise: b },
+            DataKind::Recorded => CaiData::Recorded { population: a, laser_phase: b },
+        })
+    }
+}
+
+/// The name of a force mode (option `force`); option a carries its Gauss–Markov parameters
+/// separately (see [`ForceMode::new`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum ForceKind {
+    Bias,
+    Direct,
+}
+
+impl Choice for ForceKind {
+    const PARAMETER: &'static str = "force";
+    const CHOICES: &'static [(&'static str, Self)] = &[("bias", ForceKind::Bias), ("direct", ForceKind::Direct)];
+}
+
 /// How the CAI corrects the IMU (seed 000 (E11)).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum ForceMode {
@@ -59,6 +111,23 @@ pub enum ForceMode {
     /// entering the velocity like a bias (δv̇ = −Ĉ_b^n δf); the accelerometer-bias columns
     /// of H are zero, so nothing is fed back into the bias estimate.
     Direct { tau: f64, sigma: f64 },
+}
+
+impl ForceMode {
+    /// The force mode `kind`; "direct" needs the correlation time `tau` (s) and σ `sigma`
+    /// (m/s²) of the force error, "bias" refuses them (it would ignore them).
+    pub fn new(kind: ForceKind, tau: Option<f64>, sigma: Option<f64>) -> Result<Self> {
+        match (kind, tau, sigma) {
+            (ForceKind::Bias, None, None) => Ok(ForceMode::Bias),
+            (ForceKind::Bias, _, _) => Err(invalid("force", "force_tau and force_sigma are given, but force = 'bias' would ignore them; choose force = 'direct'")),
+            (ForceKind::Direct, Some(tau), Some(sigma)) => {
+                check_positive("force_tau", tau)?;
+                check_positive("force_sigma", sigma)?;
+                Ok(ForceMode::Direct { tau, sigma })
+            }
+            (ForceKind::Direct, _, _) => Err(invalid("force", "force = 'direct' needs force_tau (s) and force_sigma (m/s²)")),
+        }
+    }
 }
 
 /// Configuration of the CAI aiding.
@@ -121,21 +190,21 @@ pub struct CaiAiding {
     pub log: ShotLog,
 }
 
-/// Samples kept before a shot start for the interpolation stencils (the Savitzky–Golay
-/// window may need more, see `CaiAiding::pad`).
-const PAD: usize = 3;
+/// Largest number of shots a schedule may hold (checked before allocating it).
+pub const MAX_SHOTS: usize = 100_000_000;
 
 /// Shot start times t0, t0 + period, ... with the last shot ending (t_s + 2T) no later
-/// than `t_end`; period = 2T + dead time.
-pub fn shot_times(t0: f64, t_end: f64, t_sep: f64, dead_time: f64) -> Result<Vec<f64>> {
+/// than `t_end`; `period` (s) between shot starts is at least 2T (2T = no dead time).
+pub fn shot_times(t0: f64, t_end: f64, t_sep: f64, period: f64) -> Result<Vec<f64>> {
     check_positive("T", t_sep)?;
-    if !(dead_time.is_finite() && dead_time >= 0.0) {
-        return Err(invalid("dead_time", format!("must be finite and >= 0, got {dead_time}")));
+    if !(period.is_finite() && period >= 2.0 * t_sep) {
+        return Err(invalid("shot_period", format!("must be >= 2T = {} s (shots must not overlap), got {period}", 2.0 * t_sep)));
     }
-    check_finite("t0", &[t0, t_end], 1)?;
-    let period = 2.0 * t_sep + dead_time;
-    let n = ((t_end - t0 - 2.0 * t_sep) / period + 1e-9).floor();
-    Ok((0..(n.max(-1.0) + 1.0) as usize).map(|i| t0 + i as f64 * period).collect())
+    check_finite("t0", &[t0], 1)?;
+    check_finite("t_end", &[t_end], 1)?;
+    let n = ((t_end - t0 - 2.0 * t_sep) / period + 1e-9).floor().max(-1.0) + 1.0;
+    let n = crate::error::check_count("t_end", n as usize, 0, MAX_SHOTS)?;
+    Ok((0..n).map(|i| t0 + i as f64 * period).collect())
 }
 
 impl CaiConfig {
@@ -145,8 +214,11 @@ impl CaiConfig {
         if self.channels.is_empty() {
             return Err(invalid("channels", "at least one interferometer channel is required"));
         }
-        if self.substeps == 0 {
-            return Err(invalid("substeps", "must be >= 1"));
+        if !(1..=MAX_SUBSTEPS).contains(&self.substeps) {
+            return Err(invalid("substeps", format!("must be in [1, {MAX_SUBSTEPS}], got {}", self.substeps)));
+        }
+        if let OmegaDot::Given(_) = self.omega_dot {
+            return Err(invalid("omega_dot", "'given' needs per-sample values, which the aiding does not have; choose zero, pwl or savgol"));
         }
         check_positive("sigma_p", self.sigma_p)?;
         check_positive("contrast", self.contrast)?;
@@ -172,11 +244,49 @@ impl CaiConfig {
         // the predictor validates the channels on its first call; do it now instead
         let probe_t = [0.0, 2.0 * self.t_sep];
         let z = [Vec3::zeros(); 2];
-        let probe = PredictorConfig { omega_dot: OmegaDot::Zero, ..CaiAiding::predictor_config(self) };
+        let probe = PredictorConfig { omega_dot: OmegaDot::Zero, ..self.predictor() };
         predict(Imu { t: &probe_t, f: &z, w: &z }, &[0.0], &self.channels, &probe)?;
         Ok(())
     }
+
+    /// The predictor of this CAI at the nominal point (no gravity gradient, zero bias
+    /// estimates: the aiding hands it the bias-compensated stream).
+    pub fn predictor(&self) -> PredictorConfig {
+        PredictorConfig {
+            t_sep: self.t_sep,
+            substeps: self.substeps,
+            gradient: None,
+            bias_a: Vec3::zeros(),
+            bias_g: Vec3::zeros(),
+            omega_dot: self.omega_dot.clone(),
+            interpolation: self.interpolation,
+        }
+    }
+
+    /// In-shot IMU noise of one shot on a regular record of spacing `dt` (s), samples from
+    /// the interpolation / ω̇ window before the shot to its end (as the aiding holds them),
+    /// white PSDs `q_a` (m²/s³), `q_g` (rad²/s): the phase covariance Σ (channels ×
+    /// channels, rad²) and, for each 15-state model `f` held over a filter step of one shot,
+    /// E[w δφ̂ᵀ] (15 × channels) (see `in_shot.rs`).
+    pub fn in_shot_noise(&self, dt: f64, q_a: f64, q_g: f64, f: &[DMatrix<f64>]) -> Result<(DMatrix<f64>, Vec<DMatrix<f64>>)> {
+        check_positive("dt", dt)?;
+        for (name, q) in [("q_a", q_a), ("q_g", q_g)] {
+            if !(q.is_finite() && q >= 0.0) {
+                return Err(invalid(name, format!("must be finite and >= 0, got {q}")));
+            }
+        }
+        let pad = self.omega_dot.pad();
+        let n = crate::error::check_count("dt", ((2.0 * self.t_sep / dt + 1e-9).floor() as usize).saturating_add(pad + 1), 2, MAX_SHOT_SAMPLES)?;
+        let t: Vec<f64> = (0..n).map(|i| (i as f64 - pad as f64) * dt).collect();
+        let sens = in_shot::sensitivity(&t, 0.0, &self.channels, &self.predictor())?;
+        let sigma = in_shot::covariance(&t, &sens, q_a, q_g, self.channels.len());
+        let cross = f.iter().map(|fk| in_shot::cross_covariance(fk, &t, 0.0, self.t_sep, &sens, q_a, q_g)).collect::<Result<_>>()?;
+        Ok((sigma, cross))
+    }
 }
+
+/// Largest number of IMU samples in one shot accepted by [`CaiConfig::in_shot_noise`].
+pub const MAX_SHOT_SAMPLES: usize = 1_000_000;
 
 impl CaiAiding {
     pub fn new(cfg: CaiConfig, data: CaiData) -> Result<Self> {
@@ -217,18 +327,6 @@ impl CaiAiding {
 
     pub fn config(&self) -> &CaiConfig {
         &self.cfg
-    }
-
-    fn predictor_config(cfg: &CaiConfig) -> PredictorConfig {
-        PredictorConfig {
-            t_sep: cfg.t_sep,
-            substeps: cfg.substeps,
-            gradient: None,
-            bias_a: Vec3::zeros(),
-            bias_g: Vec3::zeros(),
-            omega_dot: cfg.omega_dot.clone(),
-            interpolation: cfg.interpolation,
-        }
     }
 
     /// Channels with the current lever-arm and misalignment estimates applied.
@@ -279,19 +377,10 @@ impl CaiAiding {
                 return Ok(sigma.clone());
             }
         }
-        let sens = in_shot::sensitivity(&self.buf_t, ts, &self.cfg.channels, &Self::predictor_config(&self.cfg))?;
+        let sens = in_shot::sensitivity(&self.buf_t, ts, &self.cfg.channels, &self.cfg.predictor())?;
         let sigma = in_shot::covariance(&self.buf_t, &sens, qa, qg, m);
         self.noise_cache = Some((offsets, sigma.clone()));
         Ok(sigma)
-    }
-
-    /// Samples to keep before a shot start: the interpolation stencil, or a whole
-    /// Savitzky–Golay window (2m + 1 samples) so that ω̇ near the shot start is centred.
-    fn pad(&self) -> usize {
-        match self.cfg.omega_dot {
-            OmegaDot::Savgol { half_width } => PAD.max(2 * half_width + 1),
-            _ => PAD,
-        }
     }
 
     /// Drop the samples no later shot needs.
@@ -300,7 +389,7 @@ impl CaiAiding {
             // the same rounding margin as the shot times, so that a sample on the next shot's
             // start is never dropped and the kept window (and the noise cache key) is the same
             // for every shot
-            Some(ts) => self.buf_t.partition_point(|&t| t < ts - 1e-9 * self.cfg.t_sep).saturating_sub(self.pad()),
+            Some(ts) => self.buf_t.partition_point(|&t| t < ts - 1e-9 * self.cfg.t_sep).saturating_sub(self.cfg.omega_dot.pad()),
             None => self.buf_t.len(),
         };
         self.buf_t.drain(..keep_from);
@@ -323,27 +412,27 @@ impl CaiAiding {
         }
         let channels = self.current_channels(layout, extra);
         let imu = Imu { t: &self.buf_t, f: &self.buf_f, w: &self.buf_w };
-        let pcfg = Self::predictor_config(&self.cfg);
+        let pcfg = self.cfg.predictor();
         let phi_nom: Vec<f64> = predict(imu, &[ts], &channels, &pcfg)?.iter().map(|r| r[0]).collect();
         let jac = self.phase_jacobian(&jacobian(imu, &[ts], &channels, &pcfg, self.cfg.jacobian_euler)?, layout)?;
         let best = DVector::from_vec(phi_nom.clone()) - &jac * x;
         let m = channels.len();
-        let (o, half_c) = (self.cfg.offset, 0.5 * self.cfg.contrast);
+        let (o, c) = (self.cfg.offset, self.cfg.contrast);
         let mut z = Vec::with_capacity(m);
         let mut gain = Vec::with_capacity(m);
-        for c in 0..m {
-            let idx = j * m + c;
+        for ch in 0..m {
+            let idx = j * m + ch;
             let (phi0, p, err) = match &self.data {
                 CaiData::Emulated { phase, noise } => {
-                    let phi0 = (FRAC_PI_2 - best[c]).rem_euclid(TAU);
-                    (phi0, o - half_c * (phase[idx] + phi0).cos() + noise[idx], phase[idx] - best[c])
+                    let phi0 = steer_mid_fringe(best[ch]);
+                    (phi0, population(o, c, phase[idx] + phi0) + noise[idx], phase[idx] - best[ch])
                 }
                 CaiData::Recorded { population, laser_phase } => (laser_phase[idx], population[idx], f64::NAN),
             };
-            let arg = phi_nom[c] + phi0;
-            z.push(o - half_c * arg.cos() - p);
-            gain.push(half_c * arg.sin());
-            self.log.predicted.push(best[c]);
+            let arg = phi_nom[ch] + phi0;
+            z.push(population(o, c, arg) - p);
+            gain.push(slope(c, arg));
+            self.log.predicted.push(best[ch]);
             self.log.phase_error.push(err);
             self.log.laser_phase.push(phi0);
             self.log.population.push(p);
@@ -589,9 +678,61 @@ mod tests {
 
     #[test]
     fn shot_times_respect_rate_and_dead_time() {
-        let s = shot_times(0.0, 1.0, 0.025, 0.05).unwrap();
+        let s = shot_times(0.0, 1.0, 0.025, 0.1).unwrap();
         assert_eq!(s.len(), 10);
         assert!((s[9] - 0.9).abs() < 1e-12);
-        assert!(shot_times(0.0, 1.0, 0.025, -1.0).is_err());
+        // no dead time: 0, 0.05, ..., 0.95 (the last ends at 1.0)
+        assert_eq!(shot_times(0.0, 1.0, 0.025, 0.05).unwrap().len(), 20);
+        assert!(shot_times(0.0, 0.04, 0.025, 0.05).unwrap().is_empty());
+        let e = shot_times(0.0, 1.0, 0.025, 0.04).unwrap_err().to_string();
+        assert!(e.starts_with("shot_period: must be >= 2T"), "{e}");
+        assert!(shot_times(0.0, 1e300, 0.025, 0.05).is_err());
+    }
+
+    /// One predictor configuration: the aiding's is the sensor's (T, substeps, ω̇,
+    /// interpolation) at zero biases without gradient.
+    #[test]
+    fn predictor_config_is_the_sensors() {
+        let mut cfg = config(cyclic(Vec3::zeros(), Mat3::identity()), vec![]);
+        cfg.omega_dot = OmegaDot::Savgol { half_width: 4 };
+        cfg.interpolation = Interpolation::Cubic;
+        let p = cfg.predictor();
+        assert_eq!((p.t_sep, p.substeps, p.interpolation), (0.025, 2, Interpolation::Cubic));
+        assert_eq!(p.omega_dot, OmegaDot::Savgol { half_width: 4 });
+        assert!(p.gradient.is_none() && p.bias_a == Vec3::zeros() && p.bias_g == Vec3::zeros());
+        // the in-shot grid keeps the whole Savitzky–Golay window (2m + 1 = 9 samples) before the shot
+        assert_eq!(p.omega_dot.pad(), 9);
+        assert_eq!(OmegaDot::Pwl.pad(), 3);
+    }
+
+    /// The in-shot covariance on the sampled grid equals the aiding's R inflation of the
+    /// same shot (`inflated_r_matches_in_shot_noise_values`: both from `in_shot.rs` on the
+    /// 200 Hz grid), and bad PSDs or sample intervals are refused by name.
+    #[test]
+    fn in_shot_noise_checks_and_matches_the_sampled_closed_form() {
+        let cfg = config(cyclic(Vec3::zeros(), Mat3::identity()), vec![]);
+        let (sa, sg) = (0.1838f64, 0.2994f64);
+        let sampled = (2.0 * 30.0 + (5.0f64 - 1.0 / 3.0).powi(2) + 1.0 / 18.0) / (2.0 * 125.0 / 3.0);
+        let (sigma, cross) = cfg.in_shot_noise(0.005, 1.25e-11, 1.0576e-12, &[]).unwrap();
+        assert!(cross.is_empty());
+        assert!((sigma[(0, 0)] / (sampled * (sa * sa + sg * sg)) - 1.0).abs() < 1e-3, "{}", sigma[(0, 0)]);
+        for (dt, qa, qg, field) in [(0.0, 1.0, 1.0, "dt"), (0.005, -1.0, 1.0, "q_a"), (0.005, 1.0, f64::NAN, "q_g"), (1e-12, 1.0, 1.0, "dt")] {
+            let e = cfg.in_shot_noise(dt, qa, qg, &[]).unwrap_err().to_string();
+            assert!(e.starts_with(&format!("{field}:")), "{e}");
+        }
+    }
+
+    #[test]
+    fn options_by_name() {
+        assert_eq!(ForceMode::new(ForceKind::Bias, None, None).unwrap(), ForceMode::Bias);
+        assert_eq!(ForceMode::new(ForceKind::Direct, Some(0.05), Some(1e-4)).unwrap(), ForceMode::Direct { tau: 0.05, sigma: 1e-4 });
+        assert!(ForceMode::new(ForceKind::Direct, Some(0.05), None).unwrap_err().to_string().starts_with("force:"));
+        assert!(ForceMode::new(ForceKind::Direct, Some(-1.0), Some(1.0)).unwrap_err().to_string().starts_with("force_tau:"));
+        assert!(ForceMode::new(ForceKind::Bias, Some(1.0), None).is_err());
+        let e = CaiData::new(DataKind::Recorded, vec![], vec![], (6, 5), 6).unwrap_err().to_string();
+        assert!(e.starts_with("laser_phase: has 5 interferometers"), "{e}");
+        assert!(matches!(CaiData::new(DataKind::Emulated, vec![], vec![], (6, 6), 6), Ok(CaiData::Emulated { .. })));
+        assert_eq!(DataKind::parse("recorded"), Ok(DataKind::Recorded));
+        assert!(ForceKind::parse("both").unwrap_err().to_string().starts_with("force: unknown option"));
     }
 }

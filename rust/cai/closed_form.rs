@@ -1,7 +1,38 @@
 //! Constant-input closed forms of the CAI phase (spec `atom-strapdown-tennstedt2023.md`
 //! (E10), (E11); spec `cai-ekf-tennstedt2021.md` (E9), (E10)).
 
+use crate::error::{check_positive, invalid, Result};
 use crate::math::{skew, Mat3, Vec3};
+use crate::options::Choice;
+
+/// Which closed form (option `kind`): "exact" (E10), "series" (E11) or "seed000" (P-52).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum ClosedForm {
+    Exact,
+    Series,
+    Seed000,
+}
+
+impl Choice for ClosedForm {
+    const PARAMETER: &'static str = "kind";
+    const CHOICES: &'static [(&'static str, Self)] = &[("exact", ClosedForm::Exact), ("series", ClosedForm::Series), ("seed000", ClosedForm::Seed000)];
+}
+
+/// The closed form `kind` per channel (rows of `k` rad/m and `v0` m/s) for constant rate
+/// `w` (rad/s), specific force `f` (m/s²), angular acceleration `wd` (rad/s², series only)
+/// and gradient (1/s², series only); `t` is T, or the total time T0 for "seed000" (s).
+pub fn closed_form_phases(kind: ClosedForm, k: &[Vec3], v0: &[Vec3], (w, f, wd): (&Vec3, &Vec3, &Vec3), gradient: &Mat3, t: f64) -> Result<Vec<f64>> {
+    if k.len() != v0.len() {
+        return Err(invalid("v0", format!("expected {} rows like k, got {}", k.len(), v0.len())));
+    }
+    check_positive("T", t)?;
+    let one = |(k, v): (&Vec3, &Vec3)| match kind {
+        ClosedForm::Exact => phase_constant(k, w, f, v, t),
+        ClosedForm::Series => phase_series(k, w, wd, f, v, gradient, t),
+        ClosedForm::Seed000 => phase_seed000(k, w, f, v, t),
+    };
+    Ok(k.iter().zip(v0).map(one).collect())
+}
 
 /// Σ_m sign^m c_m x^{2m} for a coefficient generator, summed until negligible. Used for
 /// the even power series of the rotation kernels below at small Ωt (no cancellation).
@@ -99,6 +130,18 @@ mod tests {
             let ser = phase_series(&k, &w, &Vec3::zeros(), &f, &v0, &Mat3::zeros(), 0.025);
             assert!((ser - phi).abs() < 5e-3, "series axis {j}: {ser} vs {phi}");
         }
+    }
+
+    /// The batch form is the per-channel closed form, by name, with its checks.
+    #[test]
+    fn batch_by_name() {
+        let (k, v0) = ([Vec3::new(1e7, 0.0, 0.0), Vec3::new(0.0, 1e7, 0.0)], [Vec3::new(0.0, 2.8, 0.0), Vec3::new(0.0, 0.0, 2.8)]);
+        let (w, f, wd) = (Vec3::new(0.01, 0.02, 0.03), Vec3::new(0.1, 0.2, -9.8), Vec3::zeros());
+        let got = closed_form_phases(ClosedForm::parse("seed000").unwrap(), &k, &v0, (&w, &f, &wd), &Mat3::zeros(), 0.05).unwrap();
+        assert_eq!(got[1], phase_seed000(&k[1], &w, &f, &v0[1], 0.05));
+        assert!(closed_form_phases(ClosedForm::Exact, &k, &v0[..1], (&w, &f, &wd), &Mat3::zeros(), 0.05).unwrap_err().to_string().starts_with("v0:"));
+        assert!(closed_form_phases(ClosedForm::Exact, &k, &v0, (&w, &f, &wd), &Mat3::zeros(), 0.0).unwrap_err().to_string().starts_with("T:"));
+        assert!(ClosedForm::parse("taylor").unwrap_err().to_string().starts_with("kind: unknown option"));
     }
 
     /// Series and exact kernels agree across the switch at Ωt = 1.

@@ -7,14 +7,18 @@
 
 use super::aiding::{CaiAiding, CaiConfig, CaiData};
 use super::predictor::{predict, Imu, Interpolation, OmegaDot, PredictorConfig};
-use crate::earth::Ellipsoid;
-use crate::error::{invalid, Result};
+use crate::earth::{Ellipsoid, KINEMATIC, WGS84};
+use crate::error::{check_count, check_positive, invalid, Result};
 use crate::filter::aided::{AidedConfig, AidedIns, AidedOutput, Aiding};
+use crate::filter::discretize::Discretization;
+use crate::filter::ins::{BiasModel, InsNoise};
+use crate::filter::kf::LoopMode;
 use crate::imu::errors::{ImuErrorModel, ImuSimulator};
 use crate::imu::ideal::ideal_rates;
 use crate::imu::ImuKind;
 use crate::filter::initial_error::draw_start;
-use crate::math::{quat_mul, rotvec_from_quat, Quat, Vec3};
+use crate::math::{quat_mul, Vec3};
+use crate::options::Choice;
 use crate::strapdown::{NavState, Strapdown, Vertical};
 use crate::trajectory::{Motion, TruthState};
 use nalgebra::{DMatrix, DVector};
@@ -22,6 +26,83 @@ use rand::{RngCore, SeedableRng};
 use rand_chacha::ChaCha20Rng;
 use rand_distr::{Distribution, StandardNormal};
 use rayon::prelude::*;
+
+/// Gravity of a scenario (option `gravity`): "kinematic" (no gravity, no Earth rate:
+/// Tennstedt et al. 2023's kinematic mode) or "earth" (WGS84 normal gravity and rotation).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum GravityModel {
+    Kinematic,
+    Earth,
+}
+
+impl Choice for GravityModel {
+    const PARAMETER: &'static str = "gravity";
+    const CHOICES: &'static [(&'static str, Self)] = &[("kinematic", GravityModel::Kinematic), ("earth", GravityModel::Earth)];
+}
+
+impl GravityModel {
+    /// The Earth model the truth, the IMU and the filter use under this gravity.
+    pub fn ellipsoid(self) -> Ellipsoid {
+        match self {
+            GravityModel::Kinematic => KINEMATIC,
+            GravityModel::Earth => WGS84,
+        }
+    }
+}
+
+/// The name of a phase source (option `phase_source`), see [`PhaseSource`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum PhaseSourceKind {
+    Ideal,
+    Reference,
+}
+
+impl Choice for PhaseSourceKind {
+    const PARAMETER: &'static str = "phase_source";
+    const CHOICES: &'static [(&'static str, Self)] = &[("ideal", PhaseSourceKind::Ideal), ("reference", PhaseSourceKind::Reference)];
+}
+
+/// Largest number of IMU samples of a scenario (checked before the truth is allocated).
+pub const MAX_SAMPLES: usize = 100_000_000;
+
+/// The scenario settings besides motion, IMU models, CAI and P0, checked once by
+/// [`HybridScenario::new`].
+#[derive(Clone, Debug)]
+pub struct HybridConfig {
+    pub gravity: GravityModel,
+    /// Navigation IMU rate (Hz).
+    pub rate_hz: f64,
+    /// Rate (Hz) of the truth the ideal CAI phases are computed from ([`PhaseSourceKind::Ideal`]).
+    pub truth_rate_hz: Option<f64>,
+    pub phase_source: PhaseSourceKind,
+    /// Filter noise: white PSDs (accel m²/s³, gyro rad²/s), bias random-walk PSDs (m²/s⁵, rad²/s³).
+    pub accel_psd: f64,
+    pub gyro_psd: f64,
+    pub accel_bias_psd: f64,
+    pub gyro_bias_psd: f64,
+    /// Prediction interval in IMU steps.
+    pub predict_every: usize,
+    /// With CAI updates (false: the "no hidden aiding" check).
+    pub aiding: bool,
+    /// Draw the initial navigation error from P0 (see [`HybridScenario::draw_initial`]).
+    pub draw_initial: bool,
+}
+
+impl HybridConfig {
+    /// The filter of every CAI scenario: Van Loan discretisation, closed loop, one stacked
+    /// update per shot, bias random walks (Tennstedt et al. 2023, §2.8).
+    pub fn filter(&self) -> AidedConfig {
+        let rw = |psd: f64| BiasModel::RandomWalk { psd };
+        AidedConfig {
+            noise: InsNoise { accel_psd: self.accel_psd, gyro_psd: self.gyro_psd, accel_bias: rw(self.accel_bias_psd), gyro_bias: rw(self.gyro_bias_psd) },
+            predict_every: self.predict_every,
+            method: Discretization::VanLoan,
+            mode: LoopMode::Closed,
+            sequential: false,
+            gate: None,
+        }
+    }
+}
 
 /// How the instrument's true phase is produced.
 #[derive(Clone, Debug)]
@@ -58,14 +139,9 @@ pub struct HybridScenario {
     pub draw_initial: bool,
 }
 
-/// Navigation errors estimate − truth: NED position (m), NED velocity (m/s), ψ (rad) with
-/// C_nb(est) = (I − [ψ×]) C_nb(true), i.e. ψ = −rotvec(q_est ⊗ q_true*).
-pub fn nav_error(ell: &Ellipsoid, est: &NavState, truth: &TruthState) -> [f64; 9] {
-    let dpos = ell.ecef_to_ned(&ell.lla_to_ecef(&est.lla), &truth.lla);
-    let dv = est.vel - truth.vel;
-    let qt: Quat = truth.q_nb.conjugate();
-    let psi = -rotvec_from_quat(&quat_mul(&est.q_nb, &qt));
-    [dpos.x, dpos.y, dpos.z, dv.x, dv.y, dv.z, psi.x, psi.y, psi.z]
+/// Navigation errors estimate − truth (`trajectory::nav_error`).
+fn nav_error(ell: &Ellipsoid, est: &NavState, truth: &TruthState) -> [f64; 9] {
+    crate::trajectory::nav_error(ell, (&est.lla, &est.vel, &est.q_nb), (&truth.lla, &truth.vel, &truth.q_nb))
 }
 
 /// One run, per output epoch (the engine's prediction epochs).
@@ -93,10 +169,46 @@ fn state_at(s: &TruthState) -> NavState {
 }
 
 impl HybridScenario {
+    /// The scenario of `motion` under `cfg`: truth and ideal IMU at `cfg.rate_hz`, the true
+    /// phases of the chosen source (ideal phases from a truth at `cfg.truth_rate_hz`, which
+    /// may equal the IMU rate, or a reference IMU `reference`), the filter of
+    /// [`HybridConfig::filter`]; `cai` carries the shots.
+    pub fn new(motion: &Motion, cfg: &HybridConfig, imu_model: ImuErrorModel, reference: Option<ImuErrorModel>, cai: CaiConfig, p0: nalgebra::DMatrix<f64>) -> Result<Self> {
+        let ell = cfg.gravity.ellipsoid();
+        cai.check()?;
+        imu_model.validate()?;
+        check_count("predict_every", cfg.predict_every, 1, MAX_SAMPLES)?;
+        for (name, q) in [("accel_psd", cfg.accel_psd), ("gyro_psd", cfg.gyro_psd), ("accel_bias_psd", cfg.accel_bias_psd), ("gyro_bias_psd", cfg.gyro_bias_psd)] {
+            if !(q.is_finite() && q >= 0.0) {
+                return Err(invalid(name, format!("must be finite and >= 0, got {q}")));
+            }
+        }
+        let (t, truth, f, w) = Self::imu_truth(motion, &ell, cfg.rate_hz)?;
+        let phase = match (cfg.phase_source, reference, cfg.truth_rate_hz) {
+            (PhaseSourceKind::Reference, Some(model), _) => {
+                model.validate()?;
+                PhaseSource::Reference(model)
+            }
+            (PhaseSourceKind::Reference, None, _) => return Err(invalid("reference", "required when phase_source = 'reference'")),
+            (PhaseSourceKind::Ideal, Some(_), _) => return Err(invalid("reference", "given, but phase_source = 'ideal' would ignore it")),
+            (PhaseSourceKind::Ideal, None, Some(r)) if r == cfg.rate_hz => PhaseSource::Ideal(Self::ideal_phases(motion, &ell, &t, &truth, &f, &w, &cai)?),
+            (PhaseSourceKind::Ideal, None, Some(r)) => {
+                let (tt, tr, tf, tw) = Self::imu_truth(motion, &ell, r)?;
+                PhaseSource::Ideal(Self::ideal_phases(motion, &ell, &tt, &tr, &tf, &tw, &cai)?)
+            }
+            (PhaseSourceKind::Ideal, None, None) => return Err(invalid("truth_rate_hz", "required when phase_source = 'ideal'")),
+        };
+        let n = 15 + cai_extra_states(&cai);
+        if p0.nrows() != n || p0.ncols() != n {
+            return Err(invalid("p0", format!("expected {n} × {n} (15 INS states and the CAI's extra states), got {} × {}", p0.nrows(), p0.ncols())));
+        }
+        Ok(HybridScenario { ell, t, truth, f, w, imu_model, cai, phase, filter: cfg.filter(), p0, aiding: cfg.aiding, draw_initial: cfg.draw_initial })
+    }
+
     /// Truth and ideal IMU of `motion` at `rate_hz` over its duration.
     pub fn imu_truth(motion: &Motion, ell: &Ellipsoid, rate_hz: f64) -> Result<(Vec<f64>, Vec<TruthState>, Vec<Vec3>, Vec<Vec3>)> {
-        crate::error::check_positive("rate_hz", rate_hz)?;
-        let n = (motion.duration * rate_hz + 1e-9).floor() as usize + 1;
+        check_positive("rate_hz", rate_hz)?;
+        let n = check_count("rate_hz", ((motion.duration * rate_hz + 1e-9).floor() as usize).saturating_add(1), 2, MAX_SAMPLES)?;
         let t: Vec<f64> = (0..n).map(|i| i as f64 / rate_hz).collect();
         let truth = motion.truth(ell, &t)?;
         let (f, w, _) = ideal_rates(motion, ell, &truth);
@@ -107,15 +219,7 @@ impl HybridScenario {
     /// truth samples `t`, `truth`, `f`, `w` of `motion` (ω̇ exact).
     pub fn ideal_phases(motion: &Motion, ell: &Ellipsoid, t: &[f64], truth: &[TruthState], f: &[Vec3], w: &[Vec3], cai: &CaiConfig) -> Result<Vec<f64>> {
         let (_, _, wd) = ideal_rates(motion, ell, truth);
-        let cfg = PredictorConfig {
-            t_sep: cai.t_sep,
-            substeps: 1,
-            gradient: None,
-            bias_a: Vec3::zeros(),
-            bias_g: Vec3::zeros(),
-            omega_dot: OmegaDot::Given(wd),
-            interpolation: Interpolation::Cubic,
-        };
+        let cfg = PredictorConfig { substeps: 1, omega_dot: OmegaDot::Given(wd), interpolation: Interpolation::Cubic, ..cai.predictor() };
         Ok(predict(Imu { t, f, w }, &cai.shots, &cai.channels, &cfg)?.iter().map(|r| r[0]).collect())
     }
 
@@ -129,16 +233,7 @@ impl HybridScenario {
             PhaseSource::Ideal(p) => (p.clone(), None),
             PhaseSource::Reference(model) => {
                 let r = ImuSimulator::new(model, dt, ImuKind::Rates, rng.next_u64())?.corrupt(&self.f, &self.w)?;
-                let cfg = PredictorConfig {
-                    t_sep: self.cai.t_sep,
-                    substeps: self.cai.substeps,
-                    gradient: None,
-                    bias_a: Vec3::zeros(),
-                    bias_g: Vec3::zeros(),
-                    omega_dot: self.cai.omega_dot.clone(),
-                    interpolation: self.cai.interpolation,
-                };
-                let p = predict(Imu { t: &self.t, f: &r.accel, w: &r.gyro }, &self.cai.shots, &self.cai.channels, &cfg)?;
+                let p = predict(Imu { t: &self.t, f: &r.accel, w: &r.gyro }, &self.cai.shots, &self.cai.channels, &self.cai.predictor())?;
                 (p.iter().map(|r| r[0]).collect(), Some((r.accel_bias, r.gyro_bias)))
             }
         };
@@ -213,4 +308,60 @@ impl HybridScenario {
     pub fn monte_carlo(&self, master_seed: u64, runs: &[u64]) -> Result<Vec<HybridRun>> {
         runs.par_iter().map(|&r| self.run(master_seed, r)).collect()
     }
+
+    /// [`monte_carlo`](Self::monte_carlo) as row-major tables, run by run.
+    pub fn monte_carlo_tables(&self, master_seed: u64, runs: &[u64]) -> Result<McTables> {
+        let res = self.monte_carlo(master_seed, runs)?;
+        let epochs = res.first().map_or(0, |r| r.time.len());
+        if res.iter().any(|r| r.time.len() != epochs) {
+            return Err(crate::NavError::Numerical("runs produced different numbers of epochs".into()));
+        }
+        let channels = self.cai.channels.len();
+        let flat = |get: &dyn Fn(&HybridRun) -> Vec<f64>| res.iter().flat_map(get).collect::<Vec<f64>>();
+        Ok(McTables {
+            runs: res.len(),
+            epochs,
+            states: if epochs > 0 { res[0].sigma.len() / epochs } else { 0 },
+            shots: res.first().map_or(0, |r| r.phase_error.len() / channels),
+            channels,
+            time: res.first().map_or_else(Vec::new, |r| r.time.clone()),
+            imu_time: self.t.clone(),
+            hybrid: flat(&|r| r.hybrid.iter().flatten().copied().collect()),
+            free: flat(&|r| r.free.iter().flatten().copied().collect()),
+            bias: flat(&|r| r.bias.iter().flatten().copied().collect()),
+            bias_true: flat(&|r| r.bias_true.iter().flatten().copied().collect()),
+            accel_error: flat(&|r| r.accel_error.iter().flatten().copied().collect()),
+            sigma: flat(&|r| r.sigma.clone()),
+            nees: flat(&|r| r.nees.clone()),
+            phase_error: flat(&|r| r.phase_error.clone()),
+        })
+    }
+}
+
+/// Number of extra filter states the CAI adds (misalignment, lever arm, force blocks).
+fn cai_extra_states(cai: &CaiConfig) -> usize {
+    3 * (usize::from(cai.misalignment.is_some()) + usize::from(cai.lever_arm.is_some()) + usize::from(cai.force != super::aiding::ForceMode::Bias))
+}
+
+/// Monte-Carlo results as row-major tables: `hybrid`, `free` (runs × epochs × 9),
+/// `bias`, `bias_true` (runs × epochs × 6), `sigma` (runs × epochs × states), `nees`
+/// (runs × epochs), `accel_error` (runs × IMU samples × 3), `phase_error` (runs × shots ×
+/// channels), `time` (epochs) and `imu_time` (IMU samples).
+#[derive(Clone, Debug, Default)]
+pub struct McTables {
+    pub runs: usize,
+    pub epochs: usize,
+    pub states: usize,
+    pub shots: usize,
+    pub channels: usize,
+    pub time: Vec<f64>,
+    pub imu_time: Vec<f64>,
+    pub hybrid: Vec<f64>,
+    pub free: Vec<f64>,
+    pub bias: Vec<f64>,
+    pub bias_true: Vec<f64>,
+    pub accel_error: Vec<f64>,
+    pub sigma: Vec<f64>,
+    pub nees: Vec<f64>,
+    pub phase_error: Vec<f64>,
 }

@@ -14,6 +14,7 @@ pub mod in_shot;
 pub mod noise_id;
 pub mod oracle;
 pub mod predictor;
+pub mod readout;
 pub mod sensitivity;
 
 pub use predictor::{Channel, OmegaDot, PredictorConfig};

@@ -79,6 +79,11 @@ pub enum Method {
     Newton,
 }
 
+impl crate::options::Choice for Method {
+    const PARAMETER: &'static str = "method";
+    const CHOICES: &'static [(&'static str, Self)] = &[("gradient", Method::Gradient), ("newton", Method::Newton)];
+}
+
 #[derive(Clone, Debug)]
 pub struct MlConfig {
     pub method: Method,

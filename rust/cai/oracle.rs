@@ -93,6 +93,41 @@ impl BodyMotion for SineMotion {
     }
 }
 
+impl SineMotion {
+    /// The motion of position / Euler-angle polynomial rows (3 rows c0, c1, c2, one per
+    /// axis) and sine rows [axis, amplitude, frequency Hz, phase rad], axis 0, 1 or 2.
+    pub fn from_rows(position_poly: &[[f64; 3]], position_sines: &[[f64; 4]], attitude_poly: &[[f64; 3]], attitude_sines: &[[f64; 4]]) -> Result<Self> {
+        for (name, p) in [("position_poly", position_poly), ("attitude_poly", attitude_poly)] {
+            if p.len() != 3 {
+                return Err(invalid(name, format!("expected shape (3, 3), got ({}, 3)", p.len())));
+            }
+        }
+        for (name, s) in [("position_sines", position_sines), ("attitude_sines", attitude_sines)] {
+            if let Some(i) = s.iter().position(|r| !(r[0] == 0.0 || r[0] == 1.0 || r[0] == 2.0)) {
+                return Err(crate::error::invalid_at(name, i, "axis column must be 0, 1 or 2"));
+            }
+        }
+        let signal = |poly: &[f64; 3], sines: &[[f64; 4]], axis: usize| Signal {
+            poly: *poly,
+            sines: sines.iter().filter(|r| r[0] as usize == axis).map(|r| (r[1], r[2], r[3])).collect(),
+        };
+        Ok(SineMotion {
+            position: [0, 1, 2].map(|a| signal(&position_poly[a], position_sines, a)),
+            euler: [0, 1, 2].map(|a| signal(&attitude_poly[a], attitude_sines, a)),
+        })
+    }
+}
+
+impl YawDrive {
+    /// Forward speed (m/s), yaw-rate amplitude (rad/s) and period (s, > 0) of the yaw rate.
+    pub fn new(speed: f64, yaw_rate_amplitude: f64, period: f64) -> Result<Self> {
+        crate::error::check_finite("speed", &[speed], 1)?;
+        crate::error::check_finite("yaw_rate_amplitude", &[yaw_rate_amplitude], 1)?;
+        crate::error::check_positive("period", period)?;
+        Ok(YawDrive { speed, yaw_rate_amplitude, period })
+    }
+}
+
 /// Seed-003 Fig. 7 drive (spec §2.8 `fig7_yaw_sine`): constant forward speed V along the
 /// body x axis, level, yaw rate ω_z = A sin(2πt/P), yaw ψ = A P/(2π)(1 − cos(2πt/P)).
 #[derive(Clone, Debug)]

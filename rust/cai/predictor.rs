@@ -20,6 +20,7 @@
 
 use crate::error::{check_finite, check_increasing, check_positive, invalid, Result};
 use crate::math::{dcm_from_rotvec, Mat3, Vec3};
+use crate::options::Choice;
 
 /// One interferometer channel: effective wave vector k (rad/m, in s), lever arm l from the
 /// IMU to the release point (m, in b), C_sb (rotation b → s, may carry misalignment) and
@@ -49,6 +50,68 @@ pub enum OmegaDot {
     Given(Vec<Vec3>),
 }
 
+/// The name of an ω̇ source (option `omega_dot`); the Savitzky–Golay half width and the
+/// given samples travel as separate typed values (see [`OmegaDot::new`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum OmegaDotKind {
+    Zero,
+    Pwl,
+    Savgol,
+    Given,
+}
+
+impl Choice for OmegaDotKind {
+    const PARAMETER: &'static str = "omega_dot";
+    const CHOICES: &'static [(&'static str, Self)] =
+        &[("zero", OmegaDotKind::Zero), ("pwl", OmegaDotKind::Pwl), ("savgol", OmegaDotKind::Savgol), ("given", OmegaDotKind::Given)];
+}
+
+/// Samples kept before a shot start for the interpolation stencils (cubic Hermite tangents
+/// reach one sample further than the interval; the Savitzky–Golay window may need more).
+const STENCIL_PAD: usize = 3;
+
+/// Largest Savitzky–Golay half width accepted (a window of 2m + 1 samples).
+pub const MAX_SAVGOL_HALF_WIDTH: usize = 1000;
+/// Largest number of RK4 steps per grid interval accepted.
+pub const MAX_SUBSTEPS: usize = 1000;
+
+impl OmegaDot {
+    /// The ω̇ source `kind` with its parameters: the half width m ≥ 1 of a Savitzky–Golay
+    /// window, the per-sample values (rad/s², body frame) of `Given` (required by it and
+    /// refused by the other kinds, which would ignore them).
+    pub fn new(kind: OmegaDotKind, savgol_half_width: usize, given: Option<Vec<Vec3>>) -> Result<Self> {
+        if kind == OmegaDotKind::Savgol && !(1..=MAX_SAVGOL_HALF_WIDTH).contains(&savgol_half_width) {
+            return Err(invalid("savgol_half_width", format!("must be in [1, {MAX_SAVGOL_HALF_WIDTH}], got {savgol_half_width}")));
+        }
+        match (kind, given) {
+            (OmegaDotKind::Given, Some(wd)) => Ok(OmegaDot::Given(wd)),
+            (OmegaDotKind::Given, None) => Err(invalid("angular_acceleration", "required when omega_dot = 'given'")),
+            (other, Some(_)) => Err(invalid("angular_acceleration", format!("given, but omega_dot = '{}' would ignore it", other.name()))),
+            (OmegaDotKind::Zero, None) => Ok(OmegaDot::Zero),
+            (OmegaDotKind::Pwl, None) => Ok(OmegaDot::Pwl),
+            (OmegaDotKind::Savgol, None) => Ok(OmegaDot::Savgol { half_width: savgol_half_width }),
+        }
+    }
+
+    /// The ω̇ source `kind` of a consumer without per-sample values (the CAI aiding):
+    /// "given" is refused under `omega_dot`.
+    pub fn without_samples(kind: OmegaDotKind, savgol_half_width: usize) -> Result<Self> {
+        if kind == OmegaDotKind::Given {
+            return Err(invalid("omega_dot", "'given' needs per-sample values, which the aiding does not have; choose zero, pwl or savgol"));
+        }
+        Self::new(kind, savgol_half_width, None)
+    }
+
+    /// Samples needed before a shot start: the interpolation stencil, or a whole
+    /// Savitzky–Golay window (2m + 1 samples) so that ω̇ near the shot start is centred.
+    pub fn pad(&self) -> usize {
+        match self {
+            OmegaDot::Savgol { half_width } => STENCIL_PAD.max(2 * half_width + 1),
+            _ => STENCIL_PAD,
+        }
+    }
+}
+
 /// Interpolation of the IMU samples between sample times.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Interpolation {
@@ -58,6 +121,24 @@ pub enum Interpolation {
     /// Cubic Hermite with central-difference tangents (Catmull–Rom on non-uniform grids,
     /// one-sided at the record ends): error ∝ h⁴ for smooth signals.
     Cubic,
+}
+
+impl Choice for Interpolation {
+    const PARAMETER: &'static str = "interpolation";
+    const CHOICES: &'static [(&'static str, Self)] = &[("linear", Interpolation::Linear), ("cubic", Interpolation::Cubic)];
+}
+
+/// Channels from per-channel rows: k (rad/m), lever (m), C_sb (3 × 3 each), v0 (m/s), all
+/// of the same count.
+pub fn channels_from_rows(k: &[Vec3], lever: &[Vec3], c_sb: &[nalgebra::DMatrix<f64>], v0: &[Vec3]) -> Result<Vec<Channel>> {
+    let n = k.len();
+    if lever.len() != n || v0.len() != n || c_sb.len() != n {
+        return Err(invalid("channels", format!("k, lever, v0 must be (C, 3) and c_sb (C, 3, 3) with the same C = {n}")));
+    }
+    if let Some(j) = c_sb.iter().position(|c| c.shape() != (3, 3)) {
+        return Err(crate::error::invalid_at("c_sb", j, "expected a 3 × 3 rotation per channel"));
+    }
+    Ok((0..n).map(|j| Channel { k: k[j], lever: lever[j], c_sb: Mat3::from_fn(|r, q| c_sb[j][(r, q)]), v0: v0[j] }).collect())
 }
 
 /// Settings shared by all shots of a record.

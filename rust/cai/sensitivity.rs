@@ -134,6 +134,19 @@ pub fn convolution_phase(p: &Pulses, k: f64, t: &[f64], a: &[f64], centres: &[f6
 }
 
 /// Ideal-pulse transfer ∫ (T − |t|) cos(ωt) dt = 4 sin²(ωT/2)/ω² (s²) (E20).
+/// Sensitivity g(t) and response f(t) of `p` at every time (s, pulse centred at 0).
+pub fn sensitivity_samples(p: &Pulses, t: &[f64]) -> Result<(Vec<f64>, Vec<f64>)> {
+    crate::error::check_finite("t", t, 1)?;
+    Ok((t.iter().map(|&x| p.g(x)).collect(), t.iter().map(|&x| p.f(x)).collect()))
+}
+
+/// [`ideal_transfer`] at every angular frequency (rad/s) for pulse separation `t_sep` (s).
+pub fn ideal_transfers(t_sep: f64, omega: &[f64]) -> Result<Vec<f64>> {
+    crate::error::check_positive("T", t_sep)?;
+    crate::error::check_finite("omega", omega, 1)?;
+    Ok(omega.iter().map(|&w| ideal_transfer(t_sep, w)).collect())
+}
+
 pub fn ideal_transfer(t_sep: f64, omega: f64) -> f64 {
     if omega == 0.0 {
         t_sep * t_sep

@@ -1,34 +1,36 @@
 //! Bindings of cai: predictor, Jacobians, oracle and analytic motions, closed forms,
-//! sensitivity function, fringe tracking and ML noise identification.
+//! sensitivity function, readout, fringe tracking, ML noise identification, the CAI
+//! sensor, the aided INS and the Monte-Carlo scenarios. Conversion only: every check and
+//! loop is in `crate::cai`.
 
-use super::convert::{Wrap, rows, to_py_rows, vec3, vec3_rows, vec3_to_py, vec_to_py, vector};
+use super::convert::{count, register_choices, rows, to_py_rows, vec3, vec3_rows, vec3_to_py, vec_to_py, vector, Wrap};
+use super::filter::{mats, AidedSetup, PyAidedIns};
 use super::imu::triad_from_dict;
 use super::trajectory::Motion;
-use super::filter::{AidedSetup, PyAidedIns};
-use crate::cai::aiding::{CaiAiding, CaiConfig, CaiData, ForceMode};
-use crate::cai::in_shot;
-use nalgebra::DVector;
-use crate::cai::hybrid::{HybridRun, HybridScenario, PhaseSource};
-use crate::earth::Ellipsoid;
-use crate::filter::aided::AidedConfig;
-use crate::filter::discretize::Discretization;
-use crate::filter::ins::{BiasModel, InsNoise};
-use crate::filter::kf::LoopMode;
+use crate::cai::aiding::{shot_times, CaiAiding, CaiConfig, CaiData, DataKind, ForceKind, ForceMode};
+use crate::cai::closed_form::{closed_form_phases, ClosedForm};
+use crate::cai::hybrid::{GravityModel, HybridConfig, HybridScenario, PhaseSourceKind};
+use crate::cai::noise_id::{fringe_track, ml_windows, FringeEkf, Method, MlConfig};
+use crate::cai::oracle::{imu_from_motion, oracle_phase, BodyMotion, Gravity, SineMotion, YawDrive};
+use crate::cai::predictor::{
+    channels_from_rows, jacobian, jacobian_fd, predict, Channel, Imu, Interpolation, OmegaDot, OmegaDotKind, PredictorConfig, JACOBIAN_PARAMS,
+    MAX_SAVGOL_HALF_WIDTH, MAX_SUBSTEPS, TERM_NAMES,
+};
+use crate::cai::readout::{populations, steer_all};
+use crate::cai::sensitivity::{convolution_phase, ideal_transfers, sensitivity_samples, Pulses};
+use crate::error::invalid;
 use crate::imu::errors::ImuErrorModel;
 use crate::imu::ImuKind;
-use crate::cai::closed_form::{phase_constant, phase_seed000, phase_series};
-use crate::cai::noise_id::{fringe_track, ml_windows, FringeEkf, Method, MlConfig};
-use crate::cai::oracle::{imu_from_motion, oracle_phase, BodyMotion, Gravity, SineMotion, Signal, YawDrive};
-use crate::cai::predictor::{jacobian, jacobian_fd, predict, Channel, Imu, Interpolation, OmegaDot, PredictorConfig, JACOBIAN_PARAMS, TERM_NAMES};
-use crate::cai::sensitivity::{convolution_phase, ideal_transfer, Pulses};
-use crate::error::invalid;
 use crate::math::{Mat3, Vec3};
-use numpy::{PyArray1, PyArray2, PyArrayMethods, PyReadonlyArray1, PyReadonlyArray2, PyReadonlyArray3, PyUntypedArrayMethods};
+use crate::options::Choice;
+use nalgebra::DVector;
+use numpy::{PyArray1, PyArray2, PyArray3, PyArrayMethods, PyReadonlyArray1, PyReadonlyArray2, PyReadonlyArray3, PyUntypedArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
 type Arr1<'py> = Bound<'py, PyArray1<f64>>;
 type Arr2<'py> = Bound<'py, PyArray2<f64>>;
+type Arr3<'py> = Bound<'py, PyArray3<f64>>;
 
 fn mat3(a: &PyReadonlyArray2<'_, f64>, field: &str) -> PyResult<Mat3> {
     let r = rows::<3>(a, field)?;
@@ -43,6 +45,11 @@ fn gradient_tensor(g: Option<PyReadonlyArray2<'_, f64>>) -> PyResult<Option<Mat3
     g.map(|g| mat3(&g, "gradient")).transpose()
 }
 
+/// A flat row-major table as an array of `shape`.
+fn cube<'py>(py: Python<'py>, flat: Vec<f64>, shape: [usize; 3]) -> PyResult<Arr3<'py>> {
+    Ok(PyArray1::from_vec(py, flat).reshape(shape)?)
+}
+
 /// Interferometer channels, validated once; shared by the predictor and the oracle.
 #[pyclass(module = "atomnav._core", frozen)]
 struct CaiChannels(Vec<Channel>);
@@ -53,13 +60,18 @@ impl CaiChannels {
     #[new]
     fn new(k: PyReadonlyArray2<'_, f64>, lever: PyReadonlyArray2<'_, f64>, c_sb: PyReadonlyArray3<'_, f64>, v0: PyReadonlyArray2<'_, f64>) -> PyResult<Self> {
         let (k, l, v) = (vec3_rows(&k, "k")?, vec3_rows(&lever, "lever")?, vec3_rows(&v0, "v0")?);
-        let s = c_sb.shape();
-        if s[0] != k.len() || s[1] != 3 || s[2] != 3 || l.len() != k.len() || v.len() != k.len() {
-            return Err(invalid("channels", format!("k, lever, v0 must be (C, 3) and c_sb (C, 3, 3) with the same C = {}", k.len())).into());
-        }
-        let c = c_sb.as_array();
-        Ok(CaiChannels((0..k.len()).map(|j| Channel { k: k[j], lever: l[j], c_sb: Mat3::from_fn(|r, q| c[[j, r, q]]), v0: v[j] }).collect()))
+        Ok(CaiChannels(channels_from_rows(&k, &l, &mats(&c_sb, "c_sb")?, &v)?))
     }
+}
+
+/// An IMU array (N, 3) read without the finiteness check: NaN in the IMU stream is
+/// reported by the predictor with the shot that uses it.
+fn raw3(a: &PyReadonlyArray2<'_, f64>, field: &str) -> PyResult<Vec<Vec3>> {
+    let s = a.shape();
+    if s[1] != 3 {
+        return Err(invalid(field, format!("expected shape (N, 3), got ({}, {})", s[0], s[1])).into());
+    }
+    Ok(a.as_array().outer_iter().map(|r| Vec3::new(r[0], r[1], r[2])).collect())
 }
 
 /// Predictor inputs, validated once at construction; `predict` and `jacobian` run on them.
@@ -83,6 +95,8 @@ impl CaiSetup {
 impl CaiSetup {
     #[new]
     #[allow(clippy::too_many_arguments)]
+    #[pyo3(signature = (t, f, w, shots, channels, t_sep, *, omega_dot, angular_acceleration, savgol_half_width, interpolation, substeps,
+        gradient, bias_a, bias_g))]
     fn new(
         t: PyReadonlyArray1<'_, f64>,
         f: PyReadonlyArray2<'_, f64>,
@@ -90,39 +104,17 @@ impl CaiSetup {
         shots: PyReadonlyArray1<'_, f64>,
         channels: &CaiChannels,
         t_sep: f64,
-        omega_dot: &str,
-        wdot: Option<PyReadonlyArray2<'_, f64>>,
-        savgol_half_width: usize,
-        interpolation: &str,
-        substeps: usize,
+        omega_dot: Wrap<OmegaDotKind>,
+        angular_acceleration: Option<PyReadonlyArray2<'_, f64>>,
+        savgol_half_width: &Bound<'_, PyAny>,
+        interpolation: Wrap<Interpolation>,
+        substeps: &Bound<'_, PyAny>,
         gradient: Option<PyReadonlyArray2<'_, f64>>,
         bias_a: PyReadonlyArray1<'_, f64>,
         bias_g: PyReadonlyArray1<'_, f64>,
     ) -> PyResult<Self> {
-        // NaN in the IMU stream is reported by the predictor with the shot that uses it, so the
-        // IMU arrays are read without the finiteness check here.
-        let raw3 = |a: &PyReadonlyArray2<'_, f64>, field: &str| -> PyResult<Vec<Vec3>> {
-            let s = a.shape();
-            if s[1] != 3 {
-                return Err(invalid(field, format!("expected shape (N, 3), got ({}, {})", s[0], s[1])).into());
-            }
-            Ok(a.as_array().outer_iter().map(|r| Vec3::new(r[0], r[1], r[2])).collect())
-        };
-        let omega_dot = match omega_dot {
-            "zero" => OmegaDot::Zero,
-            "pwl" => OmegaDot::Pwl,
-            "savgol" => OmegaDot::Savgol { half_width: savgol_half_width },
-            "given" => match &wdot {
-                Some(a) => OmegaDot::Given(raw3(a, "angular_acceleration")?),
-                None => return Err(invalid("angular_acceleration", "required when omega_dot = 'given'").into()),
-            },
-            other => return Err(invalid("omega_dot", format!("unknown option {other:?}; choose zero, pwl, savgol, given")).into()),
-        };
-        let interpolation = match interpolation {
-            "linear" => Interpolation::Linear,
-            "cubic" => Interpolation::Cubic,
-            other => return Err(invalid("interpolation", format!("unknown option {other:?}; choose linear, cubic")).into()),
-        };
+        let given = angular_acceleration.map(|a| raw3(&a, "angular_acceleration")).transpose()?;
+        let omega_dot = OmegaDot::new(omega_dot.0, count(savgol_half_width, "savgol_half_width", 0, MAX_SAVGOL_HALF_WIDTH)?, given)?;
         Ok(CaiSetup {
             t: t.as_array().iter().copied().collect(),
             f: raw3(&f, "specific_force")?,
@@ -131,46 +123,31 @@ impl CaiSetup {
             channels: channels.0.clone(),
             cfg: PredictorConfig {
                 t_sep,
-                substeps,
+                substeps: count(substeps, "substeps", 1, MAX_SUBSTEPS)?,
                 gradient: gradient_tensor(gradient)?,
                 bias_a: vec3(&bias_a, "bias_a")?,
                 bias_g: vec3(&bias_g, "bias_g")?,
                 omega_dot,
-                interpolation,
+                interpolation: interpolation.0,
             },
         })
     }
 
-    /// Predicted phases: (shots · channels, 7) array, columns total, acc, rot, cen, eul, mix, gg.
+    /// Predicted phases: (shots · channels, 7) array, columns `CAI_TERMS`.
     fn predict<'py>(&self, py: Python<'py>) -> PyResult<Arr2<'py>> {
         let out = py.detach(|| predict(self.imu(), &self.shots, &self.channels, &self.cfg))?;
         Ok(to_py_rows(py, &out))
     }
 
-    /// ∂φ/∂(b_a, b_g, l, γ): (shots · channels, 12); `fd_steps` given → central differences.
-    fn jacobian<'py>(&self, py: Python<'py>, euler: bool, fd_steps: Option<PyReadonlyArray1<'py, f64>>) -> PyResult<Arr2<'py>> {
-        let steps = match fd_steps {
-            None => None,
-            Some(s) => {
-                let v = vector(&s, "fd_steps")?;
-                if v.len() != 4 {
-                    return Err(invalid("fd_steps", format!("expected 4 steps (b_a, b_g, l, gamma), got {}", v.len())).into());
-                }
-                Some([v[0], v[1], v[2], v[3]])
-            }
-        };
-        let out = py.detach(|| match steps {
+    /// ∂φ/∂(b_a, b_g, l, γ): (shots · channels, 12); `fd_steps` (b_a, b_g, l, γ) given →
+    /// central differences.
+    #[pyo3(signature = (euler, fd_steps=None))]
+    fn jacobian<'py>(&self, py: Python<'py>, euler: bool, fd_steps: Option<(f64, f64, f64, f64)>) -> PyResult<Arr2<'py>> {
+        let out = py.detach(|| match fd_steps {
             None => jacobian(self.imu(), &self.shots, &self.channels, &self.cfg, euler),
-            Some(s) => jacobian_fd(self.imu(), &self.shots, &self.channels, &self.cfg, euler, s),
+            Some(s) => jacobian_fd(self.imu(), &self.shots, &self.channels, &self.cfg, euler, [s.0, s.1, s.2, s.3]),
         })?;
         Ok(to_py_rows(py, &out))
-    }
-}
-
-fn signal(poly: &[f64], sines: &[[f64; 4]], axis: usize) -> Signal {
-    Signal {
-        poly: [poly[0], poly[1], poly[2]],
-        sines: sines.iter().filter(|r| r[0] as usize == axis).map(|r| (r[1], r[2], r[3])).collect(),
     }
 }
 
@@ -205,23 +182,13 @@ impl CaiMotion {
     ) -> PyResult<Self> {
         let (pp, ps) = (rows::<3>(&position_poly, "position_poly")?, rows::<4>(&position_sines, "position_sines")?);
         let (ap, as_) = (rows::<3>(&attitude_poly, "attitude_poly")?, rows::<4>(&attitude_sines, "attitude_sines")?);
-        if pp.len() != 3 || ap.len() != 3 {
-            return Err(invalid("position_poly", "position_poly and attitude_poly must be (3, 3)").into());
-        }
-        for (name, s) in [("position_sines", &ps), ("attitude_sines", &as_)] {
-            if let Some(i) = s.iter().position(|r| !(r[0] == 0.0 || r[0] == 1.0 || r[0] == 2.0)) {
-                return Err(invalid(name, format!("axis column must be 0, 1 or 2 (row {i})")).into());
-            }
-        }
-        let motion = SineMotion { position: [0, 1, 2].map(|a| signal(&pp[a], &ps, a)), euler: [0, 1, 2].map(|a| signal(&ap[a], &as_, a)) };
-        Ok(CaiMotion(Box::new(motion)))
+        Ok(CaiMotion(Box::new(SineMotion::from_rows(&pp, &ps, &ap, &as_)?)))
     }
 
     /// Forward speed (m/s), yaw-rate amplitude (rad/s), period (s) of the yaw rate sine.
     #[staticmethod]
     fn yaw_drive(speed: f64, yaw_rate_amplitude: f64, period: f64) -> PyResult<Self> {
-        crate::error::check_positive("period", period)?;
-        Ok(CaiMotion(Box::new(YawDrive { speed, yaw_rate_amplitude, period })))
+        Ok(CaiMotion(Box::new(YawDrive::new(speed, yaw_rate_amplitude, period)?)))
     }
 
     /// Ideal IMU (f_b, ω_b, ω̇_b) at times t.
@@ -244,7 +211,7 @@ impl CaiMotion {
 #[allow(clippy::too_many_arguments)]
 fn cai_phase_closed_form<'py>(
     py: Python<'py>,
-    kind: &str,
+    kind: Wrap<ClosedForm>,
     k: PyReadonlyArray2<'py, f64>,
     v0: PyReadonlyArray2<'py, f64>,
     w: PyReadonlyArray1<'py, f64>,
@@ -252,28 +219,17 @@ fn cai_phase_closed_form<'py>(
     wd: PyReadonlyArray1<'py, f64>,
     gradient: Option<PyReadonlyArray2<'py, f64>>,
     t: f64,
-) -> PyResult<Bound<'py, PyArray1<f64>>> {
+) -> PyResult<Arr1<'py>> {
     let (k, v0) = (vec3_rows(&k, "k")?, vec3_rows(&v0, "v0")?);
-    if k.len() != v0.len() {
-        return Err(invalid("v0", format!("expected {} rows like k, got {}", k.len(), v0.len())).into());
-    }
     let (w, f, wd, g) = (vec3(&w, "angular_rate")?, vec3(&f, "specific_force")?, vec3(&wd, "angular_acceleration")?, gradient_tensor(gradient)?.unwrap_or_else(Mat3::zeros));
-    crate::error::check_positive("T", t)?;
-    let out: Vec<f64> = match kind {
-        "exact" => k.iter().zip(&v0).map(|(k, v)| phase_constant(k, &w, &f, v, t)).collect(),
-        "series" => k.iter().zip(&v0).map(|(k, v)| phase_series(k, &w, &wd, &f, v, &g, t)).collect(),
-        "seed000" => k.iter().zip(&v0).map(|(k, v)| phase_seed000(k, &w, &f, v, t)).collect(),
-        other => return Err(invalid("kind", format!("unknown closed form {other:?}; choose exact, series, seed000")).into()),
-    };
-    Ok(vec_to_py(py, out))
+    Ok(vec_to_py(py, closed_form_phases(kind.0, &k, &v0, (&w, &f, &wd), &g, t)?))
 }
 
 /// Sensitivity g(t) and response f(t) at times t (pulse centred at 0).
 #[pyfunction]
 fn cai_sensitivity<'py>(py: Python<'py>, t: PyReadonlyArray1<'py, f64>, t_dark: f64, tau: f64) -> PyResult<(Arr1<'py>, Arr1<'py>)> {
-    let p = Pulses::new(t_dark, tau)?;
-    let t = vector(&t, "t")?;
-    Ok((vec_to_py(py, t.iter().map(|&x| p.g(x)).collect()), vec_to_py(py, t.iter().map(|&x| p.f(x)).collect())))
+    let (g, f) = sensitivity_samples(&Pulses::new(t_dark, tau)?, &vector(&t, "t")?)?;
+    Ok((vec_to_py(py, g), vec_to_py(py, f)))
 }
 
 /// Convolution phases (E20) of shots centred at `centres`.
@@ -286,7 +242,7 @@ fn cai_convolution_phase<'py>(
     t: PyReadonlyArray1<'py, f64>,
     a: PyReadonlyArray1<'py, f64>,
     centres: PyReadonlyArray1<'py, f64>,
-) -> PyResult<Bound<'py, PyArray1<f64>>> {
+) -> PyResult<Arr1<'py>> {
     let p = Pulses::new(t_dark, tau)?;
     let (t, centres) = (vector(&t, "t")?, vector(&centres, "centres")?);
     let a: Vec<f64> = a.as_array().iter().copied().collect();
@@ -294,16 +250,41 @@ fn cai_convolution_phase<'py>(
     Ok(vec_to_py(py, out))
 }
 
-/// Closed-form area ∫f and the ideal transfer 4 sin²(ωT/2)/ω² at angular frequencies.
+/// Closed-form area ∫f of the response function.
 #[pyfunction]
 fn cai_response_area(t_dark: f64, tau: f64) -> PyResult<f64> {
     Ok(Pulses::new(t_dark, tau)?.area())
 }
 
+/// The ideal transfer 4 sin²(ωT/2)/ω² at angular frequencies ω (rad/s).
 #[pyfunction]
-fn cai_ideal_transfer<'py>(py: Python<'py>, t_sep: f64, omega: PyReadonlyArray1<'py, f64>) -> PyResult<Bound<'py, PyArray1<f64>>> {
-    crate::error::check_positive("T", t_sep)?;
-    Ok(vec_to_py(py, vector(&omega, "omega")?.iter().map(|&w| ideal_transfer(t_sep, w)).collect()))
+fn cai_ideal_transfer<'py>(py: Python<'py>, t_sep: f64, omega: PyReadonlyArray1<'py, f64>) -> PyResult<Arr1<'py>> {
+    Ok(vec_to_py(py, ideal_transfers(t_sep, &vector(&omega, "omega")?)?))
+}
+
+/// Populations o − (C/2) cos(φ) of total phases φ (rad) with contrasts C (same length).
+#[pyfunction]
+fn cai_readout<'py>(py: Python<'py>, offset: f64, contrast: PyReadonlyArray1<'py, f64>, phase: PyReadonlyArray1<'py, f64>) -> PyResult<Arr1<'py>> {
+    let (c, p) = (contrast.as_array().to_vec(), phase.as_array().to_vec());
+    Ok(vec_to_py(py, populations(offset, &c, &p)?))
+}
+
+/// Laser phases (π/2 − φ̂) mod 2π putting predicted phases φ̂ (rad) at mid-fringe.
+#[pyfunction]
+fn cai_steer_mid_fringe<'py>(py: Python<'py>, phi_hat: PyReadonlyArray1<'py, f64>) -> PyResult<Arr1<'py>> {
+    Ok(vec_to_py(py, steer_all(&phi_hat.as_array().to_vec())?))
+}
+
+/// Shot start times (s) from t0, one per `period` (≥ 2T), the last ending by t_end.
+#[pyfunction]
+fn cai_shot_times<'py>(py: Python<'py>, t0: f64, t_end: f64, t_sep: f64, period: f64) -> PyResult<Arr1<'py>> {
+    Ok(vec_to_py(py, shot_times(t0, t_end, t_sep, period)?))
+}
+
+/// The Earth model (`Ellipsoid` name) of a scenario gravity ("kinematic", "earth").
+#[pyfunction]
+fn cai_gravity_ellipsoid(gravity: Wrap<GravityModel>) -> &'static str {
+    gravity.0.ellipsoid().name
 }
 
 /// Fringe-tracking EKF: ζ = [p0, φ, A] after every readout, (N, 3).
@@ -316,7 +297,7 @@ fn cai_fringe_track<'py>(
     sigma0: PyReadonlyArray1<'py, f64>,
     q: PyReadonlyArray1<'py, f64>,
     r: f64,
-) -> PyResult<Bound<'py, PyArray2<f64>>> {
+) -> PyResult<Arr2<'py>> {
     let (z, s, q) = (vec3(&zeta0, "zeta0")?, vec3(&sigma0, "sigma0")?, vec3(&q, "q")?);
     let cfg = FringeEkf { zeta0: [z.x, z.y, z.z], sigma0: [s.x, s.y, s.z], q: [q.x, q.y, q.z], r };
     let (p, psi) = (p.as_array().to_vec(), psi.as_array().to_vec());
@@ -327,26 +308,23 @@ fn cai_fringe_track<'py>(
 /// ML noise identification over batches / a sliding window; a dict of arrays.
 #[pyfunction]
 #[allow(clippy::too_many_arguments)]
+#[pyo3(signature = (x, phi, amp, *, method, free, theta0, max_iter, tol, batch, sliding))]
 fn cai_ml_identify<'py>(
     py: Python<'py>,
     x: PyReadonlyArray1<'py, f64>,
     phi: PyReadonlyArray1<'py, f64>,
     amp: PyReadonlyArray1<'py, f64>,
-    method: &str,
+    method: Wrap<Method>,
     free: [bool; 3],
     theta0: PyReadonlyArray1<'py, f64>,
-    max_iter: usize,
+    max_iter: &Bound<'py, PyAny>,
     tol: f64,
-    batch: usize,
+    batch: &Bound<'py, PyAny>,
     sliding: bool,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let method = match method {
-        "gradient" => Method::Gradient,
-        "newton" => Method::Newton,
-        other => return Err(invalid("method", format!("unknown option {other:?}; choose gradient, newton")).into()),
-    };
     let th = vec3(&theta0, "theta0")?;
-    let cfg = MlConfig { method, free, theta0: [th.x, th.y, th.z], max_iter, tol };
+    let cfg = MlConfig { method: method.0, free, theta0: [th.x, th.y, th.z], max_iter: count(max_iter, "max_iter", 0, usize::MAX)?, tol };
+    let batch = count(batch, "batch", 0, usize::MAX)?;
     let (x, phi, amp) = (x.as_array().to_vec(), phi.as_array().to_vec(), amp.as_array().to_vec());
     let res = py.detach(|| ml_windows(&x, &phi, &amp, &cfg, batch, sliding))?;
     let d = PyDict::new(py);
@@ -360,28 +338,6 @@ fn cai_ml_identify<'py>(
     Ok(d)
 }
 
-pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
-    // column names of CaiSetup.predict / CaiSetup.jacobian (single source of truth)
-    m.add("CAI_TERMS", TERM_NAMES.to_vec())?;
-    m.add("CAI_JACOBIAN_PARAMS", JACOBIAN_PARAMS.to_vec())?;
-    m.add_class::<CaiChannels>()?;
-    m.add_class::<CaiSetup>()?;
-    m.add_class::<CaiGravity>()?;
-    m.add_class::<CaiMotion>()?;
-    m.add_class::<CaiHybrid>()?;
-    m.add_function(wrap_pyfunction!(cai_aided_ins, m)?)?;
-    m.add_function(wrap_pyfunction!(cai_in_shot_noise, m)?)?;
-    m.add_class::<CaiSensor>()?;
-    m.add_function(wrap_pyfunction!(cai_phase_closed_form, m)?)?;
-    m.add_function(wrap_pyfunction!(cai_sensitivity, m)?)?;
-    m.add_function(wrap_pyfunction!(cai_convolution_phase, m)?)?;
-    m.add_function(wrap_pyfunction!(cai_response_area, m)?)?;
-    m.add_function(wrap_pyfunction!(cai_ideal_transfer, m)?)?;
-    m.add_function(wrap_pyfunction!(cai_fringe_track, m)?)?;
-    m.add_function(wrap_pyfunction!(cai_ml_identify, m)?)?;
-    Ok(())
-}
-
 /// The triad of an IMU error model from its two dicts (as `atomnav.imu.ImuErrors._to_core`).
 fn error_model(accel: &Bound<'_, PyDict>, gyro: &Bound<'_, PyDict>, name: &str) -> PyResult<ImuErrorModel> {
     let m = ImuErrorModel { accel: triad_from_dict(accel, &format!("{name}.accel"))?, gyro: triad_from_dict(gyro, &format!("{name}.gyro"))? };
@@ -389,26 +345,9 @@ fn error_model(accel: &Bound<'_, PyDict>, gyro: &Bound<'_, PyDict>, name: &str) 
     Ok(m)
 }
 
-fn omega_dot_mode(name: &str, half_width: usize) -> PyResult<OmegaDot> {
-    match name {
-        "zero" => Ok(OmegaDot::Zero),
-        "pwl" => Ok(OmegaDot::Pwl),
-        "savgol" => Ok(OmegaDot::Savgol { half_width }),
-        other => Err(invalid("omega_dot", format!("unknown option {other:?}; choose zero, pwl, savgol")).into()),
-    }
-}
-
-fn interpolation_mode(name: &str) -> PyResult<Interpolation> {
-    match name {
-        "linear" => Ok(Interpolation::Linear),
-        "cubic" => Ok(Interpolation::Cubic),
-        other => Err(invalid("interpolation", format!("unknown option {other:?}; choose linear, cubic")).into()),
-    }
-}
-
 /// The CAI sensor as the aiding sees it (channels, T, readout, R inflation, predictor and
 /// Jacobian options, extra states, force mode), checked once; built by
-/// `atomnav.cai.hybrid.CaiSensor._native()` and taken, with their shots, by the Monte Carlo
+/// `atomnav.cai.CaiSensor._native()` and taken, with their shots, by the Monte Carlo
 /// (`CaiHybrid`), `cai_aided_ins` and `cai_in_shot_noise`.
 #[pyclass(name = "CaiSensor", module = "atomnav._core", frozen)]
 pub struct CaiSensor(CaiConfig);
@@ -417,37 +356,41 @@ pub struct CaiSensor(CaiConfig);
 impl CaiSensor {
     #[new]
     #[allow(clippy::too_many_arguments)]
-    #[pyo3(signature = (channels, t_sep, readout, inflation, omega_dot, savgol_half_width, interpolation, substeps, jacobian_euler,
-        misalignment, lever_arm, force))]
+    #[pyo3(signature = (channels, t_sep, *, offset, contrast, sigma_p, inflation, omega_dot, savgol_half_width, interpolation, substeps,
+        jacobian_euler, misalignment, lever_arm, force, force_tau, force_sigma))]
     fn new(
         channels: &CaiChannels,
         t_sep: f64,
-        readout: (f64, f64, f64),
+        offset: f64,
+        contrast: f64,
+        sigma_p: f64,
         inflation: Option<(f64, f64)>,
-        omega_dot: &str,
-        savgol_half_width: usize,
-        interpolation: &str,
-        substeps: usize,
+        omega_dot: Wrap<OmegaDotKind>,
+        savgol_half_width: &Bound<'_, PyAny>,
+        interpolation: Wrap<Interpolation>,
+        substeps: &Bound<'_, PyAny>,
         jacobian_euler: bool,
         misalignment: Option<f64>,
         lever_arm: Option<f64>,
-        force: Option<(f64, f64)>,
+        force: Wrap<ForceKind>,
+        force_tau: Option<f64>,
+        force_sigma: Option<f64>,
     ) -> PyResult<Self> {
         let cfg = CaiConfig {
             channels: channels.0.clone(),
             t_sep,
             shots: Vec::new(),
-            offset: readout.0,
-            contrast: readout.1,
-            sigma_p: readout.2,
+            offset,
+            contrast,
+            sigma_p,
             inflation,
-            omega_dot: omega_dot_mode(omega_dot, savgol_half_width)?,
-            interpolation: interpolation_mode(interpolation)?,
-            substeps,
+            omega_dot: OmegaDot::without_samples(omega_dot.0, count(savgol_half_width, "savgol_half_width", 0, MAX_SAVGOL_HALF_WIDTH)?)?,
+            interpolation: interpolation.0,
+            substeps: count(substeps, "substeps", 1, MAX_SUBSTEPS)?,
             jacobian_euler,
             misalignment,
             lever_arm,
-            force: force.map_or(ForceMode::Bias, |(tau, sigma)| ForceMode::Direct { tau, sigma }),
+            force: ForceMode::new(force.0, force_tau, force_sigma)?,
             kind: ImuKind::Rates,
         };
         cfg.check()?;
@@ -461,38 +404,21 @@ impl CaiSensor {
     }
 }
 
-/// In-shot IMU noise of one shot of `sensor` on a regular record of spacing `dt` (s)
-/// (samples from the interpolation / ω̇ window before the shot to its end, as the aiding
-/// holds them), white PSDs q_a (m²/s³), q_g (rad²/s): the phase covariance Σ (channels ×
-/// channels, rad²) and, for each 15-state model f[k] (steps, 15, 15) held over a filter
-/// step of one shot, E[w δφ̂ᵀ] (steps, 15, channels) (see cai/in_shot.rs).
+/// In-shot IMU noise of one shot of `sensor` on a regular record of spacing `dt` (s),
+/// white PSDs q_a (m²/s³), q_g (rad²/s): the phase covariance Σ (channels × channels,
+/// rad²) and, for each 15-state model f[k] (steps, 15, 15) held over a filter step of one
+/// shot, E[w δφ̂ᵀ] (steps, 15, channels) (`CaiConfig::in_shot_noise`).
 #[pyfunction]
-fn cai_in_shot_noise<'py>(py: Python<'py>, sensor: &CaiSensor, dt: f64, q_a: f64, q_g: f64, f: PyReadonlyArray3<'py, f64>) -> PyResult<(Arr2<'py>, Bound<'py, numpy::PyArray3<f64>>)> {
-    crate::error::check_positive("dt", dt)?;
-    for (name, q) in [("q_a", q_a), ("q_g", q_g)] {
-        if !(q.is_finite() && q >= 0.0) {
-            return Err(invalid(name, format!("must be finite and >= 0, got {q}")).into());
-        }
-    }
-    let cfg = &sensor.0;
-    let pad = match cfg.omega_dot { OmegaDot::Savgol { half_width } => 3.max(2 * half_width + 1), _ => 3 };
-    let n = (2.0 * cfg.t_sep / dt + 1e-9).floor() as usize + pad + 1;
-    let t: Vec<f64> = (0..n).map(|i| (i as f64 - pad as f64) * dt).collect();
-    let fs = super::filter::mats(&f, "f")?;
-    let m = cfg.channels.len();
-    let (sigma, cross) = py.detach(|| -> crate::Result<_> {
-        let pcfg = PredictorConfig { t_sep: cfg.t_sep, substeps: cfg.substeps, gradient: None, bias_a: Vec3::zeros(), bias_g: Vec3::zeros(), omega_dot: cfg.omega_dot.clone(), interpolation: cfg.interpolation };
-        let sens = in_shot::sensitivity(&t, 0.0, &cfg.channels, &pcfg)?;
-        let sigma = in_shot::covariance(&t, &sens, q_a, q_g, m);
-        let cross: Vec<_> = fs.iter().map(|fk| in_shot::cross_covariance(fk, &t, 0.0, cfg.t_sep, &sens, q_a, q_g)).collect::<crate::Result<_>>()?;
-        Ok((sigma, cross))
-    })?;
-    let flat: Vec<f64> = cross.iter().flat_map(|c| (0..15).flat_map(move |i| (0..m).map(move |j| c[(i, j)]))).collect();
-    Ok((super::convert::mat_to_py(py, &sigma), numpy::PyArray1::from_vec(py, flat).reshape([cross.len(), 15, m])?))
+fn cai_in_shot_noise<'py>(py: Python<'py>, sensor: &CaiSensor, dt: f64, q_a: f64, q_g: f64, f: PyReadonlyArray3<'py, f64>) -> PyResult<(Arr2<'py>, Arr3<'py>)> {
+    let fs = mats(&f, "f")?;
+    let (sigma, cross) = py.detach(|| sensor.0.in_shot_noise(dt, q_a, q_g, &fs))?;
+    let (n, m) = (f.shape()[1], sigma.nrows());
+    let flat: Vec<f64> = cross.iter().flat_map(|c| c.transpose().as_slice().to_vec()).collect();
+    Ok((super::convert::mat_to_py(py, &sigma), cube(py, flat, [cross.len(), n, m])?))
 }
 
-/// A CAI-aided INS scenario (truth, IMU errors, CAI, filter), built once; `monte_carlo`
-/// runs seeded runs in parallel with the GIL released.
+/// A CAI-aided INS scenario (truth, IMU errors, CAI, filter), built once by the core
+/// (`HybridScenario::new`); `monte_carlo` runs seeded runs in parallel with the GIL released.
 #[pyclass(module = "atomnav._core", frozen)]
 struct CaiHybrid(HybridScenario);
 
@@ -500,95 +426,73 @@ struct CaiHybrid(HybridScenario);
 impl CaiHybrid {
     #[new]
     #[allow(clippy::too_many_arguments)]
-    #[pyo3(signature = (motion, ellipsoid, rate_hz, truth_rate_hz, imu_accel, imu_gyro, reference, sensor, shots,
-        noise, predict_every, p0, aiding, draw_initial))]
+    #[pyo3(signature = (motion, sensor, shots, imu_accel, imu_gyro, reference, p0, *, gravity, rate_hz, truth_rate_hz, phase_source,
+        accel_psd, gyro_psd, accel_bias_psd, gyro_bias_psd, predict_every, aiding, draw_initial))]
     fn new(
         py: Python<'_>,
         motion: &Motion,
-        ellipsoid: Wrap<Ellipsoid>,
-        rate_hz: f64,
-        truth_rate_hz: Option<f64>,
+        sensor: &CaiSensor,
+        shots: PyReadonlyArray1<'_, f64>,
         imu_accel: &Bound<'_, PyDict>,
         imu_gyro: &Bound<'_, PyDict>,
         reference: Option<(Bound<'_, PyDict>, Bound<'_, PyDict>)>,
-        sensor: &CaiSensor,
-        shots: PyReadonlyArray1<'_, f64>,
-        noise: (f64, f64, f64, f64),
-        predict_every: usize,
         p0: PyReadonlyArray2<'_, f64>,
+        gravity: Wrap<GravityModel>,
+        rate_hz: f64,
+        truth_rate_hz: Option<f64>,
+        phase_source: Wrap<PhaseSourceKind>,
+        accel_psd: f64,
+        gyro_psd: f64,
+        accel_bias_psd: f64,
+        gyro_bias_psd: f64,
+        predict_every: &Bound<'_, PyAny>,
         aiding: bool,
         draw_initial: bool,
     ) -> PyResult<Self> {
-        let ell = ellipsoid.0;
+        let cfg = HybridConfig {
+            gravity: gravity.0,
+            rate_hz,
+            truth_rate_hz,
+            phase_source: phase_source.0,
+            accel_psd,
+            gyro_psd,
+            accel_bias_psd,
+            gyro_bias_psd,
+            predict_every: count(predict_every, "predict_every", 1, crate::cai::hybrid::MAX_SAMPLES)?,
+            aiding,
+            draw_initial,
+        };
         let cai = sensor.with_shots(&shots)?;
         let imu_model = error_model(imu_accel, imu_gyro, "imu")?;
         let reference = reference.map(|(a, g)| error_model(&a, &g, "reference")).transpose()?;
         let p0 = super::convert::mat(&p0, "p0")?;
         let m = &motion.inner;
-        let scenario = py.detach(|| -> crate::Result<HybridScenario> {
-            let (t, truth, f, w) = HybridScenario::imu_truth(m, &ell, rate_hz)?;
-            let phase = match (reference, truth_rate_hz) {
-                (Some(model), _) => PhaseSource::Reference(model),
-                (None, Some(r)) if r == rate_hz => PhaseSource::Ideal(HybridScenario::ideal_phases(m, &ell, &t, &truth, &f, &w, &cai)?),
-                (None, Some(r)) => {
-                    let (tt, tr, tf, tw) = HybridScenario::imu_truth(m, &ell, r)?;
-                    PhaseSource::Ideal(HybridScenario::ideal_phases(m, &ell, &tt, &tr, &tf, &tw, &cai)?)
-                }
-                (None, None) => return Err(invalid("truth_rate_hz", "required without a reference IMU")),
-            };
-            let rw = |psd: f64| BiasModel::RandomWalk { psd };
-            let filter = AidedConfig {
-                noise: InsNoise { accel_psd: noise.0, gyro_psd: noise.1, accel_bias: rw(noise.2), gyro_bias: rw(noise.3) },
-                predict_every,
-                method: Discretization::VanLoan,
-                mode: LoopMode::Closed,
-                sequential: false,
-                gate: None,
-            };
-            Ok(HybridScenario { ell, t, truth, f, w, imu_model, cai, phase, filter, p0, aiding, draw_initial })
-        })?;
-        Ok(CaiHybrid(scenario))
+        Ok(CaiHybrid(py.detach(|| HybridScenario::new(m, &cfg, imu_model, reference, cai, p0))?))
     }
 
     /// Runs `runs` under `seed`: dict of arrays, each (runs, epochs, ...) except
     /// `phase_error` (runs, shots, channels), `accel_error` (runs, samples, 3), `time`
     /// (epochs) and `imu_time` (samples).
     fn monte_carlo<'py>(&self, py: Python<'py>, seed: u64, runs: Vec<u64>) -> PyResult<Bound<'py, PyDict>> {
-        let res = py.detach(|| self.0.monte_carlo(seed, &runs))?;
+        let r = py.detach(|| self.0.monte_carlo_tables(seed, &runs))?;
+        let (nr, ne) = (r.runs, r.epochs);
         let d = PyDict::new(py);
-        let nr = res.len();
-        let ne = res.first().map_or(0, |r| r.time.len());
-        if res.iter().any(|r| r.time.len() != ne) {
-            return Err(crate::NavError::Numerical("runs produced different numbers of epochs".into()).into());
-        }
-        let cube = |w: usize, get: &dyn Fn(&HybridRun) -> Vec<f64>| -> PyResult<Bound<'py, numpy::PyArray3<f64>>> {
-            let flat: Vec<f64> = res.iter().flat_map(get).collect();
-            Ok(numpy::PyArray1::from_vec(py, flat).reshape([nr, ne, w])?)
-        };
-        d.set_item("time", vec_to_py(py, res.first().map_or_else(Vec::new, |r| r.time.clone())))?;
-        d.set_item("hybrid", cube(9, &|r| r.hybrid.iter().flatten().copied().collect())?)?;
-        d.set_item("free", cube(9, &|r| r.free.iter().flatten().copied().collect())?)?;
-        d.set_item("bias", cube(6, &|r| r.bias.iter().flatten().copied().collect())?)?;
-        d.set_item("bias_true", cube(6, &|r| r.bias_true.iter().flatten().copied().collect())?)?;
-        let ns = self.0.t.len();
-        let flat: Vec<f64> = res.iter().flat_map(|r| r.accel_error.iter().flatten().copied()).collect();
-        d.set_item("accel_error", numpy::PyArray1::from_vec(py, flat).reshape([nr, ns, 3])?)?;
-        d.set_item("imu_time", vec_to_py(py, self.0.t.clone()))?;
-        let n = if ne > 0 { res[0].sigma.len() / ne } else { 0 };
-        d.set_item("sigma", cube(n, &|r| r.sigma.clone())?)?;
-        if res.iter().all(|r| r.nees.len() == ne) {
-            d.set_item("nees", cube(1, &|r| r.nees.clone())?)?;
-        }
-        let nch = self.0.cai.channels.len();
-        let nshots = res.first().map_or(0, |r| r.phase_error.len() / nch);
-        let flat: Vec<f64> = res.iter().flat_map(|r| r.phase_error.iter().copied()).collect();
-        d.set_item("phase_error", numpy::PyArray1::from_vec(py, flat).reshape([nr, nshots, nch])?)?;
+        d.set_item("time", vec_to_py(py, r.time))?;
+        d.set_item("imu_time", vec_to_py(py, r.imu_time))?;
+        d.set_item("hybrid", cube(py, r.hybrid, [nr, ne, 9])?)?;
+        d.set_item("free", cube(py, r.free, [nr, ne, 9])?)?;
+        d.set_item("bias", cube(py, r.bias, [nr, ne, 6])?)?;
+        d.set_item("bias_true", cube(py, r.bias_true, [nr, ne, 6])?)?;
+        d.set_item("accel_error", cube(py, r.accel_error, [nr, self.0.t.len(), 3])?)?;
+        d.set_item("sigma", cube(py, r.sigma, [nr, ne, r.states])?)?;
+        d.set_item("nees", cube(py, r.nees, [nr, ne, 1])?)?;
+        d.set_item("phase_error", cube(py, r.phase_error, [nr, r.shots, r.channels])?)?;
         Ok(d)
     }
 
     /// Shot start times (s).
     #[getter]
-    fn shots<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+    fn shots<'py>(&self, py: Python<'py>) -> Arr1<'py> {
         vec_to_py(py, self.0.cai.shots.clone())
     }
 
@@ -603,13 +507,12 @@ impl CaiHybrid {
 /// laser phase steered inside the loop) or recorded (`population` + `laser_phase`).
 #[pyfunction]
 #[pyo3(signature = (ins, extra0, sensor, shots, data_kind, data_a, data_b))]
-#[allow(clippy::too_many_arguments)]
 fn cai_aided_ins(
     ins: PyRef<'_, AidedSetup>,
     extra0: PyReadonlyArray1<'_, f64>,
     sensor: &CaiSensor,
     shots: PyReadonlyArray1<'_, f64>,
-    data_kind: &str,
+    data_kind: Wrap<DataKind>,
     data_a: PyReadonlyArray2<'_, f64>,
     data_b: PyReadonlyArray2<'_, f64>,
 ) -> PyResult<PyAidedIns> {
@@ -617,18 +520,42 @@ fn cai_aided_ins(
     cfg.kind = ins.kind;
     // (shots, channels) tables, read row-major; the aiding checks their sizes
     let flat = |a: &PyReadonlyArray2<'_, f64>| a.as_array().iter().copied().collect::<Vec<f64>>();
-    let (a, b) = (flat(&data_a), flat(&data_b));
-    let data = match data_kind {
-        "emulated" => CaiData::Emulated { phase: a, noise: b },
-        "recorded" => CaiData::Recorded { population: a, laser_phase: b },
-        other => return Err(invalid("data", format!("unknown kind {other:?}; choose emulated, recorded")).into()),
-    };
-    let (sa, sb) = (data_a.shape()[1], data_b.shape()[1]);
-    for (name, w) in [(if data_kind == "emulated" { "phase" } else { "population" }, sa), (if data_kind == "emulated" { "noise" } else { "laser_phase" }, sb)] {
-        if w != cfg.channels.len() {
-            return Err(invalid(name, format!("has {w} interferometers per shot, but the configuration has {}", cfg.channels.len())).into());
-        }
-    }
+    let widths = (data_a.shape()[1], data_b.shape()[1]);
+    let data = CaiData::new(data_kind.0, flat(&data_a), flat(&data_b), widths, cfg.channels.len())?;
     let aiding = CaiAiding::new(cfg, data)?;
     PyAidedIns::from_aiding(&ins, DVector::from_vec(vector(&extra0, "extra0")?), Box::new(aiding))
+}
+
+pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    // column names of CaiSetup.predict / CaiSetup.jacobian (single source of truth)
+    m.add("CAI_TERMS", TERM_NAMES.to_vec())?;
+    m.add("CAI_JACOBIAN_PARAMS", JACOBIAN_PARAMS.to_vec())?;
+    register_choices::<OmegaDotKind>(m, "OmegaDot")?;
+    register_choices::<Interpolation>(m, "Interpolation")?;
+    register_choices::<ClosedForm>(m, "ClosedForm")?;
+    register_choices::<Method>(m, "MlMethod")?;
+    register_choices::<DataKind>(m, "CaiData")?;
+    register_choices::<ForceKind>(m, "ForceMode")?;
+    register_choices::<GravityModel>(m, "Gravity")?;
+    register_choices::<PhaseSourceKind>(m, "PhaseSource")?;
+    m.add_class::<CaiChannels>()?;
+    m.add_class::<CaiSetup>()?;
+    m.add_class::<CaiGravity>()?;
+    m.add_class::<CaiMotion>()?;
+    m.add_class::<CaiHybrid>()?;
+    m.add_class::<CaiSensor>()?;
+    m.add_function(wrap_pyfunction!(cai_aided_ins, m)?)?;
+    m.add_function(wrap_pyfunction!(cai_in_shot_noise, m)?)?;
+    m.add_function(wrap_pyfunction!(cai_phase_closed_form, m)?)?;
+    m.add_function(wrap_pyfunction!(cai_sensitivity, m)?)?;
+    m.add_function(wrap_pyfunction!(cai_convolution_phase, m)?)?;
+    m.add_function(wrap_pyfunction!(cai_response_area, m)?)?;
+    m.add_function(wrap_pyfunction!(cai_ideal_transfer, m)?)?;
+    m.add_function(wrap_pyfunction!(cai_readout, m)?)?;
+    m.add_function(wrap_pyfunction!(cai_steer_mid_fringe, m)?)?;
+    m.add_function(wrap_pyfunction!(cai_shot_times, m)?)?;
+    m.add_function(wrap_pyfunction!(cai_gravity_ellipsoid, m)?)?;
+    m.add_function(wrap_pyfunction!(cai_fringe_track, m)?)?;
+    m.add_function(wrap_pyfunction!(cai_ml_identify, m)?)?;
+    Ok(())
 }

@@ -1,13 +1,12 @@
 //! Bindings of trajectory/ (motion models and generators) and imu::ideal.
 
-use super::convert::{Wrap, quat_to_py, vec3, vec3_to_py, vec_to_py, vector};
+use super::convert::{Wrap, quat_rows, quat_to_py, to_py_rows, vec3, vec3_rows, vec3_to_py, vec_to_py, vector};
 use crate::earth::{check_latitude, Ellipsoid};
-use crate::error::invalid;
 use crate::imu::ideal::{ideal_increments, ideal_rates};
 use crate::imu::ImuKind;
 use crate::math::Vec3;
-use crate::trajectory::{generators, Motion as CoreMotion};
-use numpy::{PyReadonlyArray1, PyReadonlyArray2};
+use crate::trajectory::{generators, nav_errors as core_nav_errors, Motion as CoreMotion, NavSeries, ERROR_COLUMNS};
+use numpy::{PyArray2, PyReadonlyArray1, PyReadonlyArray2};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
@@ -73,10 +72,7 @@ impl Motion {
 
     #[staticmethod]
     fn hexapod(origin_lla: PyReadonlyArray1<'_, f64>, max_tilt: f64, pitch_delay: f64, heading: f64) -> PyResult<Motion> {
-        if !(max_tilt.is_finite() && max_tilt.abs() < 0.5) {
-            return Err(invalid("max_tilt", format!("must be finite and below 0.5 rad, got {max_tilt}")).into());
-        }
-        Ok(wrap(generators::hexapod(origin(&origin_lla)?, max_tilt, pitch_delay, heading)))
+        Ok(wrap(generators::hexapod(origin(&origin_lla)?, max_tilt, pitch_delay, heading)?))
     }
 
     #[staticmethod]
@@ -157,6 +153,32 @@ impl Motion {
     }
 }
 
+/// Navigation errors (N, 9) of a solution against a reference, row by row: positions
+/// (N, 3) lat rad, lon rad, h m, NED velocities (N, 3) m/s, attitudes q_nb (N, 4);
+/// columns `NAV_ERROR_COLUMNS` (see trajectory/errors.rs).
+#[pyfunction]
+#[pyo3(signature = (lla, vel, q_nb, ref_lla, ref_vel, ref_q_nb, *, ellipsoid=Wrap(crate::earth::WGS84)))]
+#[allow(clippy::too_many_arguments)]
+fn nav_errors<'py>(
+    py: Python<'py>,
+    lla: PyReadonlyArray2<'py, f64>,
+    vel: PyReadonlyArray2<'py, f64>,
+    q_nb: PyReadonlyArray2<'py, f64>,
+    ref_lla: PyReadonlyArray2<'py, f64>,
+    ref_vel: PyReadonlyArray2<'py, f64>,
+    ref_q_nb: PyReadonlyArray2<'py, f64>,
+    ellipsoid: Wrap<Ellipsoid>,
+) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    let (lla, vel, q) = (vec3_rows(&lla, "nav")?, vec3_rows(&vel, "nav")?, quat_rows(&q_nb, "nav")?);
+    let (rl, rv, rq) = (vec3_rows(&ref_lla, "reference")?, vec3_rows(&ref_vel, "reference")?, quat_rows(&ref_q_nb, "reference")?);
+    let est = NavSeries { lla: &lla, vel: &vel, q_nb: &q };
+    let reference = NavSeries { lla: &rl, vel: &rv, q_nb: &rq };
+    let out = py.detach(|| core_nav_errors(&ellipsoid.0, est, reference))?;
+    Ok(to_py_rows(py, &out))
+}
+
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add("NAV_ERROR_COLUMNS", ERROR_COLUMNS.to_vec())?;
+    m.add_function(wrap_pyfunction!(nav_errors, m)?)?;
     m.add_class::<Motion>()
 }

@@ -45,8 +45,13 @@ fn pulse(p: Profile, start: f64, ramp: f64, hold: f64, amp: f64, shape: StepShap
 /// Hexapod tilt sequence (seed 000 §5.3; spec cai-ekf-tennstedt2021 decision 13): 10 s
 /// static, then roll performs [+a, −a, +a/2, −a/2] three times (each: 1 s raised-cosine
 /// ramp, 5 s hold, 1 s ramp back, 5 s at 0; 48 s per block); pitch the same delayed by
-/// `pitch_delay` s; static until 170 s. `max_tilt` = 0.0654 rad (3.75°) by default.
-pub fn hexapod(origin: Vec3, max_tilt: f64, pitch_delay: f64, heading: f64) -> Motion {
+/// `pitch_delay` s; static until 170 s. `max_tilt` = 0.0654 rad (3.75°) by default, below
+/// [`HEXAPOD_MAX_TILT`] in magnitude.
+pub fn hexapod(origin: Vec3, max_tilt: f64, pitch_delay: f64, heading: f64) -> Result<Motion> {
+    if !(max_tilt.is_finite() && max_tilt.abs() < HEXAPOD_MAX_TILT) {
+        return Err(invalid("max_tilt", format!("must be finite and below {HEXAPOD_MAX_TILT} rad, got {max_tilt}")));
+    }
+    crate::error::check_finite("pitch_delay", &[pitch_delay, heading], 1)?;
     let block = [max_tilt, -max_tilt, 0.5 * max_tilt, -0.5 * max_tilt];
     let tilts = |delay: f64| {
         let mut p = Profile::zero();
@@ -58,7 +63,7 @@ pub fn hexapod(origin: Vec3, max_tilt: f64, pitch_delay: f64, heading: f64) -> M
         }
         p
     };
-    Motion {
+    Ok(Motion {
         name: "hexapod".into(),
         origin,
         duration: 170.0,
@@ -66,8 +71,12 @@ pub fn hexapod(origin: Vec3, max_tilt: f64, pitch_delay: f64, heading: f64) -> M
         course: Profile::zero(),
         displacement: zero3(),
         attitude: euler_chain(tilts(0.0), tilts(pitch_delay), Profile::constant(heading)),
-    }
+    })
 }
+
+/// Largest hexapod tilt magnitude (rad) accepted by [`hexapod`]: the platform's small-angle
+/// tilt sequence (seed 000 §5.3 uses 3.75°), well inside the Euler-chain's regular range.
+pub const HEXAPOD_MAX_TILT: f64 = 0.5;
 
 /// Straight drive at constant `speed` (m/s) with sinusoidal yaw rate
 /// ω_z = `yaw_rate_amp`·sin(2πt/`period`) (seed 003 Fig. 7: 1 m/s, 0.05 rad/s, 50 s).

@@ -59,14 +59,14 @@ def identify_noise(x, phi, amplitude, *, free=("p0", "phi"), theta0=(0.02, 0.2, 
     mid-fringe), ``iterations``, ``converged``, ``log_likelihood`` and ``hessian_eig_ratio``
     (smallest / largest eigenvalue magnitude of the Hessian of ln L in the three variances,
     ≈ 0: the unidentifiable direction)."""
-    choice(method, ("gradient", "newton"), "method")
     for f in free:
         choice(f, _NAMES, "free")
     x = vector(x, None, "x")
     mask = [n in free for n in _NAMES]
     n = len(x)
-    res = _core.cai_ml_identify(x, vector(phi, n, "phi"), vector(amplitude, n, "amplitude"), method, mask,
-                                vector(theta0, 3, "theta0"), int(max_iter), float(tol), int(batch or n), bool(sliding))
+    res = _core.cai_ml_identify(x, vector(phi, n, "phi"), vector(amplitude, n, "amplitude"), method=method, free=mask,
+                                theta0=vector(theta0, 3, "theta0"), max_iter=max_iter, tol=float(tol), batch=batch or n,
+                                sliding=bool(sliding))
     th = res["theta"]
     return pd.DataFrame({
         "sigma_p0": th[:, 0], "sigma_phi_rad": th[:, 1], "sigma_A": th[:, 2],

@@ -15,7 +15,8 @@ import numpy as np
 import pandas as pd
 
 from .. import _core
-from .._validate import choice, positive, rows, vector
+from .._validate import input_error, positive, rows, vector
+from ._config import ConfigMixin
 
 #: ⁸⁷Rb D2 wavelength (m) and the two-photon effective wave number 4π/λ (rad/m).
 LAMBDA_RB87 = 780.241e-9
@@ -34,10 +35,13 @@ def k_eff(wavelength: float = LAMBDA_RB87) -> float:
 
 
 @dataclass
-class Channels:
+class Channels(ConfigMixin):
     """Interferometer channels: k (C, 3) rad/m in s, lever (C, 3) m from the IMU to the
     release point in b, c_sb (C, 3, 3) rotation b → s, v0 (C, 3) m/s initial atom velocity
-    relative to s, and a name per channel."""
+    relative to s, and a name per channel. Convertible to and from dict / JSON
+    (``to_dict``, ``from_dict``, ``to_json``, ``from_json``)."""
+
+    _ARRAYS = ("k", "lever", "c_sb", "v0", "names")
 
     k: np.ndarray
     lever: np.ndarray
@@ -87,26 +91,23 @@ def _setup(t, specific_force, angular_rate, shots, T, channels, angular_accelera
     """Validated shot start times (s) and the core predictor set up on them."""
     if omega_dot is None:
         omega_dot = "savgol" if angular_acceleration is None else "given"
-    choice(omega_dot, ("zero", "pwl", "savgol", "given"), "omega_dot")
-    choice(interpolation, ("linear", "cubic"), "interpolation")
     t = vector(t, None, "t")
     f = np.ascontiguousarray(np.asarray(specific_force, float))
     w = np.ascontiguousarray(np.asarray(angular_rate, float))
     for name, a in (("specific_force", f), ("angular_rate", w)):
         if a.shape != (len(t), 3):
-            raise ValueError(f"{name}: expected shape ({len(t)}, 3), got {a.shape}")
+            raise input_error(name, f"expected shape ({len(t)}, 3), got {a.shape}")
     wd = None
     if angular_acceleration is not None:
         wd = np.ascontiguousarray(np.asarray(angular_acceleration, float))
         if wd.shape != (len(t), 3):
-            raise ValueError(f"angular_acceleration: expected shape ({len(t)}, 3), got {wd.shape}")
-        if omega_dot != "given":
-            raise ValueError(f"angular_acceleration: given, but omega_dot = {omega_dot!r} would ignore it")
+            raise input_error("angular_acceleration", f"expected shape ({len(t)}, 3), got {wd.shape}")
     shots = np.ascontiguousarray(np.atleast_1d(np.asarray(shots, float)))
-    return shots, _core.CaiSetup(t, f, w, shots, channels._native(), float(T), omega_dot, wd, int(savgol_half_width),
-                                 interpolation, int(substeps), _gradient(gradient),
-                                 vector(np.broadcast_to(np.asarray(bias_a, float), 3).copy(), 3, "bias_a"),
-                                 vector(np.broadcast_to(np.asarray(bias_g, float), 3).copy(), 3, "bias_g"))
+    return shots, _core.CaiSetup(t, f, w, shots, channels._native(), float(T), omega_dot=omega_dot, angular_acceleration=wd,
+                                 savgol_half_width=savgol_half_width, interpolation=interpolation, substeps=substeps,
+                                 gradient=_gradient(gradient),
+                                 bias_a=vector(np.broadcast_to(np.asarray(bias_a, float), 3).copy(), 3, "bias_a"),
+                                 bias_g=vector(np.broadcast_to(np.asarray(bias_g, float), 3).copy(), 3, "bias_g"))
 
 
 @dataclass
@@ -163,7 +164,7 @@ def phase_jacobian(t, specific_force, angular_rate, shots, T: float, channels: C
     central finite differences of :func:`predict_phase` (the checker)."""
     shots, setup = _setup(t, specific_force, angular_rate, shots, T, channels, angular_acceleration, omega_dot,
                           savgol_half_width, interpolation, substeps, gradient, bias_a, bias_g)
-    steps = None if fd_steps is None else vector(fd_steps, 4, "fd_steps")
+    steps = None if fd_steps is None else tuple(vector(fd_steps, 4, "fd_steps"))
     return setup.jacobian(bool(euler), steps).reshape(len(shots), len(channels), len(JACOBIAN_PARAMS))
 
 
@@ -182,38 +183,6 @@ def readout_jacobian(phase_jac, phi_hat, phi0, contrast: float = 1.0) -> np.ndar
     at mid-fringe (φ̂ + φ0 = π/2) it is (C/2) ∂φ/∂θ. Shapes broadcast over (shots, channels)."""
     s = 0.5 * contrast * np.sin(np.asarray(phi_hat) + np.asarray(phi0))
     return s[..., None] * np.asarray(phase_jac)
-
-
-def paper_jacobian(channels: Channels, specific_force, angular_rate, T: float, *, angular_acceleration=(0.0, 0.0, 0.0),
-                   euler: bool = False) -> dict:
-    """Paper-mode phase Jacobians for constant dynamics (seed 003 (P-27), (P-31); spec
-    (E29)/(E30)), term by term, per channel: ∂φ/∂b_a = T²k^T(I − 2T[ω_s×])C_sb and ∂φ/∂b_g
-    as the sum of ``centrifugal`` (terms 1–2), ``coriolis`` (3), ``mixed_acc`` (4),
-    ``mixed_cen`` (5–7) and, with ``euler``, ``mixed_euler`` (8). Inputs in the body frame:
-    f_b (m/s²), ω_b (rad/s), ω̇_b (rad/s²). Returns arrays (C, 3) in rad per (m/s²) /
-    (rad/s); the readout Jacobian is (C/2)× these at mid-fringe (P-25/26). The exact
-    tangent-linear derivative is :func:`phase_jacobian`."""
-    T = positive(T, "T")
-    f = vector(specific_force, 3, "specific_force")
-    w = vector(angular_rate, 3, "angular_rate")
-    wd = vector(angular_acceleration, 3, "angular_acceleration")
-
-    def sk(v):
-        return np.array([[0, -v[2], v[1]], [v[2], 0, -v[0]], [-v[1], v[0], 0]])
-
-    out = {k: [] for k in ("ba", "centrifugal", "coriolis", "mixed_acc", "mixed_cen", "mixed_euler")}
-    for k, l, c, v0 in zip(channels.k, channels.lever, channels.c_sb, channels.v0):
-        ws = c @ w
-        cen_jac = sk(w) @ sk(l) + sk(np.cross(w, l))  # ∂[ω×(ω×l)]/∂ω up to sign (E30) 1–2
-        out["ba"].append(T**2 * k @ (np.eye(3) - 2 * T * sk(ws)) @ c)
-        out["centrifugal"].append(-T**2 * k @ c @ cen_jac)
-        out["coriolis"].append(-2 * T**2 * k @ sk(v0) @ c)
-        out["mixed_acc"].append(2 * T**3 * k @ sk(c @ f) @ c)
-        out["mixed_cen"].append(2 * T**3 * k @ (sk(c @ np.cross(w, np.cross(w, l))) @ c + sk(ws) @ c @ cen_jac))
-        out["mixed_euler"].append(2 * T**3 * k @ sk(c @ np.cross(wd, l)) @ c if euler else np.zeros(3))
-    res = {k: np.array(v) for k, v in out.items()}
-    res["bg"] = sum(res[k] for k in ("centrifugal", "coriolis", "mixed_acc", "mixed_cen", "mixed_euler"))
-    return res
 
 
 # --- analytic motions and the inertial oracle ------------------------------------------
@@ -308,13 +277,6 @@ def phase_seed000(k, vbar, angular_rate, specific_force, T_total: float) -> np.n
     return _closed("seed000", k, vbar, angular_rate, specific_force, T_total)
 
 
-def phase_first_order(k, v0, angular_rate, specific_force, T: float) -> np.ndarray:
-    """Library first-order phase −T² k·f_s − 2T² k·(ω×v0) (rad) (seed 000 spec (E10))."""
-    k = rows(k, 3, "k")
-    v0 = np.broadcast_to(np.asarray(v0, float), k.shape)
-    return -T**2 * k @ np.asarray(specific_force, float) + sagnac_phase(k, v0, angular_rate, T)
-
-
 def sagnac_phase(k, v0, angular_rate, T: float) -> np.ndarray:
     """Sagnac (Coriolis) term −2T² k·(ω×v0) (rad)."""
     return -2.0 * T**2 * np.einsum("ij,ij->i", np.atleast_2d(k), np.cross(np.asarray(angular_rate, float), np.atleast_2d(v0)))
@@ -358,23 +320,6 @@ def in_shot_noise_phase(q_accel: float, q_gyro: float, T: float, k: float = K_RB
         if not (np.isfinite(q) and q >= 0):
             raise ValueError(f"{name}: must be finite and >= 0, got {q}")
     return {"accel": k * np.sqrt(2 * q_accel / 3) * T**1.5, "gyro": 2 * k * v0 * np.sqrt(2 * q_gyro / 3) * T**1.5}
-
-
-def in_shot_noise_covariance(channels: Channels, q_accel: float, q_gyro: float, T: float) -> np.ndarray:
-    """Covariance (C, C) (rad²) of the predicted phases of one shot caused by white IMU noise
-    of PSD q_accel (m²/s³) and q_gyro (rad²/s) per body axis, for R inflation (seed 000 spec
-    Decision 14, full matrix including the A/B correlation). To leading order the noise acts
-    as an atom acceleration −C_sb n_a (phase −∫w k·C_sb n_a) and a Coriolis acceleration
-    −2(C_sb n_g)×v0 (phase −2∫w n_g·C_sbᵀ(v0×k)), so with ∫w² = 2T³/3:
-    Σ = (2T³/3) [q_a K Kᵀ + 4 q_g V Vᵀ],  K_j = C_sb,jᵀ k_j,  V_j = C_sb,jᵀ (v0_j × k_j).
-    This is the spec's closed form (E38): it leaves out the atom Euler term (with ω̇ taken
-    from the same gyro the rotation phase depends on the gyro over [T, 2T] only, variance
-    4T³q_g(kv0)², 1.5× the Coriolis part here) and the lever-arm Euler term (2Tq_g|l × k|²).
-    The aiding's R uses :func:`atomnav.cai.hybrid.in_shot_noise`, which includes both."""
-    in_shot_noise_phase(q_accel, q_gyro, T)  # validates q and T
-    kb = np.einsum("cji,cj->ci", channels.c_sb, channels.k)
-    vb = np.einsum("cji,cj->ci", channels.c_sb, np.cross(channels.v0, channels.k))
-    return 2 * T**3 / 3 * (q_accel * kb @ kb.T + 4 * q_gyro * vb @ vb.T)
 
 
 def phase_noise(sigma_p: float, contrast: float = 1.0) -> float:

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from .. import _core
 from .._validate import finite
 
 
@@ -32,12 +33,16 @@ def readout(phi, phi0=0.0, *, offset=0.5, contrast=1.0, sigma_p: float = 0.0, si
     n_phi = rng.normal(0.0, sigma_phi, shape) if sigma_phi else 0.0
     n_c = rng.normal(0.0, sigma_contrast, shape) if sigma_contrast else 0.0
     n_p = rng.normal(0.0, sigma_p, shape) if sigma_p else 0.0
-    return offset - 0.5 * (c + n_c) * np.cos(phi + phi0 + n_phi) + n_p
+    total, c_eff = (np.ascontiguousarray(np.broadcast_to(x, shape), dtype=float).ravel() for x in (phi + phi0 + n_phi, c + n_c))
+    p = _core.cai_readout(float(offset), c_eff, total).reshape(shape) + n_p
+    return p[()] if np.ndim(p) == 0 else p
 
 
 def steer_mid_fringe(phi_hat) -> np.ndarray:
     """Laser phase φ0 = (π/2 − φ̂) mod 2π (rad) putting the predicted phase at mid-fringe."""
-    return np.mod(np.pi / 2 - np.asarray(phi_hat, float), 2 * np.pi)
+    phi_hat = np.asarray(phi_hat, float)
+    phi0 = _core.cai_steer_mid_fringe(np.ascontiguousarray(phi_hat).ravel()).reshape(phi_hat.shape)
+    return phi0[()] if phi0.ndim == 0 else phi0
 
 
 def invert_readout(p, phi0=0.0, *, offset=0.5, contrast=1.0, flank: str = "rising") -> np.ndarray:

@@ -1,12 +1,12 @@
 """CAI-aided navigation end to end (issue 5): the seed-003 slalom and car Monte Carlo, the
 seed-000 satellite and hexapod scenarios, each with its improvement over the IMU-only
-strapdown (ratio of RMS-over-runs errors, see ``atomnav.cai.hybrid``) and its plots."""
+strapdown (ratio of RMS-over-runs errors, see ``atomnav.cai.results``) and its plots."""
 
 from __future__ import annotations
 
 import numpy as np
 
-from ..cai import hybrid
+from .. import cai
 from . import section
 
 
@@ -47,7 +47,7 @@ def _improvement_rows(report, res, times, label: str):
 
 def _slalom(report):
     runs = 8 if report.quick else 100
-    kin = hybrid.slalom(runs, gravity="kinematic", progress=False)
+    kin = cai.slalom(runs, gravity="kinematic", progress=False)
     ratio = kin.improvement([60.0]).query("quantity == 'velocity' and axis == 'norm'")["ratio"].iloc[0]
     report.row(f"slalom, kinematic: velocity IMU-only/hybrid at 60 s ({runs} runs)", "> 100", round(ratio, 1), bool(ratio >= 100))
     _improvement_rows(report, kin, [25.0, 60.0], "slalom kinematic")
@@ -56,25 +56,25 @@ def _slalom(report):
     # to the x and y channels (σ up to 0.68 rad → ≈0.44 % expected), so < 0.1 % needs l = 0
     # (σ = 0.40 rad → 0.0085 %); both are shown, each against its in-shot-noise prediction.
     imu = (1.25e-11, 1.0576e-12)
-    frac, pred = kin.phase_exceedance(), hybrid.expected_phase_exceedance(hybrid.seed003_sensor(), 0.005, *imu)
+    frac, pred = kin.phase_exceedance(), cai.expected_phase_exceedance(cai.seed003_sensor(), 0.005, *imu)
     report.row("slalom, l = [0, 0, 0.1] m: shot-channels with |phase error| > π/2 [%] (in-shot-noise prediction)",
                "< 0.1 (spec §4, which ignores the lever-arm Euler noise)", f"{100 * frac:.3f} ({100 * pred:.3f})", bool(0.5 < frac / pred < 2))
-    no_lever = hybrid.slalom(8 if report.quick else 20, gravity="kinematic", lever=(0.0, 0.0, 0.0), progress=False)
+    no_lever = cai.slalom(8 if report.quick else 20, gravity="kinematic", lever=(0.0, 0.0, 0.0), progress=False)
     frac0 = no_lever.phase_exceedance()
-    pred0 = hybrid.expected_phase_exceedance(hybrid.seed003_sensor((0.0, 0.0, 0.0)), 0.005, *imu)
+    pred0 = cai.expected_phase_exceedance(cai.seed003_sensor((0.0, 0.0, 0.0)), 0.005, *imu)
     report.row(f"slalom, l = 0: shot-channels with |phase error| > π/2 [%] ({no_lever.runs} runs; in-shot-noise prediction {100 * pred0:.4f})",
                "< 0.1", round(100 * frac0, 4), bool(frac0 < 1e-3))
     _errors_figure(report, kin, "cai_hybrid_slalom", f"Slalom, kinematic mode, {runs} runs: velocity errors of the IMU-only and hybrid solutions, accelerometer-bias error, filter σ")
-    earth = hybrid.slalom(runs, gravity="earth", progress=False)
+    earth = cai.slalom(runs, gravity="earth", progress=False)
     mc = earth.improvement([60.0]).query("quantity == 'velocity' and axis == 'norm'")["ratio"].iloc[0]
-    cov = hybrid.slalom_covariance("earth")
+    cov = cai.slalom_covariance("earth")
     cov_ratio, own_ratio = float(cov["ratio_true"].iloc[-1]), float(cov["ratio"].iloc[-1])
     report.row("slalom, Earth gravity: velocity ratio at 60 s, Monte Carlo", "3-6 (spec)", round(mc, 2), "reported")
     report.row("slalom, Earth gravity: true-error covariance analysis of the filter predicts the MC ratio", "within 30 %",
                f"{cov_ratio:.2f} ({100 * (cov_ratio / mc - 1):+.1f} %)", bool(abs(cov_ratio / mc - 1) < 0.3))
     report.row("slalom, Earth gravity: the filter's own covariance ratio (conservative: readout correlated with the IMU noise)",
                "reported", round(own_ratio, 2), "reported")
-    aided = hybrid.slalom_covariance("earth", attitude_sigma=1e-5)
+    aided = cai.slalom_covariance("earth", attitude_sigma=1e-5)
     report.row("slalom, Earth gravity + attitude aid (1e-5 rad per shot): covariance ratio at 60 s", "cap lifted", round(float(aided["ratio"].iloc[-1]), 1),
                bool(aided["ratio"].iloc[-1] > 3 * cov_ratio))
     import matplotlib.pyplot as plt
@@ -82,7 +82,7 @@ def _slalom(report):
     fig, ax = plt.subplots(figsize=(6, 3.8))
     ax.semilogy(cov["time_s"], cov["ratio"], label="Earth gravity (CAI only)")
     ax.semilogy(aided["time_s"], aided["ratio"], label="Earth gravity + attitude aid")
-    kc = hybrid.slalom_covariance("kinematic")
+    kc = cai.slalom_covariance("kinematic")
     ax.semilogy(kc["time_s"], kc["ratio"], label="kinematic mode")
     ax.set_xlabel("time (s)")
     ax.set_ylabel("free / hybrid RMS velocity error")
@@ -92,7 +92,7 @@ def _slalom(report):
 
 def _car(report):
     runs = 8 if report.quick else 100
-    res = hybrid.car_mc(runs, progress=False)
+    res = cai.car_mc(runs, progress=False)
     ratio = res.improvement([25.0]).query("quantity == 'velocity' and axis == 'norm'")["ratio"].iloc[0]
     report.row(f"car: velocity IMU-only/hybrid at 25 s ({runs} runs)", "≈100 at best, ≥ 30", round(ratio, 1), bool(ratio >= 30))
     _improvement_rows(report, res, [10.0, 25.0, 40.0], "car")
@@ -100,21 +100,21 @@ def _car(report):
     report.row("car: shot-channels with |phase error| > π/2 [%] (lever arm 0)", "≈14", round(100 * frac, 2), bool(0.01 <= frac <= 0.4))
     report.row("car: NEES inside the 95 % χ²(15) band [share of epochs]", "≥ 0.85", round(res.nees_inside(), 3), bool(res.nees_inside() >= 0.85))
     b = res.bias_errors()
-    acc = float(np.mean([b[f"{c}_in3sigma"].mean() for c in hybrid.BIAS_COLUMNS[:3]]))
+    acc = float(np.mean([b[f"{c}_in3sigma"].mean() for c in cai.BIAS_COLUMNS[:3]]))
     report.row("car: accelerometer-bias error inside the filter's 3σ [share of shots]", "≥ 0.95", round(acc, 3), bool(acc >= 0.95))
-    lev = hybrid.car_mc(runs, lever=(0.0, 0.0, 0.1), progress=False)
+    lev = cai.car_mc(runs, lever=(0.0, 0.0, 0.1), progress=False)
     r_lev = lev.improvement([25.0]).query("quantity == 'velocity' and axis == 'norm'")["ratio"].iloc[0]
     report.row("car, spec lever arm [0, 0, 0.1] m: velocity ratio at 25 s / fringe slips [%]", "reported", f"{r_lev:.1f} / {100 * lev.phase_exceedance():.2f}", "Euler lever term of the 15 Hz vibration")
     _errors_figure(report, res, "cai_hybrid_car", f"Car Monte Carlo, kinematic mode, {runs} runs: velocity errors, accelerometer-bias error and filter σ")
 
 
 def _satellite(report):
-    res = hybrid.satellite(1.0 if report.quick else 4.0, progress=False)
-    st = hybrid.satellite_steady_state(res)
+    res = cai.satellite(1.0 if report.quick else 4.0, progress=False)
+    st = cai.satellite_steady_state(res)
     report.row("satellite: steady-state accel-bias variance P⁺ [(m/s²)²]", 4.82e-20, st["filter_p_post"], bool(0.5 <= st["filter_p_post"] / 4.821853e-20 <= 2))
     report.row("satellite: std of the bias tracking error [m/s²]", "2.196e-10 (spec)", st["tracking_error_std"], bool(abs(st["tracking_error_std"] / 2.196e-10 - 1) < 0.1))
     _improvement_rows(report, res, [res.time[-1]], "satellite")
-    psd = hybrid.satellite_psd(res, nperseg=2**14 if report.quick else 2**15)
+    psd = cai.satellite_psd(res, nperseg=2**14 if report.quick else 2**15)
     f = psd["frequency_hz"].to_numpy()
     ratio = (psd["filtered_asd"] / psd["imu_asd"]).to_numpy() ** 2
     hi, lo = ratio[f > 0.1].mean(), ratio[f <= 3e-4].mean()
@@ -134,7 +134,7 @@ def _satellite(report):
 
 def _hexapod(report):
     runs = 1 if report.quick else 20
-    res = hybrid.hexapod(runs, progress=False)
+    res = cai.hexapod(runs, progress=False)
     k = res.epoch(60.0)
     err = res.bias[:, k, :] - res.bias_true[:, k, :]
     inside = float(np.mean(np.all(np.abs(err) <= 3 * res.sigma[:, k, 9:15], axis=1)))
@@ -156,7 +156,7 @@ def _hexapod(report):
         ax.plot(res.time, res.bias[0, :, i], "C0", lw=1, label="estimate")
         ax.plot(res.time, res.bias_true[0, :, i], "k--", lw=1, label="injected (MEMS − reference)")
         ax.fill_between(res.time, res.bias[0, :, i] - 3 * res.sigma[0, :, 9 + i], res.bias[0, :, i] + 3 * res.sigma[0, :, 9 + i], alpha=0.2)
-        ax.set_title(hybrid.BIAS_COLUMNS[i], fontsize=8)
+        ax.set_title(cai.BIAS_COLUMNS[i], fontsize=8)
     axes[0, 0].legend(fontsize=7)
     fig.tight_layout()
     report.figure(fig, "cai_hybrid_hexapod", "Hexapod (seed 000 §5.3): MEMS bias estimates with ±3σ vs the injected values (run 0)")

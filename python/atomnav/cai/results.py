@@ -1,0 +1,164 @@
+"""Monte-Carlo results of the CAI-aided INS scenarios (:class:`HybridResult`) and their
+statistics.
+
+Metric of the improvement report: at a time t, for each quantity (NED position, NED
+velocity, attitude ψ) the RMS over Monte-Carlo runs of the error, per axis (√mean_r e_i²)
+and of the norm (√mean_r |e|²); the improvement is IMU-only RMS / hybrid RMS (Tennstedt et
+al. 2023, §4)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+import pandas as pd
+
+from .. import _core
+from .._validate import choice
+from .predictor import K_RB87
+
+#: Error columns of every run: NED position (m), NED velocity (m/s), ψ (rad) (from the core).
+ERROR_COLUMNS = list(_core.NAV_ERROR_COLUMNS)
+BIAS_COLUMNS = ["ba_x_mps2", "ba_y_mps2", "ba_z_mps2", "bg_x_rad_s", "bg_y_rad_s", "bg_z_rad_s"]
+_QUANTITIES = {"position": slice(0, 3), "velocity": slice(3, 6), "attitude": slice(6, 9)}
+
+
+@dataclass
+class HybridResult:
+    """Monte-Carlo result of one scenario. Arrays: ``time`` (E,) s; ``hybrid`` and ``free``
+    (R, E, 9) errors (:data:`ERROR_COLUMNS`) of the CAI-aided and the IMU-only solutions;
+    ``bias`` / ``bias_true`` (R, E, 6) estimated and true biases (:data:`BIAS_COLUMNS`);
+    ``sigma`` (R, E, n) filter σ of every state; ``accel_error`` (R, N, 3) accelerometer error
+    (measured − ideal, m/s²) of every IMU sample at ``imu_time`` (N,); ``phase_error`` (R, S, C) true − predicted phase (rad) per
+    shot and channel; ``shots`` (S,) shot start times; ``nees`` (R, E) NEES of the 15 INS
+    states (navigation errors and b̂ − b) under the filter's P."""
+
+    name: str
+    params: dict
+    time: np.ndarray
+    hybrid: np.ndarray
+    free: np.ndarray
+    bias: np.ndarray
+    bias_true: np.ndarray
+    sigma: np.ndarray
+    accel_error: np.ndarray
+    phase_error: np.ndarray
+    shots: np.ndarray
+    nees: np.ndarray
+    imu_time: np.ndarray
+    channel_names: list = field(default_factory=list)
+    #: The scenario configuration (``ScenarioConfig.to_dict()``) the runs were made with.
+    config: dict = field(default_factory=dict)
+
+    @property
+    def runs(self) -> int:
+        return self.hybrid.shape[0]
+
+    def epoch(self, t: float) -> int:
+        """Index of the output epoch nearest to t (s)."""
+        return int(np.argmin(np.abs(self.time - t)))
+
+    def errors(self, which: str = "hybrid") -> pd.DataFrame:
+        """Long table run, time_s and :data:`ERROR_COLUMNS` of ``"hybrid"`` or ``"free"``."""
+        choice(which, ("hybrid", "free"), "which")
+        e = getattr(self, which)
+        r, n = e.shape[:2]
+        df = pd.DataFrame(e.reshape(r * n, 9), columns=ERROR_COLUMNS)
+        df.insert(0, "time_s", np.tile(self.time, r))
+        df.insert(0, "run", np.repeat(np.arange(r), n))
+        return df
+
+    def rms(self, which: str = "hybrid") -> pd.DataFrame:
+        """RMS over runs per epoch: per axis (:data:`ERROR_COLUMNS`) and the norms
+        ``pos_norm_m``, ``vel_norm_mps``, ``att_norm_rad``."""
+        choice(which, ("hybrid", "free"), "which")
+        e = getattr(self, which)
+        df = pd.DataFrame(np.sqrt(np.mean(e**2, axis=0)), columns=ERROR_COLUMNS)
+        for name, (q, sl) in zip(("pos_norm_m", "vel_norm_mps", "att_norm_rad"), _QUANTITIES.items()):
+            df[name] = np.sqrt(np.mean(np.sum(e[:, :, sl] ** 2, axis=2), axis=0))
+        df.insert(0, "time_s", self.time)
+        return df
+
+    def improvement(self, times) -> pd.DataFrame:
+        """IMU-only / hybrid RMS-over-runs error ratio at each time (s): one row per (time,
+        quantity, axis ∈ n, e, d, norm)."""
+        rows = []
+        for t in np.atleast_1d(times):
+            k = self.epoch(float(t))
+            for q, sl in _QUANTITIES.items():
+                f, h = self.free[:, k, sl], self.hybrid[:, k, sl]
+                for axis, (a, b) in zip(("n", "e", "d", "norm"),
+                                        [(f[:, i], h[:, i]) for i in range(3)] + [(np.linalg.norm(f, axis=1), np.linalg.norm(h, axis=1))]):
+                    fr, hr = float(np.sqrt(np.mean(a**2))), float(np.sqrt(np.mean(b**2)))
+                    rows.append({"time_s": float(self.time[k]), "quantity": q, "axis": axis, "imu_only_rms": fr, "hybrid_rms": hr,
+                                 "ratio": fr / hr if hr > 0 else np.inf})
+        return pd.DataFrame(rows)
+
+    def bias_errors(self) -> pd.DataFrame:
+        """Per epoch and bias component: mean and empirical σ over runs of the estimation
+        error b̂ − b, the mean filter σ, and the share of runs inside the filter's 3σ."""
+        err = self.bias - self.bias_true
+        sig = self.sigma[:, :, 9:15]
+        d = {"time_s": self.time}
+        for i, c in enumerate(BIAS_COLUMNS):
+            d[f"{c}_mean"] = err[:, :, i].mean(axis=0)
+            d[f"{c}_std"] = err[:, :, i].std(axis=0)
+            d[f"{c}_sigma"] = sig[:, :, i].mean(axis=0)
+            d[f"{c}_in3sigma"] = (np.abs(err[:, :, i]) <= 3 * sig[:, :, i]).mean(axis=0)
+        return pd.DataFrame(d)
+
+    def nees_inside(self, p: float = 0.95) -> float:
+        """Share of (run, epoch) NEES values inside the two-sided p band of χ²(15)."""
+        from scipy.stats import chi2
+
+        lo, hi = chi2.ppf([(1 - p) / 2, (1 + p) / 2], 15)
+        return float(np.mean((self.nees >= lo) & (self.nees <= hi)))
+
+    def phase_exceedance(self, limit: float = np.pi / 2) -> float:
+        """Share of shot-channels with |true − predicted phase| > limit (rad)."""
+        return float(np.mean(np.abs(self.phase_error) > limit))
+
+    def phase_errors(self) -> pd.DataFrame:
+        """Long table run, shot_start_s, channel, phase_error_rad."""
+        r, s, c = self.phase_error.shape
+        return pd.DataFrame({"run": np.repeat(np.arange(r), s * c), "shot_start_s": np.tile(np.repeat(self.shots, c), r),
+                             "channel": np.tile(self.channel_names or list(range(c)), r * s), "phase_error_rad": self.phase_error.ravel()})
+
+
+def satellite_steady_state(res: HybridResult) -> dict:
+    """Steady state of the satellite filter's along-track bias state, against the scalar
+    Riccati closed form (seed 000 (E26)/(E27), Table 1 case A) for the same Q, R and T:
+    filter P⁺ (median over the second half of the updates), closed-form P⁺ and P⁻, and the
+    empirical σ of the tracking error b̂ − b (bias truth = random walk + Gauss–Markov)."""
+    from ..filter import riccati_scalar
+
+    p = res.params
+    t_shot, q, r, h = p["shot_period_s"], p["q_rw"] * p["shot_period_s"], p["sigma_p"] ** 2, 0.5 * p["contrast"] * K_RB87 * p["T"] ** 2
+    upd = np.isclose(np.mod(res.time, t_shot), 0.0) & (res.time > 0)
+    half = upd & (res.time >= res.time[-1] / 2)
+    p_post = float(np.median(res.sigma[0, half, 9] ** 2))
+    p_minus_cf, p_post_cf = riccati_scalar(q, r, h)
+    err = res.bias[0, half, 0] - res.bias_true[0, half, 0]
+    return {"filter_p_post": p_post, "closed_form_p_post": p_post_cf, "closed_form_p_prior": p_minus_cf, "tracking_error_std": float(np.std(err)),
+            "H": h, "Q": q, "R": r}
+
+
+def satellite_psd(res: HybridResult, nperseg: int = 2**15) -> pd.DataFrame:
+    """One-sided Welch ASD (m/s²/√Hz) of the along-track accelerometer error of the IMU and
+    of the CAI-corrected accelerometer (IMU error − b̂). ``attrs["cai_asd"]`` is the white
+    level of the CAI alone: σ_a √Δt_shot with σ_a = σ_p/((C/2) k T²) (seed 000 §4)."""
+    from scipy.signal import welch
+
+    p = res.params
+    t = res.imu_time
+    fs = 1.0 / float(np.median(np.diff(t)))
+    e = res.accel_error[0, :, 0]
+    # b̂ held from each output epoch until the next (the estimate the IMU output is corrected with)
+    k = np.clip(np.searchsorted(res.time, t, side="right") - 1, 0, len(res.time) - 1)
+    filt = e - np.where(t >= res.time[0], res.bias[0, k, 0], 0.0)
+    f, p_imu = welch(e, fs=fs, nperseg=min(nperseg, len(e)))
+    _, p_filt = welch(filt, fs=fs, nperseg=min(nperseg, len(e)))
+    df = pd.DataFrame({"frequency_hz": f[1:], "imu_asd": np.sqrt(p_imu[1:]), "filtered_asd": np.sqrt(p_filt[1:])})
+    sigma_a = p["sigma_p"] / (0.5 * p["contrast"] * K_RB87 * p["T"] ** 2)
+    df.attrs["cai_asd"] = sigma_a * np.sqrt(p["shot_period_s"])
+    return df

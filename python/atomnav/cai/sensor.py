@@ -1,0 +1,185 @@
+"""The CAI as the filter sees it (:class:`CaiSensor`), the filter tuning
+(:class:`FilterSetup`), the in-shot IMU noise of a shot, and the CAI-aided INS on the
+generic engine (:func:`cai_aided_ins`).
+
+The Rust core (``rust/cai/aiding.rs``) plugs the CAI into the generic aided-INS engine:
+every shot's six (or fewer) raw populations are stacked into one update, the predicted
+readout comes from the atom-strapdown predictor driven by the bias-compensated IMU stream,
+the laser phase is steered to mid-fringe from the filter's own prediction, the innovation
+is nonlinear and H comes from the tangent-linear predictor (Tennstedt et al. 2023, §2.8;
+Tennstedt et al. 2021, Eqs. 3–6, 33)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from .. import _core
+from .._validate import input_error, positive, vector
+from ._config import ConfigMixin
+from .predictor import Channels
+
+#: Option names the core accepts (read from the core, which checks them).
+OMEGA_DOT_OPTIONS = tuple(_core.OPTIONS["OmegaDot"])
+INTERPOLATION_OPTIONS = tuple(_core.OPTIONS["Interpolation"])
+FORCE_OPTIONS = tuple(_core.OPTIONS["ForceMode"])
+
+
+@dataclass
+class CaiSensor(ConfigMixin):
+    """The interferometer as the filter sees it.
+
+    channels: interferometer geometry (:class:`Channels`, e.g. ``Channels.cyclic`` for the
+    six-channel sensor of Tennstedt et al. 2023); T: pulse separation (s); shot_period: time
+    between shot starts (s, ≥ 2T; None = 2T, no dead time); offset, contrast, sigma_p:
+    readout p = o − (C/2) cos(φ + φ0) + n, n ~ N(0, σ_p²); inflation: white-noise PSDs
+    (q_a m²/s³, q_g rad²/s) of the IMU(s) for the in-shot R inflation (Tennstedt et al.
+    2021, §2.4) or None; omega_dot (:data:`OMEGA_DOT_OPTIONS` but "given"),
+    savgol_half_width, interpolation (:data:`INTERPOLATION_OPTIONS`), substeps: predictor
+    options; jacobian_euler: keep the Euler terms in H (needed when the lever arm is
+    estimated: its main signature is the Euler term ω̇ × l); misalignment_psd,
+    lever_arm_psd: estimate the CAI misalignment γ / lever-arm correction l as extra
+    random-walk states (21-state filter of Tennstedt et al. 2021) with this PSD; force:
+    "bias" = estimate biases (option b of Tennstedt et al. 2021, Eq. 11), "direct" =
+    correct the specific force through a Gauss–Markov force-error block of correlation time
+    ``force_tau`` (s) and σ ``force_sigma`` (m/s²) (option a); first_shot: start of the
+    first shot (s) in a simulated scenario (a Savitzky–Golay ω̇ window needs 2m + 1 samples
+    before the first shot ends). Checked by the core when handed to it
+    (:meth:`_native`); convertible to and from dict / JSON."""
+
+    _NESTED = {"channels": Channels}
+
+    channels: Channels
+    T: float
+    shot_period: float | None = None
+    offset: float = 0.5
+    contrast: float = 1.0
+    sigma_p: float = float(np.sqrt(1e-3))
+    inflation: tuple | None = None
+    omega_dot: str = "savgol"
+    savgol_half_width: int = 2
+    interpolation: str = "linear"
+    substeps: int = 1
+    jacobian_euler: bool = False
+    misalignment_psd: float | None = None
+    lever_arm_psd: float | None = None
+    force: str = "bias"
+    force_tau: float | None = None
+    force_sigma: float | None = None
+    first_shot: float = 0.0
+
+    def shots(self, t0: float, t_end: float) -> np.ndarray:
+        """Shot start times (s) from t0, one per ``shot_period``, the last ending by t_end."""
+        period = 2 * self.T if self.shot_period is None else self.shot_period
+        return _core.cai_shot_times(float(t0), float(t_end), float(self.T), float(period))
+
+    def n_extra(self) -> int:
+        """Number of extra filter states (misalignment, lever arm, force error)."""
+        return 3 * ((self.misalignment_psd is not None) + (self.lever_arm_psd is not None) + (self.force == "direct"))
+
+    def _native(self):
+        """The checked core sensor (``_core.CaiSensor``) that the Monte Carlo, :func:`cai_aided_ins`
+        and :func:`in_shot_noise` take together with their shots."""
+        return _core.CaiSensor(self.channels._native(), positive(self.T, "T"), offset=float(self.offset), contrast=float(self.contrast),
+                               sigma_p=float(self.sigma_p), inflation=self.inflation, omega_dot=self.omega_dot,
+                               savgol_half_width=self.savgol_half_width, interpolation=self.interpolation, substeps=self.substeps,
+                               jacobian_euler=bool(self.jacobian_euler), misalignment=self.misalignment_psd, lever_arm=self.lever_arm_psd,
+                               force=self.force, force_tau=self.force_tau, force_sigma=self.force_sigma)
+
+
+@dataclass
+class FilterSetup(ConfigMixin):
+    """Filter tuning: white-noise PSDs (accel m²/s³, gyro rad²/s), bias random-walk PSDs
+    (m²/s⁵, rad²/s³), prediction interval in IMU steps, and the initial σ of
+    (position m, velocity m/s, attitude rad, accel bias m/s², gyro bias rad/s) and of the
+    extra CAI states. Convertible to and from dict / JSON."""
+
+    accel_psd: float
+    gyro_psd: float
+    accel_bias_psd: float
+    gyro_bias_psd: float
+    predict_every: int
+    sigma0: tuple = (1e-6, 1e-6, 1e-5, 2e-5, 1e-6)
+    sigma0_extra: tuple = ()
+
+    def p0(self, n_extra: int) -> np.ndarray:
+        """Diagonal P0 of the 15 INS states and ``n_extra`` extra states."""
+        s = np.repeat(np.asarray(self.sigma0, float), 3)
+        extra = np.asarray(self.sigma0_extra, float)
+        if len(extra) != n_extra:
+            raise input_error("sigma0_extra", f"expected {n_extra} values for the extra CAI states, got {len(extra)}")
+        return np.diag(np.concatenate([s, extra]) ** 2)
+
+
+def in_shot_noise(sensor: CaiSensor, dt: float, q_accel: float, q_gyro: float, f=None) -> tuple[np.ndarray, np.ndarray]:
+    """In-shot IMU noise of one shot of ``sensor`` driven by an IMU sampled every ``dt`` s with
+    white-noise PSDs ``q_accel`` (m²/s³) and ``q_gyro`` (rad²/s) (Tennstedt et al. 2021,
+    §2.4, ``rust/cai/in_shot.rs``): the phase covariance Σ (C, C) rad² from the predictor's
+    sensitivity to every sample — which, unlike the closed form of Tennstedt et al. 2023,
+    Eq. 38, includes the atom Euler term (gyro variance 4T³q_g(kv0)² instead of
+    (8/3)T³q_g(kv0)², i.e. 0.3667 instead of 0.2994 rad for the navigation IMU) and the
+    lever-arm Euler term (2Tq_g|l × k|², 0.370 rad for l = 0.1 m ⊥ k) — and, for each
+    15-state model ``f`` (S, 15, 15) held over a filter step of one shot, the
+    cross-covariance E[w δφ̂ᵀ] (S, 15, C) of the step's process noise with the shot's phase
+    noise (the readout senses the same IMU noise that drives the error)."""
+    f = np.zeros((0, 15, 15)) if f is None else np.ascontiguousarray(np.asarray(f, dtype=float))
+    if f.ndim != 3:
+        raise input_error("f", f"expected an (S, 15, 15) stack, got shape {f.shape}")
+    return _core.cai_in_shot_noise(sensor._native(), positive(dt, "dt"), float(q_accel), float(q_gyro), f)
+
+
+def expected_phase_exceedance(sensor: CaiSensor, dt: float, q_accel: float, q_gyro: float, limit: float = np.pi / 2) -> float:
+    """Share of shot-channels expected to have |true − predicted phase| > ``limit`` (rad) from
+    the in-shot IMU noise alone (Gaussian, σ_j² = Σ_jj of :func:`in_shot_noise`), averaged
+    over the channels: mean_j 2Φ(−limit/σ_j). Bias-estimation errors and dynamics add to it.
+    Six-channel sensor at 200 Hz: σ = 0.40 rad on every channel with l = 0 (→ 8.5e-5), but
+    0.53 / 0.68 / 0.33 rad on x / y-A / y-B with l = [0, 0, 0.1] m, where the lever-arm Euler
+    term adds 0.37 rad of gyro noise (→ 4.4e-3, 2.0 % on channel y-A)."""
+    from scipy.stats import norm
+
+    sigma, _ = in_shot_noise(sensor, dt, q_accel, q_gyro)
+    return float(np.mean(2 * norm.sf(positive(limit, "limit") / np.sqrt(np.diag(sigma)))))
+
+
+def cai_aided_ins(t0: float, lla0, vel0, q0, sensor: CaiSensor, shots, *, phase=None, noise=None, population=None, laser_phase=None,
+                  kind: str = "rates", setup: FilterSetup | None = None, p0=None, ba0=(0, 0, 0), bg0=(0, 0, 0), extra0=None,
+                  method: str = "van_loan", mode: str = "closed", sequential: bool = False, gate: float | None = None,
+                  ellipsoid: str = "WGS84"):
+    """A CAI-aided INS on the generic engine (:class:`atomnav.filter.AidedIns`; run it with
+    ``.run(time, gyro, accel)``). Shots start at ``shots`` (S,) s (pulses at +0, +T, +2T,
+    update at +2T). Data, (S, C) arrays with one column per interferometer of ``sensor``:
+    either an emulated instrument — true ``phase`` (rad) and population ``noise`` — whose
+    laser phase the filter steers to mid-fringe inside the loop, or ``population`` with the
+    ``laser_phase`` (rad) the instrument applied. ``setup``: filter noise (default the
+    tuning of Tennstedt et al. 2023, :func:`atomnav.cai.seed003_filter`); ``p0`` overrides
+    ``setup.p0``; the initial state and the remaining options are those of
+    :func:`atomnav.filter.position_aided_ins`."""
+    from ..filter.aided import AidedIns, ins_setup
+    from ..filter.engine import BiasModel
+    from .scenarios import seed003_filter
+
+    emulated = phase is not None or noise is not None
+    if emulated == (population is not None or laser_phase is not None):
+        raise input_error("data", "give either phase and noise (emulated instrument) or population and laser_phase (recorded)")
+    a, b = (phase, noise) if emulated else (population, laser_phase)
+    names = ("phase", "noise") if emulated else ("population", "laser_phase")
+    if a is None or b is None:
+        missing, given = (names[1], names[0]) if a is not None else (names[0], names[1])
+        raise input_error(missing, f"required together with {given}")
+    tables = []
+    for x, name in zip((a, b), names):
+        x = np.asarray(x, float)
+        if x.ndim != 2:
+            raise input_error(name, f"expected a (shots, interferometers) array, got shape {x.shape}")
+        tables.append(np.ascontiguousarray(x))
+    setup = setup or seed003_filter()
+    n_extra = sensor.n_extra()
+    ins = ins_setup(t0, lla0, vel0, q0, kind, setup.p0(n_extra) if p0 is None else p0, setup.accel_psd, setup.gyro_psd,
+                    BiasModel("random_walk", psd=setup.accel_bias_psd), BiasModel("random_walk", psd=setup.gyro_bias_psd),
+                    ba0, bg0, setup.predict_every, method, mode, sequential, gate, ellipsoid)
+    extra0 = vector(np.zeros(n_extra) if extra0 is None else extra0, n_extra, "extra0")
+    shots = vector(shots, None, "shots")
+    core = _core.cai_aided_ins(ins=ins, extra0=extra0, sensor=sensor._native(), shots=shots,
+                               data_kind="emulated" if emulated else "recorded", data_a=tables[0], data_b=tables[1])
+    return AidedIns(core, kind)
