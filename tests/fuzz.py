@@ -76,7 +76,8 @@ SPECIAL_FLOATS = (math.nan, math.inf, -math.inf, 0.0, -0.0, 5e-324, 1e308, -1e30
 EXTREME_INTS = (0, -1, 1, 2**31, 2**63, 2**64, -(2**63), 2**32 + 1)
 INVALID_STRINGS = ("", "nope", "WGS-84", " rates", "RATES", "\x00", "ééé", "a" * 300)
 TIMEOUT_S = 10.0
-TIME_BUDGET_S = 4.0  # worker seconds per callable in one campaign (hangs and aborts not counted)
+RECIPE_MAX_S = 0.05  # a call that built an instance is reused (rebuilt for every use) if it took less
+TIME_BUDGET_S = 1.0  # worker seconds per callable in one campaign (hangs and aborts not counted)
 MEMORY_LIMIT = 4 << 30
 LITERAL_MAX = 24  # arrays up to this many elements are written out in a reproducer
 QUARANTINE = {"hang": 1, "abort": 2}  # failures of a kind after which a function is not called again
@@ -785,9 +786,9 @@ def campaign(calls: int, seed: int, timeout: float = TIMEOUT_S, progress=None) -
             failures[(t.name, outcome)] += 1
         else:
             spent[t.name] += secs
-        if outcome == "ok" and made is not None and len(recipes[made]) < 12 and t.kind != "property":
+        if outcome == "ok" and made is not None and len(recipes[made]) < 12 and secs < RECIPE_MAX_S:
             recipes[made].append(("call", t.name, kwargs, this))
-        if progress is not None and len(records) % 500 == 0:
+        if progress is not None and sum(r.outcome not in SKIPPED for r in records) % 500 == 0:
             progress(Campaign(seed, len(records), list(records), TARGETS, time.monotonic() - start, pool.restarts))
 
     try:
@@ -815,6 +816,7 @@ def main(argv=None) -> int:
                 f.write(text)
         print(f"{c.calls} calls, {len(c.bad())} bad, {c.seconds:.0f} s", file=sys.stderr, flush=True)
 
+    signal.signal(signal.SIGTERM, lambda *_: sys.exit(143))  # so the workers are killed too
     c = campaign(a.calls, a.seed, a.timeout, progress=write)
     write(c)
     if not a.out:
