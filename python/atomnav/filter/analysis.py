@@ -103,12 +103,15 @@ def chi2_band(dof: int, runs: int, p: float = 0.95) -> tuple[float, float]:
 @dataclass
 class MonteCarlo:
     """Monte-Carlo result: the tidy table (run, time_s, state, error, sigma) and NEES/NIS
-    per run and epoch (NIS NaN where no measurement)."""
+    per run and epoch (NIS NaN where no measurement); ``runs`` holds the run number of
+    each row of ``nees``/``nis`` (all runs 0…R−1, or the finished ones of an incomplete
+    campaign, see :class:`MonteCarloIncomplete`)."""
 
     table: pd.DataFrame
     nees: np.ndarray
     nis: np.ndarray
     times: np.ndarray
+    runs: np.ndarray
 
     def nees_inside(self, dof: int, p: float = 0.95) -> float:
         """Fraction of epochs whose run-averaged NEES lies in the two-sided p χ² band."""
@@ -117,17 +120,81 @@ class MonteCarlo:
         return float(np.mean((m >= lo) & (m <= hi)))
 
 
+class MonteCarloIncomplete(RuntimeError):
+    """Some runs of a distributed Monte Carlo could not be computed (their tasks kept
+    failing, e.g. every worker that ran them died). Nothing finished is lost:
+    ``partial`` is the :class:`MonteCarlo` of the finished runs (``partial.runs`` their
+    numbers), ``missing`` the run numbers not computed and ``errors`` the last exception
+    of each failed group of runs."""
+
+    def __init__(self, partial: MonteCarlo, missing: list[int], errors: list[BaseException]):
+        super().__init__(f"{len(missing)} of {len(missing) + len(partial.runs)} Monte-Carlo runs not computed "
+                         f"(runs {missing[:10]}{' …' if len(missing) > 10 else ''}); last error: {errors[-1]!r}")
+        self.partial, self.missing, self.errors = partial, missing, errors
+
+
 def _runs(scenario: Scenario, seed: int, runs: list[int], mode: str):
     return scenario._core.monte_carlo(int(seed), [int(r) for r in runs], mode)
 
 
+def _same(x):
+    return x
+
+
+def _distributed(client, scenario: Scenario, seed: int, groups: list[list[int]], mode: str, retries: int):
+    """Run the groups on a Dask cluster; returns ({group index: result}, [errors]).
+
+    The scenario reaches the workers as the result of a task (not scattered data), so the
+    scheduler recomputes it when the worker that holds it dies; each group is resubmitted
+    up to ``retries`` times when its task fails (e.g. ``KilledWorker``), and results are
+    fetched as they complete, so a failure later on does not lose them."""
+    from distributed import as_completed
+
+    scn = client.submit(_same, scenario, pure=False, retries=retries)
+    done, errors, tries = {}, [], {}
+    pending = {client.submit(_runs, scn, seed, g, mode, pure=False, retries=retries): i for i, g in enumerate(groups)}
+    queue = as_completed(list(pending))
+    for fut in queue:
+        i = pending.pop(fut)
+        try:
+            done[i] = fut.result()
+        except Exception as e:  # noqa: BLE001 - a failed group is retried or reported with the finished runs
+            tries[i] = tries.get(i, 0) + 1
+            if tries[i] <= retries:
+                again = client.submit(_runs, scn, seed, groups[i], mode, pure=False, retries=retries)
+                pending[again] = i
+                queue.add(again)
+            else:
+                errors.append(e)
+        fut.release()
+    scn.release()
+    return done, errors
+
+
+def _result(scenario: Scenario, runs: list[int], parts) -> MonteCarlo:
+    err, sig, nees, nis = (np.concatenate([p[i] for p in parts]) for i in range(4))
+    e, n = err.shape[1:]
+    ids = np.asarray(runs, dtype=np.int64)
+    table = pd.DataFrame({
+        "run": np.repeat(ids, e * n),
+        "time_s": np.tile(np.repeat(scenario.times, n), len(ids)),
+        "state": pd.Categorical(np.tile(scenario.labels, len(ids) * e), categories=scenario.labels),
+        "error": err.ravel(),
+        "sigma": sig.ravel(),
+    })
+    return MonteCarlo(table, nees, nis, scenario.times, ids)
+
+
 def monte_carlo(scenario: Scenario, runs: int, seed: int, mode: str = "closed", client=None,
-                chunk: int = 10) -> MonteCarlo:
+                chunk: int = 10, retries: int = 3) -> MonteCarlo:
     """``runs`` independent runs; run i uses the random stream i of ``seed`` (ChaCha20),
     so the result does not depend on where or in which grouping runs execute.
 
     Default: all local cores (rayon). With a ``dask.distributed.Client``, runs are sent
-    in groups of ``chunk`` to the cluster and the identical table is returned.
+    in groups of ``chunk`` to the cluster and the identical table is returned. Workers
+    may die meanwhile: a group whose task fails is resubmitted up to ``retries`` times
+    (the cluster recomputes lost inputs when workers return); if some groups still fail,
+    :class:`MonteCarloIncomplete` is raised carrying every finished run in ``.partial``.
     """
     if int(runs) < 1:
         raise ValueError(f"runs: must be >= 1, got {runs}")
@@ -135,19 +202,13 @@ def monte_carlo(scenario: Scenario, runs: int, seed: int, mode: str = "closed", 
         raise ValueError(f"seed: must be >= 0, got {seed}")
     ids = list(range(int(runs)))
     if client is None:
-        err, sig, nees, nis = _runs(scenario, seed, ids, mode)
-    else:
-        groups = [ids[i:i + chunk] for i in range(0, len(ids), chunk)]
-        scn = client.scatter(scenario, broadcast=True)
-        futures = [client.submit(_runs, scn, seed, g, mode, pure=False) for g in groups]
-        parts = client.gather(futures)
-        err, sig, nees, nis = (np.concatenate([p[i] for p in parts]) for i in range(4))
-    r, e, n = err.shape
-    table = pd.DataFrame({
-        "run": np.repeat(np.arange(r), e * n),
-        "time_s": np.tile(np.repeat(scenario.times, n), r),
-        "state": pd.Categorical(np.tile(scenario.labels, r * e), categories=scenario.labels),
-        "error": err.ravel(),
-        "sigma": sig.ravel(),
-    })
-    return MonteCarlo(table, nees, nis, scenario.times)
+        return _result(scenario, ids, [_runs(scenario, seed, ids, mode)])
+    groups = [ids[i:i + chunk] for i in range(0, len(ids), chunk)]
+    done, errors = _distributed(client, scenario, seed, groups, mode, int(retries))
+    order = sorted(done)
+    e, n = len(scenario.times), scenario.size
+    none = (np.empty((0, e, n)), np.empty((0, e, n)), np.empty((0, e)), np.empty((0, e)))
+    result = _result(scenario, [r for i in order for r in groups[i]], [none] + [done[i] for i in order])
+    if len(done) < len(groups):
+        raise MonteCarloIncomplete(result, [r for i, g in enumerate(groups) if i not in done for r in g], errors)
+    return result

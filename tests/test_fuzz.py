@@ -1,0 +1,40 @@
+"""The public API never kills the user's Python process: a fixed-seed share of fuzzed
+calls (tests/fuzz.py: every public function, constructor and method of atomnav and
+atomnav._core, arguments drawn by hypothesis from the signatures, each call in a worker
+subprocess) ends in no bad outcome — no exception other than InputError (naming a real
+parameter), TypeError, MemoryError, NumericalError or OSError, no panic, no abort, no
+hang, no NaN/inf output from finite input."""
+
+import pytest
+
+import fuzz
+
+CALLS = 20_000
+SEED = 20261202
+
+
+def _failures(c: fuzz.Campaign) -> str:
+    lines = [f"{len(c.bad())} bad outcomes in {c.calls} calls; first reproducer per (callable, class):",
+             fuzz.REPRO_HEADER]
+    for (target, cls), (rec, n) in sorted(c.first_failures().items()):
+        lines.append(f"# {target}: {cls} ({n}x): {rec.message[:200]}")
+        lines.append(rec.call)
+    return "\n".join(lines)
+
+
+def _run(calls: int, seed: int) -> None:
+    c = fuzz.campaign(calls, seed)
+    assert c.calls == calls
+    assert not c.bad(), _failures(c)
+
+
+def test_fuzz_public_api():
+    """≥ 20,000 calls, a few minutes on two cores."""
+    _run(CALLS, SEED)
+
+
+@pytest.mark.fuzz_long
+@pytest.mark.parametrize("seed", [1, 2, 3, 4, 5])
+def test_fuzz_public_api_long(seed):
+    """Five more campaigns of 100,000 calls each (run with -m fuzz_long)."""
+    _run(100_000, seed)
