@@ -17,7 +17,7 @@ use crate::imu::errors::{ImuErrorModel, ImuSimulator};
 use crate::imu::ideal::ideal_rates;
 use crate::imu::ImuKind;
 use crate::filter::initial_error::draw_start;
-use crate::math::{quat_mul, Vec3};
+use crate::math::Vec3;
 use crate::options::Choice;
 use crate::strapdown::{NavState, Strapdown, Vertical};
 use crate::trajectory::{Motion, TruthState};

@@ -1,7 +1,7 @@
 //! Bindings of filter/: state layouts, the INS error model and the aided INS (the linear
 //! Kalman machinery is bound in kalman.rs).
 
-use super::convert::{register_choices, Wrap, mat, mat_to_py, quat_rows, vec3_rows, vector};
+use super::convert::{register_choices, Wrap, mat, quat_rows, vec3_rows, vector};
 use crate::earth::Ellipsoid;
 use crate::error::{invalid, NavError};
 use crate::filter::aided::{AidedConfig, AidedIns, AidedOutput, Aiding, DampedVertical, InsSetup, PositionAiding, PositionFix, VerticalMode};
@@ -14,7 +14,7 @@ use crate::imu::ImuKind;
 use crate::strapdown::NavState;
 use nalgebra::{DMatrix, DVector};
 use numpy::ndarray::Array3;
-use numpy::{IntoPyArray, PyArray3, PyReadonlyArray1, PyReadonlyArray2, PyReadonlyArray3, PyUntypedArrayMethods};
+use numpy::{IntoPyArray, PyArray1, PyArray3, PyReadonlyArray1, PyReadonlyArray2, PyReadonlyArray3, PyUntypedArrayMethods};
 use pyo3::prelude::*;
 
 pub(crate) fn stack_to_py<'py>(py: Python<'py>, ms: &[DMatrix<f64>], n: usize) -> Bound<'py, PyArray3<f64>> {
