@@ -131,3 +131,27 @@ def test_reproduce_section_all_rows_pass(tmp_path):
     assert len(verdicts) == 9
     assert all(v == "pass" or v.startswith("ratio 0.99") or v.startswith("ratio 1.00") for v in verdicts), verdicts
     assert (tmp_path / "riccati_tennstedt2021_recursion.png").exists()
+
+
+@pytest.mark.parametrize("n", [60, 150])
+def test_dare_faer_path_matches_scipy(n):
+    """Above the register kernels' sizes the doubling runs on faer: its P⁻ satisfies the
+    filter DARE (Tennstedt et al. 2021, Eq. 31) to 1e-12 relative residual, like scipy's
+    solve_discrete_are (the independent oracle), and the two agree."""
+    rng = np.random.default_rng(n)
+    phi = rng.standard_normal((n, n))
+    phi *= 0.95 / max(abs(np.linalg.eigvals(phi)))
+    g = rng.standard_normal((n, n))
+    q = g @ g.T / n + 1e-3 * np.eye(n)
+    m = n // 4
+    h, r = rng.standard_normal((m, n)), np.eye(m)
+
+    def residual(p):
+        k = phi @ p @ h.T @ np.linalg.inv(h @ p @ h.T + r)
+        return np.max(np.abs(phi @ p @ phi.T + q - k @ h @ p @ phi.T - p)) / np.max(np.abs(p))
+
+    ref = scipy.linalg.solve_discrete_are(phi.T, h.T, q, r)
+    got = dare(phi, q, h, r).p_prior
+    assert residual(got) < 1e-12, residual(got)
+    assert np.max(np.abs(got - ref)) / np.max(np.abs(ref)) < 1e-9
+    assert np.array_equal(got, got.T)

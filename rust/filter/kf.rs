@@ -245,6 +245,18 @@ pub struct StoredStep {
     pub p_post: DMatrix<f64>,
 }
 
+/// The stored steps of a run given as one sequence per quantity (all as long as `phi`).
+pub fn stored_steps(phi: Vec<DMatrix<f64>>, x_prior: Vec<DVector<f64>>, p_prior: Vec<DMatrix<f64>>, x_post: Vec<DVector<f64>>, p_post: Vec<DMatrix<f64>>) -> Result<Vec<StoredStep>> {
+    let n_steps = phi.len();
+    for (name, len) in [("x_prior", x_prior.len()), ("p_prior", p_prior.len()), ("x_post", x_post.len()), ("p_post", p_post.len())] {
+        if len != n_steps {
+            return Err(invalid(name, format!("expected {n_steps} steps like phi, got {len}")));
+        }
+    }
+    let parts = phi.into_iter().zip(x_prior).zip(p_prior).zip(x_post).zip(p_post);
+    Ok(parts.map(|((((phi, x_prior), p_prior), x_post), p_post)| StoredStep { phi, x_prior, p_prior, x_post, p_post }).collect())
+}
+
 /// Rauch–Tung–Striebel fixed-interval smoother over a stored open-loop run:
 /// C_k = P⁺_k Φ_{k+1}ᵀ (P⁻_{k+1})⁻¹, x^s_k = x⁺_k + C_k(x^s_{k+1} − x⁻_{k+1}),
 /// P^s_k = P⁺_k + C_k(P^s_{k+1} − P⁻_{k+1})C_kᵀ. `steps[0].phi` is unused. Runs on

@@ -4,10 +4,10 @@
 
 use super::convert::{count, mat, mat_to_py, register_choices, vector, Wrap};
 use super::filter::{mats, stack_to_py};
-use crate::error::{invalid, NavError};
+use crate::error::NavError;
 use crate::filter::analysis::Scenario as CoreScenario;
 use crate::filter::discretize::{discretize_checked, Discretization};
-use crate::filter::kf::{rts as core_rts, Kf, LoopMode, StoredStep};
+use crate::filter::kf::{rts as core_rts, stored_steps, Kf, LoopMode};
 use crate::filter::riccati;
 use nalgebra::{DMatrix, DVector};
 use numpy::ndarray::{Array2, Array3};
@@ -161,16 +161,8 @@ fn rts<'py>(
 ) -> PyResult<(Bound<'py, PyArray2<f64>>, Bound<'py, PyArray3<f64>>)> {
     let (phi, pp, ps) = (mats(&phi, "phi")?, mats(&p_prior, "p_prior")?, mats(&p_post, "p_post")?);
     let (xp, xs) = (rows_mat(&x_prior, "x_prior")?, rows_mat(&x_post, "x_post")?);
-    let n_steps = phi.len();
-    for (name, len) in [("x_prior", xp.len()), ("p_prior", pp.len()), ("x_post", xs.len()), ("p_post", ps.len())] {
-        if len != n_steps {
-            return Err(invalid(name, format!("expected {n_steps} steps like phi, got {len}")).into());
-        }
-    }
     let n = ps.first().map_or(0, |m| m.nrows());
-    let steps: Vec<StoredStep> = (0..n_steps)
-        .map(|k| StoredStep { phi: phi[k].clone(), x_prior: xp[k].clone(), p_prior: pp[k].clone(), x_post: xs[k].clone(), p_post: ps[k].clone() })
-        .collect();
+    let steps = stored_steps(phi, xp, pp, xs, ps)?;
     let out = py.detach(|| core_rts(&steps))?;
     let xs: Vec<DVector<f64>> = out.iter().map(|o| o.0.clone()).collect();
     let ps: Vec<DMatrix<f64>> = out.into_iter().map(|o| o.1).collect();
