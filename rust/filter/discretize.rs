@@ -1,8 +1,8 @@
 //! Discretisation of ẋ = F x + w, E[w wᵀ] = Q_c δ(t − s), over a step Δt.
 //!
 //! Van Loan (1978): with M = [[−F, Q_c], [0, Fᵀ]] Δt and E = exp(M) = [[·, E₁₂], [0, E₂₂]],
-//! Φ = E₂₂ᵀ and Q_d = Φ E₁₂ (spec atom-strapdown E24, spec gnss-ins §2.9 item 29).
-//! First-order option: Φ = I + FΔt, Q_d = Q_c Δt (spec cai-ekf E32 "(or I + FΔt)").
+//! Φ = E₂₂ᵀ and Q_d = Φ E₁₂.
+//! First-order option: Φ = I + FΔt, Q_d = Q_c Δt.
 
 use crate::error::Result;
 use nalgebra::DMatrix;

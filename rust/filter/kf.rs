@@ -2,7 +2,7 @@
 //! in Joseph form, χ² gating, closed/open loop, positive-definiteness watch, RTS smoother.
 //!
 //! Measurement model: z = H δx + v, v ~ N(0, R), with z = predicted − measured (the
-//! project's δx = estimate − true, spec cai-ekf §2.0); the estimated error δx̂ is removed
+//! project's δx = estimate − true, README "Conventions"); the estimated error δx̂ is removed
 //! from the navigation solution by the caller (closed loop) or kept (open loop).
 
 use super::dense::{self, Algebra};
@@ -10,7 +10,7 @@ use super::matrix::{check_covariance, check_square, propagate_covariance, symmet
 use crate::error::{invalid, NavError, Result};
 use nalgebra::{DMatrix, DVector};
 
-/// How the filter's estimate reaches the navigation solution (spec gnss-ins-tight §2.11).
+/// How the filter's estimate reaches the navigation solution.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum LoopMode {
     /// Feedback: after each update the caller applies δx̂ and the filter resets it to 0.
@@ -144,7 +144,7 @@ impl Kf {
     }
 
     /// Update with z (m), H (m × n), R (m × m). `sequential`: decorrelate with L = chol(R)
-    /// (z̄ = L⁻¹z, H̄ = L⁻¹H) and process scalar rows (spec gnss-ins-tight Eq. 40);
+    /// (z̄ = L⁻¹z, H̄ = L⁻¹H) and process scalar rows;
     /// otherwise one stacked vector update. `gate`: χ² threshold — on yᵀS⁻¹y (stacked)
     /// or on each scalar row's y²/s (sequential); rejected rows are reported, not applied.
     /// Covariance in Joseph form P = (I − KH)P(I − KH)ᵀ + KRKᵀ.
@@ -224,7 +224,7 @@ impl Kf {
     }
 
     /// Closed loop: hand the estimated error to the caller and reset it to 0 (P unchanged,
-    /// spec gnss-ins-tight §2.11 item 34). Open loop: returns the estimate, keeps it.
+    /// feedback correction). Open loop: returns the estimate, keeps it.
     pub fn take_correction(&mut self) -> DVector<f64> {
         let dx = self.x.clone();
         if self.mode == LoopMode::Closed {
