@@ -203,7 +203,7 @@ def test_bad_phi_dimensions():
 
 
 def test_bad_mode_name():
-    with pytest.raises(ValueError, match='loop_mode: unknown mode "feedback"'):
+    with pytest.raises(ValueError, match='mode: unknown option "feedback"; choose one of closed, open'):
         KalmanFilter(np.eye(2), mode="feedback")
 
 

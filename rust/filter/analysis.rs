@@ -7,6 +7,7 @@
 //! discretised exactly (Van Loan); the filter uses the method asked for, so the effect
 //! of the first-order option on consistency can be measured.
 
+use super::dense::{self, Algebra};
 use super::discretize::{discretize, Discretization};
 use super::kf::{Kf, LoopMode};
 use super::matrix::{check_covariance, check_square};
@@ -16,6 +17,10 @@ use rand::SeedableRng;
 use rand_chacha::ChaCha20Rng;
 use rand_distr::{Distribution, StandardNormal};
 use rayon::prelude::*;
+
+/// Where the true-error analysis moves from nalgebra's products to faer. Measured
+/// (benches/filter.rs, `true_sigmas/*`): MEASURED_ANALYSIS.
+pub const ANALYSIS_FAER_MIN: usize = 40;
 
 #[derive(Debug, Clone)]
 pub struct Scenario {
@@ -67,6 +72,9 @@ impl Scenario {
         }
         check_covariance("p0", &p0, None, true)?;
         let n = p0.nrows();
+        if n == 0 {
+            return Err(invalid("p0", "must have at least one state, got 0x0"));
+        }
         for k in 0..steps {
             check_square(&format!("f[{k}]"), &f[k], Some(n))?;
             check_covariance(&format!("qc[{k}]"), &qc[k], Some(n), false)?;
@@ -124,7 +132,15 @@ impl Scenario {
     ///   P⁺ = (I−KH) P⁻ (I−KH)ᵀ + K R_t Kᵀ − (I−KH) S Kᵀ − K Sᵀ (I−KH)ᵀ.
     /// Returns the σ of the true error after each epoch (epochs × n, row-major); with
     /// R_t = R and S = 0 it is [`Scenario::sigmas`] (for a Van Loan filter).
+    ///
+    /// The covariance products run on nalgebra below [`ANALYSIS_FAER_MIN`] states and on
+    /// faer from there on.
     pub fn true_sigmas(&self, r_true: &DMatrix<f64>, cross: &[DMatrix<f64>]) -> Result<Vec<f64>> {
+        self.true_sigmas_using(r_true, cross, Algebra::by_size(self.size(), ANALYSIS_FAER_MIN))
+    }
+
+    /// [`Scenario::true_sigmas`] with the algebra chosen by the caller (benches and tests).
+    pub fn true_sigmas_using(&self, r_true: &DMatrix<f64>, cross: &[DMatrix<f64>], algebra: Algebra) -> Result<Vec<f64>> {
         let n = self.size();
         let m = self.h.nrows();
         check_covariance("r_true", r_true, Some(m), false)?;
@@ -132,27 +148,36 @@ impl Scenario {
             return Err(invalid("cross", format!("expected one n × m matrix per step ({}), got {}", self.phi.len(), cross.len())));
         }
         if let Some(k) = cross.iter().position(|c| c.nrows() != n || c.ncols() != m) {
-            return Err(invalid("cross", format!("entry {k} is {} × {}, expected {n} × {m}", cross[k].nrows(), cross[k].ncols())));
+            return Err(crate::error::invalid_at("cross", k, format!("entry {k} is {} × {}, expected {n} × {m}", cross[k].nrows(), cross[k].ncols())));
         }
         let mut pf = self.p0.clone();
         let mut pt = self.p0.clone();
         let eye = DMatrix::<f64>::identity(n, n);
+        let (mut out_buf, mut t) = (DMatrix::zeros(n, n), DMatrix::zeros(n, n));
+        // P ← A P Aᵀ + Q on the chosen algebra.
+        let mut congruence = |p: &mut DMatrix<f64>, a: &DMatrix<f64>, q: &DMatrix<f64>| match algebra {
+            Algebra::Kernels => *p = a * &*p * a.transpose() + q,
+            Algebra::Faer => {
+                dense::congruence(&mut out_buf, a, p, Some(q), &mut t);
+                std::mem::swap(p, &mut out_buf);
+            }
+        };
         let mut out = Vec::with_capacity(self.epochs() * n);
         for k in 0..self.epochs() {
             if k > 0 {
-                pf = &self.phi[k - 1] * &pf * self.phi[k - 1].transpose() + &self.qd[k - 1];
+                congruence(&mut pf, &self.phi[k - 1], &self.qd[k - 1]);
                 let sq = &self.sqrt_qd_true[k - 1];
-                pt = &self.phi_true[k - 1] * &pt * self.phi_true[k - 1].transpose() + sq * sq.transpose();
+                congruence(&mut pt, &self.phi_true[k - 1], &(sq * sq.transpose()));
             }
             if self.measure[k] {
                 let s = &self.h * &pf * self.h.transpose() + &self.r;
                 let chol = s.cholesky().ok_or_else(|| NavError::Numerical(format!("epoch {k}: innovation covariance not positive definite")))?;
                 let gain = chol.solve(&(&self.h * &pf)).transpose();
                 let ikh = &eye - &gain * &self.h;
-                pf = &ikh * &pf * ikh.transpose() + &gain * &self.r * gain.transpose();
+                congruence(&mut pf, &ikh, &(&gain * &self.r * gain.transpose()));
                 let c = if k > 0 { cross[k - 1].clone() } else { DMatrix::zeros(n, m) };
                 let corr = &ikh * &c * gain.transpose();
-                pt = &ikh * &pt * ikh.transpose() + &gain * r_true * gain.transpose() - &corr - corr.transpose();
+                congruence(&mut pt, &ikh, &(&gain * r_true * gain.transpose() - &corr - corr.transpose()));
             }
             out.extend((0..n).map(|i| pt[(i, i)].max(0.0).sqrt()));
         }
@@ -188,7 +213,8 @@ impl Scenario {
             }
             // Error of the output estimate X̂ = X ⊖ δx̂ (δx̂ = 0 in closed loop).
             let err = &e - &kf.x;
-            let chol = kf.p.clone().cholesky().expect("P checked positive definite by the filter");
+            // the filter checks only P's diagonal after a prediction: P itself is factorised here
+            let chol = kf.p.clone().cholesky().ok_or_else(|| NavError::Numerical(format!("run {run}, epoch {k}: covariance lost positive definiteness")))?;
             res.nees.push(err.dot(&chol.solve(&err)));
             res.error.extend(err.iter());
             res.sigma.extend((0..n).map(|i| kf.p[(i, i)].sqrt()));
@@ -258,5 +284,30 @@ mod tests {
         // no correlation and R_t = R: the filter's own covariance
         let own = s.true_sigmas(&DMatrix::from_element(1, 1, r_f), &vec![DMatrix::zeros(1, 1); steps]).unwrap();
         assert!(own.iter().zip(s.sigmas().unwrap()).all(|(a, b)| (a - b).abs() < 1e-12));
+    }
+
+    /// The faer true-error analysis equals nalgebra's above the crossover, and the filter
+    /// σ of `sigmas` (whose Kf dispatches by size) equal the R_t = R, S = 0 analysis.
+    #[test]
+    fn true_sigmas_faer_equals_nalgebra() {
+        let (n, steps) = (ANALYSIS_FAER_MIN + 2, 6);
+        let f: Vec<_> = (0..steps).map(|k| DMatrix::from_fn(n, n, |i, j| if i == j { -0.05 } else { 0.01 * (((i * 7 + j * 3 + k) % 11) as f64 - 5.0) })).collect();
+        let qc = vec![DMatrix::identity(n, n) * 0.2; steps];
+        let h = DMatrix::from_fn(3, n, |i, j| if j % 3 == i { 1.0 } else { 0.0 });
+        let r = DMatrix::identity(3, 3) * 0.5;
+        let s = Scenario::new(&f, &qc, &vec![0.5; steps], DMatrix::identity(n, n), h, r.clone(), vec![true; steps + 1], Discretization::VanLoan, false).unwrap();
+        let cross = vec![DMatrix::from_element(n, 3, 0.01); steps];
+        let a = s.true_sigmas_using(&(&r * 1.5), &cross, Algebra::Kernels).unwrap();
+        let b = s.true_sigmas_using(&(&r * 1.5), &cross, Algebra::Faer).unwrap();
+        assert!(a.iter().zip(&b).all(|(x, y)| (x - y).abs() < 1e-12 * x), "{a:?} {b:?}");
+        let own = s.true_sigmas(&r, &vec![DMatrix::zeros(n, 3); steps]).unwrap();
+        assert!(own.iter().zip(s.sigmas().unwrap()).all(|(x, y)| (x - y).abs() < 1e-12 * x));
+    }
+
+    /// A scenario without states is rejected, not divided by.
+    #[test]
+    fn empty_scenario_is_rejected() {
+        let e = Scenario::new(&[], &[], &[], DMatrix::zeros(0, 0), DMatrix::zeros(0, 0), DMatrix::zeros(0, 0), vec![true], Discretization::VanLoan, false).unwrap_err();
+        assert!(matches!(&e, NavError::InvalidInput { field, .. } if field == "p0"), "{e}");
     }
 }

@@ -1,10 +1,10 @@
 //! Discretisation of ẋ = F x + w, E[w wᵀ] = Q_c δ(t − s), over a step Δt.
 //!
 //! Van Loan (1978): with M = [[−F, Q_c], [0, Fᵀ]] Δt and E = exp(M) = [[·, E₁₂], [0, E₂₂]],
-//! Φ = E₂₂ᵀ and Q_d = Φ E₁₂ (spec atom-strapdown E24, spec gnss-ins §2.9 item 29).
-//! First-order option: Φ = I + FΔt, Q_d = Q_c Δt (spec cai-ekf E32 "(or I + FΔt)").
+//! Φ = E₂₂ᵀ and Q_d = Φ E₁₂.
+//! First-order option: Φ = I + FΔt, Q_d = Q_c Δt.
 
-use crate::error::{invalid, Result};
+use crate::error::Result;
 use nalgebra::DMatrix;
 
 /// How Φ and Q_d are computed from F and Q_c.
@@ -16,14 +16,9 @@ pub enum Discretization {
     FirstOrder,
 }
 
-impl Discretization {
-    pub fn by_name(name: &str) -> Result<Self> {
-        match name {
-            "van_loan" => Ok(Self::VanLoan),
-            "first_order" => Ok(Self::FirstOrder),
-            _ => Err(invalid("discretization", format!("unknown method {name:?} (expected \"van_loan\" or \"first_order\")"))),
-        }
-    }
+impl crate::options::Choice for Discretization {
+    const PARAMETER: &'static str = "method";
+    const CHOICES: &'static [(&'static str, Self)] = &[("van_loan", Discretization::VanLoan), ("first_order", Discretization::FirstOrder)];
 }
 
 /// Matrix exponential by scaling and squaring with an 18-term Taylor series: the
@@ -43,6 +38,14 @@ pub fn expm(a: &DMatrix<f64>) -> DMatrix<f64> {
         sum = &sum * &sum;
     }
     sum
+}
+
+/// [`discretize`] of user input: F square, Q_c a covariance of the same size, `dt` > 0.
+pub fn discretize_checked(f: &DMatrix<f64>, qc: &DMatrix<f64>, dt: f64, method: Discretization) -> Result<(DMatrix<f64>, DMatrix<f64>)> {
+    super::matrix::check_square("f", f, None)?;
+    super::matrix::check_covariance("qc", qc, Some(f.nrows()), false)?;
+    crate::error::check_positive("dt", dt)?;
+    Ok(discretize(f, qc, dt, method))
 }
 
 /// (Φ, Q_d) over `dt` for continuous F (n × n) and white-noise intensity Q_c = G Q Gᵀ (n × n).

@@ -2,14 +2,15 @@
 //! in Joseph form, χ² gating, closed/open loop, positive-definiteness watch, RTS smoother.
 //!
 //! Measurement model: z = H δx + v, v ~ N(0, R), with z = predicted − measured (the
-//! project's δx = estimate − true, spec cai-ekf §2.0); the estimated error δx̂ is removed
+//! project's δx = estimate − true, README "Conventions"); the estimated error δx̂ is removed
 //! from the navigation solution by the caller (closed loop) or kept (open loop).
 
+use super::dense::{self, Algebra};
 use super::matrix::{check_covariance, check_square, propagate_covariance, symmetrize};
 use crate::error::{invalid, NavError, Result};
 use nalgebra::{DMatrix, DVector};
 
-/// How the filter's estimate reaches the navigation solution (spec gnss-ins-tight §2.11).
+/// How the filter's estimate reaches the navigation solution.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum LoopMode {
     /// Feedback: after each update the caller applies δx̂ and the filter resets it to 0.
@@ -18,14 +19,9 @@ pub enum LoopMode {
     Open,
 }
 
-impl LoopMode {
-    pub fn by_name(name: &str) -> Result<Self> {
-        match name {
-            "closed" => Ok(Self::Closed),
-            "open" => Ok(Self::Open),
-            _ => Err(invalid("loop_mode", format!("unknown mode {name:?} (expected \"closed\" or \"open\")"))),
-        }
-    }
+impl crate::options::Choice for LoopMode {
+    const PARAMETER: &'static str = "mode";
+    const CHOICES: &'static [(&'static str, Self)] = &[("closed", LoopMode::Closed), ("open", LoopMode::Open)];
 }
 
 /// Finite and strictly positive (false for NaN).
@@ -54,12 +50,39 @@ pub struct Kf {
     pub epoch: usize,
     /// Work buffer of the covariance propagation (kept to avoid an allocation per step).
     scratch: Vec<f64>,
+    /// Algebra of the covariance products (by state size, [`KF_FAER_MIN`]).
+    algebra: Algebra,
+    /// n × n work matrices of the faer path (empty on the kernel path).
+    work: (DMatrix<f64>, DMatrix<f64>),
 }
 
+/// Where the covariance products of the filter (predict ΦPΦᵀ + Q, Joseph update) move
+/// from the register kernel of matrix.rs and nalgebra to faer. Measured
+/// (benches/filter.rs, `predict/*`): MEASURED_PREDICT.
+pub const KF_FAER_MIN: usize = 40;
+
 impl Kf {
+    /// A filter from P₀ (positive definite, at least one state).
     pub fn new(p0: DMatrix<f64>, mode: LoopMode) -> Result<Kf> {
         check_covariance("p0", &p0, None, true)?;
-        Ok(Kf { x: DVector::zeros(p0.nrows()), p: p0, mode, epoch: 0, scratch: Vec::new() })
+        let n = p0.nrows();
+        if n == 0 {
+            return Err(invalid("p0", "must have at least one state, got 0x0"));
+        }
+        let kf = Kf { x: DVector::zeros(n), p: p0, mode, epoch: 0, scratch: Vec::new(), algebra: Algebra::Kernels, work: (DMatrix::zeros(0, 0), DMatrix::zeros(0, 0)) };
+        Ok(kf.with_algebra(Algebra::by_size(n, KF_FAER_MIN)))
+    }
+
+    /// The same filter with its covariance products on `algebra` (benches and tests; the
+    /// default is chosen by state size).
+    pub fn with_algebra(mut self, algebra: Algebra) -> Kf {
+        let n = self.size();
+        self.algebra = algebra;
+        self.work = match algebra {
+            Algebra::Faer => (DMatrix::zeros(n, n), DMatrix::zeros(n, n)),
+            Algebra::Kernels => (DMatrix::zeros(0, 0), DMatrix::zeros(0, 0)),
+        };
+        self
     }
 
     pub fn size(&self) -> usize {
@@ -78,7 +101,8 @@ impl Kf {
         Ok(())
     }
 
-    /// δx̂ ← Φδx̂, P ← ΦPΦᵀ + Q_d (spec cai-ekf E35).
+    /// δx̂ ← Φδx̂ (open loop), P ← ΦPΦᵀ + Q_d (Tennstedt et al. 2021, Eq. 31), for a Q_d
+    /// that is a covariance by construction: only the shapes are checked.
     pub fn predict(&mut self, phi: &DMatrix<f64>, qd: &DMatrix<f64>) -> Result<()> {
         let n = self.size();
         check_square("phi", phi, Some(n))?;
@@ -86,12 +110,33 @@ impl Kf {
         self.predict_unchecked(phi, qd)
     }
 
+    /// `steps` predictions with the same (Φ, Q_d) of user input (Q_d checked to be an
+    /// n × n covariance, once).
+    pub fn predict_many(&mut self, phi: &DMatrix<f64>, qd: &DMatrix<f64>, steps: usize) -> Result<()> {
+        let n = self.size();
+        check_square("phi", phi, Some(n))?;
+        check_covariance("qd", qd, Some(n), false)?;
+        (0..steps).try_for_each(|_| self.predict_unchecked(phi, qd))
+    }
+
     /// `predict` without shape checks, for the inner loops whose matrices are built here.
     pub(crate) fn predict_unchecked(&mut self, phi: &DMatrix<f64>, qd: &DMatrix<f64>) -> Result<()> {
         self.epoch += 1;
         let n = self.size();
-        let x = (self.mode == LoopMode::Open).then_some(self.x.as_mut_slice());
-        propagate_covariance(self.p.as_mut_slice(), x, phi.as_slice(), qd.as_slice(), n, &mut self.scratch);
+        match self.algebra {
+            Algebra::Kernels => {
+                let x = (self.mode == LoopMode::Open).then_some(self.x.as_mut_slice());
+                propagate_covariance(self.p.as_mut_slice(), x, phi.as_slice(), qd.as_slice(), n, &mut self.scratch);
+            }
+            Algebra::Faer => {
+                if self.mode == LoopMode::Open {
+                    self.x = phi * &self.x;
+                }
+                let (out, t) = &mut self.work;
+                dense::congruence(out, phi, &self.p, Some(qd), t);
+                std::mem::swap(&mut self.p, out);
+            }
+        }
         if (0..self.size()).any(|i| !positive(self.p[(i, i)])) {
             return self.check_pd("predict");
         }
@@ -99,7 +144,7 @@ impl Kf {
     }
 
     /// Update with z (m), H (m × n), R (m × m). `sequential`: decorrelate with L = chol(R)
-    /// (z̄ = L⁻¹z, H̄ = L⁻¹H) and process scalar rows (spec gnss-ins-tight Eq. 40);
+    /// (z̄ = L⁻¹z, H̄ = L⁻¹H) and process scalar rows;
     /// otherwise one stacked vector update. `gate`: χ² threshold — on yᵀS⁻¹y (stacked)
     /// or on each scalar row's y²/s (sequential); rejected rows are reported, not applied.
     /// Covariance in Joseph form P = (I − KH)P(I − KH)ᵀ + KRKᵀ.
@@ -137,9 +182,11 @@ impl Kf {
     }
 
     fn update_sequential(&mut self, z: &[f64], h: &DMatrix<f64>, r: &DMatrix<f64>, gate: Option<f64>) -> Result<UpdateReport> {
-        let l = r.clone().cholesky().expect("R checked positive definite").l();
-        let zb = l.solve_lower_triangular(&DVector::from_column_slice(z)).expect("L non-singular");
-        let hb = l.solve_lower_triangular(h).expect("L non-singular");
+        // check_covariance judged a diagonally scaled copy of R: R itself is factorised here.
+        let not_pd = || invalid("r", "not positive definite (Cholesky of r failed)");
+        let l = r.clone().cholesky().ok_or_else(not_pd)?.l();
+        let zb = l.solve_lower_triangular(&DVector::from_column_slice(z)).ok_or_else(not_pd)?;
+        let hb = l.solve_lower_triangular(h).ok_or_else(not_pd)?;
         let n = self.size();
         let one = DMatrix::from_element(1, 1, 1.0);
         let (mut innovation, mut nis, mut rejected) = (vec![], vec![], vec![]);
@@ -164,12 +211,20 @@ impl Kf {
     fn joseph(&mut self, k: &DMatrix<f64>, h: &DMatrix<f64>, r: &DMatrix<f64>) {
         let n = self.size();
         let a = DMatrix::identity(n, n) - k * h;
-        self.p = &a * &self.p * a.transpose() + k * r * k.transpose();
+        let krk = k * r * k.transpose();
+        match self.algebra {
+            Algebra::Kernels => self.p = &a * &self.p * a.transpose() + krk,
+            Algebra::Faer => {
+                let (out, t) = &mut self.work;
+                dense::congruence(out, &a, &self.p, Some(&krk), t);
+                std::mem::swap(&mut self.p, out);
+            }
+        }
         symmetrize(&mut self.p);
     }
 
     /// Closed loop: hand the estimated error to the caller and reset it to 0 (P unchanged,
-    /// spec gnss-ins-tight §2.11 item 34). Open loop: returns the estimate, keeps it.
+    /// feedback correction). Open loop: returns the estimate, keeps it.
     pub fn take_correction(&mut self) -> DVector<f64> {
         let dx = self.x.clone();
         if self.mode == LoopMode::Closed {
@@ -190,27 +245,87 @@ pub struct StoredStep {
     pub p_post: DMatrix<f64>,
 }
 
+/// The stored steps of a run given as one sequence per quantity (all as long as `phi`).
+pub fn stored_steps(phi: Vec<DMatrix<f64>>, x_prior: Vec<DVector<f64>>, p_prior: Vec<DMatrix<f64>>, x_post: Vec<DVector<f64>>, p_post: Vec<DMatrix<f64>>) -> Result<Vec<StoredStep>> {
+    let n_steps = phi.len();
+    for (name, len) in [("x_prior", x_prior.len()), ("p_prior", p_prior.len()), ("x_post", x_post.len()), ("p_post", p_post.len())] {
+        if len != n_steps {
+            return Err(invalid(name, format!("expected {n_steps} steps like phi, got {len}")));
+        }
+    }
+    let parts = phi.into_iter().zip(x_prior).zip(p_prior).zip(x_post).zip(p_post);
+    Ok(parts.map(|((((phi, x_prior), p_prior), x_post), p_post)| StoredStep { phi, x_prior, p_prior, x_post, p_post }).collect())
+}
+
 /// Rauch–Tung–Striebel fixed-interval smoother over a stored open-loop run:
 /// C_k = P⁺_k Φ_{k+1}ᵀ (P⁻_{k+1})⁻¹, x^s_k = x⁺_k + C_k(x^s_{k+1} − x⁻_{k+1}),
-/// P^s_k = P⁺_k + C_k(P^s_{k+1} − P⁻_{k+1})C_kᵀ. `steps[0].phi` is unused.
+/// P^s_k = P⁺_k + C_k(P^s_{k+1} − P⁻_{k+1})C_kᵀ. `steps[0].phi` is unused. Runs on
+/// nalgebra below [`RTS_FAER_MIN`] states and on faer from there on.
 pub fn rts(steps: &[StoredStep]) -> Result<Vec<(DVector<f64>, DMatrix<f64>)>> {
-    let Some(last) = steps.last() else { return Ok(vec![]) };
-    let mut out = vec![(last.x_post.clone(), last.p_post.clone())];
-    for k in (0..steps.len() - 1).rev() {
-        let next = &steps[k + 1];
-        let chol = next
-            .p_prior
-            .clone()
-            .cholesky()
-            .ok_or_else(|| NavError::Numerical(format!("smoother: prior covariance not positive definite at step {}", k + 1)))?;
-        // C = P⁺Φᵀ(P⁻)⁻¹  ⇔  P⁻ Cᵀ = Φ P⁺.
-        let c = chol.solve(&(&next.phi * &steps[k].p_post)).transpose();
-        let (xs, ps) = out.last().expect("non-empty");
-        let x = &steps[k].x_post + &c * (xs - &next.x_prior);
-        let mut p = &steps[k].p_post + &c * (ps - &next.p_prior) * c.transpose();
-        symmetrize(&mut p);
-        out.push((x, p));
+    let n = steps.first().map_or(0, |s| s.p_post.nrows());
+    rts_using(steps, Algebra::by_size(n, RTS_FAER_MIN))
+}
+
+/// Where the RTS smoother moves from nalgebra to faer. Measured (benches/filter.rs,
+/// `rts/*`, 200 steps): MEASURED_RTS.
+pub const RTS_FAER_MIN: usize = 40;
+
+/// Every stored step has n × n matrices and n-vectors (n of the first step's P⁺).
+fn check_steps(steps: &[StoredStep]) -> Result<usize> {
+    let n = steps.first().map_or(0, |s| s.p_post.nrows());
+    for (k, s) in steps.iter().enumerate() {
+        for (field, m) in [("phi", &s.phi), ("p_prior", &s.p_prior), ("p_post", &s.p_post)] {
+            if m.shape() != (n, n) {
+                return Err(crate::error::invalid_at(field, k, format!("step {k} is {}x{}, expected {n}x{n}", m.nrows(), m.ncols())));
+            }
+        }
+        for (field, v) in [("x_prior", &s.x_prior), ("x_post", &s.x_post)] {
+            if v.len() != n {
+                return Err(crate::error::invalid_at(field, k, format!("step {k} has {} entries, expected {n}", v.len())));
+            }
+        }
     }
+    Ok(n)
+}
+
+/// [`rts`] with the algebra chosen by the caller (benches and tests).
+pub fn rts_using(steps: &[StoredStep], algebra: Algebra) -> Result<Vec<(DVector<f64>, DMatrix<f64>)>> {
+    let n = check_steps(steps)?;
+    let Some(last) = steps.last() else { return Ok(vec![]) };
+    let mut out = Vec::with_capacity(steps.len());
+    let (mut xs, mut ps) = (last.x_post.clone(), last.p_post.clone());
+    let (mut ct, mut u) = match algebra {
+        Algebra::Faer => (DMatrix::zeros(n, n), DMatrix::zeros(n, n)),
+        Algebra::Kernels => (DMatrix::zeros(0, 0), DMatrix::zeros(0, 0)),
+    };
+    for k in (0..steps.len() - 1).rev() {
+        let (cur, next) = (&steps[k], &steps[k + 1]);
+        let not_pd = || NavError::Numerical(format!("smoother: prior covariance not positive definite at step {}", k + 1));
+        // C = P⁺Φᵀ(P⁻)⁻¹  ⇔  P⁻ Cᵀ = Φ P⁺.
+        let (x, mut p) = match algebra {
+            Algebra::Kernels => {
+                let chol = next.p_prior.clone().cholesky().ok_or_else(not_pd)?;
+                let c = chol.solve(&(&next.phi * &cur.p_post)).transpose();
+                (&cur.x_post + &c * (&xs - &next.x_prior), &cur.p_post + &c * (&ps - &next.p_prior) * c.transpose())
+            }
+            Algebra::Faer => {
+                dense::mul(dense::view_mut(&mut ct), false, dense::view(&next.phi), dense::view(&cur.p_post));
+                if !dense::cholesky_solve(&next.p_prior, &mut ct) {
+                    return Err(not_pd());
+                }
+                // P^s = P⁺ + Cᵀᵀ (D Cᵀ) with D = P^s_{k+1} − P⁻_{k+1}; lower triangle, mirrored.
+                let d = &ps - &next.p_prior;
+                dense::mul(dense::view_mut(&mut u), false, dense::view(&d), dense::view(&ct));
+                let mut p = cur.p_post.clone();
+                dense::mul_lower(dense::view_mut(&mut p), true, dense::view(&ct).transpose(), dense::view(&u));
+                dense::mirror_lower(&mut p);
+                (&cur.x_post + ct.tr_mul(&(&xs - &next.x_prior)), p)
+            }
+        };
+        symmetrize(&mut p);
+        out.push((std::mem::replace(&mut xs, x), std::mem::replace(&mut ps, p)));
+    }
+    out.push((xs, ps));
     out.reverse();
     Ok(out)
 }
@@ -235,5 +350,72 @@ mod tests {
             c.update(&[1.0], &DMatrix::from_element(1, 1, 1.0), &DMatrix::from_element(1, 1, 0.5), false, None).unwrap();
         }
         assert!((c.p[(0, 0)] - 1.0 / (0.5 + 10.0)).abs() < 1e-14);
+    }
+
+    fn sample(n: usize, m: usize, seed: usize) -> DMatrix<f64> {
+        DMatrix::from_fn(n, m, |i, j| (((i * 7 + j * 3 + seed) % 11) as f64 - 5.0) / 25.0)
+    }
+
+    /// A stored open-loop run of `len` steps of an n-state filter on `algebra`.
+    fn run(n: usize, len: usize, algebra: Algebra) -> (Vec<StoredStep>, Kf) {
+        // stable Φ and a well-conditioned Q: P stays within a few orders of magnitude
+        let phi = DMatrix::identity(n, n) * 0.9 + sample(n, n, 1) * (0.5 / n as f64);
+        let g = sample(n, n, 4);
+        let q = &g * g.transpose() / n as f64 + DMatrix::identity(n, n) * 0.1;
+        let (h, r) = (sample(3, n, 2) * 5.0, DMatrix::identity(3, 3) * 0.3);
+        let mut kf = Kf::new(DMatrix::identity(n, n), LoopMode::Open).unwrap().with_algebra(algebra);
+        let steps = (0..len)
+            .map(|k| {
+                let (x_prior, p_prior) = (kf.x.clone(), kf.p.clone());
+                kf.update(&[0.3 * k as f64, -0.2, 0.1], &h, &r, k % 2 == 0, None).unwrap();
+                let s = StoredStep { phi: phi.clone(), x_prior, p_prior, x_post: kf.x.clone(), p_post: kf.p.clone() };
+                kf.predict_many(&phi, &q, 2).unwrap();
+                s
+            })
+            .collect();
+        (steps, kf)
+    }
+
+    /// The faer path of predict, both updates and the RTS smoother equals the kernel /
+    /// nalgebra path below and above the crossovers, and keeps P exactly symmetric.
+    #[test]
+    fn faer_filter_and_smoother_equal_kernels() {
+        for n in [5, KF_FAER_MIN.max(RTS_FAER_MIN) + 3] {
+            let (sk, kk) = run(n, 12, Algebra::Kernels);
+            let (sf, kf) = run(n, 12, Algebra::Faer);
+            let scale = kk.p.abs().max();
+            assert!((&kk.p - &kf.p).abs().max() < 1e-12 * scale, "n = {n}: P differs");
+            assert!((&kk.x - &kf.x).abs().max() < 1e-12 * kk.x.abs().max(), "n = {n}: x differs");
+            assert_eq!(kf.p, kf.p.transpose(), "n = {n}");
+            drop(sk);
+            let (a, b) = (rts_using(&sf, Algebra::Kernels).unwrap(), rts_using(&sf, Algebra::Faer).unwrap());
+            for (k, ((xa, pa), (xb, pb))) in a.iter().zip(&b).enumerate() {
+                let d = (pa - pb).abs().max() / pa.abs().max();
+                assert!(d < 1e-12, "n = {n}, step {k}: P^s differs by {d}");
+                assert!((xa - xb).abs().max() < 1e-12 * xa.abs().max(), "n = {n}, step {k}: x^s differs");
+            }
+            // the dispatch by size gives one of the two
+            let auto = rts(&sf).unwrap();
+            let want = if n >= RTS_FAER_MIN { b } else { rts_using(&sf, Algebra::Kernels).unwrap() };
+            assert_eq!(auto[0].1, want[0].1, "n = {n}");
+        }
+    }
+
+    /// Bad input to the core is an error, never a panic: an empty P₀, mismatched stored
+    /// steps, an indefinite R for the sequential update.
+    #[test]
+    fn bad_input_is_an_error() {
+        let e = Kf::new(DMatrix::zeros(0, 0), LoopMode::Open).unwrap_err();
+        assert!(matches!(&e, NavError::InvalidInput { field, .. } if field == "p0"), "{e}");
+        let (mut steps, _) = run(4, 3, Algebra::Kernels);
+        steps[2].p_prior = DMatrix::identity(3, 3);
+        let e = rts(&steps).unwrap_err();
+        assert!(matches!(&e, NavError::InvalidInput { field, index: Some(2), .. } if field == "p_prior"), "{e}");
+        let mut kf = Kf::new(DMatrix::identity(2, 2), LoopMode::Open).unwrap();
+        let r = DMatrix::from_row_slice(2, 2, &[1.0, 2.0, 2.0, 1.0]);
+        let e = kf.update(&[0.0, 0.0], &DMatrix::identity(2, 2), &r, true, None).unwrap_err();
+        assert!(matches!(&e, NavError::InvalidInput { field, .. } if field == "r"), "{e}");
+        let e = kf.predict_many(&DMatrix::identity(2, 2), &(-DMatrix::identity(2, 2)), 3).unwrap_err();
+        assert!(matches!(&e, NavError::InvalidInput { field, .. } if field == "qd"), "{e}");
     }
 }

@@ -239,7 +239,7 @@ fn propagate_any(p: &mut [f64], x: Option<&mut [f64]>, phi: &[f64], q: &[f64], n
 
 /// Upper triangle ← lower triangle of a column-major n × n buffer.
 #[inline(always)]
-fn mirror_lower(p: &mut [f64], n: usize) {
+pub(crate) fn mirror_lower(p: &mut [f64], n: usize) {
     for j in 0..n {
         for i in j + 1..n {
             p[i * n + j] = p[j * n + i];

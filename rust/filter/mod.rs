@@ -3,6 +3,7 @@
 //! the DARE doubling on the padded register-chunk kernels of matrix.rs.
 
 pub mod matrix;
+pub mod dense;
 pub mod riccati;
 pub mod discretize;
 pub mod layout;

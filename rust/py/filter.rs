@@ -130,7 +130,7 @@ impl AidedSetup {
     ) -> PyResult<Self> {
         let initial = NavState { t: t0, lla: lla0.into(), vel: vel0.into(), q_nb: crate::math::quat(q0[0], q0[1], q0[2], q0[3]) };
         let noise = ins_noise(accel_psd, gyro_psd, &accel_bias, &gyro_bias)?;
-        let cfg = AidedConfig { noise, predict_every, method: Discretization::by_name(method)?, mode: LoopMode::by_name(mode)?, sequential, gate };
+        let cfg = AidedConfig { noise, predict_every, method: <Discretization as crate::options::Choice>::parse(method)?, mode: <LoopMode as crate::options::Choice>::parse(mode)?, sequential, gate };
         let bias = match (baro_bias, baro_bias_sigma0) {
             (Some((kind, p1, p2)), Some(s0)) => Some((BiasModel::from_parts("baro_bias", &kind, p1, p2)?, s0)),
             (None, None) => None,

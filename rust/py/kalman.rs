@@ -2,16 +2,16 @@
 //! discretisation, the streaming Kalman filter, the RTS smoother and the covariance
 //! analysis / Monte Carlo of a linearised scenario.
 
-use super::convert::{mat, mat_to_py, vector};
+use super::convert::{count, mat, mat_to_py, register_choices, vector, Wrap};
 use super::filter::{mats, stack_to_py};
-use crate::error::{invalid, NavError};
+use crate::error::NavError;
 use crate::filter::analysis::Scenario as CoreScenario;
-use crate::filter::discretize::{discretize, Discretization};
-use crate::filter::kf::{rts as core_rts, Kf, LoopMode, StoredStep};
+use crate::filter::discretize::{discretize_checked, Discretization};
+use crate::filter::kf::{rts as core_rts, stored_steps, Kf, LoopMode};
 use crate::filter::riccati;
 use nalgebra::{DMatrix, DVector};
 use numpy::ndarray::{Array2, Array3};
-use numpy::{IntoPyArray, PyArray1, PyArray2, PyArray3, PyReadonlyArray1, PyReadonlyArray2, PyReadonlyArray3};
+use numpy::{IntoPyArray, PyArray1, PyArray2, PyArray3, PyArrayMethods, PyReadonlyArray1, PyReadonlyArray2, PyReadonlyArray3};
 use pyo3::prelude::*;
 
 /// Filter-form DARE (a-priori P⁻, a-posteriori P⁺, gain K, doubling iterations).
@@ -29,24 +29,15 @@ fn dare<'py>(
     Ok((mat_to_py(py, &s.p_prior), mat_to_py(py, &s.p_post), mat_to_py(py, &s.gain), s.iterations))
 }
 
-/// Scalar closed forms for Φ = 1 (seed 000 Eqs. 32–35): (P⁻, P⁺).
+/// Scalar closed forms for Φ = 1 (Tennstedt et al. 2021, Eqs. 32–35): (P⁻, P⁺).
 #[pyfunction]
 fn riccati_scalar(q: f64, r: f64, h: f64) -> PyResult<(f64, f64)> {
-    for (name, x) in [("q", q), ("r", r), ("h", h)] {
-        if !x.is_finite() {
-            return Err(invalid(name, format!("must be finite, got {x}")).into());
-        }
-    }
-    if q < 0.0 {
-        return Err(invalid("q", format!("must be >= 0, got {q}")).into());
-    }
-    if r <= 0.0 {
-        return Err(invalid("r", format!("must be > 0, got {r}")).into());
-    }
-    if h == 0.0 {
-        return Err(invalid("h", "must be non-zero (an unobserved random walk has no steady state)").into());
-    }
-    Ok((riccati::scalar_prior(q, r, h), riccati::scalar_posterior(q, r, h)))
+    Ok(riccati::scalar(q, r, h)?)
+}
+
+/// A row-major buffer of `rows` × `cols` values as a 2-D array (no copy).
+fn flat_2d<'py>(py: Python<'py>, v: Vec<f64>, rows: usize, cols: usize) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    PyArray1::from_vec(py, v).reshape([rows, cols])
 }
 
 /// Kalman covariance recursion from P⁻₀: (steps, n, n) a-priori and a-posteriori stacks.
@@ -59,12 +50,13 @@ fn kalman_recursion<'py>(
     h: PyReadonlyArray2<'py, f64>,
     r: PyReadonlyArray2<'py, f64>,
     p0: PyReadonlyArray2<'py, f64>,
-    steps: usize,
+    steps: &Bound<'py, PyAny>,
 ) -> PyResult<(Bound<'py, PyArray3<f64>>, Bound<'py, PyArray3<f64>>)> {
+    let steps = count(steps, "steps", 1, riccati::MAX_RECURSION_STEPS)?;
     let (phi, q, h, r, p0) = (mat(&phi, "phi")?, mat(&q, "q")?, mat(&h, "h")?, mat(&r, "r")?, mat(&p0, "p0")?);
-    let (prior, post) = py.detach(|| riccati::recursion(&phi, &q, &h, &r, &p0, steps))?;
-    let n = phi.nrows();
-    Ok((stack_to_py(py, &prior, n), stack_to_py(py, &post, n)))
+    let rec = py.detach(|| riccati::recursion(&phi, &q, &h, &r, &p0, steps))?;
+    let shape = [steps, rec.n, rec.n];
+    Ok((PyArray1::from_vec(py, rec.prior).reshape(shape)?, PyArray1::from_vec(py, rec.post).reshape(shape)?))
 }
 
 fn rows_mat(a: &PyReadonlyArray2<'_, f64>, field: &str) -> Result<Vec<DVector<f64>>, NavError> {
@@ -78,21 +70,17 @@ fn vecs_to_py<'py>(py: Python<'py>, v: &[DVector<f64>], n: usize) -> Bound<'py, 
 
 /// Van Loan (or first-order) discretisation: (Φ, Q_d).
 #[pyfunction]
+#[pyo3(signature = (f, qc, dt, method=Wrap(Discretization::VanLoan)))]
 #[allow(clippy::type_complexity)]
 fn discretize_model<'py>(
     py: Python<'py>,
     f: PyReadonlyArray2<'py, f64>,
     qc: PyReadonlyArray2<'py, f64>,
     dt: f64,
-    method: &str,
+    method: Wrap<Discretization>,
 ) -> PyResult<(Bound<'py, PyArray2<f64>>, Bound<'py, PyArray2<f64>>)> {
-    let method = Discretization::by_name(method)?;
-    let f = mat(&f, "f")?;
-    crate::filter::matrix::check_square("f", &f, None)?;
-    let qc = mat(&qc, "qc")?;
-    crate::filter::matrix::check_covariance("qc", &qc, Some(f.nrows()), false)?;
-    crate::error::check_positive("dt", dt)?;
-    let (phi, qd) = discretize(&f, &qc, dt, method);
+    let (f, qc) = (mat(&f, "f")?, mat(&qc, "qc")?);
+    let (phi, qd) = discretize_checked(&f, &qc, dt, method.0)?;
     Ok((mat_to_py(py, &phi), mat_to_py(py, &qd)))
 }
 
@@ -105,24 +93,21 @@ pub struct KalmanFilter {
 #[pymethods]
 impl KalmanFilter {
     #[new]
-    fn new(p0: PyReadonlyArray2<'_, f64>, mode: &str) -> PyResult<Self> {
-        Ok(KalmanFilter { inner: Kf::new(mat(&p0, "p0")?, LoopMode::by_name(mode)?)? })
+    #[pyo3(signature = (p0, mode=Wrap(LoopMode::Closed)))]
+    fn new(p0: PyReadonlyArray2<'_, f64>, mode: Wrap<LoopMode>) -> PyResult<Self> {
+        Ok(KalmanFilter { inner: Kf::new(mat(&p0, "p0")?, mode.0)? })
     }
 
     fn predict(&mut self, phi: PyReadonlyArray2<'_, f64>, qd: PyReadonlyArray2<'_, f64>) -> PyResult<()> {
-        let (phi, qd) = (mat(&phi, "phi")?, mat(&qd, "qd")?);
-        crate::filter::matrix::check_covariance("qd", &qd, Some(self.inner.size()), false)?;
-        Ok(self.inner.predict(&phi, &qd)?)
+        Ok(self.inner.predict_many(&mat(&phi, "phi")?, &mat(&qd, "qd")?, 1)?)
     }
 
     /// `steps` predictions with the same (Φ, Q_d) in one call (the multirate / benchmark path).
-    fn predict_many(&mut self, py: Python<'_>, phi: PyReadonlyArray2<'_, f64>, qd: PyReadonlyArray2<'_, f64>, steps: usize) -> PyResult<()> {
+    fn predict_many(&mut self, py: Python<'_>, phi: PyReadonlyArray2<'_, f64>, qd: PyReadonlyArray2<'_, f64>, steps: &Bound<'_, PyAny>) -> PyResult<()> {
+        let steps = count(steps, "steps", 0, usize::MAX)?;
         let (phi, qd) = (mat(&phi, "phi")?, mat(&qd, "qd")?);
-        crate::filter::matrix::check_square("phi", &phi, Some(self.inner.size()))?;
-        crate::filter::matrix::check_covariance("qd", &qd, Some(self.inner.size()), false)?;
         let kf = &mut self.inner;
-        py.detach(|| (0..steps).try_for_each(|_| kf.predict_unchecked(&phi, &qd)))?;
-        Ok(())
+        Ok(py.detach(|| kf.predict_many(&phi, &qd, steps))?)
     }
 
     /// Returns (innovation, nis, rejected rows).
@@ -176,16 +161,8 @@ fn rts<'py>(
 ) -> PyResult<(Bound<'py, PyArray2<f64>>, Bound<'py, PyArray3<f64>>)> {
     let (phi, pp, ps) = (mats(&phi, "phi")?, mats(&p_prior, "p_prior")?, mats(&p_post, "p_post")?);
     let (xp, xs) = (rows_mat(&x_prior, "x_prior")?, rows_mat(&x_post, "x_post")?);
-    let n_steps = phi.len();
-    for (name, len) in [("x_prior", xp.len()), ("p_prior", pp.len()), ("x_post", xs.len()), ("p_post", ps.len())] {
-        if len != n_steps {
-            return Err(invalid(name, format!("expected {n_steps} steps like phi, got {len}")).into());
-        }
-    }
     let n = ps.first().map_or(0, |m| m.nrows());
-    let steps: Vec<StoredStep> = (0..n_steps)
-        .map(|k| StoredStep { phi: phi[k].clone(), x_prior: xp[k].clone(), p_prior: pp[k].clone(), x_post: xs[k].clone(), p_post: ps[k].clone() })
-        .collect();
+    let steps = stored_steps(phi, xp, pp, xs, ps)?;
     let out = py.detach(|| core_rts(&steps))?;
     let xs: Vec<DVector<f64>> = out.iter().map(|o| o.0.clone()).collect();
     let ps: Vec<DMatrix<f64>> = out.into_iter().map(|o| o.1).collect();
@@ -201,6 +178,7 @@ pub struct Scenario {
 #[pymethods]
 impl Scenario {
     #[new]
+    #[pyo3(signature = (f, qc, dt, p0, h, r, measure, *, method=Wrap(Discretization::VanLoan), sequential=false))]
     #[allow(clippy::too_many_arguments)]
     fn new(
         py: Python<'_>,
@@ -211,10 +189,10 @@ impl Scenario {
         h: PyReadonlyArray2<'_, f64>,
         r: PyReadonlyArray2<'_, f64>,
         measure: Vec<bool>,
-        method: &str,
+        method: Wrap<Discretization>,
         sequential: bool,
     ) -> PyResult<Self> {
-        let method = Discretization::by_name(method)?;
+        let method = method.0;
         let (f, qc, dt) = (mats(&f, "f")?, mats(&qc, "qc")?, vector(&dt, "dt")?);
         let (p0, h, r) = (mat(&p0, "p0")?, mat(&h, "h")?, mat(&r, "r")?);
         let inner = py.detach(|| CoreScenario::new(&f, &qc, &dt, p0, h, r, measure, method, sequential))?;
@@ -223,19 +201,17 @@ impl Scenario {
 
     /// σ of every state after each epoch: (epochs, n).
     fn sigmas<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
-        let n = self.inner.size();
         let s = py.detach(|| self.inner.sigmas())?;
-        Ok(Array2::from_shape_vec((s.len() / n, n), s).expect("epochs x n").into_pyarray(py))
+        flat_2d(py, s, self.inner.epochs(), self.inner.size())
     }
 
     /// σ of the true error of the filter as built when the measurement noise has
     /// covariance `r_true` and cross-covariance `cross` (steps, n, m) with the process noise
     /// of the step before each epoch (see filter/analysis.rs): (epochs, n).
     fn true_sigmas<'py>(&self, py: Python<'py>, r_true: PyReadonlyArray2<'py, f64>, cross: PyReadonlyArray3<'py, f64>) -> PyResult<Bound<'py, PyArray2<f64>>> {
-        let n = self.inner.size();
         let (r_true, cross) = (mat(&r_true, "r_true")?, mats(&cross, "cross")?);
         let s = py.detach(|| self.inner.true_sigmas(&r_true, &cross))?;
-        Ok(Array2::from_shape_vec((s.len() / n, n), s).expect("epochs x n").into_pyarray(py))
+        flat_2d(py, s, self.inner.epochs(), self.inner.size())
     }
 
     /// Runs `runs` (indices under `master_seed`) on all local cores:
@@ -246,9 +222,9 @@ impl Scenario {
         py: Python<'py>,
         master_seed: u64,
         runs: Vec<u64>,
-        mode: &str,
+        mode: Wrap<LoopMode>,
     ) -> PyResult<(Bound<'py, PyArray3<f64>>, Bound<'py, PyArray3<f64>>, Bound<'py, PyArray2<f64>>, Bound<'py, PyArray2<f64>>)> {
-        let mode = LoopMode::by_name(mode)?;
+        let mode = mode.0;
         let res = py.detach(|| self.inner.monte_carlo(master_seed, &runs, mode))?;
         let (nr, ne, n) = (res.len(), self.inner.epochs(), self.inner.size());
         let cube = |sel: fn(&crate::filter::analysis::RunResult) -> &Vec<f64>| {
@@ -270,5 +246,7 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(rts, m)?)?;
     m.add_class::<KalmanFilter>()?;
     m.add_class::<Scenario>()?;
+    register_choices::<LoopMode>(m, "LoopMode")?;
+    register_choices::<Discretization>(m, "Discretization")?;
     Ok(())
 }

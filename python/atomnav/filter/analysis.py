@@ -54,7 +54,7 @@ class Scenario:
 
     def _build(self):
         a = self._args
-        return _core.Scenario(a["f"], a["qc"], a["dt"], a["p0"], a["h"], a["r"], a["measure"], a["method"], a["sequential"])
+        return _core.Scenario(a["f"], a["qc"], a["dt"], a["p0"], a["h"], a["r"], a["measure"], method=a["method"], sequential=a["sequential"])
 
     def __getstate__(self):
         return {"args": self._args, "times": self.times, "labels": self.labels}

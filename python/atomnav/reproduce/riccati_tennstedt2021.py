@@ -1,6 +1,6 @@
-"""Seed 000 (Tennstedt, Weddig, Schön 2021) Table 1: steady-state bias variances of a
-CAI-aided IMU from the scalar Riccati closed form, the general DARE, and the iterated
-Kalman recursion (spec cai-ekf-tennstedt2021 §2.6, §4)."""
+"""Tennstedt, Weddig & Schön (2021) Table 1: steady-state bias variances of a CAI-aided
+IMU from the scalar Riccati closed form (Eqs. 32–35), the general DARE (Eq. 31), and the
+iterated Kalman recursion."""
 
 from __future__ import annotations
 
@@ -9,10 +9,10 @@ import numpy as np
 from ..filter import dare, kalman_recursion, riccati_scalar
 from . import section
 
-K_EFF = 4 * np.pi / 780.241e-9  # rad/m (⁸⁷Rb D2), spec cai-ekf §2.0
+K_EFF = 4 * np.pi / 780.241e-9  # rad/m (⁸⁷Rb D2, λ = 780.241 nm)
 A_FRINGE, V_BAR, R_CAI = 0.15, 2.8, 1.024e-3
 
-#: (label, unit, Q per step, H, paper P⁺): seed 000 Table 1 with Eqs. 34/35.
+#: (label, unit, Q per step, H, paper P⁺): Tennstedt et al. (2021) Table 1 with Eqs. 34/35.
 TABLE1 = [
     ("A satellite accelerometer, T0 = 10 s", "(m/s²)²", 1e-20, 0.25 * A_FRINGE * K_EFF * 10.0**2, 4.82e-20),
     ("B navigation accelerometer, T0 = 0.04 s", "(m/s²)²", 2.5e-9, 0.25 * A_FRINGE * K_EFF * 0.04**2, 8.25e-10),
@@ -20,7 +20,7 @@ TABLE1 = [
 ]
 
 
-@section("riccati_tennstedt2021", "Seed 000 Table 1: steady-state Riccati variances of CAI-aided bias estimation")
+@section("riccati_tennstedt2021", "Tennstedt et al. (2021) Table 1: steady-state Riccati variances of CAI-aided bias estimation")
 def reproduce(report) -> None:
     import matplotlib.pyplot as plt
 
@@ -39,7 +39,7 @@ def reproduce(report) -> None:
     ax.axhline(1.0, color="k", lw=0.8, ls="--")
     ax.set_xlabel("CAI update k")
     ax.set_ylabel("P⁺_k / P⁺ (DARE)")
-    ax.set_title("Kalman recursion converging to the DARE solution (seed 000 Table 1)")
+    ax.set_title("Kalman recursion converging to the DARE solution (Tennstedt et al. 2021, Table 1)")
     ax.legend(fontsize=7)
     report.figure(fig, "recursion", "A-posteriori variance of the Kalman recursion divided by the DARE value, "
                   "from P⁻₀ = 10⁴ P⁺ (Table 1 cases A, B, C).")
