@@ -17,8 +17,8 @@ LAT, LON, H = 0.8, 0.2, 100.0
 
 
 def _fields(**extra):
-    return dict(t0=0.0, lla0=[LAT, LON, H], vel0=[0, 0, 0], q0=[1, 0, 0, 0], kind="rates", p0=np.eye(15),
-                accel_psd=1e-8, gyro_psd=1e-12, **extra)
+    return {**dict(t0=0.0, lla0=[LAT, LON, H], vel0=[0, 0, 0], q0=[1, 0, 0, 0], kind="rates", p0=np.eye(15),
+                   accel_psd=1e-8, gyro_psd=1e-12), **extra}
 
 
 @pytest.mark.parametrize("option, bad, parameter", [
@@ -87,7 +87,8 @@ def test_initial_error_against_the_small_error_relations():
     lla, vel, q = _core.initial_error([LAT, LON, H], [1.0, 2.0, 3.0], [1.0, 0.0, 0.0, 0.0], p0, u)
     d = sig * u
     m, n = an.earth.radii(LAT)
-    np.testing.assert_allclose(lla - [LAT, LON, H], [d[0] / (m + H), d[1] / ((n + H) * np.cos(LAT)), -d[2]], rtol=1e-12)
+    # the difference lla − lla_true carries the rounding of lat (ulp 1.1e-16 rad): absolute tolerance
+    np.testing.assert_allclose(lla - [LAT, LON, H], [d[0] / (m + H), d[1] / ((n + H) * np.cos(LAT)), -d[2]], rtol=0, atol=1e-15)
     np.testing.assert_allclose(vel, np.array([1.0, 2.0, 3.0]) + d[3:6], rtol=0, atol=1e-15)
     a = np.linalg.norm(d[6:9])
     np.testing.assert_allclose(q, np.r_[np.cos(a / 2), -np.sin(a / 2) * d[6:9] / a], rtol=0, atol=1e-15)

@@ -199,7 +199,7 @@ class AidedIns:
         outside = np.nonzero((mt < t[0]) | (mt > t[-1]))[0]
         if outside.size:
             i = outside[0]
-            raise ValueError(f"measurements: time {mt[i]:g} s at index {i} is outside the IMU span [{t[0]:g}, {t[-1]:g}] s")
+            raise input_error("measurements", f"time {mt[i]:g} s at index {i} is outside the IMU span [{t[0]:g}, {t[-1]:g}] s", i)
         # chunks of a fixed sample count from the mean step (one chunk when the end times
         # are not usable; the engine then names the bad sample)
         step = (t[-1] - t[0]) / (n - 1)
@@ -224,7 +224,7 @@ def _imu(time, gyro, accel, h_ref):
         a = np.ascontiguousarray(np.asarray(x, dtype=float))
         want = (width is None and a.ndim == 1) or (width is not None and a.ndim == 2 and a.shape[1] == width)
         if not want:
-            raise ValueError(f"{name}: expected shape {'(N,)' if width is None else f'(N, {width})'}, got {a.shape}")
+            raise input_error(name, f"expected shape {'(N,)' if width is None else f'(N, {width})'}, got {a.shape}")
         return a
 
     t = arr(time, None, "time")
@@ -232,7 +232,7 @@ def _imu(time, gyro, accel, h_ref):
     h = None if h_ref is None else arr(h_ref, None, "h_ref")
     for name, x in (("gyro", g), ("accel", a), ("h_ref", h)):
         if x is not None and len(x) != len(t):
-            raise ValueError(f"{name}: expected {len(t)} rows like time, got {len(x)}")
+            raise input_error(name, f"expected {len(t)} rows like time, got {len(x)}")
     return t, g, a, h
 
 

@@ -100,7 +100,7 @@ class Layout:
 
     def __getitem__(self, name: str) -> slice:
         if name not in self._ranges:
-            raise ValueError(f"block: unknown block name {name!r} (layout has: {', '.join(self._ranges)})")
+            raise input_error("block", f"unknown block name {name!r} (layout has: {', '.join(self._ranges)})")
         return self._ranges[name]
 
     @property

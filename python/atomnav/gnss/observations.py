@@ -8,7 +8,7 @@ import numpy as np
 import pandas as pd
 
 from .. import _core
-from .._validate import rows, vector
+from .._validate import input_error, rows, vector
 from .ephemeris import Ephemerides
 from .options import GnssOptions, split_options
 
@@ -48,7 +48,7 @@ def doppler_to_rate(doppler_hz, sat, channel) -> np.ndarray:
     k = np.asarray(channel, float)
     if np.any((sys == "R") & ((k < -7) | (k > 6))):
         i = int(np.nonzero((sys == "R") & ((k < -7) | (k > 6)))[0][0])
-        raise ValueError(f"channel: unknown GLONASS frequency channel {k[i]:g} at index {i} (valid: -7..6)")
+        raise input_error("channel", f"unknown GLONASS frequency channel {k[i]:g} at index {i} (valid: -7..6)", i)
     f = np.where(sys == "R", (1602.0 + 0.5625 * k) * 1e6, 1575.42e6)
     return -C_LIGHT / f * d
 
@@ -57,7 +57,7 @@ def obs_arrays(obs: pd.DataFrame) -> tuple:
     """The observation table as the arrays the core takes."""
     missing = [c for c in OBS_COLUMNS if c not in obs.columns]
     if missing:
-        raise ValueError(f"obs: missing columns {missing}")
+        raise input_error("obs", f"missing columns {missing}")
     return (np.ascontiguousarray(obs["time_s"].to_numpy(float)), [str(s) for s in obs["sat"]],
             np.ascontiguousarray(obs["channel"].to_numpy(np.int64)), np.ascontiguousarray(obs["code_m"].to_numpy(float)),
             np.ascontiguousarray(obs["rate_mps"].to_numpy(float)))
