@@ -182,7 +182,7 @@ def test_user_p_avu_wrong_shape_rejected(scn, run7):
 def test_user_p_avu_non_finite_rejected(scn, run7):
     p = np.tile(np.eye(3) * 1e-10, (73, 1, 1))
     p[4, 1, 1] = np.nan
-    _bad_p_avu(scn, run7, p, "p_avu: non-finite value at index 4")
+    _bad_p_avu(scn, run7, p, "p_avu: non-finite value NaN at index 4")
 
 
 def test_user_p_avu_not_symmetric_rejected(scn, run7):

@@ -403,7 +403,7 @@ def test_bad_unknown_preset_in_simulator():
 
 
 def test_bad_unknown_kind():
-    _raises(r"kind: unknown option 'samples'", imu.ImuSimulator, "mems", 0.01, "samples")
+    _raises(r"kind: unknown option .samples.; choose one of rates, increments", imu.ImuSimulator, "mems", 0.01, "samples")
 
 
 def test_bad_negative_white_density():

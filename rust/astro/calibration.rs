@@ -153,6 +153,14 @@ impl Choice for Start {
 }
 
 impl Init {
+    /// The start named `start` for a call that takes no starting rotation ("axes" or "zero").
+    pub fn named(start: Start) -> Result<Init> {
+        match start {
+            Start::Given => Err(invalid("init", "'given' needs a starting rotation c0, which this call does not take; choose axes or zero")),
+            _ => Init::new(start, None),
+        }
+    }
+
     /// The start named `start`; `c0` (a rotation) is required by "given" and refused otherwise.
     pub fn new(start: Start, c0: Option<Mat3>) -> Result<Init> {
         match (start, c0) {
@@ -596,5 +604,24 @@ mod tests {
             assert!(w.dot(&k).abs() > 1.0 - 1e-9, "{w:?} vs {k:?}");
             assert!(e.to_string().contains("null direction"));
         }
+    }
+
+    #[test]
+    fn starts_and_options_are_checked() {
+        let field = |r: Result<Init>| match r {
+            Err(NavError::InvalidInput { field, .. }) => field,
+            other => panic!("{other:?}"),
+        };
+        assert_eq!(Init::new(Start::parse("given").unwrap(), Some(Mat3::identity())).unwrap(), Init::Given(Mat3::identity()));
+        assert_eq!(field(Init::new(Start::Given, None)), "c0");
+        assert_eq!(field(Init::new(Start::Axes, Some(Mat3::identity()))), "c0");
+        assert_eq!(field(Init::named(Start::Given)), "init");
+        assert_eq!(Init::named(Start::Zero).unwrap(), Init::Zero);
+        assert!(matches!(Options::new(Init::Axes, Solver::So3, 0, 1e-9, ResidualForm::Full), Err(NavError::InvalidInput { ref field, .. }) if field == "max_iter"));
+        assert!(matches!(Options::new(Init::Axes, Solver::So3, 5, f64::NAN, ResidualForm::Full), Err(NavError::InvalidInput { ref field, .. }) if field == "tol"));
+        for (e, p) in [(Solver::parse("lm").unwrap_err(), "solver"), (ResidualForm::parse("x").unwrap_err(), "residual_form"), (DiffForm::parse("x").unwrap_err(), "p_diff")] {
+            assert!(matches!(e, NavError::InvalidInput { ref field, .. } if field == p), "{e}");
+        }
+        assert_eq!(Verdict::Warn.name(), "warn");
     }
 }

@@ -438,7 +438,23 @@ mod tests {
                 assert_eq!(field, "star_directions");
                 assert!(reason.starts_with("epoch at index 1 has 0 stars"), "{reason}");
             }
+            Err(e) => panic!("{e}"),
+            Ok(_) => panic!("usize::MAX epochs accepted"),
+        }
+    }
+
+    #[test]
+    fn row_checks_name_the_row() {
+        let s = [Vec3::x(), Vec3::y()];
+        let slow = Vec3::new(0.0, 0.0, 3.0e4);
+        let got = aberration_rows(&s, &[slow]).unwrap();
+        assert_eq!(got, vec![aberration(&s[0], &slow), aberration(&s[1], &slow)]);
+        let fast = Vec3::new(0.0, 0.0, 1.0001e-3 * crate::gnss::C_LIGHT);
+        match aberration_rows(&s, &[slow, fast]) {
+            Err(crate::error::NavError::InvalidInput { field, index, .. }) => assert_eq!((field.as_str(), index), ("velocity", Some(1))),
             other => panic!("{other:?}"),
         }
+        assert!(refraction_rows(&s, &s, 0.99, true).is_err());
+        assert_eq!(refraction_rows(&s, &[Vec3::z(), Vec3::z()], 1.0003, true).unwrap()[0], refraction_apply(&s[0], &Vec3::z(), 1.0003));
     }
 }

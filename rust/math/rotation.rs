@@ -39,8 +39,9 @@ pub fn unit_quats(field: &str, q: &[Quat]) -> Result<Vec<Quat>> {
     q.iter()
         .enumerate()
         .map(|(i, q)| {
-            let u = quat_normalize(q);
-            match u.coords.iter().all(|x| x.is_finite()) {
+            let n = q.norm();
+            let u = q / n;
+            match n.is_finite() && n > 0.0 && u.coords.iter().all(|x| x.is_finite()) {
                 true => Ok(u),
                 false => Err(invalid_at(field, i, format!("quaternion {:?} at index {i} has norm {}, not a rotation", quat_to_array(q), q.norm()))),
             }

@@ -35,9 +35,9 @@ impl Kind {
     /// Number of terms in the sum at averaging factor m with `np` phase points.
     pub fn terms(self, np: usize, m: usize) -> usize {
         match self {
-            Kind::Allan => np.saturating_sub(2 * m),
-            Kind::Modified => (np + 1).saturating_sub(3 * m),
-            Kind::Hadamard => np.saturating_sub(3 * m),
+            Kind::Allan => np.saturating_sub(m.saturating_mul(2)),
+            Kind::Modified => (np + 1).saturating_sub(m.saturating_mul(3)),
+            Kind::Hadamard => np.saturating_sub(m.saturating_mul(3)),
         }
     }
 }
@@ -685,6 +685,9 @@ mod tests {
             NavError::Numerical(m) => m,
         };
         assert_eq!(field(variance(&y, 1.0, DataType::Rate, Kind::Allan, &TauSet::List(vec![])).unwrap_err()), "m");
+        for kind in [Kind::Allan, Kind::Modified, Kind::Hadamard] {
+            assert_eq!(field(variance(&y, 1.0, DataType::Rate, kind, &TauSet::List(vec![1 << 63, 1])).unwrap_err()), "m");
+        }
         assert_eq!(field(AllanStream::new(&[], 1.0, DataType::Rate).unwrap_err()), "m");
         assert_eq!(field(AllanStream::new(&[4, 1 << 62], 1.0, DataType::Rate).unwrap_err()), "m");
         assert_eq!(field(AllanStream::new(&[usize::MAX / 4], 1.0, DataType::Rate).unwrap_err()), "m");

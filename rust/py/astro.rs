@@ -411,7 +411,7 @@ impl PyScenario {
     #[pyo3(signature = (seed, init=Wrap(Start::Axes), p_diff=Wrap(DiffForm::Full)))]
     fn run<'py>(&self, py: Python<'py>, seed: &Bound<'py, PyAny>, init: Wrap<Start>, p_diff: Wrap<DiffForm>) -> PyResult<Bound<'py, PyDict>> {
         let seed = super::convert::seed(seed, "seed")?;
-        let opt = Options { init: Init::new(init.0, None)?, ..Options::default() };
+        let opt = Options { init: Init::named(init.0)?, ..Options::default() };
         let r = py.detach(|| scenario::run(&self.inner, seed, &opt, p_diff.0))?;
         run_dict(py, &r)
     }

@@ -192,14 +192,18 @@ pub fn counts(obj: &Bound<'_, PyAny>, field: &str, min: usize, max: usize) -> Py
 }
 
 /// [`count`] of any integer-like object (`int`, numpy integers: whatever has
-/// `__index__`, but not `bool`).
+/// `__index__`, but not `bool`), over the whole range of `usize`.
 pub fn index_count(obj: &Bound<'_, PyAny>, field: &str, min: usize, max: usize) -> PyResult<usize> {
-    match obj.is_instance_of::<PyBool>() {
-        true => count(obj, field, min, max),
-        false => match obj.call_method0("__index__") {
-            Ok(i) => count(&i, field, min, max),
-            Err(_) => count(obj, field, min, max),
-        },
+    let index = match obj.is_instance_of::<PyBool>() {
+        true => None,
+        false => obj.call_method0("__index__").ok(),
+    };
+    let Some(index) = index else {
+        return count(obj, field, min, max); // the TypeError naming `field`
+    };
+    match index.extract::<u64>().ok().and_then(|n| usize::try_from(n).ok()) {
+        Some(n) if (min..=max).contains(&n) => Ok(n),
+        _ => Err(invalid(field, format!("must be an integer in [{min}, {max}], got {obj}")).into()),
     }
 }
 
