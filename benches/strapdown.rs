@@ -1,10 +1,11 @@
 //! Criterion: strapdown mechanization throughput on 10 minutes of exact 100 Hz increments
-//! of a sinusoidal motion (60 000 steps per iteration), for both IMU output kinds.
+//! of a sinusoidal motion (60 000 steps per iteration), for both IMU output kinds, step by
+//! step into states and pipelined on two cores into a navigation table.
 
 use atomnav::earth::WGS84;
 use atomnav::imu::ideal::{ideal_increments, ideal_rates};
 use atomnav::math::Vec3;
-use atomnav::strapdown::{ImuKind, NavState, Strapdown, Vertical};
+use atomnav::strapdown::{ImuKind, ImuSlices, NavState, NavTable, Samples3, Strapdown, Vertical, NAV_WIDTH};
 use atomnav::trajectory::generators::sinusoidal;
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
 
@@ -30,6 +31,16 @@ fn bench(c: &mut Criterion) {
             let mut sd = Strapdown::new(init, ImuKind::Rates, WGS84, Vertical::Free).unwrap();
             out.clear();
             sd.run(&times, &w, &f, None, &mut out).unwrap();
+        })
+    });
+    let (gf, af): (Vec<f64>, Vec<f64>) = (dth.iter().flat_map(|v| v.iter().copied()).collect(), dv.iter().flat_map(|v| v.iter().copied()).collect());
+    let n = dth.len();
+    let mut table = vec![0.0; NAV_WIDTH * n];
+    g.bench_function("increments_100Hz_10min_pipelined_table", |b| {
+        b.iter(|| {
+            let mut sd = Strapdown::new(init, ImuKind::Increments, WGS84, Vertical::Free).unwrap();
+            let imu = ImuSlices::new(&times[1..], Samples3::new("gyro", &gf, [n, 3], false).unwrap(), Samples3::new("accel", &af, [n, 3], false).unwrap(), None).unwrap();
+            sd.run_pipelined(&imu, NavTable::new(&mut table, [NAV_WIDTH, n], 0).unwrap(), 0).1.unwrap();
         })
     });
     g.finish();

@@ -1,6 +1,6 @@
 """Free-inertial diagnostics of the strapdown INS: a stationary INS with injected
-initial errors or sensor biases, and the Schuler-period test of spec gnss-ins-tight §2.13
-(the factory test of seed 004, Ch. 1)."""
+initial errors or sensor biases, and the Schuler-period test (a velocity error oscillates
+with the Schuler period 2π√(R/g) ≈ 84 min; Titterton & Weston 2004, §12.3)."""
 
 from __future__ import annotations
 
@@ -10,7 +10,7 @@ import pandas as pd
 from . import earth, strapdown, trajectory
 
 
-def stationary_errors(lat: float, hours: float, rate_hz: float = 10.0, h: float = 100.0, dv0=(0.0, 0.0, 0.0),
+def stationary_errors(lat: float, hours: float, *, rate_hz: float = 10.0, h: float = 100.0, dv0=(0.0, 0.0, 0.0),
                       gyro_bias=(0.0, 0.0, 0.0), accel_bias=(0.0, 0.0, 0.0), vertical: str = "damped") -> pd.DataFrame:
     """Errors (:meth:`atomnav.trajectory.Trajectory.errors`) of a level, north-pointing INS at
     rest at latitude ``lat`` (rad) and height ``h`` (m) over ``hours``, started with NED
@@ -32,7 +32,7 @@ def stationary_errors(lat: float, hours: float, rate_hz: float = 10.0, h: float 
 
 def zero_crossing_periods(t: np.ndarray, v: np.ndarray) -> np.ndarray:
     """Oscillation periods (s) from the zero crossings of ``v(t)`` (linear interpolation):
-    T = 2·Δt between successive crossings (spec gnss-ins-tight Eq. 44)."""
+    T = 2·Δt between successive crossings."""
     t, v = np.asarray(t, float), np.asarray(v, float)
     s = np.sign(v)
     idx = np.nonzero(s[:-1] * s[1:] < 0)[0]
@@ -40,7 +40,7 @@ def zero_crossing_periods(t: np.ndarray, v: np.ndarray) -> np.ndarray:
     return 2.0 * np.diff(tc)
 
 
-def schuler_test(lat: float = np.deg2rad(55.75), v0: float = 200.0, hours: float = 4.5, h: float = 100.0) -> dict:
+def schuler_test(lat: float = np.deg2rad(55.75), *, v0: float = 200.0, hours: float = 4.5, h: float = 100.0) -> dict:
     """The Schuler test: a stationary INS started with a ``v0`` m/s north velocity error.
     Returns the error table and the measured quantities: zero-crossing periods of v_N
     (min), the Schuler period 2π√((√(MN)+h)/γ) (min), and the first-period peaks of the

@@ -3,83 +3,217 @@
 Batch: :func:`integrate` over a whole IMU table. Streaming: :class:`Strapdown`, fed
 chunk by chunk, for records that do not fit in memory. Attitude with coning
 correction, velocity with rotation/sculling, Coriolis, Earth and transport rate,
-normal gravity; second order in the step (see ``rust/strapdown.rs``).
+normal gravity; second order in the step (Savage, Strapdown Analytics §7.2; see
+``rust/strapdown/mod.rs``).
+
+Options by name are checked by the core; their accepted names are
+``atomnav._core.OPTIONS["ImuKind"]`` (``kind``), ``["Ellipsoid"]`` (``ellipsoid``) and
+``["Vertical"]`` (``vertical``).
 """
 
 from __future__ import annotations
+
+from collections.abc import Mapping
 
 import numpy as np
 import pandas as pd
 
 from . import _core
-from ._validate import choice, rows, vector
+from ._validate import as_floats, input_error, rows, scalar, vector
 from .trajectory import COLUMNS, IMU_COLUMNS
 
 #: Rows per call into Rust: the progress bar's granularity for long runs.
 CHUNK = 500_000
 
 
-def _table(columns: np.ndarray) -> pd.DataFrame:
-    """DataFrame of a (14, N) column table from the core, without copying it."""
-    return pd.DataFrame(columns.T, columns=COLUMNS, copy=False)
+def _table(columns: np.ndarray, first_row: int = 0) -> pd.DataFrame:
+    """DataFrame of a (14, N) column table from the core, without copying it; the index
+    is the row number in the whole record, from ``first_row``."""
+    index = pd.RangeIndex(first_row, first_row + columns.shape[1])
+    return pd.DataFrame(columns.T, columns=COLUMNS, index=index, copy=False)
 
 
 def _imu_arrays(imu, kind: str):
-    """(time, gyro, accel) views of an IMU table of the given kind. Only shapes are checked
-    here: the core checks values (NaN/inf, time order) once, with indices in the record."""
+    """(time, gyro, accel) views of an IMU table of the given kind, in one Fortran-ordered
+    array so the core reads each in place. Only shapes are checked here: the core checks
+    values (NaN/inf, time order) once, with indices in the record."""
     cols = IMU_COLUMNS[kind]
     if isinstance(imu, pd.DataFrame):
         missing = [c for c in cols if c not in imu.columns]
         if missing:
-            raise ValueError(f"imu: missing column(s) {missing} for kind={kind!r} (expected {cols})")
+            raise input_error("imu", f"missing column(s) {missing} for kind={kind!r} (expected {cols})")
         a = imu[cols].to_numpy(float)
     else:
-        a = np.asarray(imu, dtype=float)
+        a = as_floats(imu, "imu")
         if a.ndim != 2 or a.shape[1] != 7:
-            raise ValueError(f"imu: expected shape (N, 7), got {a.shape}")
+            raise input_error("imu", f"expected shape (N, 7), got {a.shape}")
+    a = np.asfortranarray(a)
     return a[:, 0], a[:, 1:4], a[:, 4:7]
 
 
+def _h_ref(h_ref, n: int):
+    """The reference altitudes as a float array of ``n`` values (the core checks them)."""
+    if h_ref is None:
+        return None
+    h = as_floats(h_ref, "h_ref")
+    if h.shape != (n,):
+        raise input_error("h_ref", f"expected shape ({n},), got {h.shape}")
+    return h
+
+
+def _diverged(err, table: np.ndarray, done: int, first_row: int, time: np.ndarray):
+    """Complete a divergence error: ``partial``, the DataFrame of the ``done`` rows of
+    ``table`` computed before it (rows ``first_row``… of the record), and the record row
+    ``row`` and time ``time_s`` (s) of the sample at which the solution diverged."""
+    err.partial = _table(table[:, :done], first_row)
+    err.row = first_row + done
+    err.time_s = float(time[done])
+    return err
+
+
 class Strapdown:
-    """Streaming strapdown INS. ``kind`` is ``"rates"`` or ``"increments"``; ``vertical``
-    is ``"free"`` or ``"damped"`` (baro loop on a reference altitude, damping ratio
-    ``zeta``, natural frequency ``omega`` rad/s; spec gnss-ins-tight Eq. 26).
+    """Streaming strapdown INS from an initial state: time ``t0`` (s), ``lla`` (lat rad,
+    lon rad, h m), NED velocity ``vel_ned`` (m/s) and attitude ``q_nb`` (scalar first).
 
-    With rates, the first sample must be at ``t0`` (it primes the integrator). With
-    increments, each row covers (t_{k−1}, t_k] and is stamped t_k > t0."""
+    Parameters
+    ----------
+    kind : str
+        ``"rates"`` (rad/s, m/s²) or ``"increments"`` (rad, m/s). With rates, the first
+        sample must be at ``t0`` (it primes the integrator). With increments, each row
+        covers (t_{k−1}, t_k] and is stamped t_k > t0.
+    ellipsoid : str
+        Earth model, one of ``_core.OPTIONS["Ellipsoid"]``.
+    vertical : str
+        ``"free"`` or ``"damped"``: a second-order baro loop on a reference altitude, gains
+        2ζω and ω² + 2γ/R₀.
+    zeta, omega : float, optional
+        Damping ratio and natural frequency (rad/s) of the baro loop; the core's defaults
+        (0.707, 0.01 rad/s) when not given.
 
-    def __init__(self, t0, lla, vel_ned, q_nb, kind: str = "increments", ellipsoid: str = "WGS84", vertical: str = "free",
-                 zeta: float = 0.707, omega: float = 0.01):
-        self.kind = choice(kind, IMU_COLUMNS, "kind")
-        choice(vertical, ("free", "damped"), "vertical")
-        self._core = _core.Strapdown(float(t0), vector(lla, 3, "lla"), vector(vel_ned, 3, "vel_ned"), vector(q_nb, 4, "q_nb"),
-                                     kind, ellipsoid, vertical, float(zeta), float(omega))
+    Rows are numbered in the whole record: the DataFrames of successive :meth:`run` calls
+    continue each other's index, as do error indices.
+    """
+
+    def __init__(self, t0, lla, vel_ned, q_nb, *, kind: str = "increments", ellipsoid: str = "WGS84",
+                 vertical: str = "free", zeta: float | None = None, omega: float | None = None):
+        self._core = _core.Strapdown(scalar(t0, "t0"), vector(lla, 3, "lla"), vector(vel_ned, 3, "vel_ned"),
+                                     vector(q_nb, 4, "q_nb"), kind=kind, ellipsoid=ellipsoid, vertical=vertical,
+                                     zeta=None if zeta is None else scalar(zeta, "zeta"),
+                                     omega=None if omega is None else scalar(omega, "omega"))
+        self._rows = 0
+
+    @property
+    def kind(self) -> str:
+        """The IMU kind, ``"rates"`` or ``"increments"``."""
+        return self._core.kind
 
     def run(self, imu, h_ref=None) -> pd.DataFrame:
-        """Integrate one chunk (IMU table with the columns of
-        :data:`atomnav.trajectory.IMU_COLUMNS`); returns the solution at each row."""
+        """Integrate the next chunk of the record.
+
+        Parameters
+        ----------
+        imu : DataFrame or array (N, 7)
+            IMU table with the columns of :data:`atomnav.trajectory.IMU_COLUMNS` for this
+            object's kind (time s, gyro, accel).
+        h_ref : array (N,), optional
+            Reference altitude (m) per row, required with ``vertical="damped"``.
+
+        Returns
+        -------
+        DataFrame
+            The solution after each row, indexed by the row's number in the whole record.
+
+        Raises
+        ------
+        InputError
+            For a bad row (its record row in ``.index``); the state is left unchanged.
+        NumericalError
+            If the solution diverges: ``.partial`` holds the rows computed before it (as
+            this method would return them), ``.row`` and ``.time_s`` (s) name the sample
+            at which it diverged. Restart with :meth:`reset`.
+        """
         t, g, a = _imu_arrays(imu, self.kind)
-        h = None if h_ref is None else vector(h_ref, len(t), "h_ref")
-        return _table(self._core.run(t, g, a, h))
+        first = self._rows
+        try:
+            table = self._core.run(t, g, a, _h_ref(h_ref, len(t)), first)
+        except _core.NumericalError as err:
+            self._rows = first + err.rows + 1
+            raise _diverged(err, err.table, err.rows, first, t) from None
+        self._rows = first + len(t)
+        return _table(table, first)
 
     def state(self) -> pd.DataFrame:
+        """The current state as a one-row DataFrame (the columns of :meth:`run`)."""
         return _table(self._core.state())
 
+    def reset(self, state) -> None:
+        """Restart from ``state`` as a new :class:`Strapdown` with this one's options would
+        (coning/sculling history cleared, rate priming anew, rows numbered from 0).
 
-def integrate(imu, t0, lla, vel_ned, q_nb, kind: str = "increments", ellipsoid: str = "WGS84", vertical: str = "free",
-              h_ref=None, zeta: float = 0.707, omega: float = 0.01, progress: bool | None = None) -> pd.DataFrame:
-    """Integrate a whole IMU record from the initial state (t0 s; lla rad, rad, m; NED
-    velocity m/s; q_nb). Returns a DataFrame (time_s, lat_rad, lon_rad, h_m, vn_mps,
-    ve_mps, vd_mps, qw..qz, roll_rad, pitch_rad, yaw_rad) with one row per IMU row.
+        Parameters
+        ----------
+        state : DataFrame or dict
+            A one-row DataFrame with the columns of :meth:`state` (e.g. a row of a
+            :meth:`run` result), or a dict with ``t0`` (s), ``lla`` (rad, rad, m),
+            ``vel_ned`` (m/s) and ``q_nb`` (unit norm within 1e-6).
 
-    ``h_ref`` (m, one per IMU row) is the reference altitude of a damped vertical
-    channel. A progress bar shows for records over 10⁶ rows (``progress`` forces it on or
-    off). If the solution diverges, :class:`atomnav.NumericalError` is raised with every
-    row computed before the failure attached as ``err.partial`` (a DataFrame)."""
-    choice(kind, IMU_COLUMNS, "kind")
-    t, g, a = _imu_arrays(imu, kind)
-    h = None if h_ref is None else vector(h_ref, len(t), "h_ref")
-    sd = Strapdown(t0, lla, vel_ned, q_nb, kind, ellipsoid, vertical, zeta, omega)
+        Raises
+        ------
+        InputError
+            ``parameter == "state"``: a missing field, non-unit ``q_nb``, latitude outside
+            ±90° or height outside [−10 km, 1000 km]. The object is then unchanged.
+        """
+        if isinstance(state, pd.DataFrame):
+            missing = [c for c in COLUMNS[:11] if c not in state.columns]
+            if missing or len(state) != 1:
+                raise input_error("state", f"expected one row with columns {COLUMNS[:11]}, got {len(state)} row(s), missing {missing}")
+            row = state.iloc[0]
+            fields = (row["time_s"], row[COLUMNS[1:4]], row[COLUMNS[4:7]], row[COLUMNS[7:11]])
+        elif isinstance(state, Mapping):
+            missing = [k for k in ("t0", "lla", "vel_ned", "q_nb") if k not in state]
+            if missing:
+                raise input_error("state", f"missing {missing}")
+            fields = (state["t0"], state["lla"], state["vel_ned"], state["q_nb"])
+        else:
+            raise TypeError(f"state: expected a one-row DataFrame or a dict, got {type(state).__name__}")
+        t0, lla, vel, q = fields
+        self._core.reset(scalar(t0, "state"), vector(lla, 3, "state"), vector(vel, 3, "state"), vector(q, 4, "state"))
+        self._rows = 0
+
+
+def integrate(imu, t0, lla, vel_ned, q_nb, *, kind: str = "increments", ellipsoid: str = "WGS84",
+              vertical: str = "free", h_ref=None, zeta: float | None = None, omega: float | None = None,
+              progress: bool | None = None) -> pd.DataFrame:
+    """Integrate a whole IMU record from the initial state.
+
+    Parameters
+    ----------
+    imu : DataFrame or array (N, 7)
+        IMU table (see :meth:`Strapdown.run`).
+    t0, lla, vel_ned, q_nb
+        Initial state: time (s); lat (rad), lon (rad), h (m); NED velocity (m/s); q_nb.
+    kind, ellipsoid, vertical, zeta, omega
+        As for :class:`Strapdown`.
+    h_ref : array (N,), optional
+        Reference altitude (m) per IMU row for a damped vertical channel.
+    progress : bool, optional
+        Show a progress bar; by default for records over 10⁶ rows.
+
+    Returns
+    -------
+    DataFrame
+        time_s, lat_rad, lon_rad, h_m, vn_mps, ve_mps, vd_mps, qw..qz, roll_rad,
+        pitch_rad, yaw_rad, one row per IMU row.
+
+    Raises
+    ------
+    NumericalError
+        If the solution diverges: ``.partial`` holds every row computed before it,
+        ``.row`` and ``.time_s`` (s) name the sample at which it diverged.
+    """
+    sd = Strapdown(t0, lla, vel_ned, q_nb, kind=kind, ellipsoid=ellipsoid, vertical=vertical, zeta=zeta, omega=omega)
+    t, g, a = _imu_arrays(imu, sd.kind)
+    h = _h_ref(h_ref, len(t))
     show = len(t) > 1_000_000 if progress is None else progress
     # one table for the whole record, filled chunk by chunk in place (no concatenation)
     table = np.empty((len(COLUMNS), len(t)))
@@ -91,15 +225,14 @@ def integrate(imu, t0, lla, vel_ned, q_nb, kind: str = "increments", ellipsoid: 
             try:
                 sd._core.run_into(t[sl], g[sl], a[sl], table, None if h is None else h[sl], s)
             except _core.NumericalError as err:
-                err.partial = _table(table[:, :s + err.rows])
-                raise
+                raise _diverged(err, table, s + err.rows, 0, t) from None
             bar.update(len(t[sl]))
     return _table(table)
 
 
 def integrate_attitude(q0, dtheta, dtheta_prev=None) -> np.ndarray:
     """Body attitude from gyro increments (rad) with the multi-interval coning correction
-    (see ``rust/strapdown.rs``), no navigation-frame rotation: q (N, 4) after each
+    (see ``rust/strapdown/mod.rs``), no navigation-frame rotation: q (N, 4) after each
     increment.
 
     ``dtheta_prev`` holds the increments of up to two intervals before the first one,

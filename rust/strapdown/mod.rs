@@ -1,5 +1,4 @@
-//! Strapdown mechanization in the local-level NED frame (spec gnss-ins-tight §2.8):
-//! quaternion attitude with coning correction, velocity with rotation and sculling
+//! Strapdown mechanization in the local-level NED frame: quaternion attitude with coning correction, velocity with rotation and sculling
 //! corrections, Coriolis, Earth and transport rate, normal gravity, optional baro-damped
 //! vertical channel. Second order in the step: gravity, Coriolis and the navigation-frame
 //! rotation are taken at the interval midpoint (predictor–corrector), and the specific
@@ -9,12 +8,17 @@
 //! gravity–Coriolis term (velocity), so each step evaluates the Earth model once.
 //!
 //! One `Strapdown` object serves batch use (one call over a whole record) and streaming
-//! (successive chunks): it keeps the previous sample for coning/sculling.
+//! (successive chunks): it keeps the previous sample for coning/sculling. `pipeline.rs`
+//! integrates a chunk on two cores into a navigation table.
+
+mod pipeline;
 
 use crate::earth::{check_latitude, AnchoredSinCos, Ellipsoid, LocalModel};
-use crate::error::{invalid, Result};
+use crate::error::{invalid, invalid_at, Result};
 pub use crate::imu::ImuKind;
 use crate::math::{quat_from_rotvec, quat_normalize, quat_rotate, Quat, Vec3};
+use crate::options::Choice;
+pub use pipeline::{nav_columns, ImuSlices, NavTable, Samples3, NAV_COLUMNS, NAV_WIDTH, PIPELINE_BLOCK};
 
 /// Navigation solution at one instant.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -29,13 +33,50 @@ pub struct NavState {
 }
 
 /// Vertical channel: free (unstable, e-folding ≈ √(R/2g) ≈ 9.5 min) or damped by a
-/// reference altitude h_b (barometer) with gains K_v1 = 2ζω_v, K_v2 = ω_v² + 2γ/R₀
-/// (spec gnss-ins-tight Eq. 26; thesis' baro loop).
+/// reference altitude h_b (barometer): the second-order baro loop with gains
+/// K_v1 = 2ζω_v, K_v2 = ω_v² + 2γ/R₀, whose 2γ/R₀ cancels the free channel's instability.
+/// Chosen by name ("free", "damped"); "damped" has the loop's default damping ratio and
+/// natural frequency until [`Vertical::tuned`] sets them.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Vertical {
     Free,
     Damped { zeta: f64, omega: f64 },
 }
+
+impl Vertical {
+    /// Default damping ratio ζ of the baro loop (critical damping's 1/√2).
+    pub const DEFAULT_ZETA: f64 = 0.707;
+    /// Default natural frequency ω_v of the baro loop (rad/s; a period of about 10 min).
+    pub const DEFAULT_OMEGA: f64 = 0.01;
+
+    /// This channel with the baro loop's damping ratio `zeta` and natural frequency
+    /// `omega` (rad/s) where given; a free channel stays free. `Strapdown::new` checks them.
+    pub fn tuned(self, zeta: Option<f64>, omega: Option<f64>) -> Vertical {
+        match self {
+            Vertical::Free => Vertical::Free,
+            Vertical::Damped { zeta: z, omega: w } => Vertical::Damped { zeta: zeta.unwrap_or(z), omega: omega.unwrap_or(w) },
+        }
+    }
+}
+
+impl Choice for Vertical {
+    const PARAMETER: &'static str = "vertical";
+    const CHOICES: &'static [(&'static str, Self)] =
+        &[("free", Vertical::Free), ("damped", Vertical::Damped { zeta: Vertical::DEFAULT_ZETA, omega: Vertical::DEFAULT_OMEGA })];
+
+    /// The name of either channel, whatever the damped loop's gains.
+    fn name(self) -> &'static str {
+        match self {
+            Vertical::Free => "free",
+            Vertical::Damped { .. } => "damped",
+        }
+    }
+}
+
+/// Heights (m) a restarted state may have: from the deepest ocean trench to low orbit.
+const HEIGHT_RANGE: (f64, f64) = (-1e4, 1e6);
+/// How far a restarted state's q_nb may be from unit norm.
+const UNIT_NORM_TOLERANCE: f64 = 1e-6;
 
 #[derive(Debug, Clone)]
 pub struct Strapdown {
@@ -70,6 +111,28 @@ impl Strapdown {
         }
         let state = NavState { q_nb: quat_normalize(&initial.q_nb), ..initial };
         Ok(Strapdown { ell, vertical, state, earth: ell.local_model(), lat_sin_cos: AnchoredSinCos::new(state.lla.x), front: BodyFront::new(kind), last_step: None })
+    }
+
+    /// Restart from `state` as a new object with this one's IMU kind, ellipsoid and
+    /// vertical channel would (no coning/sculling history, rate priming anew). The state is
+    /// checked (field "state"): finite, q_nb of unit norm within 1e-6, latitude within
+    /// ±90°, height in [−10 km, 1000 km]. On error nothing changes.
+    pub fn reset(&mut self, state: NavState) -> Result<()> {
+        let finite = state.lla.iter().chain(state.vel.iter()).chain(state.q_nb.coords.iter()).all(|x| x.is_finite()) && state.t.is_finite();
+        if !finite {
+            return Err(invalid("state", "non-finite value"));
+        }
+        let norm = state.q_nb.norm();
+        if (norm - 1.0).abs() > UNIT_NORM_TOLERANCE {
+            return Err(invalid("state", format!("q_nb has norm {norm}, not 1 within {UNIT_NORM_TOLERANCE}")));
+        }
+        check_latitude("state", state.lla.x, 0)?;
+        let (lo, hi) = HEIGHT_RANGE;
+        if !(lo..=hi).contains(&state.lla.z) {
+            return Err(invalid("state", format!("height {} m is outside [{lo}, {hi}] m", state.lla.z)));
+        }
+        *self = Strapdown::new(state, self.kind(), self.ell, self.vertical)?;
+        Ok(())
     }
 
     /// Rates or increments.
@@ -159,7 +222,7 @@ impl Strapdown {
         };
         let v_mid = s0.vel + 0.5 * (dv_sf_b + gc_prev * dt);
         let earth = model.at_sin_cos(self.lat_sin_cos.sin_cos(lla_mid.x), lla_mid.z);
-        // Baro loop (spec Eq. 26): ḣ gets −K_v1(h − h_b), v̇_D gets +K_v2(h − h_b), with
+        // Baro loop: ḣ gets −K_v1(h − h_b), v̇_D gets +K_v2(h − h_b), with
         // K_v1 = 2ζω_v, K_v2 = ω_v² + 2γ/R₀ (R₀ = √(R_M R_P)).
         let (k1, k2, dh0) = match (self.vertical, h_ref) {
             (Vertical::Damped { zeta, omega }, Some(hb)) => {
@@ -255,29 +318,29 @@ impl SampleCheck {
         let t0 = self.prev_t;
         for (k, &tk) in t.iter().enumerate() {
             if !tk.is_finite() {
-                return Err(invalid("time", format!("non-finite time {tk} at index {}", first_index + k)));
+                return Err(invalid_at("time", first_index + k, format!("non-finite time {tk} at index {}", first_index + k)));
             }
             // With rates the very first sample may coincide with the initial time.
             let first_rate_sample = self.kind == ImuKind::Rates && !self.primed && k == 0;
             if first_rate_sample && tk != t0 {
-                return Err(invalid("time", format!("the first rate sample must be at the initial time {t0} s, got {tk} at index {first_index}")));
+                return Err(invalid_at("time", first_index, format!("the first rate sample must be at the initial time {t0} s, got {tk} at index {first_index}")));
             }
             if !first_rate_sample && tk <= self.prev_t {
                 let what = if tk == self.prev_t { "duplicated" } else { "decreasing" };
-                return Err(invalid("time", format!("time not strictly increasing: {what} stamp {tk} at index {}", first_index + k)));
+                return Err(invalid_at("time", first_index + k, format!("time not strictly increasing: {what} stamp {tk} at index {}", first_index + k)));
             }
             self.prev_t = tk;
         }
         for (name, data) in [("gyro", gyro), ("accel", accel)] {
             if let Some(k) = data.iter().position(|v| !v.iter().all(|x| x.is_finite())) {
-                return Err(invalid(name, format!("non-finite value at index {}: {:?}", first_index + k, data[k].as_slice())));
+                return Err(invalid_at(name, first_index + k, format!("non-finite value at index {}: {:?}", first_index + k, data[k].as_slice())));
             }
         }
         match h_ref {
             None if self.damped => return Err(invalid("h_ref", "a damped vertical channel needs a reference altitude per sample")),
             Some(h) => {
                 if let Some(k) = h.iter().position(|x| !x.is_finite()) {
-                    return Err(invalid("h_ref", format!("non-finite value at index {}", first_index + k)));
+                    return Err(invalid_at("h_ref", first_index + k, format!("non-finite value at index {}", first_index + k)));
                 }
             }
             None => {}
@@ -431,6 +494,73 @@ mod tests {
         let tl = truth.last().unwrap();
         let dpos = WGS84.lla_to_ecef(&last.lla) - WGS84.lla_to_ecef(&tl.lla);
         (dpos.norm(), quat_angle_between(&last.q_nb, &tl.q_nb))
+    }
+
+    #[test]
+    fn reset_equals_a_new_object_bit_for_bit() {
+        for kind in [ImuKind::Rates, ImuKind::Increments] {
+            let (t, g, a) = (0..300).fold((vec![], vec![], vec![]), |(mut t, mut g, mut a), k| {
+                let tk = if kind == ImuKind::Rates { k } else { k + 1 } as f64 * 0.01;
+                t.push(tk);
+                g.push(Vec3::new(0.1 * tk.sin(), 0.05, -0.02 * tk));
+                a.push(Vec3::new(0.3, -0.1 * tk.cos(), -9.81));
+                (t, g, a)
+            });
+            let vertical = Vertical::Damped { zeta: 0.5, omega: 0.02 };
+            let h = vec![130.0; t.len()];
+            let run = |sd: &mut Strapdown, from: usize| {
+                let (t, g, a, h) = (&t[from..], &g[from..], &a[from..], &h[from..]);
+                let mut out = Vec::new();
+                sd.run(t, g, a, Some(h), &mut out).unwrap();
+                out
+            };
+            let first = NavState { t: 0.0, lla: Vec3::new(-0.4, 2.0, 120.0), vel: Vec3::new(1.0, 2.0, 0.1), q_nb: crate::math::quat(0.5, 0.5, -0.5, 0.5) };
+            let mut used = Strapdown::new(first, kind, WGS84, vertical).unwrap();
+            let before = run(&mut used, 0);
+            // restart from the state after row 99 (with rates, row 99 then primes anew)
+            let mid = before[99];
+            used.reset(mid).unwrap();
+            let mut fresh = Strapdown::new(mid, kind, WGS84, vertical).unwrap();
+            let from = if kind == ImuKind::Rates { 99 } else { 100 };
+            assert_eq!(run(&mut used, from), run(&mut fresh, from), "{kind:?}");
+        }
+    }
+
+    #[test]
+    fn reset_rejects_an_invalid_state_and_keeps_the_old_one() {
+        let good = NavState { t: 0.0, lla: Vec3::new(0.4, 0.1, 10.0), vel: Vec3::zeros(), q_nb: crate::math::quat(1.0, 0.0, 0.0, 0.0) };
+        let mut sd = Strapdown::new(good, ImuKind::Increments, WGS84, Vertical::Free).unwrap();
+        let nudged = |f: &dyn Fn(&mut NavState)| {
+            let mut s = good;
+            f(&mut s);
+            s
+        };
+        for (bad, why) in [
+            (nudged(&|s| s.q_nb = crate::math::quat(1.0 + 2e-6, 0.0, 0.0, 0.0)), "norm"),
+            (nudged(&|s| s.lla.x = 1.5708), "latitude"),
+            (nudged(&|s| s.lla.z = -1.1e4), "height"),
+            (nudged(&|s| s.lla.z = 1.1e6), "height"),
+            (nudged(&|s| s.vel.y = f64::NAN), "non-finite"),
+        ] {
+            let e = sd.reset(bad).unwrap_err();
+            assert!(matches!(&e, crate::error::NavError::InvalidInput { field, .. } if field == "state"), "{e}");
+            assert!(e.to_string().contains(why), "{e}");
+            assert_eq!(sd.state, good);
+        }
+        // within the tolerance: accepted, normalised like a new object's
+        let near = nudged(&|s| s.q_nb = crate::math::quat(1.0 + 5e-7, 0.0, 0.0, 0.0));
+        sd.reset(near).unwrap();
+        assert_eq!(sd.state.q_nb, Strapdown::new(near, ImuKind::Increments, WGS84, Vertical::Free).unwrap().state.q_nb);
+    }
+
+    #[test]
+    fn vertical_by_name() {
+        assert_eq!(Vertical::parse("free"), Ok(Vertical::Free));
+        assert_eq!(Vertical::parse("damped"), Ok(Vertical::Damped { zeta: 0.707, omega: 0.01 }));
+        assert_eq!(Vertical::parse("damped").unwrap().tuned(Some(0.5), None), Vertical::Damped { zeta: 0.5, omega: 0.01 });
+        assert_eq!(Vertical::Free.tuned(Some(0.5), Some(0.1)), Vertical::Free);
+        assert_eq!(Vertical::Damped { zeta: 0.3, omega: 0.2 }.name(), "damped");
+        assert!(Vertical::parse("baro").unwrap_err().to_string().starts_with("vertical: unknown option \"baro\""));
     }
 
     #[test]
