@@ -8,7 +8,7 @@ al. 2023, §4)."""
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import KW_ONLY, dataclass, field
 
 import numpy as np
 import pandas as pd
@@ -35,6 +35,7 @@ class HybridResult:
 
     name: str
     params: dict
+    _: KW_ONLY
     time: np.ndarray
     hybrid: np.ndarray
     free: np.ndarray

@@ -5,7 +5,7 @@ analysis, with the IMU-only strapdown as baseline."""
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import KW_ONLY, dataclass
 
 import numpy as np
 import pandas as pd
@@ -44,6 +44,7 @@ class ScenarioConfig(ConfigMixin):
 
     sensor: CaiSensor
     setup: FilterSetup
+    _: KW_ONLY
     imu: str = "navigation"
     reference: str | None = None
     gravity: str = "kinematic"
