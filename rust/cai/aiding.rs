@@ -218,7 +218,7 @@ impl CaiConfig {
             return Err(invalid("substeps", format!("must be in [1, {MAX_SUBSTEPS}], got {}", self.substeps)));
         }
         if let OmegaDot::Given(_) = self.omega_dot {
-            return Err(invalid("omega_dot", "'given' needs per-sample values, which the aiding does not have; choose zero, pwl or savgol"));
+            return Err(OmegaDot::given_without_samples());
         }
         check_positive("sigma_p", self.sigma_p)?;
         check_positive("contrast", self.contrast)?;
