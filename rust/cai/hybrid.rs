@@ -1,4 +1,4 @@
-//! CAI-aided INS scenarios and their Monte Carlo (seed 003 §5, seed 000 §5): a truth
+//! CAI-aided INS scenarios and their Monte Carlo (Tennstedt et al. 2023, §5; Tennstedt et al. 2021, §5): a truth
 //! trajectory with its ideal IMU, an IMU error model, a CAI (channels, shots, readout
 //! noise) and the aided-INS engine with [`CaiAiding`]; every run also integrates the same
 //! IMU record without aiding (the IMU-only baseline). Runs are independent and seeded
@@ -111,7 +111,7 @@ pub enum PhaseSource {
     /// interpolation (atom-strapdown §2.8: "truth integrated at 2 kHz"); one set of phases
     /// serves every run.
     Ideal(Vec<f64>),
-    /// A CAI emulated from a better reference IMU (seed 000 (E38), hexapod): per run, the
+    /// A CAI emulated from a better reference IMU (Tennstedt et al. 2021, Eq. 38, hexapod): per run, the
     /// predictor applied to the ideal IMU corrupted with this model (Savitzky–Golay ω̇);
     /// the estimated biases are then relative to the reference IMU's.
     Reference(ImuErrorModel),
