@@ -110,3 +110,25 @@ def test_shot_schedule_is_the_cores():
     np.testing.assert_allclose(s.shots(0.0, 1.0), 0.05 * np.arange(20), atol=1e-15)
     s.shot_period = 0.1
     assert len(s.shots(0.0, 1.0)) == 10
+
+
+def _positional(obj) -> int:
+    import inspect
+
+    try:
+        sig = inspect.signature(obj)
+    except (TypeError, ValueError):
+        return 0
+    kinds = (inspect.Parameter.POSITIONAL_ONLY, inspect.Parameter.POSITIONAL_OR_KEYWORD)
+    return sum(p.kind in kinds and p.name not in ("self", "cls") for p in sig.parameters.values())
+
+
+def test_no_public_cai_callable_takes_more_than_eight_positional_parameters():
+    import inspect
+
+    names = [n for n in dir(cai) if not n.startswith("_") and callable(getattr(cai, n)) and not inspect.ismodule(getattr(cai, n))]
+    core = [n for n in dir(_core) if n.startswith(("cai_", "Cai", "nav_errors"))] + ["Motion"]
+    targets = [getattr(cai, n) for n in names] + [getattr(_core, n) for n in core]
+    targets += [getattr(_core.Motion, n) for n in dir(_core.Motion) if not n.startswith("_")]
+    too_many = [getattr(t, "__qualname__", str(t)) for t in targets if _positional(t) > 8]
+    assert too_many == []

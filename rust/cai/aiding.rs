@@ -1,6 +1,6 @@
 //! CAI aiding of the generic aided INS (`filter::aided`): the measurement of one shot is
 //! the raw population readout of every interferometer channel, stacked into one vector
-//! (spec cai-ekf-tennstedt2021 decision 6, atom-strapdown decision 7: 3 axes × A/B = 6
+//! (Tennstedt et al. 2021, §2.3; Tennstedt et al. 2023, §2.2: 3 axes × A/B = 6
 //! rows). The predicted readout comes from the atom-strapdown predictor (`predictor.rs`)
 //! driven by the bias-compensated IMU stream the engine hands to `observe`.
 //!
@@ -14,7 +14,7 @@
 //! - H_j = (C/2) sin(φ̂_j + φ0_j) J_j, J_j = ∂φ̂_j/∂(δb_a, δb_g, δl, δγ) from the
 //!   tangent-linear predictor                                         (cai-ekf E33)
 //! - R = σ_p² I + (C/2)² sin² · Σ_shot (in-shot IMU white noise, full 6 × 6 with the A/B
-//!   correlation, decision 14): Σ = Σ_i s_i Q_i s_iᵀ from the predictor's sensitivity s_i to
+//!   correlation, Tennstedt et al. 2021, §2.4): Σ = Σ_i s_i Q_i s_iᵀ from the predictor's sensitivity s_i to
 //!   each IMU sample (`in_shot.rs`; it includes the atom and lever-arm Euler terms that the
 //!   closed form (E38) (2T³/3)[q_a K Kᵀ + 4 q_g V Vᵀ] leaves out)
 //!
@@ -101,7 +101,7 @@ impl Choice for ForceKind {
     const CHOICES: &'static [(&'static str, Self)] = &[("bias", ForceKind::Bias), ("direct", ForceKind::Direct)];
 }
 
-/// How the CAI corrects the IMU (seed 000 (E11)).
+/// How the CAI corrects the IMU (Tennstedt et al. 2021, Eq. 11).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum ForceMode {
     /// Option b (default): the readout observes the accelerometer (and gyro) bias states.
@@ -145,12 +145,12 @@ pub struct CaiConfig {
     /// Population noise σ_p per channel.
     pub sigma_p: f64,
     /// White-noise PSDs (q_a m²/s³, q_g rad²/s) of the IMU for the in-shot R inflation
-    /// (decision 14); None = no inflation.
+    /// (Tennstedt et al. 2021, §2.4); None = no inflation.
     pub inflation: Option<(f64, f64)>,
     pub omega_dot: OmegaDot,
     pub interpolation: Interpolation,
     pub substeps: usize,
-    /// Keep the Euler terms in the Jacobian (atom-strapdown decision 9; default false).
+    /// Keep the Euler terms in the Jacobian (Tennstedt et al. 2023, Eq. 31; default false).
     pub jacobian_euler: bool,
     /// Estimate the CAI misalignment γ (3 states, random walk of this PSD rad²/s).
     pub misalignment: Option<f64>,
@@ -218,7 +218,7 @@ impl CaiConfig {
             return Err(invalid("substeps", format!("must be in [1, {MAX_SUBSTEPS}], got {}", self.substeps)));
         }
         if let OmegaDot::Given(_) = self.omega_dot {
-            return Err(invalid("omega_dot", "'given' needs per-sample values, which the aiding does not have; choose zero, pwl or savgol"));
+            return Err(OmegaDot::given_without_samples());
         }
         check_positive("sigma_p", self.sigma_p)?;
         check_positive("contrast", self.contrast)?;
@@ -362,8 +362,8 @@ impl CaiAiding {
         Ok(j)
     }
 
-    /// In-shot IMU-noise phase covariance Σ (rad²) of the shot starting at `ts` (decision
-    /// 14, `in_shot.rs`): from the predictor's sensitivity to every buffered sample, for the
+    /// In-shot IMU-noise phase covariance Σ (rad²) of the shot starting at `ts`
+    /// (Tennstedt et al. 2021, §2.4, `in_shot.rs`): from the predictor's sensitivity to every buffered sample, for the
     /// nominal channels (the small lever-arm / misalignment corrections do not change it).
     /// The sensitivities depend only on the sample times relative to the shot start, so Σ
     /// is cached and recomputed only when that pattern changes (first shots, irregular data).
@@ -633,7 +633,7 @@ mod tests {
         assert!((m.h[(0, ba)] / expect - 1.0).abs() < 0.05, "{} vs {expect}", m.h[(0, ba)]);
     }
 
-    /// R inflation (decision 14) at mid-fringe reproduces the spec's in-shot phase noise
+    /// R inflation (Tennstedt et al. 2021, §2.4) at mid-fringe reproduces the in-shot phase noise
     /// (atom-strapdown §4: 0.1838 rad accelerometer, 0.2994 rad gyro at T = 25 ms, the
     /// closed form (E38) of a continuous record without Euler terms, as here with ω̇ = 0) and
     /// the A/B correlation (common accelerometer, opposite Coriolis part), sampled at 200 Hz:

@@ -1,4 +1,4 @@
-//! CAI-aided INS scenarios and their Monte Carlo (seed 003 §5, seed 000 §5): a truth
+//! CAI-aided INS scenarios and their Monte Carlo (Tennstedt et al. 2023, §5; Tennstedt et al. 2021, §5): a truth
 //! trajectory with its ideal IMU, an IMU error model, a CAI (channels, shots, readout
 //! noise) and the aided-INS engine with [`CaiAiding`]; every run also integrates the same
 //! IMU record without aiding (the IMU-only baseline). Runs are independent and seeded
@@ -112,7 +112,7 @@ pub enum PhaseSource {
     /// interpolation (atom-strapdown §2.8: "truth integrated at 2 kHz"); one set of phases
     /// serves every run.
     Ideal(Vec<f64>),
-    /// A CAI emulated from a better reference IMU (seed 000 (E38), hexapod): per run, the
+    /// A CAI emulated from a better reference IMU (Tennstedt et al. 2021, Eq. 38, hexapod): per run, the
     /// predictor applied to the ideal IMU corrupted with this model (Savitzky–Golay ω̇);
     /// the estimated biases are then relative to the reference IMU's.
     Reference(ImuErrorModel),
@@ -364,4 +364,83 @@ pub struct McTables {
     pub sigma: Vec<f64>,
     pub nees: Vec<f64>,
     pub phase_error: Vec<f64>,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::cai::aiding::ForceMode;
+    use crate::cai::predictor::Channel;
+    use crate::math::Mat3;
+
+    fn cai(shots: Vec<f64>) -> CaiConfig {
+        let channels = vec![Channel { k: Vec3::new(1.6e7, 0.0, 0.0), lever: Vec3::zeros(), c_sb: Mat3::identity(), v0: Vec3::new(0.0, 2.8, 0.0) }];
+        CaiConfig {
+            channels,
+            t_sep: 0.025,
+            shots,
+            offset: 0.5,
+            contrast: 1.0,
+            sigma_p: 0.03,
+            inflation: None,
+            omega_dot: OmegaDot::Pwl,
+            interpolation: Interpolation::Linear,
+            substeps: 1,
+            jacobian_euler: false,
+            misalignment: None,
+            lever_arm: None,
+            force: ForceMode::Bias,
+            kind: ImuKind::Rates,
+        }
+    }
+
+    fn config(phase_source: PhaseSourceKind, truth_rate_hz: Option<f64>) -> HybridConfig {
+        HybridConfig {
+            gravity: GravityModel::Kinematic,
+            rate_hz: 200.0,
+            truth_rate_hz,
+            phase_source,
+            accel_psd: 1e-11,
+            gyro_psd: 1e-12,
+            accel_bias_psd: 1e-10,
+            gyro_bias_psd: 1e-14,
+            predict_every: 10,
+            aiding: true,
+            draw_initial: false,
+        }
+    }
+
+    /// At rest in kinematic mode an ideal CAI reads zero phase (no force, no rotation), the
+    /// filter is the closed-loop Van Loan one, and a missing source or a wrong P0 is refused
+    /// by name.
+    #[test]
+    fn scenario_assembly_and_its_checks() {
+        let motion = Motion::stationary("rest", Vec3::new(0.9, 0.17, 60.0), 1.0, Vec3::zeros());
+        let p0 = DMatrix::identity(15, 15) * 1e-12;
+        let s = HybridScenario::new(&motion, &config(PhaseSourceKind::Ideal, Some(400.0)), ImuErrorModel::default(), None, cai(vec![0.1, 0.2]), p0.clone()).unwrap();
+        assert_eq!(s.t.len(), 201);
+        assert_eq!((s.filter.method, s.filter.mode), (Discretization::VanLoan, LoopMode::Closed));
+        match &s.phase {
+            PhaseSource::Ideal(p) => assert!(p.len() == 2 && p.iter().all(|x| x.abs() < 1e-9), "{p:?}"),
+            other => panic!("{other:?}"),
+        }
+        let err = |cfg: HybridConfig, reference: Option<ImuErrorModel>, p0: DMatrix<f64>| {
+            HybridScenario::new(&motion, &cfg, ImuErrorModel::default(), reference, cai(vec![0.1]), p0).err().unwrap().to_string()
+        };
+        assert!(err(config(PhaseSourceKind::Ideal, None), None, p0.clone()).starts_with("truth_rate_hz:"));
+        assert!(err(config(PhaseSourceKind::Reference, None), None, p0.clone()).starts_with("reference:"));
+        assert!(err(config(PhaseSourceKind::Ideal, Some(400.0)), Some(ImuErrorModel::default()), p0.clone()).starts_with("reference:"));
+        assert!(err(config(PhaseSourceKind::Ideal, Some(400.0)), None, DMatrix::identity(9, 9)).starts_with("p0:"));
+        let mut bad = config(PhaseSourceKind::Ideal, Some(400.0));
+        bad.gyro_psd = -1.0;
+        assert!(err(bad, None, p0).starts_with("gyro_psd:"));
+    }
+
+    #[test]
+    fn gravity_by_name() {
+        assert_eq!(GravityModel::parse("earth").unwrap().ellipsoid(), WGS84);
+        assert_eq!(GravityModel::parse("kinematic").unwrap().ellipsoid(), KINEMATIC);
+        assert!(GravityModel::parse("moon").unwrap_err().to_string().starts_with("gravity: unknown option"));
+        assert!(PhaseSourceKind::parse("oracle").unwrap_err().to_string().starts_with("phase_source:"));
+    }
 }

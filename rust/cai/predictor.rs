@@ -97,9 +97,14 @@ impl OmegaDot {
     /// "given" is refused under `omega_dot`.
     pub fn without_samples(kind: OmegaDotKind, savgol_half_width: usize) -> Result<Self> {
         if kind == OmegaDotKind::Given {
-            return Err(invalid("omega_dot", "'given' needs per-sample values, which the aiding does not have; choose zero, pwl or savgol"));
+            return Err(Self::given_without_samples());
         }
         Self::new(kind, savgol_half_width, None)
+    }
+
+    /// The error of a "given" ω̇ where no per-sample values exist.
+    pub(crate) fn given_without_samples() -> crate::error::NavError {
+        invalid("omega_dot", "'given' needs per-sample values, which the aiding does not have; choose zero, pwl or savgol")
     }
 
     /// Samples needed before a shot start: the interpolation stencil, or a whole

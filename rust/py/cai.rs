@@ -22,7 +22,6 @@ use crate::error::invalid;
 use crate::imu::errors::ImuErrorModel;
 use crate::imu::ImuKind;
 use crate::math::{Mat3, Vec3};
-use crate::options::Choice;
 use nalgebra::DVector;
 use numpy::{PyArray1, PyArray2, PyArray3, PyArrayMethods, PyReadonlyArray1, PyReadonlyArray2, PyReadonlyArray3, PyUntypedArrayMethods};
 use pyo3::prelude::*;

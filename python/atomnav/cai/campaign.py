@@ -42,6 +42,7 @@ def run_campaign(name: str, motion, config, *, runs: int = 1, seed: int = 0, pro
             parts.append(core.monte_carlo(int(seed), ids))
             bar.update(len(ids))
     cat = {k: np.concatenate([p[k] for p in parts]) for k in parts[0] if k not in ("time", "imu_time")}
-    return HybridResult(name, dict(params or {}), parts[0]["time"], cat["hybrid"], cat["free"], cat["bias"], cat["bias_true"],
-                        cat["sigma"], cat["accel_error"], cat["phase_error"], np.asarray(core.shots), cat["nees"][:, :, 0],
-                        parts[0]["imu_time"], list(sensor.channels.names), config.to_dict())
+    return HybridResult(name, dict(params or {}), time=parts[0]["time"], hybrid=cat["hybrid"], free=cat["free"], bias=cat["bias"],
+                        bias_true=cat["bias_true"], sigma=cat["sigma"], accel_error=cat["accel_error"], phase_error=cat["phase_error"],
+                        shots=np.asarray(core.shots), nees=cat["nees"][:, :, 0], imu_time=parts[0]["imu_time"],
+                        channel_names=list(sensor.channels.names), config=config.to_dict())

