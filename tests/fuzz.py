@@ -722,6 +722,13 @@ def _md(s: str) -> str:
     return s.replace("\n", " ").replace("|", "\\|")[:400]
 
 
+def _plain_dataclass(cls) -> bool:
+    """A dataclass without checks of its own (``__post_init__``): any fields make one, so
+    an instance it built is no evidence of a usable object (results are built by the
+    functions that return them)."""
+    return dataclasses.is_dataclass(cls) and not hasattr(cls, "__post_init__")
+
+
 def _instances(spec, made: list):
     """An ``('instance', i)`` placeholder replaced by the i-th (mod) call that built an
     instance of an API class so far (None before any did)."""
@@ -786,7 +793,8 @@ def campaign(calls: int, seed: int, timeout: float = TIMEOUT_S, progress=None) -
             failures[(t.name, outcome)] += 1
         else:
             spent[t.name] += secs
-        if outcome == "ok" and made is not None and len(recipes[made]) < 12 and secs < RECIPE_MAX_S:
+        if outcome == "ok" and made is not None and len(recipes[made]) < 12 and secs < RECIPE_MAX_S \
+                and not (t.kind == "constructor" and _plain_dataclass(resolve(t.module, t.qualname))):
             recipes[made].append(("call", t.name, kwargs, this))
         if progress is not None and sum(r.outcome not in SKIPPED for r in records) % 500 == 0:
             progress(Campaign(seed, len(records), list(records), TARGETS, time.monotonic() - start, pool.restarts))

@@ -4,6 +4,7 @@ on a linearised 15-state INS with 1 Hz position aiding."""
 import numpy as np
 import pytest
 
+from atomnav import InputError
 from atomnav.trajectory import sinusoidal
 from atomnav.filter import (BiasModel, Layout, Scenario, chi2_band, covariance_analysis, dare, discretize,
                             ins_error_model, monte_carlo)
@@ -146,8 +147,30 @@ def test_dask_local_cluster_gives_identical_table():
 
 
 def test_bad_monte_carlo_runs():
-    with pytest.raises(ValueError, match="runs: must be >= 1"):
+    with pytest.raises(ValueError, match="runs: must be >= 1") as info:
         monte_carlo(ins_scenario(duration=2.0), runs=0, seed=1)
+    assert isinstance(info.value, InputError) and info.value.parameter == "runs"
+
+
+@pytest.mark.parametrize("name, value, error, match", [
+    ("seed", -1, InputError, "seed: must be >= 0, got -1"),
+    ("seed", 2**64, InputError, "seed: must be <= 18446744073709551615"),
+    ("chunk", 0, InputError, "chunk: must be >= 1, got 0"),
+    ("retries", -1, InputError, "retries: must be >= 0, got -1"),
+    ("runs", 2.5, TypeError, "runs: expected an integer, got float"),
+    ("seed", "1", TypeError, "seed: expected an integer, got str"),
+])
+def test_bad_monte_carlo_counts(name, value, error, match):
+    kw = dict(runs=2, seed=1) | {name: value}
+    with pytest.raises(error, match=match) as info:
+        monte_carlo(ins_scenario(duration=2.0), **kw)
+    if error is InputError:
+        assert info.value.parameter == name
+
+
+def test_local_result_numbers_every_run():
+    mc = monte_carlo(ins_scenario(duration=4.0), runs=3, seed=2)
+    assert list(mc.runs) == [0, 1, 2] and mc.nees.shape[0] == 3
 
 
 def test_bad_scenario_measure_length():

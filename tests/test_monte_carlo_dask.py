@@ -29,17 +29,13 @@ def local(scenario):
     return monte_carlo(scenario, runs=RUNS, seed=SEED)
 
 
-@pytest.fixture(scope="module")
-def cluster():
-    with distributed.LocalCluster(n_workers=3, threads_per_worker=1, processes=True, dashboard_address=None,
-                                  silence_logs=50) as c:
-        yield c
-
-
 @pytest.fixture
-def client(cluster):
-    with distributed.Client(cluster) as c:
-        c.wait_for_workers(3, timeout=300)  # nannies restart killed workers; slow on a loaded machine
+def client():
+    """A fresh cluster of three worker processes per test (its nannies restart killed
+    workers)."""
+    with distributed.LocalCluster(n_workers=3, threads_per_worker=1, processes=True, dashboard_address=None,
+                                  silence_logs=50) as cluster, distributed.Client(cluster) as c:
+        c.wait_for_workers(3, timeout=120)
         yield c
 
 

@@ -16,6 +16,7 @@ import pandas as pd
 from scipy.stats import chi2
 
 from .. import _core
+from .._validate import input_error
 from .riccati import _mat
 
 
@@ -133,6 +134,18 @@ class MonteCarloIncomplete(RuntimeError):
         self.partial, self.missing, self.errors = partial, missing, errors
 
 
+def _integer(x, name: str, low: int, high: int) -> int:
+    """``x`` as an int in [low, high]: a non-integer is a ``TypeError``, one out of range
+    an :class:`atomnav.InputError`, both naming ``name``."""
+    if isinstance(x, (bool, np.bool_)) or not isinstance(x, (int, np.integer)):
+        raise TypeError(f"{name}: expected an integer, got {type(x).__name__}")
+    if x < low:
+        raise input_error(name, f"must be >= {low}, got {x}")
+    if x > high:
+        raise input_error(name, f"must be <= {high}, got {x}")
+    return int(x)
+
+
 def _runs(scenario: Scenario, seed: int, runs: list[int], mode: str):
     return scenario._core.monte_carlo(int(seed), [int(r) for r in runs], mode)
 
@@ -196,15 +209,13 @@ def monte_carlo(scenario: Scenario, runs: int, seed: int, mode: str = "closed", 
     (the cluster recomputes lost inputs when workers return); if some groups still fail,
     :class:`MonteCarloIncomplete` is raised carrying every finished run in ``.partial``.
     """
-    if int(runs) < 1:
-        raise ValueError(f"runs: must be >= 1, got {runs}")
-    if int(seed) < 0:
-        raise ValueError(f"seed: must be >= 0, got {seed}")
-    ids = list(range(int(runs)))
+    runs, seed = _integer(runs, "runs", 1, 2**32), _integer(seed, "seed", 0, 2**64 - 1)
+    chunk, retries = _integer(chunk, "chunk", 1, 2**32), _integer(retries, "retries", 0, 1000)
+    ids = list(range(runs))
     if client is None:
         return _result(scenario, ids, [_runs(scenario, seed, ids, mode)])
     groups = [ids[i:i + chunk] for i in range(0, len(ids), chunk)]
-    done, errors = _distributed(client, scenario, seed, groups, mode, int(retries))
+    done, errors = _distributed(client, scenario, seed, groups, mode, retries)
     order = sorted(done)
     e, n = len(scenario.times), scenario.size
     none = (np.empty((0, e, n)), np.empty((0, e, n)), np.empty((0, e)), np.empty((0, e)))
