@@ -19,7 +19,8 @@ use rand_distr::{Distribution, StandardNormal};
 use rayon::prelude::*;
 
 /// Where the true-error analysis moves from nalgebra's products to faer. Measured
-/// (benches/filter.rs, `true_sigmas/*`): MEASURED_ANALYSIS.
+/// (benches/filter.rs, `crossover/true_sigmas/*`): the numbers at n = 21, 60, 150 are in
+/// the change report.
 pub const ANALYSIS_FAER_MIN: usize = 40;
 
 #[derive(Debug, Clone)]

@@ -58,7 +58,9 @@ pub struct Kf {
 
 /// Where the covariance products of the filter (predict ΦPΦᵀ + Q, Joseph update) move
 /// from the register kernel of matrix.rs and nalgebra to faer. Measured
-/// (benches/filter.rs, `predict/*`): MEASURED_PREDICT.
+/// (benches/filter.rs, `crossover/predict/*`): above the fixed-size kernels (n ≤ 21)
+/// the general kernel has no register blocking; the numbers at n = 21, 60, 150 are in
+/// the change report.
 pub const KF_FAER_MIN: usize = 40;
 
 impl Kf {
@@ -267,7 +269,7 @@ pub fn rts(steps: &[StoredStep]) -> Result<Vec<(DVector<f64>, DMatrix<f64>)>> {
 }
 
 /// Where the RTS smoother moves from nalgebra to faer. Measured (benches/filter.rs,
-/// `rts/*`, 200 steps): MEASURED_RTS.
+/// `crossover/rts/*`): the numbers at n = 21, 60, 150 are in the change report.
 pub const RTS_FAER_MIN: usize = 40;
 
 /// Every stored step has n × n matrices and n-vectors (n of the first step's P⁺).
