@@ -156,7 +156,7 @@ def cai_aided_ins(t0: float, lla0, vel0, q0, sensor: CaiSensor, shots, *, phase=
     tuning of Tennstedt et al. 2023, :func:`atomnav.cai.seed003_filter`); ``p0`` overrides
     ``setup.p0``; the initial state and the remaining options are those of
     :func:`atomnav.filter.position_aided_ins`."""
-    from ..filter.aided import AidedIns, ins_setup
+    from ..filter.aided import AidedIns, InsSetup
     from ..filter.engine import BiasModel
     from .scenarios import seed003_filter
 
@@ -176,11 +176,14 @@ def cai_aided_ins(t0: float, lla0, vel0, q0, sensor: CaiSensor, shots, *, phase=
         tables.append(np.ascontiguousarray(x))
     setup = setup or seed003_filter()
     n_extra = sensor.n_extra()
-    ins = ins_setup(t0, lla0, vel0, q0, kind, setup.p0(n_extra) if p0 is None else p0, setup.accel_psd, setup.gyro_psd,
-                    BiasModel("random_walk", psd=setup.accel_bias_psd), BiasModel("random_walk", psd=setup.gyro_bias_psd),
-                    ba0, bg0, setup.predict_every, method, mode, sequential, gate, ellipsoid)
+    ins = InsSetup(t0=t0, lla0=lla0, vel0=vel0, q0=q0, kind=kind, p0=setup.p0(n_extra) if p0 is None else p0,
+                   accel_psd=setup.accel_psd, gyro_psd=setup.gyro_psd,
+                   accel_bias=BiasModel("random_walk", psd=setup.accel_bias_psd),
+                   gyro_bias=BiasModel("random_walk", psd=setup.gyro_bias_psd), ba0=ba0, bg0=bg0,
+                   predict_every=setup.predict_every, method=method, mode=mode, sequential=sequential, gate=gate,
+                   ellipsoid=ellipsoid)
     extra0 = vector(np.zeros(n_extra) if extra0 is None else extra0, n_extra, "extra0")
     shots = vector(shots, None, "shots")
-    core = _core.cai_aided_ins(ins=ins, extra0=extra0, sensor=sensor._native(), shots=shots,
+    core = _core.cai_aided_ins(ins=ins.native, extra0=extra0, sensor=sensor._native(), shots=shots,
                                data_kind="emulated" if emulated else "recorded", data_a=tables[0], data_b=tables[1])
-    return AidedIns(core, kind)
+    return AidedIns(core, ins)
