@@ -10,15 +10,7 @@ import pytest
 import atomnav as an
 from atomnav import _core, cai
 
-N = 201
-T_IMU = np.arange(N) * 1e-3
-F = np.tile([0.0, 0.0, -9.8], (N, 1))
-W = np.zeros((N, 3))
-CH = cai.Channels.cyclic()
-
-
-def _predict(**kw):
-    return cai.predict_phase(T_IMU, F, W, [0.01, 0.07], 0.025, CH, **kw)
+from test_cai_bad_input import predict as _predict
 
 
 def _sensor(**kw):
@@ -26,13 +18,12 @@ def _sensor(**kw):
 
 
 def _aided_ins_data_kind(kind):
-    from atomnav.filter.aided import ins_setup
+    from atomnav.filter.aided import InsSetup
     from atomnav.filter.engine import BiasModel
 
-    setup = cai.seed003_filter()
     rw = BiasModel("random_walk", psd=1e-10)
-    ins = ins_setup(0.0, np.array([0.9, 0.1, 0.0]), np.zeros(3), np.array([1.0, 0, 0, 0]), "rates", setup.p0(0), 1e-11, 1e-12, rw, rw,
-                    (0, 0, 0), (0, 0, 0), 10, "van_loan", "closed", False, None, "WGS84")
+    ins = InsSetup(t0=0.0, lla0=(0.9, 0.1, 0.0), vel0=(0, 0, 0), q0=(1.0, 0, 0, 0), kind="rates", p0=cai.seed003_filter().p0(0),
+                   accel_psd=1e-11, gyro_psd=1e-12, accel_bias=rw, gyro_bias=rw, predict_every=10).native
     table = np.zeros((1, 6))
     _core.cai_aided_ins(ins=ins, extra0=np.zeros(0), sensor=cai.seed003_sensor()._native(), shots=np.array([0.1]), data_kind=kind,
                         data_a=table, data_b=table)

@@ -25,7 +25,6 @@ use crate::earth::Ellipsoid;
 use crate::error::{invalid, NavError, Result};
 use crate::imu::ImuKind;
 use crate::math::{Mat3, Vec3};
-use crate::options::Choice;
 use crate::strapdown::{NavState, Strapdown, Vertical};
 use nalgebra::{DMatrix, DVector};
 
@@ -177,20 +176,6 @@ impl InsIndex {
 
 fn block(x: &DVector<f64>, start: usize) -> Vec3 {
     Vec3::new(x[start], x[start + 1], x[start + 2])
-}
-
-/// The vertical channel of an aided INS, chosen by name.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub enum VerticalMode {
-    /// Free (unstable; Schuler-free exponential divergence, Groves 2013 §5.7.2).
-    Free,
-    /// Damped by a reference (barometric) altitude per IMU sample (third-order baro loop).
-    Damped,
-}
-
-impl Choice for VerticalMode {
-    const PARAMETER: &'static str = "vertical";
-    const CHOICES: &'static [(&'static str, Self)] = &[("free", VerticalMode::Free), ("damped", VerticalMode::Damped)];
 }
 
 /// The baro loop of a damped vertical channel: damping ratio ζ, natural frequency ω_v

@@ -4,7 +4,8 @@
 use super::convert::{register_choices, Wrap, mat, quat_rows, vec3_rows, vector};
 use crate::earth::Ellipsoid;
 use crate::error::{invalid, NavError};
-use crate::filter::aided::{AidedConfig, AidedIns, AidedOutput, Aiding, DampedVertical, InsSetup, PositionAiding, PositionFix, VerticalMode};
+use crate::filter::aided::{AidedConfig, AidedIns, AidedOutput, Aiding, DampedVertical, InsSetup, PositionAiding, PositionFix};
+use crate::strapdown::Vertical;
 use crate::filter::discretize::Discretization;
 use crate::filter::initial_error::perturbed_start;
 use crate::filter::ins::{error_dynamics_along, BaroModel, BiasKind, BiasModel, InsNoise};
@@ -100,7 +101,7 @@ impl AidedSetup {
     /// bias state `baro_bias` = (model, p1, p2) as for the IMU biases with initial σ
     /// `baro_bias_sigma0` (m).
     #[new]
-    #[pyo3(signature = (*, t0, lla0, vel0, q0, kind, p0, accel_psd, gyro_psd, accel_bias, gyro_bias, ba0, bg0, predict_every, method, mode, sequential=false, gate=None, ellipsoid=Wrap(crate::earth::WGS84), vertical=Wrap(VerticalMode::Free), zeta=0.707, omega=0.01, baro_psd=0.0, baro_bias=None, baro_bias_sigma0=None))]
+    #[pyo3(signature = (*, t0, lla0, vel0, q0, kind, p0, accel_psd, gyro_psd, accel_bias, gyro_bias, ba0, bg0, predict_every, method, mode, sequential=false, gate=None, ellipsoid=Wrap(crate::earth::WGS84), vertical=Wrap(Vertical::Free), zeta=None, omega=None, baro_psd=0.0, baro_bias=None, baro_bias_sigma0=None))]
     #[allow(clippy::too_many_arguments)]
     fn new(
         t0: f64,
@@ -121,9 +122,9 @@ impl AidedSetup {
         sequential: bool,
         gate: Option<f64>,
         ellipsoid: Wrap<Ellipsoid>,
-        vertical: Wrap<VerticalMode>,
-        zeta: f64,
-        omega: f64,
+        vertical: Wrap<Vertical>,
+        zeta: Option<f64>,
+        omega: Option<f64>,
         baro_psd: f64,
         baro_bias: Option<(String, f64, f64)>,
         baro_bias_sigma0: Option<f64>,
@@ -137,7 +138,10 @@ impl AidedSetup {
             (Some(_), None) => return Err(invalid("baro_bias_sigma0", "required with baro_bias (initial σ of the bias state, m)").into()),
             (None, Some(_)) => return Err(invalid("baro_bias_sigma0", "given without baro_bias").into()),
         };
-        let damped = (vertical.0 == VerticalMode::Damped).then_some(DampedVertical { zeta, omega, baro: BaroModel { noise_psd: baro_psd, bias } });
+        let damped = match vertical.0.tuned(zeta, omega) {
+            Vertical::Free => None,
+            Vertical::Damped { zeta, omega } => Some(DampedVertical { zeta, omega, baro: BaroModel { noise_psd: baro_psd, bias } }),
+        };
         let setup = InsSetup::new(initial, kind.0, ellipsoid.0, ba0.into(), bg0.into(), mat(&p0, "p0")?, cfg, damped)?;
         Ok(AidedSetup { setup, kind: kind.0 })
     }
@@ -285,7 +289,6 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(initial_error, m)?)?;
     m.add("STATE_BLOCKS", STANDARD_BLOCKS.to_vec())?;
     m.add("INS15", INS15.to_vec())?;
-    register_choices::<VerticalMode>(m, "VerticalMode")?;
     register_choices::<BiasKind>(m, "BiasKind")?;
     m.add_class::<PyAidedIns>()?;
     m.add_class::<AidedSetup>()?;

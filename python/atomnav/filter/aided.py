@@ -24,7 +24,7 @@ from .engine import BiasModel, Config, _floats
 from .riccati import _mat
 
 #: Names of the vertical-channel options (from the core).
-VERTICAL = tuple(_core.OPTIONS["VerticalMode"])
+VERTICAL = tuple(_core.OPTIONS["Vertical"])
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -44,7 +44,8 @@ class InsSetup(Config):
 
     Vertical channel: ``vertical`` one of :data:`VERTICAL` — "free" (default) or
     "damped", then :meth:`AidedIns.run` needs ``h_ref``, the reference (barometric)
-    altitude (m) per IMU sample; ``zeta``, ``omega`` (rad/s) of the baro loop
+    altitude (m) per IMU sample; ``zeta``, ``omega`` (rad/s) of the baro loop (default None:
+    the core's 0.707 and 0.01 rad/s)
     (K_v1 = 2ζω, K_v2 = ω² + 2γ/R₀; Demidov 2009, Eq. 26); the reference-altitude error
     h_b − h = b + n: ``baro_psd`` the PSD of the white part n (m²·s; σ²Δt for independent
     samples of σ every Δt), ``baro_bias`` a :class:`BiasModel` of b carried as the state
@@ -78,8 +79,8 @@ class InsSetup(Config):
     gate: float | None = None
     ellipsoid: str = "WGS84"
     vertical: str = "free"
-    zeta: float = 0.707
-    omega: float = 0.01
+    zeta: float | None = None
+    omega: float | None = None
     baro_psd: float = 0.0
     baro_bias: BiasModel | None = None
     baro_bias_sigma0: float | None = None
@@ -98,7 +99,7 @@ class InsSetup(Config):
             gyro_bias=self.gyro_bias._parts(), ba0=list(self.ba0), bg0=list(self.bg0), predict_every=int(self.predict_every),
             method=self.method, mode=self.mode, sequential=bool(self.sequential),
             gate=None if self.gate is None else float(self.gate), ellipsoid=self.ellipsoid, vertical=self.vertical,
-            zeta=float(self.zeta), omega=float(self.omega), baro_psd=float(self.baro_psd),
+            zeta=None if self.zeta is None else float(self.zeta), omega=None if self.omega is None else float(self.omega), baro_psd=float(self.baro_psd),
             baro_bias=None if self.baro_bias is None else self.baro_bias._parts(),
             baro_bias_sigma0=None if self.baro_bias_sigma0 is None else float(self.baro_bias_sigma0))
         object.__setattr__(self, "_native", native)

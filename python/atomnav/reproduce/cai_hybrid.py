@@ -84,10 +84,16 @@ def _slalom(report):
     ax.semilogy(aided["time_s"], aided["ratio"], label="Earth gravity + attitude aid")
     kc = cai.slalom_covariance("kinematic")
     ax.semilogy(kc["time_s"], kc["ratio"], label="kinematic mode")
-    ax.set_xlabel("time (s)")
-    ax.set_ylabel("free / hybrid RMS velocity error")
+    _save(report, fig, ax, ("time (s)", "free / hybrid RMS velocity error"), "cai_hybrid_slalom_cap",
+          "Slalom, covariance analysis: the CAI cannot observe tilt, so in Earth gravity the gain is capped; an attitude aid lifts the cap")
+
+
+def _save(report, fig, ax, labels, name, caption):
+    """Label the axes (x, y), add the legend and save the figure into the report."""
+    ax.set_xlabel(labels[0])
+    ax.set_ylabel(labels[1])
     ax.legend(fontsize=8)
-    report.figure(fig, "cai_hybrid_slalom_cap", "Slalom, covariance analysis: the CAI cannot observe tilt, so in Earth gravity the gain is capped; an attitude aid lifts the cap")
+    report.figure(fig, name, caption)
 
 
 def _car(report):
@@ -126,10 +132,8 @@ def _satellite(report):
     for col, lab in (("imu_asd", "IMU error"), ("filtered_asd", "IMU − b̂ (hybrid)")):
         ax.loglog(psd["frequency_hz"], psd[col], label=lab)
     ax.axhline(psd.attrs["cai_asd"], color="k", ls=":", label="CAI per-shot noise")
-    ax.set_xlabel("frequency (Hz)")
-    ax.set_ylabel("ASD (m/s²/√Hz)")
-    ax.legend(fontsize=8)
-    report.figure(fig, "cai_hybrid_satellite", "Satellite (seed 000 §5.2, drift variant): ASD of the accelerometer error, raw and CAI-corrected")
+    _save(report, fig, ax, ("frequency (Hz)", "ASD (m/s²/√Hz)"), "cai_hybrid_satellite",
+          "Satellite (Tennstedt et al. 2021, §5.2, drift variant): ASD of the accelerometer error, raw and CAI-corrected")
 
 
 def _hexapod(report):
