@@ -16,6 +16,10 @@ from test_filter_analysis import ins_scenario
 
 distributed = pytest.importorskip("distributed")
 
+# each test starts a cluster of three worker processes and kills some of them: outside the
+# default run (bash tests/run.sh -m slow)
+pytestmark = pytest.mark.slow
+
 RUNS, CHUNK, SEED = 24, 2, 11
 
 

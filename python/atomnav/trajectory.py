@@ -183,7 +183,7 @@ def stationary(duration: float, rate_hz: float = 100.0, origin=MOSCOW, euler=(0.
     return Trajectory.from_motion(_core.Motion.stationary(_origin(origin), float(duration), vector(euler, 3, "euler")), rate_hz, ellipsoid)
 
 
-def sinusoidal(duration: float, rate_hz: float = 100.0, origin=MOSCOW, amp_ned=(20.0, 15.0, 2.0), period_ned=(60.0, 45.0, 30.0),
+def sinusoidal(duration: float, rate_hz: float = 100.0, *, origin=MOSCOW, amp_ned=(20.0, 15.0, 2.0), period_ned=(60.0, 45.0, 30.0),
                amp_euler=(0.1, 0.08, 0.3), period_euler=(20.0, 25.0, 40.0), heading: float = 0.5, ellipsoid: str = "WGS84") -> Trajectory:
     """Sinusoidal motion: NED displacement amplitudes (m) and periods (s), roll/pitch/yaw
     oscillation amplitudes (rad) and periods (s) about ``heading`` (rad)."""

@@ -31,7 +31,7 @@ class Scenario:
     Picklable (it keeps its inputs), so it can be shipped to Dask workers.
     """
 
-    def __init__(self, f, qc, dt, p0, h, r, measure, times=None, labels=None,
+    def __init__(self, f, qc, dt, p0, h, r, measure, *, times=None, labels=None,
                  method: str = "van_loan", sequential: bool = False):
         self._args = dict(
             f=np.ascontiguousarray(np.asarray(f, dtype=float)),

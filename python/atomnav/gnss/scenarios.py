@@ -14,7 +14,7 @@ noise of PSD σ²·1 s = 1 m²·s (the loop's time constants, ~100 s, are far lo
 
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
+from dataclasses import KW_ONLY, dataclass, replace
 
 import numpy as np
 import pandas as pd
@@ -43,6 +43,7 @@ class Scenario:
     n highest at the start (0 = free INS); ``outage``: (start s, length s) without GNSS."""
 
     imu_class: str = "precise"
+    _: KW_ONLY
     motion: str = "MOVE"
     duration_s: float = 1200.0
     n_sats: int | None = None
