@@ -18,9 +18,9 @@ use rand_chacha::ChaCha20Rng;
 use rand_distr::{Distribution, StandardNormal};
 use rayon::prelude::*;
 
-/// Where the true-error analysis moves from nalgebra's products to faer. Measured
-/// (benches/filter.rs, `crossover/true_sigmas/*`): the numbers at n = 21, 60, 150 are in
-/// the change report.
+/// Where the true-error analysis moves from nalgebra's products to faer. PROVISIONAL (not yet
+/// measured): `cargo bench --bench filter -- crossover/true_sigmas` times both paths at
+/// n = 21, 60, 150; set this to the measured crossover.
 pub const ANALYSIS_FAER_MIN: usize = 40;
 
 #[derive(Debug, Clone)]

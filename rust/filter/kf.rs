@@ -57,10 +57,9 @@ pub struct Kf {
 }
 
 /// Where the covariance products of the filter (predict ΦPΦᵀ + Q, Joseph update) move
-/// from the register kernel of matrix.rs and nalgebra to faer. Measured
-/// (benches/filter.rs, `crossover/predict/*`): above the fixed-size kernels (n ≤ 21)
-/// the general kernel has no register blocking; the numbers at n = 21, 60, 150 are in
-/// the change report.
+/// from the register kernel of matrix.rs and nalgebra to faer. PROVISIONAL (not yet
+/// measured): `cargo bench --bench filter -- crossover/predict` times both paths at
+/// n = 21, 60, 150; set this to the measured crossover.
 pub const KF_FAER_MIN: usize = 40;
 
 impl Kf {
@@ -268,8 +267,9 @@ pub fn rts(steps: &[StoredStep]) -> Result<Vec<(DVector<f64>, DMatrix<f64>)>> {
     rts_using(steps, Algebra::by_size(n, RTS_FAER_MIN))
 }
 
-/// Where the RTS smoother moves from nalgebra to faer. Measured (benches/filter.rs,
-/// `crossover/rts/*`): the numbers at n = 21, 60, 150 are in the change report.
+/// Where the RTS smoother moves from nalgebra to faer. PROVISIONAL (not yet measured):
+/// `cargo bench --bench filter -- crossover/rts` times both paths at n = 21, 60, 150; set
+/// this to the measured crossover.
 pub const RTS_FAER_MIN: usize = 40;
 
 /// Every stored step has n × n matrices and n-vectors (n of the first step's P⁺).

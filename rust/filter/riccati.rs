@@ -87,9 +87,10 @@ pub fn dare(phi: &DMatrix<f64>, q: &DMatrix<f64>, h: &DMatrix<f64>, r: &DMatrix<
     dare_using(phi, q, h, r, Algebra::by_size(phi.nrows(), DARE_FAER_MIN))
 }
 
-/// Where the DARE doubling moves from the padded register kernels to faer. Measured
-/// (benches/filter.rs, `crossover/dare/*`): set above the largest single register chunk (32);
-/// the criterion numbers at n = 21, 60, 150 are in the change report.
+/// Where the DARE doubling moves from the padded register kernels to faer: above the
+/// largest single register chunk (32). PROVISIONAL (not yet measured): `cargo bench
+/// --bench filter -- crossover/dare` times both paths at n = 21, 60, 150; set this to the
+/// measured crossover.
 pub const DARE_FAER_MIN: usize = 33;
 
 /// [`dare`] with the algebra of the doubling chosen by the caller (benches and tests).
