@@ -18,9 +18,9 @@ use rand_chacha::ChaCha20Rng;
 use rand_distr::{Distribution, StandardNormal};
 use rayon::prelude::*;
 
-/// Where the true-error analysis moves from nalgebra's products to faer. PROVISIONAL (not yet
-/// measured): `cargo bench --bench filter -- crossover/true_sigmas` times both paths at
-/// n = 21, 60, 150; set this to the measured crossover.
+/// Where the true-error analysis moves from nalgebra's products to faer. PROVISIONAL: one
+/// short run of `cargo bench --bench filter -- crossover/true_sigmas` gave nalgebra/faer
+/// 352/336 µs at n = 21, 3.26/3.29 ms at 60, 37.6/35.2 ms at 150: a tie up to 60.
 pub const ANALYSIS_FAER_MIN: usize = 40;
 
 #[derive(Debug, Clone)]

@@ -57,9 +57,10 @@ pub struct Kf {
 }
 
 /// Where the covariance products of the filter (predict ΦPΦᵀ + Q, Joseph update) move
-/// from the register kernel of matrix.rs and nalgebra to faer. PROVISIONAL (not yet
-/// measured): `cargo bench --bench filter -- crossover/predict` times both paths at
-/// n = 21, 60, 150; set this to the measured crossover.
+/// from the register kernel of matrix.rs and nalgebra to faer. PROVISIONAL: one
+/// short run of `cargo bench --bench filter -- crossover/predict` gave kernel/faer
+/// 13.6/6.0 µs at n = 21, 130/66 µs at 60, 1.43/0.60 ms at 150, so faer already wins at 21
+/// and the crossover lies below it; to be measured between 16 and 21 and set here.
 pub const KF_FAER_MIN: usize = 40;
 
 impl Kf {
@@ -267,9 +268,10 @@ pub fn rts(steps: &[StoredStep]) -> Result<Vec<(DVector<f64>, DMatrix<f64>)>> {
     rts_using(steps, Algebra::by_size(n, RTS_FAER_MIN))
 }
 
-/// Where the RTS smoother moves from nalgebra to faer. PROVISIONAL (not yet measured):
-/// `cargo bench --bench filter -- crossover/rts` times both paths at n = 21, 60, 150; set
-/// this to the measured crossover.
+/// Where the RTS smoother moves from nalgebra to faer. PROVISIONAL: one short run of
+/// `cargo bench --bench filter -- crossover/rts` gave nalgebra/faer 2.77/1.47 ms at
+/// n = 21, 28.6/13.6 ms at 60, 93.8/42.5 ms at 150 (faer wins at every size tried); the
+/// crossover below 21 is still to be measured and set here.
 pub const RTS_FAER_MIN: usize = 40;
 
 /// Every stored step has n × n matrices and n-vectors (n of the first step's P⁺).
