@@ -1,5 +1,5 @@
 """Astro-inertial calibration: star-camera (virtual camera VF) to IMU (MF) mount from
-attitude increments (Vasilyuk et al. 2024; spec astro-calibration-vasilyuk2024).
+attitude increments (Vasilyuk et al. 2024).
 
 Conventions of this module (the paper's, spec §2): ENU navigation frame, body axes
 right-forward-up (MF), ``S_X2^X1`` maps X1 coordinates into X2, small errors are

@@ -1,4 +1,4 @@
-"""Sensor noise analysis (spec ``aig-noise-arma-niu2025``, Niu et al. 2025 Niu et al. 2025).
+"""Sensor noise analysis (Niu et al. 2025).
 
 - :mod:`.allan` — overlapping/modified Allan and Hadamard variance (Rust), EDF
   confidence intervals, the five-term IEEE-952 fit, bias / bias stability / SS / LS,

@@ -1,4 +1,4 @@
-"""Allan family and the metrics of Niu et al. 2025 (spec E14–E18, D15–D17).
+"""Allan family and the metrics of Niu et al. 2025.
 
 All functions are unit-agnostic: a rate series in some unit U sampled every ``tau0``
 seconds gives variances in U², fit coefficients A_k in U²·s^k, ARW in U·√s, bias

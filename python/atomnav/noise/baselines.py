@@ -1,4 +1,4 @@
-"""Non-model baselines of Niu et al. 2025 §5.2 with the spec's settings (D13, D14)."""
+"""Non-model baselines of Niu et al. 2025, §5.2, with the paper's settings."""
 
 from __future__ import annotations
 

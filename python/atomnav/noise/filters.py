@@ -1,4 +1,4 @@
-"""ARIMA state-space form and Kalman filters of Niu et al. 2025 (spec E7–E11, D5–D12); the
+"""ARIMA state-space form and Kalman filters of Niu et al. 2025; the
 numerical work runs in Rust.
 
 Eq. 17 has two readings (spec E10, D7): ``"literal"`` takes y = ω (the raw rate);
