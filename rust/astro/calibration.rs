@@ -1,5 +1,5 @@
-//! Mount calibration C = C_MF^VF from pairs of attitude increments (Vasilyuk et al. 2024 §3; spec
-//! E14–E20): identifiability, closed-form start, Gauss–Newton on SO(3), the sandwich
+//! Mount calibration C = C_MF^VF from pairs of attitude increments (Vasilyuk et al. 2024 §3):
+//! identifiability, closed-form start, Gauss–Newton on SO(3), the sandwich
 //! covariance P_β, P^clb, P^mfa and the dead-reckoning consistency check.
 
 use super::{d1, d2, euler_dcm, euler_from_dcm, nearest_rotation, rotation_angle, vee};
@@ -295,7 +295,7 @@ fn normal_equations_euler_fd(beta: &Vec3, ds_imu: &[Mat3], ds_avu: &[Mat3]) -> (
 }
 
 /// Gauss–Newton on SO(3): C_j = C_{j−1} exp([Δθ×]), Δθ = −(HᵀH)⁻¹Hᵀf, stop at ‖Δθ‖ ≤ tol
-/// (Vasilyuk et al. 2024 §3, spec E17), then the sandwich covariance (E18).
+/// (Vasilyuk et al. 2024 §3), then the sandwich covariance.
 ///
 /// Errors: an unobservable trajectory (κ < 1e-12, the null direction named) is
 /// `InvalidInput`; no convergence within `max_iter`, or convergence to a point whose

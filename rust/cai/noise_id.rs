@@ -1,4 +1,4 @@
-//! Fringe noise identification (seed 000 §3; spec `cai-ekf-tennstedt2021.md` (E15)–(E21)).
+//! Fringe noise identification (Tennstedt et al. 2021, §3).
 //!
 //! Readout p_i = p0 + A cos(φ + ψ_i) with noise on the offset (σ_p0), the phase (σ_φ) and
 //! the amplitude (σ_A). A small EKF tracks ζ = [p0, φ, A]; the residuals

@@ -1,4 +1,4 @@
-"""Fringe noise identification (seed 000 §3; spec ``cai-ekf-tennstedt2021.md`` (E15)–(E21)).
+"""Fringe noise identification (Tennstedt et al. 2021, §3).
 
 Readout p_i = p0 + A cos(φ + ψ_i) with noise on offset (σ_p0), phase (σ_φ, rad) and
 amplitude (σ_A); ψ_i is the known phase of shot i (from a vibration sensor). The residual

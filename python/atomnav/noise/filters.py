@@ -22,7 +22,7 @@ from .._validate import finite, input_error, positive, vector
 #: The default reading of Eq. 17 (spec D7, binding).
 DEFAULT_READING = "differenced"
 READINGS = ("differenced", "literal")
-#: Niu et al. 2025 Eq. 10 (spec E5): φ₁, φ₂, β₁, σ_a² (°/h)².
+#: Niu et al. 2025 Eq. 10: φ₁, φ₂, β₁, σ_a² (°/h)².
 PAPER_AR = (-0.018, 0.029)
 PAPER_MA = (-0.99,)
 PAPER_SIGMA2 = 0.035

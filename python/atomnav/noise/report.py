@@ -10,7 +10,7 @@ reported BS = 0.0766 °/h, so the paper's BS must average at least 3 samples; mo
 therefore matches SS at w = 1 and BS at w = 3, and does not attempt LS = 3.56e-4 °/h
 (13 h of data cannot measure such a floor).
 
-Claims that do not reproduce with the paper's stated settings (spec §4c), reported as
+Claims that do not reproduce with the paper's stated settings, reported as
 such by :func:`compare` (``claims``) and ``atomnav reproduce``: the LS improvements
 (every KF raises the fitted LS on model-B data: the suppressed short-τ points move
 weight into A₀), and "adaptive KF ≳ WD > LPF" (with a 0.002 Hz cutoff on 52 s data and
@@ -31,7 +31,7 @@ METHODS = ("raw", "fixed KF", "adaptive KF (literal)", "adaptive KF (differenced
 
 
 def paper_tables() -> pd.DataFrame:
-    """Niu et al. 2025 Tables 2–4 (spec §4c). Table 4's BS entries for LPF and WD (0.7020,
+    """Niu et al. 2025 Tables 2–4. Table 4's BS entries for LPF and WD (0.7020,
     0.6970) equal the bias, not BS (spec D18): kept in ``bs_table4_misprint`` and NaN
     in ``bs_dph``."""
     return pd.DataFrame(
@@ -97,7 +97,7 @@ def compare(omega, tau0: float = 52.0, order=(2, 1), bs_windows=(1, 3)) -> Compa
 
 
 def _claims(t: pd.DataFrame, bs_windows) -> pd.DataFrame:
-    """The paper's directional claims (spec §4c) evaluated on the table."""
+    """The paper's directional claims evaluated on the table."""
     ad, fx = "adaptive KF (differenced)", "fixed KF"
     rows = []
     for metric in [f"bs{k}_dph" for k in bs_windows] + ["ss_dpsh", "ls_dph"]:

@@ -11,7 +11,7 @@ from .. import units
 from .._validate import input_error
 from .filters import PAPER_AR, PAPER_MA, PAPER_SIGMA2
 
-#: Niu et al. 2025: sample interval (s), record length, Table 2 raw mean (°/h, spec D20).
+#: Niu et al. 2025: sample interval (s), record length, Table 2 raw mean (°/h).
 TAU0 = 52.0
 N_SAMPLES = 900
 MEAN = 0.6851
