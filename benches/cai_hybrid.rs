@@ -1,7 +1,7 @@
 //! CAI-aided INS throughput: one 35 s seed-003 car run (200 Hz IMU, kinematic mode, one
 //! shot per 50 ms with 6 channels, 15 states) through the generic engine with `CaiAiding`.
 
-use atomnav::cai::aiding::{shot_times, CaiAiding, CaiConfig, CaiData, ForceMode};
+use atomnav::cai::aiding::{shot_times, CaiAiding, CaiConfig, CaiData};
 use atomnav::cai::predictor::{predict, Channel, Imu, Interpolation, OmegaDot, PredictorConfig};
 use atomnav::earth::KINEMATIC;
 use atomnav::filter::aided::{run_aided, AidedConfig, AidedIns};
@@ -28,21 +28,9 @@ fn bench(c: &mut Criterion) {
     let phase: Vec<f64> = predict(Imu { t: &t, f: &f, w: &w }, &shots, &channels, &pcfg).unwrap().iter().map(|r| r[0]).collect();
     let noise = vec![0.0; phase.len()];
     let cfg = CaiConfig {
-        channels,
-        t_sep: 0.025,
-        shots,
-        offset: 0.5,
-        contrast: 1.0,
-        sigma_p: 1e-3f64.sqrt(),
         inflation: Some((1.25e-11, 1.0576e-12)),
-        omega_dot: OmegaDot::Pwl,
         interpolation: Interpolation::Cubic,
-        substeps: 1,
-        jacobian_euler: false,
-        misalignment: None,
-        lever_arm: None,
-        force: ForceMode::Bias,
-        kind: ImuKind::Rates,
+        ..CaiConfig::ideal(channels, 0.025, shots, 1e-3f64.sqrt())
     };
     let filter = AidedConfig {
         noise: InsNoise { accel_psd: 1.25e-11, gyro_psd: 1.0576e-12, accel_bias: BiasModel::RandomWalk { psd: 9e-10 }, gyro_bias: BiasModel::RandomWalk { psd: 4e-14 } },

@@ -208,6 +208,30 @@ pub fn shot_times(t0: f64, t_end: f64, t_sep: f64, period: f64) -> Result<Vec<f6
 }
 
 impl CaiConfig {
+    /// An ideal interferometer: readout offset ½ and contrast 1, piecewise-linear Ω̇,
+    /// linear IMU interpolation, one substep, no R inflation, no extra states (γ, l), the
+    /// force term as an accelerometer bias, rate samples. Change fields with struct update
+    /// syntax (`CaiConfig { contrast: 0.9, ..CaiConfig::ideal(…) }`).
+    pub fn ideal(channels: Vec<Channel>, t_sep: f64, shots: Vec<f64>, sigma_p: f64) -> Self {
+        CaiConfig {
+            channels,
+            t_sep,
+            shots,
+            offset: 0.5,
+            contrast: 1.0,
+            sigma_p,
+            inflation: None,
+            omega_dot: OmegaDot::Pwl,
+            interpolation: Interpolation::Linear,
+            substeps: 1,
+            jacobian_euler: false,
+            misalignment: None,
+            lever_arm: None,
+            force: ForceMode::Bias,
+            kind: ImuKind::Rates,
+        }
+    }
+
     /// Checks everything but the shots (which [`CaiAiding::new`] checks against the data).
     pub fn check(&self) -> Result<()> {
         check_positive("T", self.t_sep)?;
@@ -331,8 +355,7 @@ impl CaiAiding {
 
     /// Channels with the current lever-arm and misalignment estimates applied.
     fn current_channels(&self, layout: &Layout, extra: &DVector<f64>) -> Vec<Channel> {
-        let n_ins = 15;
-        let get = |name: &str| layout.get(name).map(|r| Vec3::new(extra[r.start - n_ins], extra[r.start + 1 - n_ins], extra[r.start + 2 - n_ins]));
+        let get = |name: &str| layout.extra_index(name).and_then(|i| extra.as_slice().get(i..i + 3)).map(Vec3::from_column_slice);
         let dl = get(LEVER_BLOCK).unwrap_or_else(Vec3::zeros);
         let rot = get(MISALIGNMENT_BLOCK).map_or_else(Mat3::identity, |g| dcm_from_rotvec(&-g));
         self.cfg.channels.iter().map(|c| Channel { lever: c.lever + dl, c_sb: rot * c.c_sb, ..c.clone() }).collect()
@@ -525,21 +548,12 @@ mod tests {
 
     fn config(channels: Vec<Channel>, shots: Vec<f64>) -> CaiConfig {
         CaiConfig {
-            channels,
-            t_sep: 0.025,
-            shots,
-            offset: 0.5,
             contrast: 0.9,
-            sigma_p: 1e-3f64.sqrt(),
-            inflation: None,
             omega_dot: OmegaDot::Zero,
-            interpolation: Interpolation::Linear,
             substeps: 2,
-            jacobian_euler: false,
             misalignment: Some(1e-12),
             lever_arm: Some(1e-12),
-            force: ForceMode::Bias,
-            kind: ImuKind::Rates,
+            ..CaiConfig::ideal(channels, 0.025, shots, 1e-3f64.sqrt())
         }
     }
 

@@ -13,6 +13,7 @@ use crate::filter::aided::{AidedConfig, AidedIns, AidedOutput, Aiding};
 use crate::filter::discretize::Discretization;
 use crate::filter::ins::{BiasModel, InsNoise};
 use crate::filter::kf::LoopMode;
+use crate::filter::layout::ins_size;
 use crate::imu::errors::{ImuErrorModel, ImuSimulator};
 use crate::imu::ideal::ideal_rates;
 use crate::imu::ImuKind;
@@ -198,9 +199,9 @@ impl HybridScenario {
             }
             (PhaseSourceKind::Ideal, None, None) => return Err(invalid("truth_rate_hz", "required when phase_source = 'ideal'")),
         };
-        let n = 15 + cai_extra_states(&cai);
+        let n = ins_size() + cai_extra_states(&cai);
         if p0.nrows() != n || p0.ncols() != n {
-            return Err(invalid("p0", format!("expected {n} × {n} (15 INS states and the CAI's extra states), got {} × {}", p0.nrows(), p0.ncols())));
+            return Err(invalid("p0", format!("expected {n} × {n} ({} INS states and the CAI's extra states), got {} × {}", ins_size(), p0.nrows(), p0.ncols())));
         }
         Ok(HybridScenario { ell, t, truth, f, w, imu_model, cai, phase, filter: cfg.filter(), p0, aiding: cfg.aiding, draw_initial: cfg.draw_initial })
     }
@@ -369,29 +370,12 @@ pub struct McTables {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::cai::aiding::ForceMode;
     use crate::cai::predictor::Channel;
     use crate::math::Mat3;
 
     fn cai(shots: Vec<f64>) -> CaiConfig {
         let channels = vec![Channel { k: Vec3::new(1.6e7, 0.0, 0.0), lever: Vec3::zeros(), c_sb: Mat3::identity(), v0: Vec3::new(0.0, 2.8, 0.0) }];
-        CaiConfig {
-            channels,
-            t_sep: 0.025,
-            shots,
-            offset: 0.5,
-            contrast: 1.0,
-            sigma_p: 0.03,
-            inflation: None,
-            omega_dot: OmegaDot::Pwl,
-            interpolation: Interpolation::Linear,
-            substeps: 1,
-            jacobian_euler: false,
-            misalignment: None,
-            lever_arm: None,
-            force: ForceMode::Bias,
-            kind: ImuKind::Rates,
-        }
+        CaiConfig::ideal(channels, 0.025, shots, 0.03)
     }
 
     fn config(phase_source: PhaseSourceKind, truth_rate_hz: Option<f64>) -> HybridConfig {

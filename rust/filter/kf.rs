@@ -6,7 +6,7 @@
 //! from the navigation solution by the caller (closed loop) or kept (open loop).
 
 use super::dense::{self, Algebra};
-use super::matrix::{check_covariance, check_square, propagate_covariance, symmetrize};
+use super::matrix::{check_covariance, check_square, has_register_kernel, propagate_covariance, symmetrize};
 use crate::error::{invalid, NavError, Result};
 use nalgebra::{DMatrix, DVector};
 
@@ -57,11 +57,14 @@ pub struct Kf {
 }
 
 /// Where the covariance products of the filter (predict ΦPΦᵀ + Q, Joseph update) move
-/// from the register kernel of matrix.rs and nalgebra to faer. PROVISIONAL: one
-/// short run of `cargo bench --bench filter -- crossover/predict` gave kernel/faer
-/// 13.6/6.0 µs at n = 21, 130/66 µs at 60, 1.43/0.60 ms at 150, so faer already wins at 21
-/// and the crossover lies below it; to be measured between 16 and 21 and set here.
-pub const KF_FAER_MIN: usize = 40;
+/// from the register kernels of matrix.rs and nalgebra to faer: from this size on, except
+/// at the sizes with a fixed-size register kernel ([`has_register_kernel`]: 9, 15–18,
+/// 21), which stay on it. `cargo bench --bench filter -- crossover/predict` (steady-state
+/// predict, thread CPU time, kernels/faer µs): n = 9: 0.52/1.26, 12: 2.34/1.62,
+/// 15: 1.32/2.30, 21: 4.31/4.19, 30: 18.0/9.3, 45: 51.6/20.9, 60: 96.2/43.4,
+/// 150: 1244/442. The general loop loses to faer from 12 on; the fixed 15-state kernel
+/// wins by 1.7×, and the 21-state one ties.
+pub const KF_FAER_MIN: usize = 12;
 
 impl Kf {
     /// A filter from P₀ (positive definite, at least one state).
@@ -72,7 +75,8 @@ impl Kf {
             return Err(invalid("p0", "must have at least one state, got 0x0"));
         }
         let kf = Kf { x: DVector::zeros(n), p: p0, mode, epoch: 0, scratch: Vec::new(), algebra: Algebra::Kernels, work: (DMatrix::zeros(0, 0), DMatrix::zeros(0, 0)) };
-        Ok(kf.with_algebra(Algebra::by_size(n, KF_FAER_MIN)))
+        let algebra = if has_register_kernel(n) { Algebra::Kernels } else { Algebra::by_size(n, KF_FAER_MIN) };
+        Ok(kf.with_algebra(algebra))
     }
 
     /// The same filter with its covariance products on `algebra` (benches and tests; the
@@ -268,11 +272,11 @@ pub fn rts(steps: &[StoredStep]) -> Result<Vec<(DVector<f64>, DMatrix<f64>)>> {
     rts_using(steps, Algebra::by_size(n, RTS_FAER_MIN))
 }
 
-/// Where the RTS smoother moves from nalgebra to faer. PROVISIONAL: one short run of
-/// `cargo bench --bench filter -- crossover/rts` gave nalgebra/faer 2.77/1.47 ms at
-/// n = 21, 28.6/13.6 ms at 60, 93.8/42.5 ms at 150 (faer wins at every size tried); the
-/// crossover below 21 is still to be measured and set here.
-pub const RTS_FAER_MIN: usize = 40;
+/// Where the RTS smoother moves from nalgebra to faer. `cargo bench --bench filter --
+/// crossover/rts` (100 stored steps, 30 at n = 150; thread CPU time, nalgebra/faer ms):
+/// n = 9: 0.44/0.49 and 0.58/0.40 in two runs (a tie within their scatter), 12: 0.89/0.49,
+/// 15: 1.21/0.89, 21: 2.55/1.53, 60: 33.4/15.4, 150: 96.6/42.4. faer wins from 12 on.
+pub const RTS_FAER_MIN: usize = 12;
 
 /// Every stored step has n × n matrices and n-vectors (n of the first step's P⁺).
 fn check_steps(steps: &[StoredStep]) -> Result<usize> {
@@ -403,6 +407,14 @@ mod tests {
             let want = if n >= RTS_FAER_MIN { b } else { rts_using(&sf, Algebra::Kernels).unwrap() };
             assert_eq!(auto[0].1, want[0].1, "n = {n}");
         }
+        // the filter's own dispatch: a register kernel where one exists, faer from
+        // KF_FAER_MIN on otherwise
+        let algebra = |n: usize| Kf::new(DMatrix::identity(n, n), LoopMode::Open).unwrap().algebra;
+        assert_eq!(algebra(KF_FAER_MIN - 1), Algebra::Kernels);
+        assert_eq!(algebra(KF_FAER_MIN), Algebra::Faer);
+        assert_eq!(algebra(15), Algebra::Kernels);
+        assert_eq!(algebra(21), Algebra::Kernels);
+        assert_eq!(algebra(22), Algebra::Faer);
     }
 
     /// Bad input to the core is an error, never a panic: an empty P₀, mismatched stored

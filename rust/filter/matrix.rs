@@ -112,6 +112,12 @@ unsafe fn propagate_avx2_fma(p: &mut [f64], x: Option<&mut [f64]>, phi: &[f64], 
     propagate_sizes::<2>(p, x, phi, q, n, t)
 }
 
+/// Whether `n` states have a fixed-size register kernel in [`propagate_covariance`] (the
+/// sizes of the match in `propagate_sizes`; every other size takes the general loop).
+pub fn has_register_kernel(n: usize) -> bool {
+    matches!(n, 9 | 15 | 16 | 17 | 18 | 21)
+}
+
 /// `J` output columns are built at once (J independent accumulator sets hide the
 /// multiply-add latency; J divides 4).
 #[inline(always)]
@@ -221,6 +227,7 @@ fn propagate_fixed<const N: usize, const S: usize, const J: usize>(p: &mut [f64]
 /// The same for any n.
 #[inline(always)]
 fn propagate_any(p: &mut [f64], x: Option<&mut [f64]>, phi: &[f64], q: &[f64], n: usize, t: &mut [f64]) {
+    debug_assert!(!has_register_kernel(n), "n = {n} has a register kernel: has_register_kernel and propagate_sizes disagree");
     if let Some(x) = x {
         let mut acc = vec![0.0; n];
         add_columns(&mut acc, phi, n, |k| x[k], 0..n);

@@ -87,12 +87,11 @@ pub fn dare(phi: &DMatrix<f64>, q: &DMatrix<f64>, h: &DMatrix<f64>, r: &DMatrix<
     dare_using(phi, q, h, r, Algebra::by_size(phi.nrows(), DARE_FAER_MIN))
 }
 
-/// Where the DARE doubling moves from the padded register kernels to faer: above the
-/// largest single register chunk (32). One short run of `cargo bench --bench
-/// filter -- crossover/dare` gave kernels/faer 148/285 µs at n = 21, 2.75/2.44 ms at 60,
-/// 63.6/31.0 ms at 150: the crossover lies between 21 and 60 (PROVISIONAL until measured
-/// in that range).
-pub const DARE_FAER_MIN: usize = 33;
+/// Where the DARE doubling moves from the padded register kernels to faer. `cargo bench
+/// --bench filter -- crossover/dare` (thread CPU time, kernels/faer µs): n = 9: 21.6/68.1,
+/// 15: 60.3/133, 21: 137/310, 30: 294/614, 45: 1280/1470, 52: 1796/1599, 60: 2963/2749,
+/// 150: 46,600/28,000. The kernels win up to 45 and faer from 52 on.
+pub const DARE_FAER_MIN: usize = 48;
 
 /// [`dare`] with the algebra of the doubling chosen by the caller (benches and tests).
 pub fn dare_using(phi: &DMatrix<f64>, q: &DMatrix<f64>, h: &DMatrix<f64>, r: &DMatrix<f64>, algebra: Algebra) -> Result<SteadyState> {
