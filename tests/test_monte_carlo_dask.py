@@ -82,6 +82,20 @@ def _kill(cluster, how_many: int) -> list[int]:
     return victims
 
 
+def _kill_at_first_submit(cluster, client, monkeypatch, how_many: int) -> list[int]:
+    """Make the client's first ``submit`` (the scenario going to the cluster) kill
+    ``how_many`` workers just before it sends; returns the list the victims' pids go to."""
+    submit, fired = client.submit, []
+
+    def killing_submit(*a, **kw):
+        if not fired:
+            fired.extend(_kill(cluster, how_many))
+        return submit(*a, **kw)
+
+    monkeypatch.setattr(client, "submit", killing_submit)
+    return fired
+
+
 def _check(result, local):
     """Every run in ``result`` equals the in-process run of the same number."""
     rows = local.table[local.table["run"].isin(result.runs)].reset_index(drop=True)
@@ -107,14 +121,7 @@ def _campaign(scenario, client, local, runs=RUNS):
 def test_killing_a_worker_while_inputs_are_sent_loses_nothing(scenario, local, cluster, client, monkeypatch):
     """The first submission (the scenario going to the cluster) kills a worker first.
     In the default run: the one kill test CI always exercises."""
-    submit, fired = client.submit, []
-
-    def killing_submit(*a, **kw):
-        if not fired:
-            fired.extend(_kill(cluster, 1))
-        return submit(*a, **kw)
-
-    monkeypatch.setattr(client, "submit", killing_submit)
+    fired = _kill_at_first_submit(cluster, client, monkeypatch, 1)
     result = _campaign(scenario, client, local, runs=12)
     assert fired and len(result.runs) == 12
 
@@ -141,14 +148,7 @@ def test_killing_workers_at_a_random_moment_keeps_every_finished_run(scenario, l
 def test_two_workers_killed_while_inputs_are_sent_lose_nothing(scenario, local, cluster, client, monkeypatch):
     """Two of three killed as the scenario goes to the cluster: one worker (and the
     restarted ones) compute every run."""
-    submit, fired = client.submit, []
-
-    def killing_submit(*a, **kw):
-        if not fired:
-            fired.extend(_kill(cluster, 2))
-        return submit(*a, **kw)
-
-    monkeypatch.setattr(client, "submit", killing_submit)
+    fired = _kill_at_first_submit(cluster, client, monkeypatch, 2)
     result = _campaign(scenario, client, local)
     assert len(fired) == 2 and len(result.runs) == RUNS
 
