@@ -76,6 +76,63 @@ def test_integrate_divergence_names_row_and_time(monkeypatch):
     pd.testing.assert_frame_equal(err.partial, integrate(imu.iloc[:err.row], **long.initial_state()))
 
 
+def _fault_at(k: int):
+    """A 200 s stationary record at 100 Hz and its copy with an absurd (finite) velocity
+    increment of 1e308 m/s on every axis at row ``k``: the velocity of that step
+    overflows, so the solution diverges exactly at row ``k`` and nowhere before."""
+    long = an.trajectory.stationary(200.0, 100.0)
+    clean = long.ideal_imu("increments")
+    bad = clean.copy()
+    bad.loc[k, ["dv_x_mps", "dv_y_mps", "dv_z_mps"]] = 1e308
+    return long, clean, bad
+
+
+def _init(row: pd.DataFrame) -> dict:
+    """Constructor arguments of a Strapdown starting from a one-row solution."""
+    return dict(t0=row["time_s"].item(), lla=row[COLUMNS[1:4]].to_numpy()[0], vel_ned=row[COLUMNS[4:7]].to_numpy()[0],
+                q_nb=row[COLUMNS[7:11]].to_numpy()[0])
+
+
+@pytest.mark.parametrize("k", [5000, 6234, 9999])  # first, inner and last row of the second chunk
+def test_divergence_at_a_known_row_of_a_later_chunk(k):
+    """Streaming in chunks of 5000 rows, a fault at record row ``k`` (second chunk) raises
+    with ``.row == k``, ``.time_s`` its time stamp and ``.partial`` the DataFrame a normal
+    run returns for that chunk up to the last row before the fault (record rows 5000…k−1):
+    together with the first chunk, the clean record's rows 0…k−1 bit for bit. ``reset``
+    to the last good row and going on with the clean samples equals a fresh object
+    started from that row, bit for bit."""
+    long, clean, bad = _fault_at(k)
+    sd = Strapdown(**long.initial_state())
+    first = sd.run(bad.iloc[:5000])
+    with pytest.raises(an.NumericalError, match=f"diverged at sample {k} ") as info:
+        sd.run(bad.iloc[5000:10000])
+    err = info.value
+    assert (err.row, err.time_s) == (k, bad["time_s"].iloc[k])
+    assert isinstance(err.partial, pd.DataFrame) and list(err.partial.columns) == COLUMNS
+    assert err.partial.index.equals(pd.RangeIndex(5000, k))  # last index k - 1, the last finite row
+    before = pd.concat([first, err.partial])
+    pd.testing.assert_frame_equal(before, integrate(clean.iloc[:k], **long.initial_state()), check_exact=True)
+    last = before.iloc[[-1]]
+    sd.reset(last)
+    again = sd.run(clean.iloc[k:12000])
+    fresh = Strapdown(**_init(last)).run(clean.iloc[k:12000])
+    pd.testing.assert_frame_equal(again, fresh, check_exact=True)
+    assert again.index.equals(pd.RangeIndex(0, 12000 - k)) and np.isfinite(again.to_numpy()).all()
+
+
+@pytest.mark.parametrize("k", [4000, 6234])  # first row of the second call into the core, and inside it
+def test_integrate_diverges_at_the_known_record_row(monkeypatch, k):
+    """The batch run over calls of 4000 rows: ``.row == k`` record-wide, ``.partial`` the
+    clean record's rows 0…k−1 bit for bit."""
+    long, clean, bad = _fault_at(k)
+    monkeypatch.setattr(an.strapdown, "CHUNK", 4000)
+    with pytest.raises(an.NumericalError) as info:
+        integrate(bad, **long.initial_state(), progress=False)
+    err = info.value
+    assert (err.row, err.time_s) == (k, bad["time_s"].iloc[k])
+    pd.testing.assert_frame_equal(err.partial, integrate(clean.iloc[:k], **long.initial_state()), check_exact=True)
+
+
 @pytest.mark.parametrize("kind", ["rates", "increments"])
 @pytest.mark.parametrize("as_dict", [False, True])
 def test_reset_equals_a_fresh_object(traj, kind, as_dict):

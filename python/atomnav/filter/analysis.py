@@ -154,32 +154,66 @@ def _same(x):
     return x
 
 
-def _distributed(client, scenario: Scenario, seed: int, groups: list[list[int]], mode: str, retries: int):
+def _workers(client) -> int:
+    """Number of workers the scheduler has now (0 if it cannot be asked)."""
+    try:
+        return len(client.nthreads())
+    except Exception:  # noqa: BLE001 - a scheduler that cannot answer has no worker for us
+        return 0
+
+
+def _distributed(client, scenario: Scenario, seed: int, groups: list[list[int]], mode: str, retries: int,
+                 timeout: float | None):
     """Run the groups on a Dask cluster; returns ({group index: result}, [errors]).
 
     The scenario reaches the workers as the result of a task (not scattered data), so the
     scheduler recomputes it when the worker that holds it dies; each group is resubmitted
     up to ``retries`` times when its task fails (e.g. ``KilledWorker``), and results are
-    fetched as they complete, so a failure later on does not lose them."""
+    fetched as they complete, so a failure later on does not lose them. Nothing waits
+    without bound: when the cluster has had no worker for ``timeout`` s, or a finished
+    result cannot be fetched within ``timeout`` s, the groups not yet done are given up
+    (cancelled) and reported as errors."""
+    import time
+
     from distributed import as_completed
 
     scn = client.submit(_same, scenario, pure=False, retries=retries)
-    done, errors, tries = {}, [], {}
-    pending = {client.submit(_runs, scn, seed, g, mode, pure=False, retries=retries): i for i, g in enumerate(groups)}
-    queue = as_completed(list(pending))
-    for fut in queue:
-        i = pending.pop(fut)
-        try:
-            done[i] = fut.result()
-        except Exception as e:  # noqa: BLE001 - a failed group is retried or reported with the finished runs
-            tries[i] = tries.get(i, 0) + 1
-            if tries[i] <= retries:
-                again = client.submit(_runs, scn, seed, groups[i], mode, pure=False, retries=retries)
-                pending[again] = i
-                queue.add(again)
-            else:
-                errors.append(e)
-        fut.release()
+    done, errors, tries, pending = {}, [], {}, {}
+
+    def send(i: int):
+        fut = client.submit(_runs, scn, seed, groups[i], mode, pure=False, retries=retries)
+        pending[fut] = i
+        return fut
+
+    # the client's own event loop: not the default client's, which may be another one
+    queue = as_completed([send(i) for i in range(len(groups))], loop=client.loop)
+    seen, asked = time.monotonic(), 0.0
+    while not queue.is_empty():
+        batch = queue.next_batch(block=False)
+        if not batch:
+            now = time.monotonic()
+            if timeout is not None and now - asked >= 1.0:
+                asked = now
+                if _workers(client):
+                    seen = now
+                elif now - seen > timeout:
+                    errors.append(TimeoutError(f"no worker in the cluster for {timeout} s"))
+                    break
+            time.sleep(0.05)
+            continue
+        for fut in batch:
+            i = pending.pop(fut)
+            try:
+                done[i] = fut.result(timeout=timeout)
+            except Exception as e:  # noqa: BLE001 - a failed group is retried or reported with the finished runs
+                tries[i] = tries.get(i, 0) + 1
+                if tries[i] <= retries:
+                    queue.add(send(i))
+                else:
+                    errors.append(e)
+            fut.release()
+    for fut in pending:
+        fut.cancel()
     scn.release()
     return done, errors
 
@@ -199,7 +233,7 @@ def _result(scenario: Scenario, runs: list[int], parts) -> MonteCarlo:
 
 
 def monte_carlo(scenario: Scenario, runs: int, seed: int, mode: str = "closed", client=None,
-                chunk: int = 10, retries: int = 3) -> MonteCarlo:
+                chunk: int = 10, retries: int = 3, *, timeout: float | None = 60.0) -> MonteCarlo:
     """``runs`` independent runs; run i uses the random stream i of ``seed`` (ChaCha20),
     so the result does not depend on where or in which grouping runs execute.
 
@@ -208,6 +242,9 @@ def monte_carlo(scenario: Scenario, runs: int, seed: int, mode: str = "closed", 
     may die meanwhile: a group whose task fails is resubmitted up to ``retries`` times
     (the cluster recomputes lost inputs when workers return); if some groups still fail,
     :class:`MonteCarloIncomplete` is raised carrying every finished run in ``.partial``.
+    The same happens, for the runs not yet done, when the cluster has had no worker for
+    ``timeout`` seconds (none came back) or a finished result could not be fetched within
+    ``timeout`` s; ``timeout=None`` waits for workers without bound.
     """
     runs, seed = _integer(runs, "runs", 1, 2**32), _integer(seed, "seed", 0, 2**64 - 1)
     chunk, retries = _integer(chunk, "chunk", 1, 2**32), _integer(retries, "retries", 0, 1000)
@@ -215,7 +252,12 @@ def monte_carlo(scenario: Scenario, runs: int, seed: int, mode: str = "closed", 
     if client is None:
         return _result(scenario, ids, [_runs(scenario, seed, ids, mode)])
     groups = [ids[i:i + chunk] for i in range(0, len(ids), chunk)]
-    done, errors = _distributed(client, scenario, seed, groups, mode, retries)
+    if timeout is not None:
+        if isinstance(timeout, (bool, np.bool_)) or not isinstance(timeout, (int, float, np.integer, np.floating)):
+            raise TypeError(f"timeout: expected a number of seconds or None, got {type(timeout).__name__}")
+        if not 0 < timeout < np.inf:  # also rejects NaN
+            raise input_error("timeout", f"must be a finite number of seconds > 0, or None; got {timeout}")
+    done, errors = _distributed(client, scenario, seed, groups, mode, retries, timeout)
     order = sorted(done)
     e, n = len(scenario.times), scenario.size
     none = (np.empty((0, e, n)), np.empty((0, e, n)), np.empty((0, e)), np.empty((0, e)))
