@@ -92,12 +92,12 @@ impl Kf {
     }
 
     fn check_pd(&self, stage: &str) -> Result<()> {
-        let bad_diag = (0..self.size()).find(|&i| !positive(self.p[(i, i)]));
+        let bad_diag = self.p.diagonal().iter().enumerate().find(|(_, &d)| !positive(d)).map(|(i, &d)| (i, d));
         if bad_diag.is_some() || self.p.clone().cholesky().is_none() {
             return Err(NavError::Numerical(format!(
                 "covariance lost positive definiteness at epoch {} ({stage}){}",
                 self.epoch,
-                bad_diag.map_or(String::new(), |i| format!(": P[{i},{i}] = {}", self.p[(i, i)]))
+                bad_diag.map_or(String::new(), |(i, d)| format!(": P[{i},{i}] = {d}"))
             )));
         }
         Ok(())
@@ -139,7 +139,8 @@ impl Kf {
                 std::mem::swap(&mut self.p, out);
             }
         }
-        if (0..self.size()).any(|i| !positive(self.p[(i, i)])) {
+        // the diagonal of the column-major n × n P: every (n + 1)-th value
+        if self.p.as_slice().iter().step_by(n + 1).any(|&d| !positive(d)) {
             return self.check_pd("predict");
         }
         Ok(())
@@ -183,6 +184,9 @@ impl Kf {
         Ok(UpdateReport { innovation: y.as_slice().to_vec(), nis: vec![nis], rejected: vec![] })
     }
 
+    // invariant: i < m = z.len() = rows of hb (update checks h m × n), j < n; the
+    // // products hi·x and hi·ph are 1 × 1.
+    #[allow(clippy::indexing_slicing)]
     fn update_sequential(&mut self, z: &[f64], h: &DMatrix<f64>, r: &DMatrix<f64>, gate: Option<f64>) -> Result<UpdateReport> {
         // check_covariance judged a diagonally scaled copy of R: R itself is factorised here.
         let not_pd = || invalid("r", "not positive definite (Cholesky of r failed)");
@@ -302,8 +306,8 @@ pub fn rts_using(steps: &[StoredStep], algebra: Algebra) -> Result<Vec<(DVector<
         Algebra::Faer => (DMatrix::zeros(n, n), DMatrix::zeros(n, n)),
         Algebra::Kernels => (DMatrix::zeros(0, 0), DMatrix::zeros(0, 0)),
     };
-    for k in (0..steps.len() - 1).rev() {
-        let (cur, next) = (&steps[k], &steps[k + 1]);
+    for (k, pair) in steps.windows(2).enumerate().rev() {
+        let [cur, next] = pair else { continue };
         let not_pd = || NavError::Numerical(format!("smoother: prior covariance not positive definite at step {}", k + 1));
         // C = P⁺Φᵀ(P⁻)⁻¹  ⇔  P⁻ Cᵀ = Φ P⁺.
         let (x, mut p) = match algebra {
