@@ -426,7 +426,7 @@ fn prepare<'a>(imu: Imu<'a>, shots: &[f64], channels: &[Channel], cfg: &Predicto
         check_finite("gradient", g.as_slice(), 3)?;
     }
     let t_sep = cfg.t_sep;
-    let (&[t_first, ..], &[.., t_last]) = (imu.t, imu.t) else {
+    let &[t_first, .., t_last] = imu.t else {
         return Err(invalid("t", format!("need at least 2 IMU samples, got {n}")));
     };
     let eps = 1e-9 * t_sep;
