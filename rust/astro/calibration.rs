@@ -419,7 +419,7 @@ pub struct ConstantGyroErrors<'a> {
 /// Cᵀ(J_m,n P_m J_m,pᵀ + J_b,n P_b J_b,pᵀ)C — and its systematic part
 /// P_β^sys = G_mP_mG_mᵀ + G_bP_bG_bᵀ, G = −(HᵀH)⁻¹Σ_n H_nᵀCᵀJ_n. Returns (P_β^model, P_β^sys) in rad².
 // invariant: ds_imu, ds_avu, e_imu, h (and the sensitivities) have m entries and
-// // p_avu m + 1 (checked above); n < m, n + 1 ≤ m.
+// p_avu m + 1 (checked above); n < m, n + 1 ≤ m.
 #[allow(clippy::indexing_slicing)]
 pub fn model_covariance(c: &Mat3, ds_imu: &[Mat3], ds_avu: &[Mat3], e_imu: &[Mat3], p_avu: &[Mat3], constant: Option<&ConstantGyroErrors>) -> Result<(Mat3, Mat3)> {
     let m = ds_imu.len();
@@ -483,7 +483,7 @@ impl Choice for DiffForm {
 /// Dead-reckoning check (E20): S_1^MF = S_1^VF Cᵀ (D9), S_n^MF = S_{n−1}^MF ΔS_n^imu,
 /// θ_n^diff = vee((S_n^MF)ᵀ S_n^VF Cᵀ − I) and P_n^diff, for n = 2..N.
 // invariant: s_vf, p_avu, p_imu have n ≥ 1 entries and ds_imu n − 1 (checked
-// // above); 1 ≤ k < n.
+// above); 1 ≤ k < n.
 #[allow(clippy::indexing_slicing)]
 pub fn dead_reckoning_check(
     c: &Mat3,

@@ -189,7 +189,7 @@ pub struct ImuRecord<'a, R = Vec3> {
 impl<R: Copy + Into<Vec3> + Sync> ImuRecord<'_, R> {
     #[inline]
     // invariant: j < rho.len(): locate clamps to the last sample and check_epochs keeps
-    // // every epoch inside the record, so the interval loops stop below rho.len().
+    // every epoch inside the record, so the interval loops stop below rho.len().
     #[allow(clippy::indexing_slicing)]
     fn rho(&self, j: usize) -> Vec3 {
         self.rho[j].into()

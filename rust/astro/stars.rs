@@ -221,8 +221,8 @@ pub fn check_covariances(field: &str, p: &[Mat3], n: usize) -> Result<()> {
 /// the user's `p_avu` (one per epoch, rad², VF) in its place (E12, D11).
 /// `up_gcrs` (one per epoch) and `n_refr` enable refraction; `None` skips it.
 // invariant: every obs array has m entries, obs.camera < cameras.len() and obs.epoch <
-// // n_epochs (checked above), so r < m, e < n_epochs = rows.len() = up.len() = p.len(),
-// // k < idx.len() = s.len() and the camera indices are in range.
+// n_epochs (checked above), so r < m, e < n_epochs = rows.len() = up.len() = p.len(),
+// k < idx.len() = s.len() and the camera indices are in range.
 #[allow(clippy::indexing_slicing)]
 pub fn star_attitudes(
     obs: &Observations,

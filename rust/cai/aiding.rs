@@ -341,7 +341,7 @@ impl CaiAiding {
 
     /// Phase Jacobian rows (channels × n) w.r.t. the full error state.
     // invariant: the layout's blocks lie inside its n columns (3 states each), c < 3 so
-    // // c, 3 + c, 6 + c, 9 + c < 12 index the Jacobian rows, r < rows.len().
+    // c, 3 + c, 6 + c, 9 + c < 12 index the Jacobian rows, r < rows.len().
     #[allow(clippy::indexing_slicing)]
     fn phase_jacobian(&self, rows: &[[f64; 12]], layout: &Layout) -> Result<DMatrix<f64>> {
         let n = layout.size();
@@ -403,8 +403,8 @@ impl CaiAiding {
 
     /// The measurement of shot j given the filter's state (the engine's `measure`).
     // invariant: j < shots.len() (read above) and new checks every data series to hold
-    // // shots × m values, so idx = j·m + ch is in range; predict and jacobian return one row per
-    // // channel, so ch < m indexes best and phi_nom.
+    // shots × m values, so idx = j·m + ch is in range; predict and jacobian return one row per
+    // channel, so ch < m indexes best and phi_nom.
     #[allow(clippy::indexing_slicing)]
     fn shot_measurement(&mut self, j: usize, x: &DVector<f64>, extra: &DVector<f64>, layout: &Layout) -> Result<Measurement> {
         let ts = *self.cfg.shots.get(j).ok_or_else(|| invalid("shots", format!("no shot {j} (of {})", self.cfg.shots.len())))?;
@@ -497,7 +497,7 @@ impl Aiding for CaiAiding {
     }
 
     // invariant: f and qc are n × n for this layout, whose blocks (and the velocity
-    // // block) lie inside n; a, b < 3 index the 3-state blocks and the 3 × 3 C_nb.
+    // block) lie inside n; a, b < 3 index the 3-state blocks and the 3 × 3 C_nb.
     #[allow(clippy::indexing_slicing)]
     fn extra_dynamics(&self, layout: &Layout, f: &mut DMatrix<f64>, qc: &mut DMatrix<f64>) {
         for (name, psd) in [(MISALIGNMENT_BLOCK, self.cfg.misalignment), (LEVER_BLOCK, self.cfg.lever_arm)] {

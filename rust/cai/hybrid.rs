@@ -225,8 +225,8 @@ impl HybridScenario {
 
     /// Run `run` of the Monte Carlo seeded by `master_seed`.
     // invariant: new makes t ≥ 2 samples (imu_truth) with truth, f, w one per sample; the
-    // // simulated IMU series, its biases and free_nav have one entry per sample too, k < t.len()
-    // // is checked before use, lo < hi ≤ t.len(), and nees holds one entry per output epoch e.
+    // simulated IMU series, its biases and free_nav have one entry per sample too, k < t.len()
+    // is checked before use, lo < hi ≤ t.len(), and nees holds one entry per output epoch e.
     #[allow(clippy::indexing_slicing)]
     pub fn run(&self, master_seed: u64, run: u64) -> Result<HybridRun> {
         let mut rng = ChaCha20Rng::seed_from_u64(master_seed);

@@ -36,7 +36,7 @@ const STEP_W: f64 = 1e-6;
 /// s_i (channels × 6) = ∂φ̂/∂(f_x, f_y, f_z, ω_x, ω_y, ω_z) of sample i (rad per m/s², rad
 /// per rad/s). `cfg`'s ω̇ option is kept except `Given` (independent of the gyro: `Zero`).
 // invariant: f and w have t.len() entries and i < t.len(); c < 6, so c or c − 3 is
-// // < 3 for a Vec3; predict returns one row per channel, j < m.
+// < 3 for a Vec3; predict returns one row per channel, j < m.
 #[allow(clippy::indexing_slicing)]
 pub fn sensitivity(t: &[f64], ts: f64, channels: &[Channel], cfg: &PredictorConfig) -> Result<Vec<(usize, DMatrix<f64>)>> {
     check_increasing("t", t)?;

@@ -33,7 +33,7 @@ fn wrap(phi: f64) -> f64 {
 /// Track ζ over the readouts `p` with known input phases `psi` (rad); returns ζ after each
 /// update (A kept > 0, φ wrapped to (−π, π]).
 // invariant: fixed-size 3-vectors and 3 × 3 matrices indexed by constants < 3; the
-// // product hᵀ P h is 1 × 1.
+// product hᵀ P h is 1 × 1.
 #[allow(clippy::indexing_slicing)]
 pub fn fringe_track(p: &[f64], psi: &[f64], cfg: &FringeEkf) -> Result<Vec<[f64; 3]>> {
     check_finite("p", p, 1)?;
@@ -118,7 +118,7 @@ struct Data<'a> {
 }
 
 // invariant: c has one row per sample of x (built so in ml_identify), i < x.len(),
-// // and j, m < 3 index its fixed-size rows and the 3-vectors θ, g, h, f.
+// and j, m < 3 index its fixed-size rows and the 3-vectors θ, g, h, f.
 #[allow(clippy::indexing_slicing)]
 impl Data<'_> {
     fn var(&self, i: usize, th: &[f64; 3]) -> f64 {
@@ -162,7 +162,7 @@ impl Data<'_> {
 /// amplitudes `amp` (one per sample). All three free is rejected: they are not jointly
 /// identifiable (only a, b are).
 // invariant: free holds indices j < 3 of the fixed-size θ arrays and 3-vectors;
-// // r < free.len(), the size of gs, hs, fs, d and step; the 3 × 3 Hessian has 3 eigenvalues.
+// r < free.len(), the size of gs, hs, fs, d and step; the 3 × 3 Hessian has 3 eigenvalues.
 #[allow(clippy::indexing_slicing)]
 pub fn ml_identify(x: &[f64], phi: &[f64], amp: &[f64], cfg: &MlConfig) -> Result<MlResult> {
     let n = x.len();

@@ -281,7 +281,7 @@ impl Record<'_> {
     /// Value and time derivative of the interpolant of `v` at absolute time `t` in IMU
     /// interval i.
     // invariant: prepare clamps seg.imu (= i) to [0, n − 2] and makes every series n
-    // // long, so i, i + 1, a, b < n.
+    // long, so i, i + 1, a, b < n.
     #[allow(clippy::indexing_slicing)]
     fn interp(&self, v: &[Vec3], i: usize, t: f64) -> (Vec3, Vec3) {
         let ts = self.imu.t;
@@ -381,7 +381,7 @@ fn check_series(field: &str, v: &[Vec3], t: &[f64], shots: &[f64], t_sep: f64) -
 }
 
 // invariant: n ≥ 2m + 1 (checked above), c ∈ [m, n − 1 − m] and j ≤ m, so c ± j and
-// // c ± m are in [0, n); w has n samples like t (checked by prepare).
+// c ± m are in [0, n); w has n samples like t (checked by prepare).
 #[allow(clippy::indexing_slicing)]
 fn savgol(t: &[f64], w: &[Vec3], m: usize) -> Result<Vec<Vec3>> {
     if m == 0 {
@@ -634,7 +634,7 @@ fn tangent(b: &BodyStage, s: &ChStage, ch: &Channel, gradient: Option<&Mat3>) ->
 /// `shot * channels.len() + channel`. Euler terms (ω̇) are removed from the linearisation
 /// point unless `euler` (spec (E30) item 8, Decision 9); use [`jacobian_fd`] to check.
 // invariant: fixed-size arrays: y holds 26 = 2 + 2·12 vectors indexed by 2 + 2p and
-// // 3 + 2p (p < 12) or 2p (p < 13), mid 13, the stage arrays 3 (i < 3).
+// 3 + 2p (p < 12) or 2p (p < 13), mid 13, the stage arrays 3 (i < 3).
 #[allow(clippy::indexing_slicing)]
 pub fn jacobian(imu: Imu, shots: &[f64], channels: &[Channel], cfg: &PredictorConfig, euler: bool) -> Result<Vec<[f64; 12]>> {
     let cfg = jacobian_config(cfg, euler);
@@ -696,7 +696,7 @@ fn jacobian_config(cfg: &PredictorConfig, euler: bool) -> PredictorConfig {
 /// [`JACOBIAN_PARAMS`], with steps `step_a` (m/s²), `step_g` (rad/s), `step_l` (m) and
 /// `step_gamma` (rad); same linearisation point and Euler switch as [`jacobian`].
 // invariant: p < 12 indexes the 12 columns of a row and p / 3 < 4 the 4 steps;
-// // plus, minus and out have one row per (shot, channel), r < out.len().
+// plus, minus and out have one row per (shot, channel), r < out.len().
 #[allow(clippy::indexing_slicing)]
 pub fn jacobian_fd(
     imu: Imu,

@@ -95,7 +95,7 @@ const GL5: [(f64, f64); 5] = [
 /// ∫ f(t − t_c) a(t) dt (s · unit of a) with a piecewise linear between its samples and f
 /// exact: 5-point Gauss–Legendre on every piece between sample times and f's breakpoints.
 // invariant: t has ≥ 2 samples and a as many (checked above); i is clamped to
-// // [0, t.len() − 2], so i and i + 1 are in range.
+// [0, t.len() − 2], so i and i + 1 are in range.
 #[allow(clippy::indexing_slicing)]
 pub fn response_integral(p: &Pulses, t: &[f64], a: &[f64], t_centre: f64) -> Result<f64> {
     check_increasing("t", t)?;

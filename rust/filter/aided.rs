@@ -411,8 +411,8 @@ impl<A: Aiding> AidedIns<A> {
     /// [`Self::process`] with the reference altitude `h_ref` (m) per sample, required with
     /// a damped vertical channel and refused with a free one.
     // invariant: gyro and accel have n = t.len() entries (checked above), h_ref n
-    // // entries (validate), n ≥ 1 here, and baro_bias is a layout index of the extra blocks
-    // // (< extra.len()); k < n.
+    // entries (validate), n ≥ 1 here, and baro_bias is a layout index of the extra blocks
+    // (< extra.len()); k < n.
     #[allow(clippy::indexing_slicing)]
     pub fn process_ref(&mut self, t: &[f64], gyro: &[Vec3], accel: &[Vec3], h_ref: Option<&[f64]>, out: &mut AidedOutput) -> Result<()> {
         let n = t.len();

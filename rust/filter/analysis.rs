@@ -145,7 +145,7 @@ impl Scenario {
     /// [`Scenario::true_sigmas`] with the algebra chosen by the caller (benches and tests).
     // invariant: Scenario::new makes measure (epochs) one longer than phi, qd, phi_true, sqrt_qd_true
     // (steps; private fields) and P n × n, so k − 1 < steps for 0 < k < epochs and i < n.
-    // // cross has one entry per step (checked above).
+    // cross has one entry per step (checked above).
     #[allow(clippy::indexing_slicing)]
     pub fn true_sigmas_using(&self, r_true: &DMatrix<f64>, cross: &[DMatrix<f64>], algebra: Algebra) -> Result<Vec<f64>> {
         let n = self.size();
@@ -195,7 +195,7 @@ impl Scenario {
     /// stream = run index, so any subset of runs reproduces the same numbers anywhere).
     // invariant: Scenario::new makes measure (epochs) one longer than phi, qd, phi_true, sqrt_qd_true
     // (steps; private fields) and P n × n, so k − 1 < steps for 0 < k < epochs and i < n.
-    // // res.nis has one entry per epoch.
+    // res.nis has one entry per epoch.
     #[allow(clippy::indexing_slicing)]
     pub fn run(&self, master_seed: u64, run: u64, mode: LoopMode) -> Result<RunResult> {
         let n = self.size();

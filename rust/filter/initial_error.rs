@@ -47,7 +47,7 @@ pub fn add_nav_error(ell: &Ellipsoid, s: &NavState, dr: &Vec3, dv: &Vec3, psi: &
 /// δx = L u for the navigation block of `p0` (n × n over a layout starting with the
 /// INS blocks) and standard normals `u` (one per navigation state).
 // invariant: idx holds the m navigation indices of the layout, all < m ≤ rows of
-// // the square p0 (checked above); i, j < m.
+// the square p0 (checked above); i, j < m.
 #[allow(clippy::indexing_slicing)]
 pub fn initial_error(p0: &DMatrix<f64>, u: &[f64]) -> Result<Vec<f64>> {
     let idx = nav_indices()?;

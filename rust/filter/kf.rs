@@ -185,7 +185,7 @@ impl Kf {
     }
 
     // invariant: i < m = z.len() = rows of hb (update checks h m × n), j < n; the
-    // // products hi·x and hi·ph are 1 × 1.
+    // products hi·x and hi·ph are 1 × 1.
     #[allow(clippy::indexing_slicing)]
     fn update_sequential(&mut self, z: &[f64], h: &DMatrix<f64>, r: &DMatrix<f64>, gate: Option<f64>) -> Result<UpdateReport> {
         // check_covariance judged a diagonally scaled copy of R: R itself is factorised here.

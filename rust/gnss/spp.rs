@@ -60,7 +60,7 @@ fn corrected_code(o: &Observation, g: &Geometry, atm: &Atmosphere, lla: &Vec3, t
 /// Position solution at GPS time t from the code observations of one epoch; `x0` is the
 /// initial ECEF guess (the Earth's centre when None).
 // invariant: x has n ∈ {4, 5} unknowns (5 exactly when with_tau), h is m × n, z and
-// // w have m = obs.len() rows, i < m; cov is n × n.
+// w have m = obs.len() rows, i < m; cov is n × n.
 #[allow(clippy::indexing_slicing)]
 pub fn solve_position(eph: &Ephemerides, t: f64, obs: &[Observation], cfg: &SppConfig, x0: Option<Vec3>) -> Result<SppSolution> {
     check_unique("obs", obs)?;
@@ -194,7 +194,7 @@ pub fn solve_epochs(eph: &Ephemerides, epochs: &[(f64, Vec<Observation>)], cfg: 
 
 /// DOP from the design matrix rotated into local NED (position columns).
 // invariant: h has n ≥ 4 columns (the solver's unknowns: position, clock[, τ]), so q
-// // is n × n with n ≥ 4 and i < rows of h, j < 3.
+// is n × n with n ≥ 4 and i < rows of h, j < 3.
 #[allow(clippy::indexing_slicing)]
 fn dop(h: &DMatrix<f64>, lla: &Vec3, n: usize) -> Result<Dop> {
     let cne = dcm_ned_to_ecef(lla.x, lla.y);

@@ -100,7 +100,7 @@ impl TightAiding {
     }
 
     // invariant: ip, iv, ipsi and the extra-block starts are ranges of ctx.layout, whose
-    // // size n is the length of h_code and h_rate (clock: 2 states, so i + 1 < n); k < 3.
+    // size n is the length of h_code and h_rate (clock: 2 states, so i + 1 < n); k < 3.
     #[allow(clippy::indexing_slicing)]
     fn rows(&mut self, j: usize, ctx: &AidingContext) -> Result<Vec<Row>> {
         let (Some(&t), Some(epoch)) = (self.times.get(j), self.epochs.get(j)) else {
@@ -205,7 +205,7 @@ impl TightAiding {
 /// Stack (z, H, R) of a set of rows; FD against row `r0` when given, with
 /// R = σ₀²11ᵀ + diag(σᵢ²) (Eq. 39).
 // invariant: h and s have one entry per z (built from the same rows), i, k < z.len(),
-// // and a, b < m = rows and columns of hm and r.
+// and a, b < m = rows and columns of hm and r.
 #[allow(clippy::indexing_slicing)]
 fn stack(z: &[f64], h: &[&RowDVector<f64>], s: &[f64], r0: Option<usize>, n: usize) -> (Vec<f64>, DMatrix<f64>, DMatrix<f64>) {
     let idx: Vec<usize> = (0..z.len()).filter(|&i| Some(i) != r0).collect();
@@ -294,7 +294,7 @@ impl Aiding for TightAiding {
     }
 
     // invariant: f and qc are n × n for this layout, whose c_tau_gps (1 state) and clock
-    // // (2 states) ranges lie inside n.
+    // (2 states) ranges lie inside n.
     #[allow(clippy::indexing_slicing)]
     fn extra_dynamics(&self, layout: &Layout, f: &mut DMatrix<f64>, qc: &mut DMatrix<f64>) {
         if let Some(r) = layout.get("c_tau_gps") {

@@ -61,7 +61,7 @@ impl ArimaStateSpace {
     /// ARIMA(p,d,q) with AR coefficients `ar` (φ), MA coefficients `ma` (β) and
     /// innovation variance `sigma2`, in the paper's or the exact noise form.
     // invariant: n ≥ c.len() = r, n ≥ q + 1 (paper) or n = max(r, 1) + q (exact), cols = n
-    // // or 1: every index below is inside the n × n Φ and n × cols B.
+    // or 1: every index below is inside the n × n Φ and n × cols B.
     #[allow(clippy::indexing_slicing)]
     pub fn from_arma(ar: &[f64], ma: &[f64], sigma2: f64, d: usize, form: NoiseForm) -> Result<ArimaStateSpace> {
         check_finite("ar", ar, 1)?;
@@ -311,7 +311,7 @@ struct Core<const N: usize> {
 }
 
 // invariant: AnyCore::new builds Core<N> only for N = model.dim() with Φ and Q_d
-// // checked N × N (check_companion); every i, j below is < N, and i − 1 is taken for i > 0.
+// checked N × N (check_companion); every i, j below is < N, and i − 1 is taken for i > 0.
 #[allow(clippy::indexing_slicing)]
 impl<const N: usize> Core<N> {
     fn new(model: &ArimaStateSpace, p0: f64, first: bool) -> Core<N> {

@@ -6,7 +6,7 @@ use nalgebra::{DMatrix, DVector};
 
 /// min ‖A x − b‖₂ subject to x ≥ 0. `A` is m×n (small, dense).
 // invariant: x, w, z have n entries and passive n flags; idx holds indices j < n and
-// // c < idx.len() = columns of ap and rows of zp.
+// c < idx.len() = columns of ap and rows of zp.
 #[allow(clippy::indexing_slicing)]
 pub fn nnls(a: &DMatrix<f64>, b: &DVector<f64>) -> Result<DVector<f64>> {
     let (m, n) = a.shape();

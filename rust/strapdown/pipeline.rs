@@ -56,7 +56,7 @@ impl<'a> Samples3<'a> {
 
     /// Append rows `r` (within `0..rows`) to `out`.
     // invariant: callers pass rows r within 0..rows, and new checked data to hold
-    // // 3·rows values, so every range below lies inside data.
+    // 3·rows values, so every range below lies inside data.
     #[allow(clippy::indexing_slicing)]
     fn extend(&self, r: Range<usize>, out: &mut Vec<Vec3>) {
         if self.column_major {
@@ -140,7 +140,7 @@ pub fn nav_columns(states: &[NavState]) -> Vec<f64> {
 
 /// Write states as rows `first`… of a column-by-column table with columns of `n` values.
 // invariant: buf holds NAV_WIDTH columns of n values and first + i < n (NavTable's
-// // check_room, or n = s.len() with first = 0); c < NAV_WIDTH = row.len().
+// check_room, or n = s.len() with first = 0); c < NAV_WIDTH = row.len().
 #[allow(clippy::indexing_slicing)]
 fn write_columns(buf: &mut [f64], n: usize, first: usize, s: &[NavState]) {
     for (i, x) in s.iter().enumerate() {
@@ -166,7 +166,7 @@ struct Block {
 
 impl Block {
     // invariant: callers pass rows within the record, whose t, gyro, accel and h_ref
-    // // hold one entry per row (validated before the blocks are cut).
+    // hold one entry per row (validated before the blocks are cut).
     #[allow(clippy::indexing_slicing)]
     fn fill(&mut self, imu: &ImuSlices<'_>, rows: Range<usize>) {
         self.t.clear();

@@ -185,7 +185,7 @@ pub fn car(origin: Vec3, heading: f64, vibration: bool) -> Motion {
 /// next at `move_starts[j]` (s) over `move_duration` s with the quintic profile
 /// 10x³ − 15x⁴ + 6x⁵.
 // invariant: states is non-empty and has move_starts.len() + 1 entries (checked
-// // above), so j + 1 < states.len(); windows(2) yields pairs.
+// above), so j + 1 < states.len(); windows(2) yields pairs.
 #[allow(clippy::indexing_slicing)]
 pub fn rotary_stand(origin: Vec3, states: &[(f64, f64)], move_starts: &[f64], move_duration: f64, duration: f64) -> Result<Motion> {
     if states.is_empty() {
