@@ -406,9 +406,8 @@ fn savgol(t: &[f64], w: &[Vec3], m: usize) -> Result<Vec<Vec3>> {
 /// Validate everything and build the per-shot integration grids.
 fn prepare<'a>(imu: Imu<'a>, shots: &[f64], channels: &[Channel], cfg: &PredictorConfig) -> Result<Record<'a>> {
     check_positive("T", cfg.t_sep)?;
-    if cfg.substeps == 0 {
-        return Err(invalid("substeps", "must be >= 1"));
-    }
+    // the stage buffer holds substeps per grid interval: bounded before it is allocated
+    crate::error::check_count("substeps", cfg.substeps, 1, MAX_SUBSTEPS)?;
     let n = imu.t.len();
     if n < 2 {
         return Err(invalid("t", format!("need at least 2 IMU samples, got {n}")));
