@@ -43,10 +43,19 @@ pub struct Scenario {
 
 /// Symmetric square root S (S Sᵀ = A) of a PSD matrix via its eigen-decomposition
 /// (clips round-off negative eigenvalues to 0; Cholesky would fail on singular Q_d).
-fn sqrt_psd(a: &DMatrix<f64>) -> DMatrix<f64> {
-    let e = SymmetricEigen::new(a.clone());
+/// An empty matrix (no measurement rows) is its own root; a non-finite one (a discretised
+/// model that overflowed) is a numerical error, as is a decomposition that does not converge.
+fn sqrt_psd(field: &str, a: &DMatrix<f64>) -> Result<DMatrix<f64>> {
+    if a.is_empty() {
+        return Ok(a.clone());
+    }
+    if !a.iter().all(|x| x.is_finite()) {
+        return Err(NavError::Numerical(format!("{field}: non-finite covariance (the model overflows the floating-point range)")));
+    }
+    // the tolerance of SymmetricEigen::new, with an iteration limit instead of its panic
+    let e = SymmetricEigen::try_new(a.clone(), f64::EPSILON, 1_000_000).ok_or_else(|| NavError::Numerical(format!("{field}: eigen-decomposition did not converge")))?;
     let d = DMatrix::from_diagonal(&e.eigenvalues.map(|x| x.max(0.0).sqrt()));
-    &e.eigenvectors * d * e.eigenvectors.transpose()
+    Ok(&e.eigenvectors * d * e.eigenvectors.transpose())
 }
 
 impl Scenario {
@@ -89,12 +98,13 @@ impl Scenario {
         let truth: Vec<_> = (f.par_iter().zip(qc).zip(dt).zip(&filt))
             .map(|(((fk, qk), &dk), filt_k)| {
                 let (p, q) = if method == Discretization::VanLoan { filt_k.clone() } else { discretize(fk, qk, dk, Discretization::VanLoan) };
-                (p, sqrt_psd(&q))
+                Ok((p, sqrt_psd("qc", &q)?))
             })
-            .collect();
+            .collect::<Result<_>>()?;
         let (phi, qd) = filt.into_iter().unzip();
         let (phi_true, sqrt_qd_true) = truth.into_iter().unzip();
-        Ok(Scenario { phi, qd, phi_true, sqrt_qd_true, sqrt_p0: sqrt_psd(&p0), p0, sqrt_r: sqrt_psd(&r), h, r, measure, sequential })
+        let (sqrt_p0, sqrt_r) = (sqrt_psd("p0", &p0)?, sqrt_psd("r", &r)?);
+        Ok(Scenario { phi, qd, phi_true, sqrt_qd_true, sqrt_p0, p0, sqrt_r, h, r, measure, sequential })
     }
 
     pub fn size(&self) -> usize {

@@ -158,6 +158,7 @@ impl Kf {
         if h.nrows() != m || h.ncols() != n {
             return Err(invalid("h", format!("expected {m}x{n} (measurements x states), got {}x{}", h.nrows(), h.ncols())));
         }
+        crate::error::check_finite("h", h.as_slice(), 1)?;
         check_covariance("r", r, Some(m), true)?;
         if let Some(g) = gate {
             if !positive(g) {
@@ -166,6 +167,10 @@ impl Kf {
         }
         let report = if sequential { self.update_sequential(z, h, r, gate) } else { self.update_stacked(z, h, r, gate) }?;
         self.check_pd("update")?;
+        // finite z, H, R and P can still give an innovation beyond the f64 range
+        if !report.innovation.iter().chain(&report.nis).all(|v| v.is_finite()) {
+            return Err(NavError::Numerical(format!("innovation overflows the floating-point range at epoch {}", self.epoch)));
+        }
         Ok(report)
     }
 
@@ -281,16 +286,22 @@ pub const RTS_FAER_MIN: usize = 40;
 /// Every stored step has n × n matrices and n-vectors (n of the first step's P⁺).
 fn check_steps(steps: &[StoredStep]) -> Result<usize> {
     let n = steps.first().map_or(0, |s| s.p_post.nrows());
+    let finite = |field: &str, k: usize, v: &[f64]| match v.iter().find(|x| !x.is_finite()) {
+        Some(x) => Err(crate::error::invalid_at(field, k, format!("step {k} holds the non-finite value {x}"))),
+        None => Ok(()),
+    };
     for (k, s) in steps.iter().enumerate() {
         for (field, m) in [("phi", &s.phi), ("p_prior", &s.p_prior), ("p_post", &s.p_post)] {
             if m.shape() != (n, n) {
                 return Err(crate::error::invalid_at(field, k, format!("step {k} is {}x{}, expected {n}x{n}", m.nrows(), m.ncols())));
             }
+            finite(field, k, m.as_slice())?;
         }
         for (field, v) in [("x_prior", &s.x_prior), ("x_post", &s.x_post)] {
             if v.len() != n {
                 return Err(crate::error::invalid_at(field, k, format!("step {k} has {} entries, expected {n}", v.len())));
             }
+            finite(field, k, v.as_slice())?;
         }
     }
     Ok(n)
@@ -331,6 +342,9 @@ pub fn rts_using(steps: &[StoredStep], algebra: Algebra) -> Result<Vec<(DVector<
             }
         };
         symmetrize(&mut p);
+        if !x.iter().chain(p.iter()).all(|v| v.is_finite()) {
+            return Err(NavError::Numerical(format!("smoother: the smoothed estimate of step {k} overflows the floating-point range")));
+        }
         out.push((std::mem::replace(&mut xs, x), std::mem::replace(&mut ps, p)));
     }
     out.push((xs, ps));

@@ -126,6 +126,9 @@ pub fn dare_using(phi: &DMatrix<f64>, q: &DMatrix<f64>, h: &DMatrix<f64>, r: &DM
     let mut p_prior = DMatrix::from_fn(n, n, |i, j| x[(i, j)] * d[i] * d[j]);
     symmetrize(&mut p_prior);
     let (p_post, gain) = posterior(&p_prior, h, r)?;
+    if !p_prior.iter().chain(p_post.iter()).chain(gain.iter()).all(|v| v.is_finite()) {
+        return Err(NavError::Numerical("the DARE solution overflows the floating-point range".into()));
+    }
     Ok(SteadyState { p_prior, p_post, gain, iterations })
 }
 
@@ -349,6 +352,9 @@ pub fn recursion(phi: &DMatrix<f64>, q: &DMatrix<f64>, h: &DMatrix<f64>, r: &DMa
         pr.copy_from_slice(p.transpose().as_slice());
         po.copy_from_slice(pp.as_slice());
         p = next;
+    }
+    if let Some(i) = prior.iter().chain(&post).position(|v| !v.is_finite()) {
+        return Err(NavError::Numerical(format!("the covariance of step {} overflows the floating-point range", (i % len) / (n * n))));
     }
     Ok(Recursion { n, prior, post })
 }

@@ -351,12 +351,14 @@ pub fn variance(data: &[f64], tau0: f64, data_type: DataType, kind: Kind, set: &
         Kind::Modified => ms.iter().map(|&m| modified_sum(&x, m)).collect(),
     };
     let n: Vec<usize> = ms.iter().map(|&m| kind.terms(x.len(), m)).collect();
-    Ok(AllanResult {
+    let res = AllanResult {
         tau: ms.iter().map(|&m| m as f64 * tau0).collect(),
         var: sums.iter().zip(&ms).zip(&n).map(|((s, &m), &nj)| s * scale / divisor(kind, m, nj)).collect(),
         m: ms,
         n,
-    })
+    };
+    check_overflow(&res)?;
+    Ok(res)
 }
 
 /// Streaming accumulation of all three variances at fixed averaging factors, for
@@ -450,7 +452,8 @@ impl AllanStream {
         self.np += 1;
     }
 
-    /// Feed the next chunk of samples (rate or phase, as constructed).
+    /// Feed the next chunk of samples (rate or phase, as constructed). Samples so large that
+    /// the sums overflow the f64 range are an error.
     pub fn update(&mut self, chunk: &[f64]) -> Result<()> {
         check_finite("chunk", chunk, 1)?;
         for &y in chunk {
@@ -465,6 +468,9 @@ impl AllanStream {
                     self.push_phase(self.phase);
                 }
             }
+        }
+        if !self.sum_a.iter().chain(&self.sum_m).chain(&self.sum_h).all(|s| s.is_finite()) {
+            return Err(invalid("chunk", "the sums overflow the floating-point range: the samples are too large (rescale them)"));
         }
         Ok(())
     }
@@ -488,6 +494,14 @@ impl AllanStream {
             }
         }
         out
+    }
+}
+
+/// τ and variances of a finite record can still overflow the f64 range (samples near 1e300).
+fn check_overflow(res: &AllanResult) -> Result<()> {
+    match res.tau.iter().chain(&res.var).find(|v| !v.is_finite()) {
+        Some(v) => Err(invalid("data", format!("a variance or τ overflows the floating-point range ({v}): rescale the data or tau0"))),
+        None => Ok(()),
     }
 }
 
@@ -622,6 +636,9 @@ pub fn fit(res: &AllanResult, n_samples: usize, terms: [bool; 5], tau_min: f64, 
         if let Some(slot) = usize::try_from(k + 2).ok().and_then(|i| coeffs.get_mut(i)) {
             *slot = zc / nrm;
         }
+    }
+    if !coeffs.iter().all(|c| c.is_finite()) {
+        return Err(NavError::Numerical("the Allan fit overflows the floating-point range (rescale the variances)".into()));
     }
     Ok(AllanFit {
         coeffs,

@@ -515,6 +515,9 @@ pub fn steady_state(model: &ArimaStateSpace, r: f64) -> Result<(Vec<f64>, DMatri
             let s = pm[(0, 0)] + r;
             let k = pm.column(0) / s;
             let pp = &pm - &k * pm.row(0);
+            if !k.iter().chain(pm.iter()).chain(pp.iter()).all(|v| v.is_finite()) {
+                return Err(NavError::Numerical("steady_state: the Riccati solution overflows the floating-point range".into()));
+            }
             return Ok((k.iter().copied().collect(), pm, pp));
         }
     }
