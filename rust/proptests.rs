@@ -24,10 +24,13 @@ use nalgebra::{DMatrix, DVector};
 use proptest::prelude::*;
 use std::sync::OnceLock;
 
-/// Few cases per property, no regression files in the tree.
+/// Few cases per property, no regression files in the tree. The seed is fixed, so CI runs
+/// the same cases every time; `PROPTEST_RNG_SEED` (a u64) and `PROPTEST_CASES` explore others.
 fn config(cases: u32) -> ProptestConfig {
-    // a fixed seed: CI runs the same cases every time
-    ProptestConfig { cases, failure_persistence: None, rng_seed: proptest::test_runner::RngSeed::Fixed(0x5eed_a70e), ..ProptestConfig::default() }
+    let env = |name: &str| std::env::var(name).ok().and_then(|v| v.parse::<u64>().ok());
+    let seed = env("PROPTEST_RNG_SEED").unwrap_or(0x5eed_a70e);
+    let cases = env("PROPTEST_CASES").and_then(|c| u32::try_from(c).ok()).unwrap_or(cases);
+    ProptestConfig { cases, failure_persistence: None, rng_seed: proptest::test_runner::RngSeed::Fixed(seed), ..ProptestConfig::default() }
 }
 
 fn finite<'a>(v: impl IntoIterator<Item = &'a f64>) -> bool {
@@ -82,7 +85,7 @@ fn count() -> impl Strategy<Value = usize> {
 }
 
 proptest! {
-    #![proptest_config(config(48))]
+    #![proptest_config(config(128))]
 
     #[test]
     fn kalman_predict_update((p0, phi, qd, z, h, r) in (0usize..4, 0usize..3).prop_flat_map(|(n, m)| (sym(n), mat(n, n), sym(n), vals(m), mat(m, n), sym(m))), sequential in any::<bool>(), gate in prop::option::of(val())) {
@@ -210,7 +213,7 @@ fn gnss_epoch() -> &'static (Ephemerides, Vec<Observation>) {
 }
 
 proptest! {
-    #![proptest_config(config(32))]
+    #![proptest_config(config(64))]
 
     #[test]
     fn cai_predictor(

@@ -592,7 +592,16 @@ pub fn predict(imu: Imu, shots: &[f64], channels: &[Channel], cfg: &PredictorCon
             out.push(channel_phase(sol, ch, grad.is_some()));
         }
     }
+    check_rows(&out)?;
     Ok(out)
+}
+
+/// Finite inputs near the f64 range can overflow on the way: an error, not a NaN row.
+fn check_rows<const W: usize>(rows: &[[f64; W]]) -> Result<()> {
+    match rows.iter().position(|r| !r.iter().all(|v| v.is_finite())) {
+        Some(i) => Err(crate::NavError::Numerical(format!("output row {i} (shot × channel) is not finite: the inputs overflow the floating-point range"))),
+        None => Ok(()),
+    }
 }
 
 /// Per-stage sensitivities of (ω_s, ω̇_s, forcing F) to the 12 Jacobian parameters.
@@ -680,6 +689,7 @@ pub fn jacobian(imu: Imu, shots: &[f64], channels: &[Channel], cfg: &PredictorCo
             out.push(std::array::from_fn(|p| ch.k.dot(&(y[2 + 2 * p] - 2.0 * mid[1 + p]))));
         }
     }
+    check_rows(&out)?;
     Ok(out)
 }
 

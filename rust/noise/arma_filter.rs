@@ -510,6 +510,9 @@ pub fn steady_state(model: &ArimaStateSpace, r: f64) -> Result<(Vec<f64>, DMatri
         let pp = &pm - &k * pm.row(0);
         let next = phi * &pp * phi.transpose() + &model.qd;
         let diff = (&next - &pm).abs().max();
+        if !diff.is_finite() {
+            return Err(NavError::Numerical("steady_state: the Riccati iteration diverged (model not detectable?)".into()));
+        }
         pm = next;
         if diff <= 1e-15 * pm.abs().max() {
             let s = pm[(0, 0)] + r;
