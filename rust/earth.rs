@@ -453,6 +453,8 @@ impl Helmert {
     }
 
     /// WGS-84 → PZ-90 position (m), the exact inverse of `forward`.
+    // invariant: Rot = I + S with S skew-symmetric has det = 1 + |w|² ≥ 1, never 0.
+    #[allow(clippy::expect_used)]
     pub fn inverse(&self, r: &Vec3) -> Vec3 {
         self.rot().try_inverse().expect("Rot is I + small skew, always invertible") * (r - self.translation) / (1.0 + self.scale)
     }

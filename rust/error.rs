@@ -54,28 +54,23 @@ pub fn try_vec<T: Clone>(field: &str, n: usize, value: T) -> Result<Vec<T>> {
 
 /// Reject NaN/inf values in a flat slice of `width`-wide rows, naming the first bad row.
 pub fn check_finite(field: &str, data: &[f64], width: usize) -> Result<()> {
-    match data.iter().position(|x| !x.is_finite()) {
+    match data.iter().enumerate().find(|(_, x)| !x.is_finite()) {
         None => Ok(()),
-        Some(i) if width == 1 => Err(invalid_at(field, i, format!("non-finite value {} at index {i}", data[i]))),
-        Some(i) => Err(invalid_at(
-            field,
-            i / width,
-            format!("non-finite value {} at index {} (column {})", data[i], i / width, i % width),
-        )),
+        Some((i, v)) if width <= 1 => Err(invalid_at(field, i, format!("non-finite value {v} at index {i}"))),
+        Some((i, v)) => Err(invalid_at(field, i / width, format!("non-finite value {v} at index {} (column {})", i / width, i % width))),
     }
 }
 
 /// Time stamps must be finite and strictly increasing.
 pub fn check_increasing(field: &str, t: &[f64]) -> Result<()> {
     check_finite(field, t, 1)?;
-    for k in 1..t.len() {
-        if t[k] <= t[k - 1] {
-            let what = if t[k] == t[k - 1] { "duplicated" } else { "decreasing" };
-            return Err(invalid_at(
-                field,
-                k,
-                format!("time not strictly increasing: {what} stamp {} at index {k} (previous {})", t[k], t[k - 1]),
-            ));
+    for (k, w) in t.windows(2).enumerate() {
+        if let [prev, cur] = *w {
+            if cur <= prev {
+                let what = if cur == prev { "duplicated" } else { "decreasing" };
+                let k = k + 1;
+                return Err(invalid_at(field, k, format!("time not strictly increasing: {what} stamp {cur} at index {k} (previous {prev})")));
+            }
         }
     }
     Ok(())

@@ -18,6 +18,9 @@ pub mod strapdown;
 pub mod trajectory;
 pub mod units;
 
+#[cfg(test)]
+mod proptests;
+
 #[cfg(feature = "python")]
 mod py;
 

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # The README's test command: from a fresh clone, create .venv, build and install atomnav
-# (release wheel through maturin), run the Python suite, then the Rust unit tests, and
-# compile (not run) the criterion benches so a broken bench fails here.
+# (release wheel through maturin), run the Python suite, then clippy's no-panic lints, the
+# Rust unit and property tests, and compile (not run) the criterion benches so a broken
+# bench fails here.
 # Extra arguments go to pytest (e.g. `bash tests/run.sh -m slow` for the full-size runs).
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -9,5 +10,10 @@ python3 -m venv .venv
 .venv/bin/python -m pip install --quiet --upgrade pip
 .venv/bin/python -m pip install ".[test]"
 .venv/bin/python -m pytest tests "$@"
+# No reachable panic in the core: unwrap, expect, panic! and unchecked indexing are denied
+# in non-test code; each place where an invariant makes an index safe carries a justified
+# #[allow] (tests may unwrap).
+cargo clippy --version >/dev/null 2>&1 || rustup component add clippy
+cargo clippy --release --lib --features python -- -D clippy::unwrap_used -D clippy::expect_used -D clippy::panic -D clippy::indexing_slicing
 cargo test --release
 cargo bench --no-run --quiet

@@ -56,6 +56,8 @@ impl Observability {
 }
 
 /// Symmetric eigen-decomposition with ascending eigenvalues.
+// invariant: idx is a permutation of 0..3 indexing the 3 eigenvalues and eigenvectors.
+#[allow(clippy::indexing_slicing)]
 fn sorted_eigen(m: &Mat3) -> (Vec3, Mat3) {
     let e = SymmetricEigen::new(*m);
     let mut idx = [0usize, 1, 2];
@@ -416,8 +418,14 @@ pub struct ConstantGyroErrors<'a> {
 /// cov(ε_n, ε_{n+1}) = −P_n^avu ΔS_{n+1}, and with constant gyro errors the cross blocks
 /// Cᵀ(J_m,n P_m J_m,pᵀ + J_b,n P_b J_b,pᵀ)C — and its systematic part
 /// P_β^sys = G_mP_mG_mᵀ + G_bP_bG_bᵀ, G = −(HᵀH)⁻¹Σ_n H_nᵀCᵀJ_n. Returns (P_β^model, P_β^sys) in rad².
+// invariant: ds_imu, ds_avu, e_imu, h (and the sensitivities) have m entries and
+// p_avu m + 1 (checked above); n < m, n + 1 ≤ m.
+#[allow(clippy::indexing_slicing)]
 pub fn model_covariance(c: &Mat3, ds_imu: &[Mat3], ds_avu: &[Mat3], e_imu: &[Mat3], p_avu: &[Mat3], constant: Option<&ConstantGyroErrors>) -> Result<(Mat3, Mat3)> {
     let m = ds_imu.len();
+    if ds_avu.len() != m {
+        return Err(invalid("ds_avu", format!("expected {m} increments like ds_imu, got {}", ds_avu.len())));
+    }
     if e_imu.len() != m || p_avu.len() != m + 1 || constant.is_some_and(|k| k.sensitivities.len() != m) {
         return Err(invalid("e_imu", format!("expected {m} interval covariances (and sensitivities) and {} epoch covariances", m + 1)));
     }
@@ -474,6 +482,9 @@ impl Choice for DiffForm {
 
 /// Dead-reckoning check (E20): S_1^MF = S_1^VF Cᵀ (D9), S_n^MF = S_{n−1}^MF ΔS_n^imu,
 /// θ_n^diff = vee((S_n^MF)ᵀ S_n^VF Cᵀ − I) and P_n^diff, for n = 2..N.
+// invariant: s_vf, p_avu, p_imu have n ≥ 1 entries and ds_imu n − 1 (checked
+// above); 1 ≤ k < n.
+#[allow(clippy::indexing_slicing)]
 pub fn dead_reckoning_check(
     c: &Mat3,
     s_vf: &[Mat3],

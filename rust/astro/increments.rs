@@ -102,6 +102,8 @@ impl GyroErrorModel {
 /// and the six unique entries of the symmetric result: 30 multiplications instead of the
 /// 54 of two dense 3×3 products (the hot loop of the calibration benchmark).
 #[inline(always)]
+// invariant: fixed-size 3 × 3 and 3-arrays indexed by i, k < 3.
+#[allow(clippy::indexing_slicing)]
 fn transport(e: &Mat3, rho: &Vec3) -> Mat3 {
     let (x, y, z) = (rho.x, rho.y, rho.z);
     // X = E S, S columns (0, z, −y), (−z, 0, x), (y, −x, 0)
@@ -141,6 +143,8 @@ impl ErrorPropagator {
     /// J_m ← (I − [ρ×])J_m + I₃⊗ρᵀ and J_b ← (I − [ρ×])J_b + T I (E8).
     // inlined into the per-interval loop so that E stays in registers
     #[inline(always)]
+    // invariant: fixed-size: J_m is 3 × 9, so (i, 3i + j) with i, j < 3 is in range.
+    #[allow(clippy::indexing_slicing)]
     fn step(&mut self, rho: &Vec3, model: &GyroErrorModel, period: f64) {
         match self.mode {
             GyroErrorMode::Paper => self.e = transport(&self.e, rho) + model.sample_cov(rho, period),
@@ -184,6 +188,9 @@ pub struct ImuRecord<'a, R = Vec3> {
 
 impl<R: Copy + Into<Vec3> + Sync> ImuRecord<'_, R> {
     #[inline]
+    // invariant: j < rho.len(): locate clamps to the last sample and check_epochs keeps
+    // every epoch inside the record, so the interval loops stop below rho.len().
+    #[allow(clippy::indexing_slicing)]
     fn rho(&self, j: usize) -> Vec3 {
         self.rho[j].into()
     }
@@ -207,7 +214,7 @@ impl<R: Copy + Into<Vec3> + Sync> ImuRecord<'_, R> {
     /// Sample index j and fraction x ∈ [0, 1) of an instant inside the record.
     fn locate(&self, t: f64) -> (usize, f64) {
         let u = (t - self.t_start) / self.period;
-        let j = (u.floor() as usize).min(self.rho.len() - 1);
+        let j = (u.floor() as usize).min(self.rho.len().saturating_sub(1));
         (j, u - j as f64)
     }
 
@@ -215,11 +222,8 @@ impl<R: Copy + Into<Vec3> + Sync> ImuRecord<'_, R> {
     fn check_epochs(&self, epochs: &[f64]) -> Result<()> {
         check_increasing("epochs", epochs)?;
         let end = self.t_start + self.rho.len() as f64 * self.period;
-        if let Some(i) = epochs.iter().position(|&t| t < self.t_start || t >= end) {
-            return Err(invalid(
-                "epochs",
-                format!("epoch {} s at index {i} outside the IMU record [{}, {}) s", epochs[i], self.t_start, end),
-            ));
+        if let Some((i, t)) = epochs.iter().enumerate().find(|(_, &t)| t < self.t_start || t >= end) {
+            return Err(invalid("epochs", format!("epoch {t} s at index {i} outside the IMU record [{}, {}) s", self.t_start, end)));
         }
         Ok(())
     }
@@ -301,7 +305,7 @@ pub fn integrate_increments<R: Copy + Into<Vec3> + Sync>(rec: &ImuRecord<R>, epo
     rec.validate()?;
     model.validate()?;
     rec.check_epochs(epochs)?;
-    Ok(epochs.par_windows(2).map(|w| rec.interval(w[0], w[1], model, variant)).collect())
+    Ok(epochs.par_windows(2).filter_map(|w| if let &[a, b] = w { Some(rec.interval(a, b, model, variant)) } else { None }).collect())
 }
 
 /// Continuous dead-reckoning covariance P_n^imu at every epoch (spec E20): E7/E8 run from
@@ -312,7 +316,8 @@ pub fn dead_reckoning_cov<R: Copy + Into<Vec3> + Sync>(rec: &ImuRecord<R>, epoch
     rec.check_epochs(epochs)?;
     let mut out = Vec::with_capacity(epochs.len());
     let mut p = ErrorPropagator::zero(model.mode);
-    let mut j = rec.locate(epochs[0]).0;
+    let Some(&t0) = epochs.first() else { return Ok(out) };
+    let mut j = rec.locate(t0).0;
     for &t in epochs {
         let (jt, x) = rec.locate(t);
         while j < jt {

@@ -64,6 +64,8 @@ pub fn rotation_angle(s: &Mat3) -> f64 {
 }
 
 /// Nearest rotation matrix U diag(1, 1, det U det V) Vᵀ of B = U Σ Vᵀ (Wahba, spec E11).
+// invariant: svd(true, true) always computes u and v_t.
+#[allow(clippy::expect_used)]
 pub fn nearest_rotation(b: &Mat3) -> Mat3 {
     let svd = b.svd(true, true);
     let (u, vt) = (svd.u.expect("u requested"), svd.v_t.expect("v_t requested"));

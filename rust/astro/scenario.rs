@@ -200,7 +200,7 @@ pub fn monte_carlo(scn: &Scenario, runs: usize, seed0: u64, opt: &Options, diff_
                 .theta_diff
                 .iter()
                 .zip(&r.p_diff)
-                .map(|(t, p)| p.try_inverse().map_or(f64::INFINITY, |pi| (t.transpose() * pi * t)[0]))
+                .map(|(t, p)| p.try_inverse().map_or(f64::INFINITY, |pi| (t.transpose() * pi * t).x))
                 .sum::<f64>()
                 / r.theta_diff.len() as f64;
             let sd = |p: &Mat3| Vec3::new(p[(0, 0)].sqrt(), p[(1, 1)].sqrt(), p[(2, 2)].sqrt());

@@ -94,9 +94,9 @@ impl Catalog {
 
 pub fn check_unit(field: &str, v: &[Vec3]) -> Result<()> {
     // NaN norms fail too: `is_nan() ||` keeps them out of the accepted set
-    match v.iter().position(|s| (s.norm() - 1.0).is_nan() || (s.norm() - 1.0).abs() > UNIT_TOLERANCE) {
+    match v.iter().enumerate().find(|(_, s)| (s.norm() - 1.0).is_nan() || (s.norm() - 1.0).abs() > UNIT_TOLERANCE) {
         None => Ok(()),
-        Some(i) => Err(invalid_at(field, i, format!("not a unit vector at index {i} (norm {})", v[i].norm()))),
+        Some((i, vi)) => Err(invalid_at(field, i, format!("not a unit vector at index {i} (norm {})", vi.norm()))),
     }
 }
 
@@ -111,10 +111,14 @@ pub fn aberration_rows(s: &[Vec3], v: &[Vec3]) -> Result<Vec<Vec3>> {
         return Err(invalid("velocity", format!("expected 1 or {} rows like directions, got {}", s.len(), v.len())));
     }
     check_unit("directions", s)?;
-    if let Some(i) = v.iter().position(|v| v.norm() >= ABERRATION_MAX_SPEED) {
-        return Err(invalid_at("velocity", i, format!("|v| = {} m/s at index {i}: the first-order formula needs |v| < 1e-3 c", v[i].norm())));
+    if let Some((i, vi)) = v.iter().enumerate().find(|(_, v)| v.norm() >= ABERRATION_MAX_SPEED) {
+        return Err(invalid_at("velocity", i, format!("|v| = {} m/s at index {i}: the first-order formula needs |v| < 1e-3 c", vi.norm())));
     }
-    Ok(s.iter().enumerate().map(|(i, s)| aberration(s, &v[if v.len() == 1 { 0 } else { i }])).collect())
+    let vel = |i: usize| if v.len() == 1 { v.first() } else { v.get(i) };
+    s.iter()
+        .enumerate()
+        .map(|(i, s)| vel(i).map(|v| aberration(s, v)).ok_or_else(|| invalid_at("velocity", i, format!("no velocity for direction {i}"))))
+        .collect()
 }
 
 fn check_cameras(cameras: &[Camera]) -> Result<()> {
@@ -216,6 +220,10 @@ pub fn check_covariances(field: &str, p: &[Mat3], n: usize) -> Result<()> {
 /// σ_s²K_n + K_n(Σᵢ Cᵢ Aᵢ D1(αⁱ) P_aⁱ D1(αⁱ)ᵀ Aᵢ Cᵢᵀ)K_n, K_n = (Σ(I − ssᵀ))⁻¹), or take
 /// the user's `p_avu` (one per epoch, rad², VF) in its place (E12, D11).
 /// `up_gcrs` (one per epoch) and `n_refr` enable refraction; `None` skips it.
+// invariant: every obs array has m entries, obs.camera < cameras.len() and obs.epoch <
+// n_epochs (checked above), so r < m, e < n_epochs = rows.len() = up.len() = p.len(),
+// k < idx.len() = s.len() and the camera indices are in range.
+#[allow(clippy::indexing_slicing)]
 pub fn star_attitudes(
     obs: &Observations,
     n_epochs: usize,
@@ -237,11 +245,11 @@ pub fn star_attitudes(
     if !(sigma_s.is_finite() && sigma_s >= 0.0) {
         return Err(invalid("sigma_s", format!("must be finite and ≥ 0, got {sigma_s}")));
     }
-    if let Some(i) = obs.camera.iter().position(|&c| c >= cameras.len()) {
-        return Err(invalid("camera", format!("camera index {} at index {i} but {} cameras", obs.camera[i], cameras.len())));
+    if let Some((i, c)) = obs.camera.iter().enumerate().find(|(_, &c)| c >= cameras.len()) {
+        return Err(invalid("camera", format!("camera index {c} at index {i} but {} cameras", cameras.len())));
     }
-    if let Some(i) = obs.epoch.iter().position(|&e| e >= n_epochs) {
-        return Err(invalid("epoch", format!("epoch index {} at index {i} but {n_epochs} epochs", obs.epoch[i])));
+    if let Some((i, e)) = obs.epoch.iter().enumerate().find(|(_, &e)| e >= n_epochs) {
+        return Err(invalid("epoch", format!("epoch index {e} at index {i} but {n_epochs} epochs")));
     }
     if let Some((up, n)) = refraction {
         check_refractive_index(n)?;
@@ -310,10 +318,11 @@ pub fn star_attitudes(
 
 /// ΔS_n^avu = S_{n−1}ᵀ S_n and E_n^avu = P_n + ΔS_nᵀ P_{n−1} ΔS_n (spec E13).
 pub fn astro_increments(s: &[Mat3], p: &[Mat3]) -> (Vec<Mat3>, Vec<Mat3>) {
-    (1..s.len())
-        .map(|n| {
-            let ds = s[n - 1].transpose() * s[n];
-            (ds, p[n] + ds.transpose() * p[n - 1] * ds)
+    (s.windows(2).zip(p.windows(2)))
+        .filter_map(|pair| {
+            let ([s0, s1], [p0, p1]) = pair else { return None };
+            let ds = s0.transpose() * s1;
+            Some((ds, p1 + ds.transpose() * p0 * ds))
         })
         .unzip()
 }

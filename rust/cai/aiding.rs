@@ -316,10 +316,11 @@ impl CaiAiding {
     pub fn new(cfg: CaiConfig, data: CaiData) -> Result<Self> {
         cfg.check()?;
         check_finite("shots", &cfg.shots, 1)?;
-        for i in 1..cfg.shots.len() {
-            let end = cfg.shots[i - 1] + 2.0 * cfg.t_sep;
-            if cfg.shots[i] < end - 1e-9 * cfg.t_sep {
-                return Err(invalid("shots", format!("shot {i} starts at {} s, before shot {} ends at {end} s (shots must not overlap)", cfg.shots[i], i - 1)));
+        for (i, pair) in cfg.shots.windows(2).enumerate() {
+            let &[prev, cur] = pair else { continue };
+            let end = prev + 2.0 * cfg.t_sep;
+            if cur < end - 1e-9 * cfg.t_sep {
+                return Err(invalid("shots", format!("shot {} starts at {cur} s, before shot {i} ends at {end} s (shots must not overlap)", i + 1)));
             }
         }
         let expected = cfg.shots.len() * cfg.channels.len();
@@ -362,6 +363,9 @@ impl CaiAiding {
     }
 
     /// Phase Jacobian rows (channels × n) w.r.t. the full error state.
+    // invariant: the layout's blocks lie inside its n columns (3 states each), c < 3 so
+    // c, 3 + c, 6 + c, 9 + c < 12 index the Jacobian rows, r < rows.len().
+    #[allow(clippy::indexing_slicing)]
     fn phase_jacobian(&self, rows: &[[f64; 12]], layout: &Layout) -> Result<DMatrix<f64>> {
         let n = layout.size();
         let mut j = DMatrix::<f64>::zeros(rows.len(), n);
@@ -421,8 +425,12 @@ impl CaiAiding {
     }
 
     /// The measurement of shot j given the filter's state (the engine's `measure`).
+    // invariant: j < shots.len() (read above) and new checks every data series to hold
+    // shots × m values, so idx = j·m + ch is in range; predict and jacobian return one row per
+    // channel, so ch < m indexes best and phi_nom.
+    #[allow(clippy::indexing_slicing)]
     fn shot_measurement(&mut self, j: usize, x: &DVector<f64>, extra: &DVector<f64>, layout: &Layout) -> Result<Measurement> {
-        let ts = self.cfg.shots[j];
+        let ts = *self.cfg.shots.get(j).ok_or_else(|| invalid("shots", format!("no shot {j} (of {})", self.cfg.shots.len())))?;
         let first = self.buf_t.iter().position(|&t| t >= ts - 1e-9 * self.cfg.t_sep);
         match (self.buf_t.first(), first) {
             (Some(&t0), Some(_)) if t0 <= ts + 1e-9 * self.cfg.t_sep => {}
@@ -511,6 +519,9 @@ impl Aiding for CaiAiding {
         self.shot_measurement(j, ctx.x, ctx.extra, ctx.layout).map(Some)
     }
 
+    // invariant: f and qc are n × n for this layout, whose blocks (and the velocity
+    // block) lie inside n; a, b < 3 index the 3-state blocks and the 3 × 3 C_nb.
+    #[allow(clippy::indexing_slicing)]
     fn extra_dynamics(&self, layout: &Layout, f: &mut DMatrix<f64>, qc: &mut DMatrix<f64>) {
         for (name, psd) in [(MISALIGNMENT_BLOCK, self.cfg.misalignment), (LEVER_BLOCK, self.cfg.lever_arm)] {
             if let (Some(r), Some(q)) = (layout.get(name), psd) {

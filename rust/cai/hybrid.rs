@@ -225,6 +225,10 @@ impl HybridScenario {
     }
 
     /// Run `run` of the Monte Carlo seeded by `master_seed`.
+    // invariant: new makes t ≥ 2 samples (imu_truth) with truth, f, w one per sample; the
+    // simulated IMU series, its biases and free_nav have one entry per sample too, k < t.len()
+    // is checked before use, lo < hi ≤ t.len(), and nees holds one entry per output epoch e.
+    #[allow(clippy::indexing_slicing)]
     pub fn run(&self, master_seed: u64, run: u64) -> Result<HybridRun> {
         let mut rng = ChaCha20Rng::seed_from_u64(master_seed);
         rng.set_stream(run);
@@ -322,8 +326,8 @@ impl HybridScenario {
         Ok(McTables {
             runs: res.len(),
             epochs,
-            states: if epochs > 0 { res[0].sigma.len() / epochs } else { 0 },
-            shots: res.first().map_or(0, |r| r.phase_error.len() / channels),
+            states: res.first().and_then(|r| r.sigma.len().checked_div(epochs)).unwrap_or(0),
+            shots: res.first().and_then(|r| r.phase_error.len().checked_div(channels)).unwrap_or(0),
             channels,
             time: res.first().map_or_else(Vec::new, |r| r.time.clone()),
             imu_time: self.t.clone(),

@@ -35,6 +35,9 @@ const STEP_W: f64 = 1e-6;
 /// (a window around the shot), at rest: per sample i with a non-zero effect, (i, s_i) with
 /// s_i (channels × 6) = ∂φ̂/∂(f_x, f_y, f_z, ω_x, ω_y, ω_z) of sample i (rad per m/s², rad
 /// per rad/s). `cfg`'s ω̇ option is kept except `Given` (independent of the gyro: `Zero`).
+// invariant: f and w have t.len() entries and i < t.len(); c < 6, so c or c − 3 is
+// < 3 for a Vec3; predict returns one row per channel, j < m.
+#[allow(clippy::indexing_slicing)]
 pub fn sensitivity(t: &[f64], ts: f64, channels: &[Channel], cfg: &PredictorConfig) -> Result<Vec<(usize, DMatrix<f64>)>> {
     check_increasing("t", t)?;
     let mut cfg = cfg.clone();
@@ -73,11 +76,13 @@ pub fn sensitivity(t: &[f64], ts: f64, channels: &[Channel], cfg: &PredictorConf
 /// one-sided at the ends).
 fn spacing(t: &[f64], i: usize) -> f64 {
     let n = t.len();
+    // NaN for an index outside the record
+    let at = |k: usize| t.get(k).copied().unwrap_or(f64::NAN);
     match (i, n) {
         (_, 0 | 1) => f64::NAN,
-        (0, _) => t[1] - t[0],
-        (i, n) if i == n - 1 => t[n - 1] - t[n - 2],
-        (i, _) => 0.5 * (t[i + 1] - t[i - 1]),
+        (0, _) => at(1) - at(0),
+        (i, n) if i == n - 1 => at(n - 1) - at(n - 2),
+        (i, _) => 0.5 * (at(i + 1) - at(i - 1)),
     }
 }
 
@@ -110,12 +115,12 @@ pub fn cross_covariance(f: &DMatrix<f64>, t: &[f64], ts: f64, t_sep: f64, sens: 
     let fb = f.columns(9, 6).into_owned();
     let m = sens.first().map_or(0, |s| s.1.nrows());
     let mut out = DMatrix::<f64>::zeros(15, m);
-    for (i, s) in sens {
-        let ti = t[*i];
+    for (k, (i, s)) in sens.iter().enumerate() {
+        let ti = *t.get(*i).ok_or_else(|| crate::error::invalid_at("sens", k, format!("sample index {i} outside the record of {} samples", t.len())))?;
         if ti < ts - eps || ti > end + eps {
             continue;
         }
-        let (prev, next) = (if *i > 0 { t[i - 1] } else { ti }, if i + 1 < t.len() { t[i + 1] } else { ti });
+        let (prev, next) = (i.checked_sub(1).and_then(|j| t.get(j)).copied().unwrap_or(ti), t.get(i + 1).copied().unwrap_or(ti));
         let weight = 0.5 * (ti - prev.max(ts)).max(0.0) + 0.5 * (next.min(end) - ti).max(0.0);
         let dt = spacing(t, *i);
         let q = DMatrix::from_diagonal(&nalgebra::DVector::from_fn(6, |c, _| if c < 3 { q_a } else { q_g } / dt));

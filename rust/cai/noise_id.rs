@@ -32,6 +32,9 @@ fn wrap(phi: f64) -> f64 {
 
 /// Track ζ over the readouts `p` with known input phases `psi` (rad); returns ζ after each
 /// update (A kept > 0, φ wrapped to (−π, π]).
+// invariant: fixed-size 3-vectors and 3 × 3 matrices indexed by constants < 3; the
+// product hᵀ P h is 1 × 1.
+#[allow(clippy::indexing_slicing)]
 pub fn fringe_track(p: &[f64], psi: &[f64], cfg: &FringeEkf) -> Result<Vec<[f64; 3]>> {
     check_finite("p", p, 1)?;
     check_finite("psi", psi, 1)?;
@@ -114,6 +117,9 @@ struct Data<'a> {
     c: Vec<[f64; 3]>,
 }
 
+// invariant: c has one row per sample of x (built so in ml_identify), i < x.len(),
+// and j, m < 3 index its fixed-size rows and the 3-vectors θ, g, h, f.
+#[allow(clippy::indexing_slicing)]
 impl Data<'_> {
     fn var(&self, i: usize, th: &[f64; 3]) -> f64 {
         (0..3).map(|j| self.c[i][j] * th[j] * th[j]).sum()
@@ -155,6 +161,9 @@ impl Data<'_> {
 /// Maximum-likelihood (σ_p0, σ_φ, σ_A) from residuals `x`, fringe phases `phi` (rad) and
 /// amplitudes `amp` (one per sample). All three free is rejected: they are not jointly
 /// identifiable (only a, b are).
+// invariant: free holds indices j < 3 of the fixed-size θ arrays and 3-vectors;
+// r < free.len(), the size of gs, hs, fs, d and step; the 3 × 3 Hessian has 3 eigenvalues.
+#[allow(clippy::indexing_slicing)]
 pub fn ml_identify(x: &[f64], phi: &[f64], amp: &[f64], cfg: &MlConfig) -> Result<MlResult> {
     let n = x.len();
     check_finite("x", x, 1)?;
@@ -181,7 +190,7 @@ pub fn ml_identify(x: &[f64], phi: &[f64], amp: &[f64], cfg: &MlConfig) -> Resul
             return Err(invalid("theta0", format!("component {j} must be finite, >= 0 (> 0 when free), got {t}")));
         }
     }
-    let data = Data { x, c: (0..n).map(|i| [1.0, (amp[i] * phi[i].sin()).powi(2), phi[i].cos().powi(2)]).collect() };
+    let data = Data { x, c: amp.iter().zip(phi).map(|(&a, &ph)| [1.0, (a * ph.sin()).powi(2), ph.cos().powi(2)]).collect() };
     if (0..n).any(|i| data.var(i, &cfg.theta0) <= 0.0) {
         return Err(invalid("theta0", "start value gives zero variance for some samples"));
     }
@@ -267,21 +276,24 @@ pub fn ml_windows(x: &[f64], phi: &[f64], amp: &[f64], cfg: &MlConfig, batch: us
     if batch < 3 || batch > x.len() {
         return Err(invalid("batch", format!("must be in [3, {}], got {batch}", x.len())));
     }
+    if phi.len() != x.len() || amp.len() != x.len() {
+        return Err(invalid("phi", format!("phi ({}) and amplitude ({}) must have the length of x ({})", phi.len(), amp.len(), x.len())));
+    }
     let mut out = Vec::new();
     if sliding {
         let mut c = cfg.clone();
-        for end in batch..=x.len() {
-            let r = ml_identify(&x[end - batch..end], &phi[end - batch..end], &amp[end - batch..end], &c)?;
+        for ((xw, pw), aw) in x.windows(batch).zip(phi.windows(batch)).zip(amp.windows(batch)) {
+            let r = ml_identify(xw, pw, aw, &c)?;
             // warm start, floored at 10 % of the initial value: J_j ∝ θ_j, so a component
             // that reached the boundary 0 in one window could never leave it again
-            for j in 0..3 {
-                c.theta0[j] = if cfg.free[j] { r.theta[j].max(0.1 * cfg.theta0[j]) } else { cfg.theta0[j] };
+            for ((t0, &free), (&rj, &init)) in c.theta0.iter_mut().zip(&cfg.free).zip(r.theta.iter().zip(&cfg.theta0)) {
+                *t0 = if free { rj.max(0.1 * init) } else { init };
             }
             out.push(r);
         }
     } else {
-        for s in (0..=x.len() - batch).step_by(batch) {
-            out.push(ml_identify(&x[s..s + batch], &phi[s..s + batch], &amp[s..s + batch], cfg)?);
+        for ((xw, pw), aw) in x.chunks_exact(batch).zip(phi.chunks_exact(batch)).zip(amp.chunks_exact(batch)) {
+            out.push(ml_identify(xw, pw, aw, cfg)?);
         }
     }
     Ok(out)

@@ -69,7 +69,7 @@ pub struct SineMotion {
 
 impl BodyMotion for SineMotion {
     fn attitude(&self, t: f64) -> (Mat3, Vec3, Vec3) {
-        let [r, p, y] = [0, 1, 2].map(|i| self.euler[i].eval(t));
+        let [r, p, y] = self.euler.each_ref().map(|s| s.eval(t));
         let (sr, cr) = r[0].sin_cos();
         let (sp, cp) = p[0].sin_cos();
         // ω_b = E(roll, pitch) · (ṙ, ṗ, ẏ) for the z-y-x sequence.
@@ -83,13 +83,13 @@ impl BodyMotion for SineMotion {
         (dcm_from_euler(r[0], p[0], y[0]), w, wd)
     }
     fn velocity(&self, t: f64) -> Vec3 {
-        Vec3::from_fn(|i, _| self.position[i].eval(t)[1])
+        Vec3::from(self.position.each_ref().map(|s| s.eval(t)[1]))
     }
     fn acceleration(&self, t: f64) -> Vec3 {
-        Vec3::from_fn(|i, _| self.position[i].eval(t)[2])
+        Vec3::from(self.position.each_ref().map(|s| s.eval(t)[2]))
     }
     fn displacement(&self, t0: f64, t1: f64) -> Vec3 {
-        Vec3::from_fn(|i, _| self.position[i].difference(t0, t1))
+        Vec3::from(self.position.each_ref().map(|s| s.difference(t0, t1)))
     }
 }
 
@@ -111,9 +111,12 @@ impl SineMotion {
             poly: *poly,
             sines: sines.iter().filter(|r| r[0] as usize == axis).map(|r| (r[1], r[2], r[3])).collect(),
         };
+        let (&[p0, p1, p2], &[e0, e1, e2]) = (position_poly, attitude_poly) else {
+            return Err(invalid("position_poly", "expected shape (3, 3)"));
+        };
         Ok(SineMotion {
-            position: [0, 1, 2].map(|a| signal(&position_poly[a], position_sines, a)),
-            euler: [0, 1, 2].map(|a| signal(&attitude_poly[a], attitude_sines, a)),
+            position: [(p0, 0), (p1, 1), (p2, 2)].map(|(c, a)| signal(&c, position_sines, a)),
+            euler: [(e0, 0), (e1, 1), (e2, 2)].map(|(c, a)| signal(&c, attitude_sines, a)),
         })
     }
 }
@@ -257,6 +260,8 @@ fn mode_functions(lam: f64, tau: f64) -> [f64; 3] {
 
 /// Atom displacement r_a(t_s + τ) − r_a(t_s) for release position offset u0 = r_a(t_s) −
 /// r_ref, velocity u1, in g(r) = g0 + Γ (r − r_ref): exact mode-wise solution.
+// invariant: fixed-size: from_fn gives i < 3 for the 3-vectors and 3 eigenvalues.
+#[allow(clippy::indexing_slicing)]
 fn atom_displacement(gravity: &Gravity, u0: &Vec3, u1: &Vec3, tau: f64) -> Vec3 {
     match &gravity.gradient {
         None => u1 * tau + 0.5 * gravity.g0 * tau * tau,

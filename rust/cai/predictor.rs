@@ -143,7 +143,10 @@ pub fn channels_from_rows(k: &[Vec3], lever: &[Vec3], c_sb: &[nalgebra::DMatrix<
     if let Some(j) = c_sb.iter().position(|c| c.shape() != (3, 3)) {
         return Err(crate::error::invalid_at("c_sb", j, "expected a 3 × 3 rotation per channel"));
     }
-    Ok((0..n).map(|j| Channel { k: k[j], lever: lever[j], c_sb: Mat3::from_fn(|r, q| c_sb[j][(r, q)]), v0: v0[j] }).collect())
+    // each c_sb is 3 × 3 (checked above): its 9 column-major values
+    Ok((k.iter().zip(lever).zip(c_sb).zip(v0))
+        .map(|(((&k, &lever), c), &v0)| Channel { k, lever, c_sb: Mat3::from_iterator(c.iter().copied()), v0 })
+        .collect())
 }
 
 /// Settings shared by all shots of a record.
@@ -231,14 +234,16 @@ fn atom_accel(s: &ChStage, x: &Vec3, v: &Vec3, force: &Vec3, gradient: Option<&M
 
 /// One classical RK4 step of y' = rhs(stage, y) with stages at the start, middle, end.
 #[inline]
+// invariant: fixed-size arrays: from_fn gives i < N, the length of y and k.
+#[allow(clippy::indexing_slicing)]
 fn rk4<S, const N: usize>(y: &mut [Vec3; N], h: f64, s: [&S; 3], rhs: impl Fn(&S, &[Vec3; N]) -> [Vec3; N]) {
     let axpy = |y: &[Vec3; N], a: f64, k: &[Vec3; N]| -> [Vec3; N] { std::array::from_fn(|i| y[i] + a * k[i]) };
     let k1 = rhs(s[0], y);
     let k2 = rhs(s[1], &axpy(y, 0.5 * h, &k1));
     let k3 = rhs(s[1], &axpy(y, 0.5 * h, &k2));
     let k4 = rhs(s[2], &axpy(y, h, &k3));
-    for i in 0..N {
-        y[i] += h / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]);
+    for ((((yi, a), b), c), d) in y.iter_mut().zip(&k1).zip(&k2).zip(&k3).zip(&k4) {
+        *yi += h / 6.0 * (a + 2.0 * b + 2.0 * c + d);
     }
 }
 
@@ -275,6 +280,9 @@ struct Record<'a> {
 impl Record<'_> {
     /// Value and time derivative of the interpolant of `v` at absolute time `t` in IMU
     /// interval i.
+    // invariant: prepare clamps seg.imu (= i) to [0, n − 2] and makes every series n
+    // long, so i, i + 1, a, b < n.
+    #[allow(clippy::indexing_slicing)]
     fn interp(&self, v: &[Vec3], i: usize, t: f64) -> (Vec3, Vec3) {
         let ts = self.imu.t;
         let h = ts[i + 1] - ts[i];
@@ -313,7 +321,7 @@ impl Record<'_> {
 
     /// The three RK4 stage inputs of each sub-step of each segment of a shot.
     fn stages(&self, shot: usize) -> Vec<([BodyStage; 3], bool)> {
-        let (ts, segs) = &self.shots[shot];
+        let Some((ts, segs)) = self.shots.get(shot) else { return Vec::new() };
         let mut out = Vec::with_capacity(segs.len() * self.substeps);
         for seg in segs {
             let h = (seg.b - seg.a) / self.substeps as f64;
@@ -359,8 +367,7 @@ fn check_channels(channels: &[Channel]) -> Result<()> {
 
 /// NaN/inf in an IMU series: name the field, the sample index and the shot that uses it.
 fn check_series(field: &str, v: &[Vec3], t: &[f64], shots: &[f64], t_sep: f64) -> Result<()> {
-    if let Some(i) = v.iter().position(|x| x.iter().any(|c| !c.is_finite())) {
-        let ti = t[i];
+    if let Some((i, (vi, &ti))) = v.iter().zip(t).enumerate().find(|(_, (x, _))| x.iter().any(|c| !c.is_finite())) {
         // the shot containing the sample, else one whose interpolation/derivative stencil may
         // reach it
         let shot = shots
@@ -368,18 +375,22 @@ fn check_series(field: &str, v: &[Vec3], t: &[f64], shots: &[f64], t_sep: f64) -
             .position(|&s| ti >= s && ti <= s + 2.0 * t_sep)
             .or_else(|| shots.iter().position(|&s| ti >= s - t_sep && ti <= s + 3.0 * t_sep));
         let where_ = shot.map_or(String::from("outside every shot"), |s| format!("used by shot {s}"));
-        return Err(invalid(field, format!("non-finite value {:?} at index {i} (t = {ti} s, {where_})", [v[i].x, v[i].y, v[i].z])));
+        return Err(invalid(field, format!("non-finite value {:?} at index {i} (t = {ti} s, {where_})", [vi.x, vi.y, vi.z])));
     }
     Ok(())
 }
 
+// invariant: n ≥ 2m + 1 (checked above), c ∈ [m, n − 1 − m] and j ≤ m, so c ± j and
+// c ± m are in [0, n); w has n samples like t (checked by prepare).
+#[allow(clippy::indexing_slicing)]
 fn savgol(t: &[f64], w: &[Vec3], m: usize) -> Result<Vec<Vec3>> {
     if m == 0 {
         return Err(invalid("omega_dot", "Savitzky-Golay half width must be >= 1"));
     }
     let n = t.len();
-    if n < 2 * m + 1 {
-        return Err(invalid("omega_dot", format!("Savitzky-Golay window of {} samples needs at least as many IMU samples, got {n}", 2 * m + 1)));
+    if m >= n / 2 + n % 2 {
+        // n < 2m + 1, written so that no m overflows
+        return Err(invalid("omega_dot", format!("Savitzky-Golay window of 2·{m} + 1 samples needs at least as many IMU samples, got {n}")));
     }
     let s2: f64 = (1..=m).map(|j| 2.0 * (j * j) as f64).sum();
     Ok((0..n)
@@ -395,9 +406,8 @@ fn savgol(t: &[f64], w: &[Vec3], m: usize) -> Result<Vec<Vec3>> {
 /// Validate everything and build the per-shot integration grids.
 fn prepare<'a>(imu: Imu<'a>, shots: &[f64], channels: &[Channel], cfg: &PredictorConfig) -> Result<Record<'a>> {
     check_positive("T", cfg.t_sep)?;
-    if cfg.substeps == 0 {
-        return Err(invalid("substeps", "must be >= 1"));
-    }
+    // the stage buffer holds substeps per grid interval: bounded before it is allocated
+    crate::error::check_count("substeps", cfg.substeps, 1, MAX_SUBSTEPS)?;
     let n = imu.t.len();
     if n < 2 {
         return Err(invalid("t", format!("need at least 2 IMU samples, got {n}")));
@@ -415,8 +425,11 @@ fn prepare<'a>(imu: Imu<'a>, shots: &[f64], channels: &[Channel], cfg: &Predicto
         check_finite("gradient", g.as_slice(), 3)?;
     }
     let t_sep = cfg.t_sep;
-    let (t_first, t_last) = (imu.t[0], imu.t[n - 1]);
+    let &[t_first, .., t_last] = imu.t else {
+        return Err(invalid("t", format!("need at least 2 IMU samples, got {n}")));
+    };
     let eps = 1e-9 * t_sep;
+    let mut prev: Option<f64> = None;
     for (s, &ts) in shots.iter().enumerate() {
         if ts < t_first - eps || ts + 2.0 * t_sep > t_last + eps {
             return Err(invalid(
@@ -424,12 +437,10 @@ fn prepare<'a>(imu: Imu<'a>, shots: &[f64], channels: &[Channel], cfg: &Predicto
                 format!("shot {s}: pulse times [{ts}, {}] s outside the IMU record [{t_first}, {t_last}] s", ts + 2.0 * t_sep),
             ));
         }
-        if s > 0 && ts < shots[s - 1] + 2.0 * t_sep - eps {
-            return Err(invalid(
-                "shots",
-                format!("shot {s} starts at {ts} s, before shot {} ends at {} s (shots must not overlap)", s - 1, shots[s - 1] + 2.0 * t_sep),
-            ));
+        if let Some(p) = prev.filter(|&p| ts < p + 2.0 * t_sep - eps) {
+            return Err(invalid("shots", format!("shot {s} starts at {ts} s, before shot {} ends at {} s (shots must not overlap)", s - 1, p + 2.0 * t_sep)));
         }
+        prev = Some(ts);
     }
     check_series("specific_force", imu.f, imu.t, shots, t_sep)?;
     check_series("angular_rate", imu.w, imu.t, shots, t_sep)?;
@@ -450,7 +461,7 @@ fn prepare<'a>(imu: Imu<'a>, shots: &[f64], channels: &[Channel], cfg: &Predicto
         .map(|&ts| {
             let mut knots: Vec<(f64, bool)> = vec![(0.0, false), (t_sep, true), (2.0 * t_sep, false)];
             let i0 = imu.t.partition_point(|&x| x <= ts);
-            for &ti in &imu.t[i0..] {
+            for &ti in imu.t.get(i0..).unwrap_or_default() {
                 let tau = ti - ts;
                 if tau >= 2.0 * t_sep {
                     break;
@@ -462,10 +473,11 @@ fn prepare<'a>(imu: Imu<'a>, shots: &[f64], channels: &[Channel], cfg: &Predicto
             knots.sort_by(|a, b| a.0.total_cmp(&b.0));
             let segs = knots
                 .windows(2)
-                .map(|w| {
-                    let mid = ts + 0.5 * (w[0].0 + w[1].0);
+                .filter_map(|w| {
+                    let &[(a, _), (b, pulse)] = w else { return None };
+                    let mid = ts + 0.5 * (a + b);
                     let imu_i = imu.t.partition_point(|&x| x <= mid).clamp(1, n - 1) - 1;
-                    Segment { a: w[0].0, b: w[1].0, imu: imu_i, pulse: w[1].1 }
+                    Some(Segment { a, b, imu: imu_i, pulse })
                 })
                 .collect();
             (ts, segs)
@@ -491,6 +503,8 @@ struct GeometrySolution {
 }
 
 /// Right-hand side for [Φ e_1, Φ e_2, Φ e_3, x_p] and their velocities (8 vectors).
+// invariant: fixed-size arrays of 8 vectors indexed by 2c, 2c + 1 with c < 4.
+#[allow(clippy::indexing_slicing)]
 fn block_rhs(s: &ChStage, y: &[Vec3; 8], force: &Vec3, gradient: Option<&Mat3>) -> [Vec3; 8] {
     let zero = Vec3::zeros();
     let mut d = [zero; 8];
@@ -509,7 +523,7 @@ fn solve_geometry(rec: &Record, stages: &[([BodyStage; 3], bool)], ch: &Channel,
     let (mut mid, mut mid_g) = (init, init);
     let (mut acc, mut cen, mut eul) = (zero, zero, zero);
     for (st, pulse) in stages {
-        let cs = [0, 1, 2].map(|i| ChStage::new(&st[i], ch, gradient));
+        let cs = st.each_ref().map(|b| ChStage::new(b, ch, gradient));
         let h = cs[2].tau - cs[0].tau;
         // Simpson's rule for (E12)–(E14), −∫ w f dτ (exact for the piecewise-polynomial
         // integrands of linear inputs).
@@ -533,6 +547,8 @@ fn solve_geometry(rec: &Record, stages: &[([BodyStage; 3], bool)], ch: &Channel,
 }
 
 /// Phase of one channel with its breakdown, in the order of [`TERM_NAMES`].
+// invariant: fixed-size arrays of 4 vectors indexed by c < 4, Vec3 by c < 3.
+#[allow(clippy::indexing_slicing)]
 fn channel_phase(g: &GeometrySolution, ch: &Channel, gradient: bool) -> [f64; 7] {
     // φ = k·D[x] with x(0) = 0 (E4), x = Φ v0 + x_p.
     let d = |mid: &[Vec3; 4], end: &[Vec3; 4], c: usize| ch.k.dot(&(end[c] - 2.0 * mid[c]));
@@ -555,13 +571,13 @@ fn channel_phase(g: &GeometrySolution, ch: &Channel, gradient: bool) -> [f64; 7]
 pub fn predict(imu: Imu, shots: &[f64], channels: &[Channel], cfg: &PredictorConfig) -> Result<Vec<[f64; 7]>> {
     let rec = prepare(imu, shots, channels, cfg)?;
     // channels with identical (C_sb, l) share one GeometrySolution
-    let mut reps: Vec<usize> = Vec::new();
+    let mut reps: Vec<&Channel> = Vec::new();
     let mut group = Vec::with_capacity(channels.len());
-    for (j, ch) in channels.iter().enumerate() {
-        match reps.iter().position(|&r| channels[r].c_sb == ch.c_sb && channels[r].lever == ch.lever) {
+    for ch in channels {
+        match reps.iter().position(|r| r.c_sb == ch.c_sb && r.lever == ch.lever) {
             Some(g) => group.push(g),
             None => {
-                reps.push(j);
+                reps.push(ch);
                 group.push(reps.len() - 1);
             }
         }
@@ -570,12 +586,22 @@ pub fn predict(imu: Imu, shots: &[f64], channels: &[Channel], cfg: &PredictorCon
     let mut out = Vec::with_capacity(shots.len() * channels.len());
     for s in 0..shots.len() {
         let stages = rec.stages(s);
-        let sols: Vec<GeometrySolution> = reps.iter().map(|&r| solve_geometry(&rec, &stages, &channels[r], grad)).collect();
-        for (ch, &g) in channels.iter().zip(&group) {
-            out.push(channel_phase(&sols[g], ch, grad.is_some()));
+        let sols: Vec<GeometrySolution> = reps.iter().map(|r| solve_geometry(&rec, &stages, r, grad)).collect();
+        // group[j] < reps.len() = sols.len() by construction
+        for (ch, sol) in channels.iter().zip(&group).filter_map(|(ch, &g)| Some((ch, sols.get(g)?))) {
+            out.push(channel_phase(sol, ch, grad.is_some()));
         }
     }
+    check_rows(&out)?;
     Ok(out)
+}
+
+/// Finite inputs near the f64 range can overflow on the way: an error, not a NaN row.
+fn check_rows<const W: usize>(rows: &[[f64; W]]) -> Result<()> {
+    match rows.iter().position(|r| !r.iter().all(|v| v.is_finite())) {
+        Some(i) => Err(crate::NavError::Numerical(format!("output row {i} (shot × channel) is not finite: the inputs overflow the floating-point range"))),
+        None => Ok(()),
+    }
 }
 
 /// Per-stage sensitivities of (ω_s, ω̇_s, forcing F) to the 12 Jacobian parameters.
@@ -585,6 +611,8 @@ struct Tangent {
     df: [Vec3; 12],
 }
 
+// invariant: fixed-size arrays of 12 vectors indexed by j, 3 + j, 6 + j, 9 + j with j < 3.
+#[allow(clippy::indexing_slicing)]
 fn tangent(b: &BodyStage, s: &ChStage, ch: &Channel, gradient: Option<&Mat3>) -> Tangent {
     let c = &ch.c_sb;
     let l = &ch.lever;
@@ -613,6 +641,9 @@ fn tangent(b: &BodyStage, s: &ChStage, ch: &Channel, gradient: Option<&Mat3>) ->
 /// [`JACOBIAN_PARAMS`] (b_a, b_g, l, γ) at the configured estimates: row
 /// `shot * channels.len() + channel`. Euler terms (ω̇) are removed from the linearisation
 /// point unless `euler` (spec (E30) item 8, Decision 9); use [`jacobian_fd`] to check.
+// invariant: fixed-size arrays: y holds 26 = 2 + 2·12 vectors indexed by 2 + 2p and
+// 3 + 2p (p < 12) or 2p (p < 13), mid 13, the stage arrays 3 (i < 3).
+#[allow(clippy::indexing_slicing)]
 pub fn jacobian(imu: Imu, shots: &[f64], channels: &[Channel], cfg: &PredictorConfig, euler: bool) -> Result<Vec<[f64; 12]>> {
     let cfg = jacobian_config(cfg, euler);
     let rec = prepare(imu, shots, channels, &cfg)?;
@@ -658,6 +689,7 @@ pub fn jacobian(imu: Imu, shots: &[f64], channels: &[Channel], cfg: &PredictorCo
             out.push(std::array::from_fn(|p| ch.k.dot(&(y[2 + 2 * p] - 2.0 * mid[1 + p]))));
         }
     }
+    check_rows(&out)?;
     Ok(out)
 }
 
@@ -672,6 +704,9 @@ fn jacobian_config(cfg: &PredictorConfig, euler: bool) -> PredictorConfig {
 /// Central finite differences of the predicted total phase with respect to
 /// [`JACOBIAN_PARAMS`], with steps `step_a` (m/s²), `step_g` (rad/s), `step_l` (m) and
 /// `step_gamma` (rad); same linearisation point and Euler switch as [`jacobian`].
+// invariant: p < 12 indexes the 12 columns of a row and p / 3 < 4 the 4 steps;
+// plus, minus and out have one row per (shot, channel), r < out.len().
+#[allow(clippy::indexing_slicing)]
 pub fn jacobian_fd(
     imu: Imu,
     shots: &[f64],

@@ -94,6 +94,9 @@ const GL5: [(f64, f64); 5] = [
 
 /// ∫ f(t − t_c) a(t) dt (s · unit of a) with a piecewise linear between its samples and f
 /// exact: 5-point Gauss–Legendre on every piece between sample times and f's breakpoints.
+// invariant: t has ≥ 2 samples and a as many (checked above); i is clamped to
+// [0, t.len() − 2], so i and i + 1 are in range.
+#[allow(clippy::indexing_slicing)]
 pub fn response_integral(p: &Pulses, t: &[f64], a: &[f64], t_centre: f64) -> Result<f64> {
     check_increasing("t", t)?;
     check_finite("acceleration", a, 1)?;
@@ -103,7 +106,10 @@ pub fn response_integral(p: &Pulses, t: &[f64], a: &[f64], t_centre: f64) -> Res
     }
     let hw = p.half_width();
     let (lo, hi) = (t_centre - hw, t_centre + hw);
-    if t.is_empty() || lo < t[0] || hi > t[t.len() - 1] {
+    let &[t_first, .., t_last] = t else {
+        return Err(invalid("t", format!("need at least 2 samples, got {}", t.len())));
+    };
+    if lo < t_first || hi > t_last {
         return Err(invalid("t_centre", format!("pulse window [{lo}, {hi}] s outside the acceleration record")));
     }
     let mut knots: Vec<f64> = p.knots().iter().flat_map(|&k| [t_centre - k, t_centre + k]).collect();
@@ -114,7 +120,7 @@ pub fn response_integral(p: &Pulses, t: &[f64], a: &[f64], t_centre: f64) -> Res
     knots.dedup();
     let mut sum = 0.0;
     for w in knots.windows(2) {
-        let (x0, x1) = (w[0], w[1]);
+        let &[x0, x1] = w else { continue };
         let mid = 0.5 * (x0 + x1);
         let i = t.partition_point(|&x| x <= mid).clamp(1, t.len() - 1) - 1;
         let slope = (a[i + 1] - a[i]) / (t[i + 1] - t[i]);

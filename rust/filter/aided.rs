@@ -226,6 +226,8 @@ impl InsSetup {
     /// P₀ of the whole layout: this P₀ over the INS blocks and `extra_var` on the
     /// diagonal of the extra blocks (a sensor that supplies its own initial covariance;
     /// then this P₀ must be the INS block).
+    // invariant: p is resized to n = m + extra_var.len(), so m + i < n.
+    #[allow(clippy::indexing_slicing)]
     pub fn p0_with_extra(&self, extra_var: &[f64]) -> Result<DMatrix<f64>> {
         let m = ins_size();
         if self.p0.nrows() != m {
@@ -305,13 +307,15 @@ impl<A: Aiding> AidedIns<A> {
             crate::error::check_finite(field, v.as_slice(), 1)?;
         }
         let times = aiding.times();
+        let mut prev = None;
         for (i, &tm) in times.iter().enumerate() {
             if !tm.is_finite() {
                 return Err(invalid(aiding.name(), format!("non-finite time {tm} at index {i}")));
             }
-            if i > 0 && tm <= times[i - 1] {
+            if prev.is_some_and(|p| tm <= p) {
                 return Err(invalid(aiding.name(), format!("time not strictly increasing at index {i}")));
             }
+            prev = Some(tm);
         }
         let kf = Kf::new(p0, cfg.mode)?;
         let sd = Strapdown::new(initial, kind, ell, Vertical::Free)?;
@@ -364,7 +368,10 @@ impl<A: Aiding> AidedIns<A> {
             self.layout = Layout::new(&spec)?;
             let n = self.layout.size();
             let mut p0 = self.kf.p.clone().resize(n, n, 0.0);
-            p0[(n - 1, n - 1)] = sigma0 * sigma0;
+            // the last entry of the column-major n × n P₀: (n − 1, n − 1), the new block
+            if let Some(v) = p0.as_mut_slice().last_mut() {
+                *v = sigma0 * sigma0;
+            }
             self.kf = Kf::new(p0, self.cfg.mode)?;
             self.extra = self.extra.clone().push(0.0);
         }
@@ -403,6 +410,10 @@ impl<A: Aiding> AidedIns<A> {
 
     /// [`Self::process`] with the reference altitude `h_ref` (m) per sample, required with
     /// a damped vertical channel and refused with a free one.
+    // invariant: gyro and accel have n = t.len() entries (checked above), h_ref n
+    // entries (validate), n ≥ 1 here, and baro_bias is a layout index of the extra blocks
+    // (< extra.len()); k < n.
+    #[allow(clippy::indexing_slicing)]
     pub fn process_ref(&mut self, t: &[f64], gyro: &[Vec3], accel: &[Vec3], h_ref: Option<&[f64]>, out: &mut AidedOutput) -> Result<()> {
         let n = t.len();
         if gyro.len() != n || accel.len() != n {
@@ -462,7 +473,8 @@ impl<A: Aiding> AidedIns<A> {
 
     /// Predict to the last sample, apply the measurements due, feed back, record.
     fn epoch(&mut self, out: &mut AidedOutput) -> Result<()> {
-        let (tk, f_b) = self.last_sample.expect("epoch after a sample");
+        // an epoch follows a sample; without one there is nothing to predict to
+        let Some((tk, f_b)) = self.last_sample else { return Ok(()) };
         self.steps_since = 0;
         if tk <= self.t_last_predict {
             return Ok(());
@@ -479,9 +491,11 @@ impl<A: Aiding> AidedIns<A> {
         // nominal values of the extra blocks follow their dynamics too (δx = nominal − true)
         self.aiding.propagate_extra(&self.layout, dt, self.extra.as_mut_slice());
         if let (Some(i), Some((model, _))) = (self.layout.extra_index("baro_bias"), self.baro.bias) {
-            self.extra[i] *= (model.dynamics().0 * dt).exp();
+            if let Some(e) = self.extra.get_mut(i) {
+                *e *= (model.dynamics().0 * dt).exp();
+            }
         }
-        while self.next_meas < self.aiding.times().len() && self.aiding.times()[self.next_meas] <= tk {
+        while let Some(&tm) = self.aiding.times().get(self.next_meas).filter(|&&tm| tm <= tk) {
             let j = self.next_meas;
             self.next_meas += 1;
             let ctx = AidingContext {
@@ -496,7 +510,7 @@ impl<A: Aiding> AidedIns<A> {
             };
             let Some(m) = self.aiding.measure(j, &ctx)? else { continue };
             let rep = self.kf.update(&m.z, &m.h, &m.r, self.cfg.sequential, self.cfg.gate).map_err(|e| at_measurement(e, self.aiding.name(), j))?;
-            out.meas_time.push(self.aiding.times()[j]);
+            out.meas_time.push(tm);
             out.meas_rows.push(m.z.len());
             out.innovation.extend_from_slice(&rep.innovation);
             out.nis.push(rep.nis.iter().sum());
@@ -530,7 +544,7 @@ impl<A: Aiding> AidedIns<A> {
         out.accel_bias.push(ba);
         out.gyro_bias.push(bg);
         out.extra.extend(extra.iter());
-        out.sigma.extend((0..self.kf.size()).map(|i| self.kf.p[(i, i)].sqrt()));
+        out.sigma.extend(self.kf.p.diagonal().iter().map(|d| d.sqrt()));
     }
 }
 
@@ -546,10 +560,9 @@ fn at_measurement(e: NavError, name: &str, j: usize) -> NavError {
 
 /// Run over a whole record: every measurement must lie inside the IMU span.
 pub fn run_aided<A: Aiding>(mut ins: AidedIns<A>, t: &[f64], gyro: &[Vec3], accel: &[Vec3]) -> Result<(AidedOutput, AidedIns<A>)> {
-    if t.len() < 2 {
+    let &[t0, .., t1] = t else {
         return Err(invalid("imu", format!("need >= 2 samples, got {}", t.len())));
-    }
-    let (t0, t1) = (t[0], t[t.len() - 1]);
+    };
     if let Some((i, tm)) = ins.aiding.times().iter().enumerate().find(|(_, &tm)| !(tm >= t0 && tm <= t1)) {
         return Err(invalid(ins.aiding.name(), format!("time {tm} s at index {i} is outside the IMU span [{t0}, {t1}] s")));
     }
@@ -579,10 +592,11 @@ impl PositionFix {
         if lla.len() != t.len() || cov.len() != t.len() {
             return Err(invalid("fixes", format!("fix_t has {} entries but fix_lla {} and fix_cov {}", t.len(), lla.len(), cov.len())));
         }
-        if let Some(i) = cov.iter().position(|c| c.nrows() != 3 || c.ncols() != 3) {
-            return Err(invalid("fix_cov", format!("expected (M, 3, 3), entry {i} is {}x{}", cov[i].nrows(), cov[i].ncols())));
+        if let Some((i, c)) = cov.iter().enumerate().find(|(_, c)| c.nrows() != 3 || c.ncols() != 3) {
+            return Err(invalid("fix_cov", format!("expected (M, 3, 3), entry {i} is {}x{}", c.nrows(), c.ncols())));
         }
-        Ok((0..t.len()).map(|i| PositionFix { t: t[i], lla: lla[i], cov_ned: Mat3::from_fn(|r, c| cov[i][(r, c)]) }).collect())
+        // each covariance is 3 × 3 (checked above): its 9 column-major values
+        Ok(t.iter().zip(lla).zip(cov).map(|((&t, &lla), c)| PositionFix { t, lla, cov_ned: Mat3::from_iterator(c.iter().copied()) }).collect())
     }
 }
 
@@ -592,7 +606,7 @@ impl PositionAiding {
             if !f.lla.iter().all(|x| x.is_finite()) {
                 return Err(invalid("fixes", format!("non-finite position at index {i}")));
             }
-            super::matrix::check_covariance(&format!("fixes[{i}] covariance"), &DMatrix::from_fn(3, 3, |a, b| f.cov_ned[(a, b)]), Some(3), true)?;
+            super::matrix::check_covariance(&format!("fixes[{i}] covariance"), &DMatrix::from_column_slice(3, 3, f.cov_ned.as_slice()), Some(3), true)?;
         }
         Ok(PositionAiding { times: fixes.iter().map(|f| f.t).collect(), fixes })
     }
@@ -606,11 +620,11 @@ impl Aiding for PositionAiding {
         &self.times
     }
     fn measure(&mut self, j: usize, ctx: &AidingContext) -> Result<Option<Measurement>> {
-        let fx = &self.fixes[j];
+        let fx = self.fixes.get(j).ok_or_else(|| invalid("fixes", format!("no fix {j} (of {})", self.fixes.len())))?;
         let z = ned_diff(ctx.ell, &ctx.nav.lla, &fx.lla);
         let mut h = DMatrix::<f64>::zeros(3, ctx.layout.size());
         h.view_mut((0, ctx.layout.range("position")?.start), (3, 3)).fill_with_identity();
-        Ok(Some(Measurement { z: z.as_slice().to_vec(), h, r: DMatrix::from_fn(3, 3, |a, b| fx.cov_ned[(a, b)]) }))
+        Ok(Some(Measurement { z: z.as_slice().to_vec(), h, r: DMatrix::from_column_slice(3, 3, fx.cov_ned.as_slice()) }))
     }
 }
 

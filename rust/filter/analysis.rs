@@ -46,10 +46,19 @@ pub struct Scenario {
 
 /// Symmetric square root S (S Sᵀ = A) of a PSD matrix via its eigen-decomposition
 /// (clips round-off negative eigenvalues to 0; Cholesky would fail on singular Q_d).
-fn sqrt_psd(a: &DMatrix<f64>) -> DMatrix<f64> {
-    let e = SymmetricEigen::new(a.clone());
+/// An empty matrix (no measurement rows) is its own root; a non-finite one (a discretised
+/// model that overflowed) is a numerical error, as is a decomposition that does not converge.
+fn sqrt_psd(field: &str, a: &DMatrix<f64>) -> Result<DMatrix<f64>> {
+    if a.is_empty() {
+        return Ok(a.clone());
+    }
+    if !a.iter().all(|x| x.is_finite()) {
+        return Err(NavError::Numerical(format!("{field}: non-finite covariance (the model overflows the floating-point range)")));
+    }
+    // the tolerance of SymmetricEigen::new, with an iteration limit instead of its panic
+    let e = SymmetricEigen::try_new(a.clone(), f64::EPSILON, 1_000_000).ok_or_else(|| NavError::Numerical(format!("{field}: eigen-decomposition did not converge")))?;
     let d = DMatrix::from_diagonal(&e.eigenvalues.map(|x| x.max(0.0).sqrt()));
-    &e.eigenvectors * d * e.eigenvectors.transpose()
+    Ok(&e.eigenvectors * d * e.eigenvectors.transpose())
 }
 
 impl Scenario {
@@ -79,26 +88,26 @@ impl Scenario {
         if n == 0 {
             return Err(invalid("p0", "must have at least one state, got 0x0"));
         }
-        for k in 0..steps {
-            check_square(&format!("f[{k}]"), &f[k], Some(n))?;
-            check_covariance(&format!("qc[{k}]"), &qc[k], Some(n), false)?;
-            crate::error::check_positive(&format!("dt[{k}]"), dt[k])?;
+        for (k, ((fk, qk), &dk)) in f.iter().zip(qc).zip(dt).enumerate() {
+            check_square(&format!("f[{k}]"), fk, Some(n))?;
+            check_covariance(&format!("qc[{k}]"), qk, Some(n), false)?;
+            crate::error::check_positive(&format!("dt[{k}]"), dk)?;
         }
         if h.ncols() != n {
             return Err(invalid("h", format!("expected {n} columns (state size), got {}", h.ncols())));
         }
         check_covariance("r", &r, Some(h.nrows()), true)?;
-        let filt: Vec<_> = (0..steps).into_par_iter().map(|k| discretize(&f[k], &qc[k], dt[k], method)).collect();
-        let truth: Vec<_> = (0..steps)
-            .into_par_iter()
-            .map(|k| {
-                let (p, q) = if method == Discretization::VanLoan { filt[k].clone() } else { discretize(&f[k], &qc[k], dt[k], Discretization::VanLoan) };
-                (p, sqrt_psd(&q))
+        let filt: Vec<_> = f.par_iter().zip(qc).zip(dt).map(|((fk, qk), &dk)| discretize(fk, qk, dk, method)).collect();
+        let truth: Vec<_> = (f.par_iter().zip(qc).zip(dt).zip(&filt))
+            .map(|(((fk, qk), &dk), filt_k)| {
+                let (p, q) = if method == Discretization::VanLoan { filt_k.clone() } else { discretize(fk, qk, dk, Discretization::VanLoan) };
+                Ok((p, sqrt_psd("qc", &q)?))
             })
-            .collect();
+            .collect::<Result<_>>()?;
         let (phi, qd) = filt.into_iter().unzip();
         let (phi_true, sqrt_qd_true) = truth.into_iter().unzip();
-        Ok(Scenario { phi, qd, phi_true, sqrt_qd_true, sqrt_p0: sqrt_psd(&p0), p0, sqrt_r: sqrt_psd(&r), h, r, measure, sequential })
+        let (sqrt_p0, sqrt_r) = (sqrt_psd("p0", &p0)?, sqrt_psd("r", &r)?);
+        Ok(Scenario { phi, qd, phi_true, sqrt_qd_true, sqrt_p0, p0, sqrt_r, h, r, measure, sequential })
     }
 
     pub fn size(&self) -> usize {
@@ -110,6 +119,9 @@ impl Scenario {
     }
 
     /// Covariance-only analysis: σ of every state after each epoch's update (epochs × n, row-major).
+    // invariant: Scenario::new makes measure (epochs) one longer than phi, qd, phi_true, sqrt_qd_true
+    // (steps; private fields) and P n × n, so k − 1 < steps for 0 < k < epochs and i < n.
+    #[allow(clippy::indexing_slicing)]
     pub fn sigmas(&self) -> Result<Vec<f64>> {
         let n = self.size();
         let mut kf = Kf::new(self.p0.clone(), LoopMode::Closed)?;
@@ -144,6 +156,10 @@ impl Scenario {
     }
 
     /// [`Scenario::true_sigmas`] with the algebra chosen by the caller (benches and tests).
+    // invariant: Scenario::new makes measure (epochs) one longer than phi, qd, phi_true, sqrt_qd_true
+    // (steps; private fields) and P n × n, so k − 1 < steps for 0 < k < epochs and i < n.
+    // cross has one entry per step (checked above).
+    #[allow(clippy::indexing_slicing)]
     pub fn true_sigmas_using(&self, r_true: &DMatrix<f64>, cross: &[DMatrix<f64>], algebra: Algebra) -> Result<Vec<f64>> {
         let n = self.size();
         let m = self.h.nrows();
@@ -151,8 +167,8 @@ impl Scenario {
         if cross.len() != self.phi.len() {
             return Err(invalid("cross", format!("expected one n × m matrix per step ({}), got {}", self.phi.len(), cross.len())));
         }
-        if let Some(k) = cross.iter().position(|c| c.nrows() != n || c.ncols() != m) {
-            return Err(crate::error::invalid_at("cross", k, format!("entry {k} is {} × {}, expected {n} × {m}", cross[k].nrows(), cross[k].ncols())));
+        if let Some((k, c)) = cross.iter().enumerate().find(|(_, c)| c.nrows() != n || c.ncols() != m) {
+            return Err(crate::error::invalid_at("cross", k, format!("entry {k} is {} × {}, expected {n} × {m}", c.nrows(), c.ncols())));
         }
         let mut pf = self.p0.clone();
         let mut pt = self.p0.clone();
@@ -190,6 +206,10 @@ impl Scenario {
 
     /// One Monte-Carlo run with the seed of run `run` under `master_seed` (ChaCha20
     /// stream = run index, so any subset of runs reproduces the same numbers anywhere).
+    // invariant: Scenario::new makes measure (epochs) one longer than phi, qd, phi_true, sqrt_qd_true
+    // (steps; private fields) and P n × n, so k − 1 < steps for 0 < k < epochs and i < n.
+    // res.nis has one entry per epoch.
+    #[allow(clippy::indexing_slicing)]
     pub fn run(&self, master_seed: u64, run: u64, mode: LoopMode) -> Result<RunResult> {
         let n = self.size();
         let m = self.h.nrows();

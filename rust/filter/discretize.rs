@@ -26,7 +26,9 @@ impl crate::options::Choice for Discretization {
 pub fn expm(a: &DMatrix<f64>) -> DMatrix<f64> {
     let n = a.nrows();
     let norm = (0..n).map(|j| a.column(j).iter().map(|x| x.abs()).sum::<f64>()).fold(0.0, f64::max);
-    let s = if norm > 0.5 { (norm / 0.5).log2().ceil() as i32 } else { 0 };
+    // at most 1100 squarings: any finite norm needs ≤ 1025, and an infinite one (an input
+    // that overflowed) would otherwise ask for i32::MAX of them
+    let s = if norm > 0.5 { (norm / 0.5).log2().ceil().min(1100.0) as i32 } else { 0 };
     let x = a * 0.5f64.powi(s);
     let mut term = DMatrix::<f64>::identity(n, n);
     let mut sum = term.clone();

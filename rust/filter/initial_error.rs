@@ -46,6 +46,9 @@ pub fn add_nav_error(ell: &Ellipsoid, s: &NavState, dr: &Vec3, dv: &Vec3, psi: &
 
 /// δx = L u for the navigation block of `p0` (n × n over a layout starting with the
 /// INS blocks) and standard normals `u` (one per navigation state).
+// invariant: idx holds the m navigation indices of the layout, all < m ≤ rows of
+// the square p0 (checked above); i, j < m.
+#[allow(clippy::indexing_slicing)]
 pub fn initial_error(p0: &DMatrix<f64>, u: &[f64]) -> Result<Vec<f64>> {
     let idx = nav_indices()?;
     let m = idx.len();
@@ -68,8 +71,11 @@ pub fn initial_error(p0: &DMatrix<f64>, u: &[f64]) -> Result<Vec<f64>> {
 /// The estimate at the start: `truth` ⊕ δx with δx = L u ([`initial_error`]).
 pub fn perturbed_start(ell: &Ellipsoid, truth: &NavState, p0: &DMatrix<f64>, u: &[f64]) -> Result<NavState> {
     let d = initial_error(p0, u)?;
-    let v = |k: usize| Vec3::new(d[k], d[k + 1], d[k + 2]);
-    Ok(add_nav_error(ell, truth, &v(0), &v(3), &v(6)))
+    let v = |k: usize| match d.get(k..k + 3) {
+        Some(&[a, b, c]) => Ok(Vec3::new(a, b, c)),
+        _ => Err(invalid("p0", format!("the navigation blocks need 9 states, got {}", d.len()))),
+    };
+    Ok(add_nav_error(ell, truth, &v(0)?, &v(3)?, &v(6)?))
 }
 
 /// [`perturbed_start`] with the standard normals drawn from `rng` (one per navigation

@@ -132,8 +132,8 @@ pub fn error_dynamics(layout: &Layout, ell: &Ellipsoid, nav: &NavState, f_b: &Ve
     // 2γ/R₀ approximates −γ_h; the central difference is exact for the quadratic in h).
     let g_h = (ell.gravity(lat, h + 1.0) - ell.gravity(lat, h - 1.0)) / 2.0;
     let mut f_vr = skew(&v) * (2.0 * a_ie + a_er);
-    f_vr[(2, 0)] += ell.gravity_dlat(lat, h) / rm;
-    f_vr[(2, 2)] -= g_h;
+    f_vr.m31 += ell.gravity_dlat(lat, h) / rm;
+    f_vr.m33 -= g_h;
     let f_vv = -skew(&(2.0 * w_ie + w_en)) + skew(&v) * a_ev;
     put(&mut f, ir, ir, &f_rr);
     put(&mut f, ir, iv, &Mat3::identity());
@@ -165,11 +165,11 @@ pub fn error_dynamics_along(layout: &Layout, ell: &Ellipsoid, lla: &[Vec3], vel:
     if let Some((name, len)) = [("vel_ned", vel.len()), ("q_nb", q_nb.len()), ("f_b", f_b.len())].into_iter().find(|x| x.1 != n) {
         return Err(invalid(name, format!("expected {n} rows like lla, got {len}")));
     }
-    (0..n)
-        .map(|k| {
-            crate::earth::check_latitude("lla", lla[k].x, k)?;
-            let nav = NavState { t: 0.0, lla: lla[k], vel: vel[k], q_nb: q_nb[k] };
-            error_dynamics(layout, ell, &nav, &f_b[k], noise)
+    (lla.iter().zip(vel).zip(q_nb).zip(f_b).enumerate())
+        .map(|(k, (((&lla, &vel), &q_nb), f))| {
+            crate::earth::check_latitude("lla", lla.x, k)?;
+            let nav = NavState { t: 0.0, lla, vel, q_nb };
+            error_dynamics(layout, ell, &nav, f, noise)
         })
         .collect()
 }

@@ -96,12 +96,12 @@ impl Kf {
     }
 
     fn check_pd(&self, stage: &str) -> Result<()> {
-        let bad_diag = (0..self.size()).find(|&i| !positive(self.p[(i, i)]));
+        let bad_diag = self.p.diagonal().iter().enumerate().find(|(_, &d)| !positive(d)).map(|(i, &d)| (i, d));
         if bad_diag.is_some() || self.p.clone().cholesky().is_none() {
             return Err(NavError::Numerical(format!(
                 "covariance lost positive definiteness at epoch {} ({stage}){}",
                 self.epoch,
-                bad_diag.map_or(String::new(), |i| format!(": P[{i},{i}] = {}", self.p[(i, i)]))
+                bad_diag.map_or(String::new(), |(i, d)| format!(": P[{i},{i}] = {d}"))
             )));
         }
         Ok(())
@@ -143,7 +143,8 @@ impl Kf {
                 std::mem::swap(&mut self.p, out);
             }
         }
-        if (0..self.size()).any(|i| !positive(self.p[(i, i)])) {
+        // the diagonal of the column-major n × n P: every (n + 1)-th value
+        if self.p.as_slice().iter().step_by(n + 1).any(|&d| !positive(d)) {
             return self.check_pd("predict");
         }
         Ok(())
@@ -161,6 +162,7 @@ impl Kf {
         if h.nrows() != m || h.ncols() != n {
             return Err(invalid("h", format!("expected {m}x{n} (measurements x states), got {}x{}", h.nrows(), h.ncols())));
         }
+        crate::error::check_finite("h", h.as_slice(), 1)?;
         check_covariance("r", r, Some(m), true)?;
         if let Some(g) = gate {
             if !positive(g) {
@@ -169,6 +171,10 @@ impl Kf {
         }
         let report = if sequential { self.update_sequential(z, h, r, gate) } else { self.update_stacked(z, h, r, gate) }?;
         self.check_pd("update")?;
+        // finite z, H, R and P can still give an innovation beyond the f64 range
+        if !report.innovation.iter().chain(&report.nis).all(|v| v.is_finite()) {
+            return Err(NavError::Numerical(format!("innovation overflows the floating-point range at epoch {}", self.epoch)));
+        }
         Ok(report)
     }
 
@@ -187,6 +193,9 @@ impl Kf {
         Ok(UpdateReport { innovation: y.as_slice().to_vec(), nis: vec![nis], rejected: vec![] })
     }
 
+    // invariant: i < m = z.len() = rows of hb (update checks h m × n), j < n; the
+    // products hi·x and hi·ph are 1 × 1.
+    #[allow(clippy::indexing_slicing)]
     fn update_sequential(&mut self, z: &[f64], h: &DMatrix<f64>, r: &DMatrix<f64>, gate: Option<f64>) -> Result<UpdateReport> {
         // check_covariance judged a diagonally scaled copy of R: R itself is factorised here.
         let not_pd = || invalid("r", "not positive definite (Cholesky of r failed)");
@@ -281,16 +290,22 @@ pub const RTS_FAER_MIN: usize = 12;
 /// Every stored step has n × n matrices and n-vectors (n of the first step's P⁺).
 fn check_steps(steps: &[StoredStep]) -> Result<usize> {
     let n = steps.first().map_or(0, |s| s.p_post.nrows());
+    let finite = |field: &str, k: usize, v: &[f64]| match v.iter().find(|x| !x.is_finite()) {
+        Some(x) => Err(crate::error::invalid_at(field, k, format!("step {k} holds the non-finite value {x}"))),
+        None => Ok(()),
+    };
     for (k, s) in steps.iter().enumerate() {
         for (field, m) in [("phi", &s.phi), ("p_prior", &s.p_prior), ("p_post", &s.p_post)] {
             if m.shape() != (n, n) {
                 return Err(crate::error::invalid_at(field, k, format!("step {k} is {}x{}, expected {n}x{n}", m.nrows(), m.ncols())));
             }
+            finite(field, k, m.as_slice())?;
         }
         for (field, v) in [("x_prior", &s.x_prior), ("x_post", &s.x_post)] {
             if v.len() != n {
                 return Err(crate::error::invalid_at(field, k, format!("step {k} has {} entries, expected {n}", v.len())));
             }
+            finite(field, k, v.as_slice())?;
         }
     }
     Ok(n)
@@ -306,8 +321,8 @@ pub fn rts_using(steps: &[StoredStep], algebra: Algebra) -> Result<Vec<(DVector<
         Algebra::Faer => (DMatrix::zeros(n, n), DMatrix::zeros(n, n)),
         Algebra::Kernels => (DMatrix::zeros(0, 0), DMatrix::zeros(0, 0)),
     };
-    for k in (0..steps.len() - 1).rev() {
-        let (cur, next) = (&steps[k], &steps[k + 1]);
+    for (k, pair) in steps.windows(2).enumerate().rev() {
+        let [cur, next] = pair else { continue };
         let not_pd = || NavError::Numerical(format!("smoother: prior covariance not positive definite at step {}", k + 1));
         // C = P⁺Φᵀ(P⁻)⁻¹  ⇔  P⁻ Cᵀ = Φ P⁺.
         let (x, mut p) = match algebra {
@@ -331,6 +346,9 @@ pub fn rts_using(steps: &[StoredStep], algebra: Algebra) -> Result<Vec<(DVector<
             }
         };
         symmetrize(&mut p);
+        if !x.iter().chain(p.iter()).all(|v| v.is_finite()) {
+            return Err(NavError::Numerical(format!("smoother: the smoothed estimate of step {k} overflows the floating-point range")));
+        }
         out.push((std::mem::replace(&mut xs, x), std::mem::replace(&mut ps, p)));
     }
     out.push((xs, ps));

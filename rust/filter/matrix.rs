@@ -25,7 +25,7 @@ pub fn check_square(field: &str, m: &DMatrix<f64>, n: Option<usize>) -> Result<(
     }
     // x·0 is NaN exactly for NaN and ±inf: one vectorisable pass for the common case.
     if m.as_slice().iter().fold(0.0, |acc, x| acc + x * 0.0) != 0.0 {
-        let i = m.iter().position(|x| !x.is_finite()).expect("a non-finite entry");
+        let i = m.iter().position(|x| !x.is_finite()).unwrap_or_default();
         // nalgebra storage is column-major: index i is (i % rows, i / rows).
         return Err(invalid(field, format!("non-finite entry at ({}, {})", i % m.nrows(), i / m.nrows())));
     }
@@ -34,6 +34,8 @@ pub fn check_square(field: &str, m: &DMatrix<f64>, n: Option<usize>) -> Result<(
 
 /// A covariance: square, finite, symmetric to 1e-9 relative, and positive definite
 /// (`definite = true`) or positive semi-definite (`false`, e.g. a process noise).
+// invariant: i, j < n = nrows = ncols (check_square above) and d, s have n entries.
+#[allow(clippy::indexing_slicing)]
 pub fn check_covariance(field: &str, m: &DMatrix<f64>, n: Option<usize>, definite: bool) -> Result<()> {
     check_square(field, m, n)?;
     let scale = m.iter().fold(0.0f64, |a, x| a.max(x.abs()));
@@ -64,8 +66,10 @@ pub fn check_covariance(field: &str, m: &DMatrix<f64>, n: Option<usize>, definit
 }
 
 /// Symmetrize in place: P ← (P + Pᵀ)/2.
+// invariant: n = min(rows, cols), so j·n + i < n² ≤ len (P is square in every caller).
+#[allow(clippy::indexing_slicing)]
 pub fn symmetrize(p: &mut DMatrix<f64>) {
-    let n = p.nrows();
+    let n = p.nrows().min(p.ncols());
     let s = p.as_mut_slice();
     for j in 0..n {
         for i in j + 1..n {
@@ -135,6 +139,9 @@ fn propagate_sizes<const J: usize>(p: &mut [f64], x: Option<&mut [f64]>, phi: &[
 
 /// Σ_k a_k · column k of the column-major buffer `m` (n rows), added to `acc`, over
 /// rows `rows` only.
+// invariant: propagate_covariance asserts p, phi, q n × n and x of n entries and sizes t
+// to 2(n+3)n ≥ 2·S·N; every index below stays inside those buffers.
+#[allow(clippy::indexing_slicing)]
 #[inline(always)]
 fn add_columns(acc: &mut [f64], m: &[f64], n: usize, a: impl Fn(usize) -> f64, rows: std::ops::Range<usize>) {
     for k in 0..n {
@@ -147,6 +154,9 @@ fn add_columns(acc: &mut [f64], m: &[f64], n: usize, a: impl Fn(usize) -> f64, r
 
 /// The C values from row `row0` of column `k` of a column-major buffer with columns of
 /// `stride` values.
+// invariant: propagate_covariance asserts p, phi, q n × n and x of n entries and sizes t
+// to 2(n+3)n ≥ 2·S·N; every index below stays inside those buffers.
+#[allow(clippy::indexing_slicing, clippy::expect_used)]
 #[inline(always)]
 fn chunk<const C: usize>(m: &[f64], stride: usize, k: usize, row0: usize) -> &[f64; C] {
     m[k * stride + row0..k * stride + row0 + C].try_into().expect("chunk of C values")
@@ -155,6 +165,9 @@ fn chunk<const C: usize>(m: &[f64], stride: usize, k: usize, row0: usize) -> &[f
 /// For J outputs j at once: acc_j + Σ_k a(j, k) · rows row0..row0+C of column k (k < n)
 /// of the column-major buffer `m` (columns of `stride` values); the accumulators live in
 /// vector registers, and each chunk of `m` is loaded once for all J.
+// invariant: propagate_covariance asserts p, phi, q n × n and x of n entries and sizes t
+// to 2(n+3)n ≥ 2·S·N; every index below stays inside those buffers.
+#[allow(clippy::indexing_slicing, clippy::expect_used)]
 #[inline(always)]
 fn sum_columns<const C: usize, const J: usize>(mut acc: [[f64; C]; J], m: &[f64], stride: usize, row0: usize, n: usize, a: impl Fn(usize, usize) -> f64) -> [[f64; C]; J] {
     for (k, col) in m[..n * stride].chunks_exact(stride).enumerate() {
@@ -174,6 +187,9 @@ fn sum_columns<const C: usize, const J: usize>(mut acc: [[f64; C]; J], m: &[f64]
 /// registers and stored whole: a column pieced together in memory from narrower stores
 /// and read back at once cannot be store-forwarded, and the reload stalls until the
 /// stores retire.
+// invariant: propagate_covariance asserts p, phi, q n × n and x of n entries and sizes t
+// to 2(n+3)n ≥ 2·S·N; every index below stays inside those buffers.
+#[allow(clippy::indexing_slicing, clippy::expect_used)]
 #[inline(always)]
 fn pad<const N: usize, const S: usize>(m: &[f64], out: &mut [f64]) {
     let mut last = [0.0; S];
@@ -192,6 +208,9 @@ fn pad<const N: usize, const S: usize>(m: &[f64], out: &mut [f64]) {
 /// at a time; `t` holds 2·S·N values. U = ΦP, then P ← Q + UΦᵀ: the vector operands are
 /// columns of Φ and U (stored whole, in padded columns), P is read only entry by entry, so
 /// no reload has to wait for the narrower stores that wrote the previous P.
+// invariant: propagate_covariance asserts p, phi, q n × n and x of n entries and sizes t
+// to 2(n+3)n ≥ 2·S·N; every index below stays inside those buffers.
+#[allow(clippy::indexing_slicing)]
 #[inline(always)]
 fn propagate_fixed<const N: usize, const S: usize, const J: usize>(p: &mut [f64], x: Option<&mut [f64]>, phi: &[f64], q: &[f64], t: &mut [f64]) {
     let (phi_p, u) = t.split_at_mut(S * N);
@@ -225,6 +244,9 @@ fn propagate_fixed<const N: usize, const S: usize, const J: usize>(p: &mut [f64]
 }
 
 /// The same for any n.
+// invariant: propagate_covariance asserts p, phi, q n × n and x of n entries and sizes t
+// to 2(n+3)n ≥ 2·S·N; every index below stays inside those buffers.
+#[allow(clippy::indexing_slicing)]
 #[inline(always)]
 fn propagate_any(p: &mut [f64], x: Option<&mut [f64]>, phi: &[f64], q: &[f64], n: usize, t: &mut [f64]) {
     debug_assert!(!has_register_kernel(n), "n = {n} has a register kernel: has_register_kernel and propagate_sizes disagree");
@@ -245,6 +267,9 @@ fn propagate_any(p: &mut [f64], x: Option<&mut [f64]>, phi: &[f64], q: &[f64], n
 }
 
 /// Upper triangle ← lower triangle of a column-major n × n buffer.
+// invariant: propagate_covariance asserts p, phi, q n × n and x of n entries and sizes t
+// to 2(n+3)n ≥ 2·S·N; every index below stays inside those buffers.
+#[allow(clippy::indexing_slicing)]
 #[inline(always)]
 pub(crate) fn mirror_lower(p: &mut [f64], n: usize) {
     for j in 0..n {
@@ -265,6 +290,10 @@ pub(crate) struct Padded<const C: usize> {
     pub stride: usize,
 }
 
+// invariant: every buffer passed to these methods is a padded n × n buffer of
+// buffer_len() = stride·n values (u: ≥ 2 padded columns, f: ≥ 2·cols values), allocated
+// so by doubling_padded in riccati.rs; stride is a multiple of C, so every chunk is whole.
+#[allow(clippy::indexing_slicing, clippy::expect_used)]
 impl<const C: usize> Padded<C> {
     pub fn new(n: usize) -> Self {
         Self { n, stride: n.div_ceil(C).max(1) * C }

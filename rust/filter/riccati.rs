@@ -94,6 +94,9 @@ pub fn dare(phi: &DMatrix<f64>, q: &DMatrix<f64>, h: &DMatrix<f64>, r: &DMatrix<
 pub const DARE_FAER_MIN: usize = 48;
 
 /// [`dare`] with the algebra of the doubling chosen by the caller (benches and tests).
+// invariant: check_system makes phi, q n × n (n ≥ 1) and h m × n, so i, j < n index
+// phi, q, g (n × n), hs (m × n), d and x (n entries / n × n) in range.
+#[allow(clippy::indexing_slicing)]
 pub fn dare_using(phi: &DMatrix<f64>, q: &DMatrix<f64>, h: &DMatrix<f64>, r: &DMatrix<f64>, algebra: Algebra) -> Result<SteadyState> {
     check_system(phi, q, h, r)?;
     let n = phi.nrows();
@@ -122,6 +125,9 @@ pub fn dare_using(phi: &DMatrix<f64>, q: &DMatrix<f64>, h: &DMatrix<f64>, r: &DM
     let mut p_prior = DMatrix::from_fn(n, n, |i, j| x[(i, j)] * d[i] * d[j]);
     symmetrize(&mut p_prior);
     let (p_post, gain) = posterior(&p_prior, h, r)?;
+    if !p_prior.iter().chain(p_post.iter()).chain(gain.iter()).all(|v| v.is_finite()) {
+        return Err(NavError::Numerical("the DARE solution overflows the floating-point range".into()));
+    }
     Ok(SteadyState { p_prior, p_post, gain, iterations })
 }
 
@@ -165,6 +171,9 @@ fn doubling_sizes(n: usize, a0: impl Fn(usize, usize) -> f64, g0: impl Fn(usize,
 const DOUBLING_TOL: f64 = 1e-14;
 
 #[inline(always)]
+// invariant: ws holds 8·len + 2s + 4n values split into buffers of len = s·n
+// (2·len for rhs), and i, j < n ≤ s, so j·s + i < len.
+#[allow(clippy::indexing_slicing)]
 fn doubling_padded<const C: usize>(
     d: Padded<C>,
     a0: impl Fn(usize, usize) -> f64,
@@ -245,6 +254,8 @@ fn doubling_padded<const C: usize>(
 /// iteration and stopping rule as [`doubling_padded`], with blocked products and an LU
 /// solve. Writes the limit of H_k to `x_out`; None when the iteration diverges or W is
 /// singular.
+// invariant: a, g, x are n × n (built by dare_using), w, t, dx likewise; i, j < n.
+#[allow(clippy::indexing_slicing)]
 fn doubling_faer(mut a: DMatrix<f64>, mut g: DMatrix<f64>, mut x: DMatrix<f64>, x_out: &mut DMatrix<f64>) -> Option<usize> {
     let n = a.nrows();
     let (mut w, mut t, mut dx) = (DMatrix::zeros(n, n), DMatrix::zeros(n, n), DMatrix::zeros(n, n));
@@ -340,6 +351,9 @@ pub fn recursion(phi: &DMatrix<f64>, q: &DMatrix<f64>, h: &DMatrix<f64>, r: &DMa
         pr.copy_from_slice(p.transpose().as_slice());
         po.copy_from_slice(pp.as_slice());
         p = next;
+    }
+    if let Some(i) = prior.iter().chain(&post).position(|v| !v.is_finite()) {
+        return Err(NavError::Numerical(format!("the covariance of step {} overflows the floating-point range", (i % len) / (n * n))));
     }
     Ok(Recursion { n, prior, post })
 }

@@ -105,7 +105,7 @@ pub fn nominal(cfg: &ConstellationConfig) -> Result<Ephemerides> {
                     (tc, rc, vcur) = (tb, rn, vn);
                     glo.push(GloEphemeris {
                         slot: slot as u8,
-                        channel: GLONASS_CHANNELS[slot - 1],
+                        channel: GLONASS_CHANNELS.get(8 * j + s).copied().unwrap_or_default(),
                         tb,
                         pos: rn,
                         vel: vn,

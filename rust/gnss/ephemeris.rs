@@ -87,12 +87,12 @@ impl Ephemerides {
     pub fn channel(&self, sat: SatId) -> Result<i8> {
         match sat.system {
             System::Gps => Ok(0),
-            System::Glonass => self.glo.get(&sat.prn).map(|v| v[0].channel).ok_or_else(|| invalid("sat", format!("no GLONASS ephemeris for {}", sat.name()))),
+            System::Glonass => self.glo.get(&sat.prn).and_then(|v| v.first()).map(|e| e.channel).ok_or_else(|| invalid("sat", format!("no GLONASS ephemeris for {}", sat.name()))),
         }
     }
 
-    fn nearest<T>(v: &[T], key: impl Fn(&T) -> f64, t: f64) -> &T {
-        v.iter().min_by(|a, b| (key(a) - t).abs().total_cmp(&(key(b) - t).abs())).expect("non-empty by construction")
+    fn nearest<T>(v: &[T], key: impl Fn(&T) -> f64, t: f64) -> Option<&T> {
+        v.iter().min_by(|a, b| (key(a) - t).abs().total_cmp(&(key(b) - t).abs()))
     }
 
     fn stale(sat: SatId, t: f64, age: f64, max: f64) -> crate::error::NavError {
@@ -117,7 +117,7 @@ impl Ephemerides {
         match sat.system {
             System::Gps => {
                 let v = self.gps.get(&sat.prn).ok_or_else(|| invalid("sat", format!("no GPS ephemeris for {}", sat.name())))?;
-                let e = Self::nearest(v, |e| e.toe, t);
+                let e = Self::nearest(v, |e| e.toe, t).ok_or_else(|| invalid("sat", format!("no GPS ephemeris for {}", sat.name())))?;
                 let age = (t - e.toe).abs();
                 if age > MAX_AGE_GPS {
                     return Err(Self::stale(sat, t, age, MAX_AGE_GPS));
@@ -129,7 +129,7 @@ impl Ephemerides {
             System::Glonass => {
                 let v = self.glo.get(&sat.prn).ok_or_else(|| invalid("sat", format!("no GLONASS ephemeris for {}", sat.name())))?;
                 let tg = self.time.glonass_time(t, tau_gps);
-                let e = Self::nearest(v, |e| e.tb, tg);
+                let e = Self::nearest(v, |e| e.tb, tg).ok_or_else(|| invalid("sat", format!("no GLONASS ephemeris for {}", sat.name())))?;
                 let age = (tg - e.tb).abs();
                 if age > MAX_AGE_GLO {
                     return Err(Self::stale(sat, t, age, MAX_AGE_GLO));

@@ -105,6 +105,8 @@ pub fn receiver_ecef(lla: &Vec3, vel_ned: &Vec3) -> (Vec3, Vec3) {
 /// Observations at GPS times `t` of a receiver at `lla` moving with `vel_ned`, each with its
 /// true elevation (rad). Satellites are those with ephemerides, in the order of
 /// `Ephemerides::satellites`.
+// invariant: lla and vel_ned have one row per epoch of t (checked above), k < t.len().
+#[allow(clippy::indexing_slicing)]
 pub fn simulate(eph: &Ephemerides, t: &[f64], lla: &[Vec3], vel_ned: &[Vec3], cfg: &SimConfig, vis: &Visibility) -> Result<Vec<Vec<(Observation, f64)>>> {
     if lla.len() != t.len() || vel_ned.len() != t.len() {
         return Err(invalid("lla", format!("{} positions and {} velocities for {} epochs", lla.len(), vel_ned.len(), t.len())));
@@ -144,11 +146,10 @@ pub fn observations(sat: &[String], channel: &[i64], code: &[f64], rate: &[f64])
     if channel.len() != ids.len() || code.len() != ids.len() || rate.len() != ids.len() {
         return Err(invalid("sat", format!("{} satellites, {} channels, {} codes, {} rates", ids.len(), channel.len(), code.len(), rate.len())));
     }
-    ids.iter()
-        .enumerate()
-        .map(|(i, &sat)| {
-            let channel = if sat.system == System::Glonass { super::check_channel("channel", channel[i], i)? } else { 0 };
-            Ok(Observation { sat, channel, code: code[i], rate: rate[i] })
+    (ids.iter().zip(channel).zip(code).zip(rate).enumerate())
+        .map(|(i, (((&sat, &ch), &code), &rate))| {
+            let channel = if sat.system == System::Glonass { super::check_channel("channel", ch, i)? } else { 0 };
+            Ok(Observation { sat, channel, code, rate })
         })
         .collect()
 }
@@ -171,11 +172,11 @@ pub fn simulate_table(eph: &Ephemerides, t: &[f64], lla: &[Vec3], vel_ned: &[Vec
     crate::error::check_increasing("t", t)?;
     let epochs = simulate(eph, t, lla, vel_ned, cfg, vis)?;
     let mut out = ObservationTable::default();
-    for (k, ep) in epochs.iter().enumerate() {
+    for (ep, &tk) in epochs.iter().zip(t) {
         for (o, e) in ep {
             out.sat.push(o.sat.name());
             out.channel.push(o.channel as i64);
-            out.time.push(t[k]);
+            out.time.push(tk);
             out.code.push(o.code);
             out.rate.push(o.rate);
             out.elevation.push(*e);

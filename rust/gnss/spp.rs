@@ -59,6 +59,9 @@ fn corrected_code(o: &Observation, g: &Geometry, atm: &Atmosphere, lla: &Vec3, t
 
 /// Position solution at GPS time t from the code observations of one epoch; `x0` is the
 /// initial ECEF guess (the Earth's centre when None).
+// invariant: x has n ∈ {4, 5} unknowns (5 exactly when with_tau), h is m × n, z and
+// w have m = obs.len() rows, i < m; cov is n × n.
+#[allow(clippy::indexing_slicing)]
 pub fn solve_position(eph: &Ephemerides, t: f64, obs: &[Observation], cfg: &SppConfig, x0: Option<Vec3>) -> Result<SppSolution> {
     check_unique("obs", obs)?;
     let has_glo = obs.iter().any(|o| o.sat.system == System::Glonass);
@@ -164,6 +167,8 @@ pub const SPP_COLUMNS: [&str; 22] = [
 /// previous epoch's (the first from the Earth's centre); the Doppler velocity
 /// ([`solve_velocity`], rate σ `sigma_rate` m/s) when at least four rates are finite.
 /// One row per epoch, columns [`SPP_COLUMNS`].
+// invariant: tau is Some only for the 5-unknown solution, whose cov is 5 × 5.
+#[allow(clippy::indexing_slicing)]
 pub fn solve_epochs(eph: &Ephemerides, epochs: &[(f64, Vec<Observation>)], cfg: &SppConfig, sigma_rate: f64) -> Result<Vec<[f64; 22]>> {
     crate::error::check_positive("sigma_rate", sigma_rate)?;
     let mut x0 = None;
@@ -188,6 +193,9 @@ pub fn solve_epochs(eph: &Ephemerides, epochs: &[(f64, Vec<Observation>)], cfg: 
 }
 
 /// DOP from the design matrix rotated into local NED (position columns).
+// invariant: h has n ≥ 4 columns (the solver's unknowns: position, clock[, τ]), so q
+// is n × n with n ≥ 4 and i < rows of h, j < 3.
+#[allow(clippy::indexing_slicing)]
 fn dop(h: &DMatrix<f64>, lla: &Vec3, n: usize) -> Result<Dop> {
     let cne = dcm_ned_to_ecef(lla.x, lla.y);
     let mut g = h.clone();
@@ -210,6 +218,8 @@ fn dop(h: &DMatrix<f64>, lla: &Vec3, n: usize) -> Result<Dop> {
 
 /// Doppler velocity (Eq. 24): least squares for (v ECEF m/s, c·δṫ_r m/s) at the known
 /// antenna position `pos`, with rows (−κu_iᵀ, 1); returns (velocity, clock drift, covariance).
+// invariant: x has 4 unknowns, h and z one row per used observation (i < used.len()).
+#[allow(clippy::indexing_slicing)]
 pub fn solve_velocity(eph: &Ephemerides, t: f64, obs: &[Observation], pos: &Vec3, sigma: f64) -> Result<(Vec3, f64, DMatrix<f64>)> {
     check_unique("obs", obs)?;
     let used: Vec<&Observation> = obs.iter().filter(|o| o.rate.is_finite()).collect();

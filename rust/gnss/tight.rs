@@ -99,8 +99,13 @@ impl TightAiding {
         self.reference
     }
 
+    // invariant: ip, iv, ipsi and the extra-block starts are ranges of ctx.layout, whose
+    // size n is the length of h_code and h_rate (clock: 2 states, so i + 1 < n); k < 3.
+    #[allow(clippy::indexing_slicing)]
     fn rows(&mut self, j: usize, ctx: &AidingContext) -> Result<Vec<Row>> {
-        let t = self.times[j];
+        let (Some(&t), Some(epoch)) = (self.times.get(j), self.epochs.get(j)) else {
+            return Err(invalid("gnss", format!("no epoch {j} (of {})", self.times.len())));
+        };
         let nav = ctx.nav;
         let n = ctx.layout.size();
         let cne = dcm_ned_to_ecef(nav.lla.x, nav.lla.y);
@@ -114,7 +119,7 @@ impl TightAiding {
         // (state index, nominal value, nominal value of the next component) of an extra block
         let extra = |name: &str| {
             let (r, e) = (ctx.layout.get(name)?, ctx.layout.extra_index(name)?);
-            Some((r.start, ctx.extra[e], ctx.extra.get(e + 1).copied().unwrap_or(0.0)))
+            Some((r.start, *ctx.extra.get(e)?, ctx.extra.get(e + 1).copied().unwrap_or(0.0)))
         };
         let tau = extra("c_tau_gps");
         let clock = extra("clock");
@@ -126,7 +131,7 @@ impl TightAiding {
         let a_ev = Mat3::new(0.0, 1.0 / loc.rp, 0.0, -1.0 / loc.rm, 0.0, 0.0, 0.0, -loc.sin / (loc.cos * loc.rp), 0.0);
         let frame_term = skew(&(cne.transpose() * v_a)) * a_ev;
         let mut rows = Vec::new();
-        for o in &self.epochs[j] {
+        for o in epoch {
             let glo = o.sat.system == System::Glonass;
             let g = geometry(&self.eph, o.sat, t, &r_a, &v_a, lla_a.x, lla_a.y, tau.map_or(0.0, |x| x.1 / C_LIGHT))?;
             if g.elevation <= 0.0 {
@@ -184,21 +189,24 @@ impl TightAiding {
 
     /// Keep the reference while it is seen; otherwise the highest GPS satellite (the
     /// highest GLONASS one when no GPS satellite is seen). Returns its index in `rows`.
-    fn pick_reference(&mut self, rows: &[Row]) -> usize {
+    fn pick_reference(&mut self, rows: &[Row]) -> Option<usize> {
         if let Some(i) = self.reference.and_then(|r| rows.iter().position(|x| x.sat == r)) {
-            return i;
+            return Some(i);
         }
         let best = |sys: System| {
             rows.iter().enumerate().filter(|(_, r)| r.sat.system == sys).max_by(|a, b| a.1.elevation.total_cmp(&b.1.elevation)).map(|(i, _)| i)
         };
-        let i = best(System::Gps).or_else(|| best(System::Glonass)).expect("at least one row");
-        self.reference = Some(rows[i].sat);
-        i
+        let i = best(System::Gps).or_else(|| best(System::Glonass))?;
+        self.reference = rows.get(i).map(|r| r.sat);
+        Some(i)
     }
 }
 
 /// Stack (z, H, R) of a set of rows; FD against row `r0` when given, with
 /// R = σ₀²11ᵀ + diag(σᵢ²) (Eq. 39).
+// invariant: h and s have one entry per z (built from the same rows), i, k < z.len(),
+// and a, b < m = rows and columns of hm and r.
+#[allow(clippy::indexing_slicing)]
 fn stack(z: &[f64], h: &[&RowDVector<f64>], s: &[f64], r0: Option<usize>, n: usize) -> (Vec<f64>, DMatrix<f64>, DMatrix<f64>) {
     let idx: Vec<usize> = (0..z.len()).filter(|&i| Some(i) != r0).collect();
     let m = idx.len();
@@ -256,17 +264,23 @@ impl Aiding for TightAiding {
         if rows.is_empty() || (fd && rows.len() < 2) {
             return Ok(None);
         }
-        let r0 = if fd { Some(self.pick_reference(&rows)) } else { None };
+        let r0 = match fd {
+            true => match self.pick_reference(&rows) {
+                Some(i) => Some(i),
+                None => return Ok(None),
+            },
+            false => None,
+        };
         let zc: Vec<f64> = rows.iter().map(|r| r.z_code).collect();
         let hc: Vec<&RowDVector<f64>> = rows.iter().map(|r| &r.h_code).collect();
         let sc: Vec<f64> = rows.iter().map(|r| r.s_code).collect();
         let (mut z, mut h, mut r) = stack(&zc, &hc, &sc, r0, n);
         // rate rows: only satellites with a rate, differenced against the same reference
-        let with_rate: Vec<usize> = (0..rows.len()).filter(|&i| rows[i].z_rate.is_finite()).collect();
-        let rate_ref = r0.and_then(|k| with_rate.iter().position(|&i| i == k));
+        let with_rate: Vec<(usize, &Row)> = rows.iter().enumerate().filter(|(_, r)| r.z_rate.is_finite()).collect();
+        let rate_ref = r0.and_then(|k| with_rate.iter().position(|&(i, _)| i == k));
         if with_rate.len() > usize::from(fd) && (!fd || rate_ref.is_some()) {
-            let zr: Vec<f64> = with_rate.iter().map(|&i| rows[i].z_rate).collect();
-            let hr: Vec<&RowDVector<f64>> = with_rate.iter().map(|&i| &rows[i].h_rate).collect();
+            let zr: Vec<f64> = with_rate.iter().map(|(_, r)| r.z_rate).collect();
+            let hr: Vec<&RowDVector<f64>> = with_rate.iter().map(|(_, r)| &r.h_rate).collect();
             let sr = vec![self.cfg.sigma_rate; with_rate.len()];
             let (z2, h2, r2) = stack(&zr, &hr, &sr, rate_ref, n);
             let (m1, m2) = (z.len(), z2.len());
@@ -279,6 +293,9 @@ impl Aiding for TightAiding {
         Ok(Some(Measurement { z, h, r }))
     }
 
+    // invariant: f and qc are n × n for this layout, whose c_tau_gps (1 state) and clock
+    // (2 states) ranges lie inside n.
+    #[allow(clippy::indexing_slicing)]
     fn extra_dynamics(&self, layout: &Layout, f: &mut DMatrix<f64>, qc: &mut DMatrix<f64>) {
         if let Some(r) = layout.get("c_tau_gps") {
             qc[(r.start, r.start)] = self.cfg.tau_psd;
@@ -294,8 +311,8 @@ impl Aiding for TightAiding {
 
     fn propagate_extra(&self, layout: &Layout, dt: f64, extra: &mut [f64]) {
         // nominal clock bias follows the drift (the F block above): c·δt_r += c·δṫ_r·Δt
-        if let Some(i) = layout.extra_index("clock") {
-            extra[i] += extra[i + 1] * dt;
+        if let Some(&mut [ref mut bias, drift, ..]) = layout.extra_index("clock").and_then(|i| extra.get_mut(i..)) {
+            *bias += drift * dt;
         }
     }
 }

@@ -102,11 +102,8 @@ impl TriadErrors {
             let (r, c) = (i % 3, i / 3); // nalgebra is column-major
             return Err(invalid(&format!("{name}.misalignment"), format!("non-finite value at index ({r}, {c})")));
         }
-        if let Some(i) = (0..3).find(|&i| self.misalignment[(i, i)] != 0.0) {
-            return Err(invalid(
-                &format!("{name}.misalignment"),
-                format!("diagonal must be zero (scale-factor errors go in `scale`), got {} at index ({i}, {i})", self.misalignment[(i, i)]),
-            ));
+        if let Some((i, d)) = self.misalignment.diagonal().iter().enumerate().find(|(_, &d)| d != 0.0) {
+            return Err(invalid(&format!("{name}.misalignment"), format!("diagonal must be zero (scale-factor errors go in `scale`), got {d} at index ({i}, {i})")));
         }
         check_nonneg(format!("{name}.white"), self.white)?;
         check_nonneg(format!("{name}.bias_rw"), self.bias_rw)?;
@@ -238,8 +235,8 @@ pub struct ImuSimulator {
     gyro: TriadSim,
 }
 
-fn first_non_finite(v: &[Vec3]) -> Option<(usize, usize)> {
-    v.iter().enumerate().find_map(|(i, r)| r.iter().position(|x| !x.is_finite()).map(|c| (i, c)))
+fn first_non_finite(v: &[Vec3]) -> Option<(usize, usize, f64)> {
+    v.iter().enumerate().find_map(|(i, r)| r.iter().enumerate().find(|(_, x)| !x.is_finite()).map(|(c, &x)| (i, c, x)))
 }
 
 impl ImuSimulator {
@@ -273,8 +270,8 @@ impl ImuSimulator {
             return Err(invalid("gyro", format!("expected {} rows like accel, got {}", accel.len(), gyro.len())));
         }
         for (name, v) in [("accel", accel), ("gyro", gyro)] {
-            if let Some((i, c)) = first_non_finite(v) {
-                return Err(invalid(name, format!("non-finite value {} at index {i} (column {c})", v[i][c])));
+            if let Some((i, c, x)) = first_non_finite(v) {
+                return Err(invalid(name, format!("non-finite value {x} at index {i} (column {c})")));
             }
         }
         let n = accel.len();

@@ -65,7 +65,7 @@ pub fn ideal_increments(motion: &Motion, ell: &Ellipsoid, truth: &[TruthState]) 
     let mut dv = Vec::with_capacity(truth.len().saturating_sub(1));
     let mut dth = Vec::with_capacity(truth.len().saturating_sub(1));
     for pair in truth.windows(2) {
-        let (a, b) = (&pair[0], &pair[1]);
+        let [a, b] = pair else { continue };
         let span = b.t - a.t;
         let pieces = (span / 0.01).ceil().max(1.0) as usize;
         let h = span / pieces as f64;

@@ -113,7 +113,14 @@ pub fn resolve_m(set: &TauSet, kind: Kind, np: usize) -> Result<Vec<usize>> {
     Ok(match set {
         TauSet::Octave => gen(&|k| 1usize << k),
         TauSet::All => gen(&|k| k + 1),
-        TauSet::Decade => gen(&|k| [1, 2, 4][k % 3] * 10usize.pow((k / 3) as u32)),
+        TauSet::Decade => gen(&|k| {
+            let mantissa = match k % 3 {
+                0 => 1,
+                1 => 2,
+                _ => 4,
+            };
+            u32::try_from(k / 3).ok().and_then(|e| 10usize.checked_pow(e)).and_then(|p| p.checked_mul(mantissa)).unwrap_or(usize::MAX)
+        }),
         TauSet::List(ms) => {
             if ms.is_empty() {
                 return Err(invalid("m", "no averaging factors given"));
@@ -153,16 +160,13 @@ fn par_parts<T: Send>(work: usize, f: impl Fn(usize) -> T + Sync) -> Vec<T> {
         return (0..PARTS).map(f).collect();
     }
     let f = &f;
-    let mut out: Vec<Option<T>> = (0..PARTS).map(|_| None).collect();
-    std::thread::scope(|s| {
+    let mut out: Vec<(usize, T)> = std::thread::scope(|s| {
         let handles: Vec<_> = (0..threads).map(|t| s.spawn(move || (t..PARTS).step_by(threads).map(|p| (p, f(p))).collect::<Vec<_>>())).collect();
-        for h in handles {
-            for (p, v) in h.join().expect("worker thread panicked") {
-                out[p] = Some(v);
-            }
-        }
+        // a worker fails only by a panic of `f` itself: passed on unchanged
+        handles.into_iter().flat_map(|h| h.join().unwrap_or_else(|e| std::panic::resume_unwind(e))).collect()
     });
-    out.into_iter().map(|v| v.expect("every part computed")).collect()
+    out.sort_by_key(|(p, _)| *p);
+    out.into_iter().map(|(_, v)| v).collect()
 }
 
 /// Σ f(v) with eight independent accumulators (vectorisable).
@@ -170,8 +174,8 @@ fn lane_sum(v: &[f64], f: impl Fn(f64) -> f64) -> f64 {
     let mut acc = [0.0f64; 8];
     let mut chunks = v.chunks_exact(8);
     for c in &mut chunks {
-        for l in 0..8 {
-            acc[l] += f(c[l]);
+        for (a, &x) in acc.iter_mut().zip(c) {
+            *a += f(x);
         }
     }
     chunks.remainder().iter().map(|&x| f(x)).sum::<f64>() + acc.iter().sum::<f64>()
@@ -183,7 +187,7 @@ fn lane_sum(v: &[f64], f: impl Fn(f64) -> f64) -> f64 {
 fn rate_to_phase(y: &[f64]) -> Vec<f64> {
     let n = y.len();
     let len = n.div_ceil(PARTS);
-    let part = |p: usize| &y[(p * len).min(n)..((p + 1) * len).min(n)];
+    let part = |p: usize| y.get((p * len).min(n)..((p + 1) * len).min(n)).unwrap_or_default();
     let sums = par_parts(n, |p| lane_sum(part(p), |v| v));
     let mean = sums.iter().sum::<f64>() / n as f64;
     let mut x = vec![0.0; n + 1];
@@ -193,12 +197,13 @@ fn rate_to_phase(y: &[f64]) -> Vec<f64> {
         starts.push(start);
         start += s - part(p).len() as f64 * mean;
     }
-    let mut outs: Vec<&mut [f64]> = x[1..].chunks_mut(len.max(1)).collect();
+    let mut outs: Vec<&mut [f64]> = x.get_mut(1..).unwrap_or_default().chunks_mut(len.max(1)).collect();
     outs.resize_with(PARTS, || &mut []);
     let outs: Vec<std::sync::Mutex<&mut [f64]>> = outs.into_iter().map(std::sync::Mutex::new).collect();
     par_parts(n, |p| {
-        let mut out = outs[p].lock().expect("one part per worker");
-        let mut acc = starts[p];
+        // one part per worker: the lock is never contended, nor poisoned (nothing below panics)
+        let (Some(Ok(mut out)), Some(&start)) = (outs.get(p).map(|o| o.lock()), starts.get(p)) else { return };
+        let mut acc = start;
         for (o, v) in out.iter_mut().zip(part(p)) {
             acc += v - mean;
             *o = acc;
@@ -211,6 +216,9 @@ fn rate_to_phase(y: &[f64]) -> Vec<f64> {
 /// independent accumulators over fixed-size blocks so the loop vectorises.
 #[inline(always)]
 #[allow(clippy::needless_range_loop)] // index i runs across the K slices
+// invariant: K ≥ 1 slices of one common length (difference_sums cuts each to end − i0), so
+// every index below n = s[0].len() is in range and each block is exactly L long.
+#[allow(clippy::indexing_slicing, clippy::expect_used)]
 fn sum_sq_impl<const K: usize>(s: [&[f64]; K], c: [f64; K]) -> f64 {
     const L: usize = 8;
     let n = s[0].len();
@@ -254,10 +262,14 @@ fn sum_sq<const K: usize>(s: [&[f64]; K], c: [f64; K]) -> f64 {
 /// terms and each block is visited once for all m, so the windows x_{i+km} of
 /// neighbouring octave factors (2m_k = m_{k+1}) are read from cache rather than memory.
 /// The range is split into `PARTS` fixed parts (see [`par_parts`]).
+// invariant: resolve_m keeps only m with x.len() − (K−1)m ≥ MIN_TERMS, and end ≤ terms(m),
+// so x[i0 + km .. end + km] ends at most at x.len().
+#[allow(clippy::indexing_slicing)]
 fn difference_sums<const K: usize>(x: &[f64], ms: &[usize], c: [f64; K]) -> Vec<f64> {
     const BLOCK: usize = 2048;
     let terms = |m: usize| x.len() - (K - 1) * m;
-    let total = terms(ms[0]);
+    let Some(&m0) = ms.first() else { return Vec::new() };
+    let total = terms(m0);
     let part_len = total.div_ceil(PARTS).div_ceil(BLOCK) * BLOCK;
     let parts = par_parts(total * ms.len(), |p| {
         let mut sums = vec![0.0; ms.len()];
@@ -279,6 +291,9 @@ fn difference_sums<const K: usize>(x: &[f64], ms: &[usize], c: [f64; K]) -> Vec<
 
 /// Σ_j v_j², v_j = Σ_{i=j}^{j+m−1} (x_{i+2m} − 2x_{i+m} + x_i), updated by
 /// v_{j+1} = v_j + x_{j+3m} − 3x_{j+2m} + 3x_{j+m} − x_j (NIST SP 1065 Eq. 15).
+// invariant: resolve_m keeps only m with x.len() + 1 − 3m ≥ MIN_TERMS, so i + 2m and
+// j + 3m stay below x.len().
+#[allow(clippy::indexing_slicing)]
 fn modified_sum(x: &[f64], m: usize) -> f64 {
     let mut v: f64 = (0..m).map(|i| x[i + 2 * m] - 2.0 * x[i + m] + x[i]).sum();
     let mut s = v * v;
@@ -311,8 +326,8 @@ fn check_series(data: &[f64], data_type: DataType, tau0: f64) -> Result<()> {
     }
     // A constant rate (or a phase ramp) has identically zero variance at every τ.
     let constant = match data_type {
-        DataType::Rate => data.iter().all(|&v| v == data[0]),
-        DataType::Phase => data.windows(3).all(|w| w[2] - 2.0 * w[1] + w[0] == 0.0),
+        DataType::Rate => data.split_first().is_some_and(|(d0, rest)| rest.iter().all(|v| v == d0)),
+        DataType::Phase => data.windows(3).all(|w| matches!(w, [a, b, c] if c - 2.0 * b + a == 0.0)),
     };
     if constant {
         let what = if data_type == DataType::Rate { "constant series" } else { "phase is a straight line (constant rate)" };
@@ -336,12 +351,14 @@ pub fn variance(data: &[f64], tau0: f64, data_type: DataType, kind: Kind, set: &
         Kind::Modified => ms.iter().map(|&m| modified_sum(&x, m)).collect(),
     };
     let n: Vec<usize> = ms.iter().map(|&m| kind.terms(x.len(), m)).collect();
-    Ok(AllanResult {
+    let res = AllanResult {
         tau: ms.iter().map(|&m| m as f64 * tau0).collect(),
-        var: (0..ms.len()).map(|j| sums[j] * scale / divisor(kind, ms[j], n[j])).collect(),
+        var: sums.iter().zip(&ms).zip(&n).map(|((s, &m), &nj)| s * scale / divisor(kind, m, nj)).collect(),
         m: ms,
         n,
-    })
+    };
+    check_overflow(&res)?;
+    Ok(res)
 }
 
 /// Streaming accumulation of all three variances at fixed averaging factors, for
@@ -403,6 +420,9 @@ impl AllanStream {
         })
     }
 
+    // invariant: ring indices are masked by mask = ring capacity − 1 once the ring is
+    // full and below n = ring.len() before; sum_a, sum_m, sum_h and v have one entry per m.
+    #[allow(clippy::indexing_slicing)]
     fn push_phase(&mut self, x: f64) {
         let n = self.np;
         if self.ring.len() > self.mask {
@@ -432,7 +452,8 @@ impl AllanStream {
         self.np += 1;
     }
 
-    /// Feed the next chunk of samples (rate or phase, as constructed).
+    /// Feed the next chunk of samples (rate or phase, as constructed). Samples so large that
+    /// the sums overflow the f64 range are an error.
     pub fn update(&mut self, chunk: &[f64]) -> Result<()> {
         check_finite("chunk", chunk, 1)?;
         for &y in chunk {
@@ -448,6 +469,9 @@ impl AllanStream {
                 }
             }
         }
+        if !self.sum_a.iter().chain(&self.sum_m).chain(&self.sum_h).all(|s| s.is_finite()) {
+            return Err(invalid("chunk", "the sums overflow the floating-point range: the samples are too large (rescale them)"));
+        }
         Ok(())
     }
 
@@ -460,16 +484,24 @@ impl AllanStream {
             Kind::Hadamard => &self.sum_h,
         };
         let mut out = AllanResult { m: Vec::new(), tau: Vec::new(), var: Vec::new(), n: Vec::new() };
-        for (j, &m) in self.ms.iter().enumerate() {
+        for (&m, s) in self.ms.iter().zip(sums) {
             let n = kind.terms(self.np, m);
             if n >= MIN_TERMS {
                 out.m.push(m);
                 out.tau.push(m as f64 * self.tau0);
-                out.var.push(sums[j] * scale / divisor(kind, m, n));
+                out.var.push(s * scale / divisor(kind, m, n));
                 out.n.push(n);
             }
         }
         out
+    }
+}
+
+/// τ and variances of a finite record can still overflow the f64 range (samples near 1e300).
+fn check_overflow(res: &AllanResult) -> Result<()> {
+    match res.tau.iter().chain(&res.var).find(|v| !v.is_finite()) {
+        Some(v) => Err(invalid("data", format!("a variance or τ overflows the floating-point range ({v}): rescale the data or tau0"))),
+        None => Ok(()),
     }
 }
 
@@ -498,8 +530,8 @@ impl Choice for NoiseType {
 /// of `np` phase points: [`edf_overlapping_allan`] for the Allan variance, the
 /// non-overlapping count [`edf_non_overlapping`] otherwise.
 pub fn edf(kind: Kind, noise: NoiseType, np: usize, m: &[usize]) -> Result<Vec<f64>> {
-    if let Some(i) = m.iter().position(|&mj| mj == 0 || mj >= np) {
-        return Err(invalid_at("m", i, format!("averaging factor {} at index {i} outside [1, {np}) for {np} phase points", m[i])));
+    if let Some((i, mi)) = m.iter().enumerate().find(|(_, &mj)| mj == 0 || mj >= np) {
+        return Err(invalid_at("m", i, format!("averaging factor {mi} at index {i} outside [1, {np}) for {np} phase points")));
     }
     Ok(m.iter()
         .map(|&mj| if kind == Kind::Allan { edf_overlapping_allan(noise, np, mj) } else { edf_non_overlapping(kind, np, mj) })
@@ -574,29 +606,39 @@ pub fn fit(res: &AllanResult, n_samples: usize, terms: [bool; 5], tau_min: f64, 
     }
     check_finite("tau", &res.tau, 1)?;
     check_finite("var", &res.var, 1)?;
-    let idx: Vec<usize> = (0..res.tau.len()).filter(|&j| res.tau[j] >= tau_min && res.tau[j] <= tau_max && res.var[j] > 0.0).collect();
-    let cols: Vec<i32> = (-2..=2).filter(|k| terms[(k + 2) as usize]).collect();
+    // (τ_j, AVAR_j, σ_j) of the points used
+    let sigma = |var: f64, m: usize| var / (((n_samples / m) as f64 - 1.0).max(1.0)).sqrt();
+    let pts: Vec<(f64, f64, f64)> = (res.tau.iter().zip(&res.var).zip(&res.m))
+        .filter(|((&t, &v), _)| t >= tau_min && t <= tau_max && v > 0.0)
+        .map(|((&t, &v), &m)| (t, v, sigma(v, m)))
+        .collect();
+    let cols: Vec<i32> = (-2..=2).zip(terms).filter(|(_, on)| *on).map(|(k, _)| k).collect();
     if cols.is_empty() {
         return Err(invalid("terms", "no term selected"));
     }
-    if idx.len() < cols.len() {
+    if pts.len() < cols.len() {
         return Err(invalid(
             "tau_min/tau_max",
-            format!("{} Allan points with positive variance in [{tau_min}, {tau_max}] s; the fit needs at least {}", idx.len(), cols.len()),
+            format!("{} Allan points with positive variance in [{tau_min}, {tau_max}] s; the fit needs at least {}", pts.len(), cols.len()),
         ));
     }
-    let rows = idx.len();
-    let sigma = |j: usize| res.var[j] / (((n_samples / res.m[j]) as f64 - 1.0).max(1.0)).sqrt();
-    let mut a = DMatrix::from_fn(rows, cols.len(), |r, c| res.tau[idx[r]].powi(cols[c]) / sigma(idx[r]));
-    let b = DVector::from_fn(rows, |r, _| res.var[idx[r]] / sigma(idx[r]));
+    let rows = pts.len();
+    // column-major: one column per selected power of τ
+    let mut a = DMatrix::from_iterator(rows, cols.len(), cols.iter().flat_map(|&k| pts.iter().map(move |&(t, _, s)| t.powi(k) / s)));
+    let b = DVector::from_iterator(rows, pts.iter().map(|&(_, v, s)| v / s));
     let norms: Vec<f64> = (0..cols.len()).map(|c| a.column(c).norm()).collect();
     for (c, nrm) in norms.iter().enumerate() {
         a.column_mut(c).unscale_mut(*nrm);
     }
     let z = nnls(&a, &b)?;
     let mut coeffs = [0.0; 5];
-    for (c, &k) in cols.iter().enumerate() {
-        coeffs[(k + 2) as usize] = z[c] / norms[c];
+    for ((&k, zc), nrm) in cols.iter().zip(z.iter()).zip(&norms) {
+        if let Some(slot) = usize::try_from(k + 2).ok().and_then(|i| coeffs.get_mut(i)) {
+            *slot = zc / nrm;
+        }
+    }
+    if !coeffs.iter().all(|c| c.is_finite()) {
+        return Err(NavError::Numerical("the Allan fit overflows the floating-point range (rescale the variances)".into()));
     }
     Ok(AllanFit {
         coeffs,

@@ -41,6 +41,8 @@ pub struct ArimaStateSpace {
 
 /// Coefficients c of ω_k = Σ c_i ω_{k−i} + …: (1 − Σφ_i Lⁱ)(1 − L)^d = 1 − Σ c_i Lⁱ.
 /// For (2,1): [1+φ₁, φ₂−φ₁, −φ₂] (Niu et al. 2025 Eq. 12).
+// invariant: next has poly.len() + 1 entries, so i + 1 ≤ poly.len() is in range.
+#[allow(clippy::indexing_slicing)]
 pub fn integrated_ar(ar: &[f64], d: usize) -> Vec<f64> {
     // Polynomial in L with constant term first.
     let mut poly: Vec<f64> = std::iter::once(1.0).chain(ar.iter().map(|a| -a)).collect();
@@ -52,12 +54,15 @@ pub fn integrated_ar(ar: &[f64], d: usize) -> Vec<f64> {
         }
         poly = next;
     }
-    poly[1..].iter().map(|c| -c).collect()
+    poly.iter().skip(1).map(|c| -c).collect()
 }
 
 impl ArimaStateSpace {
     /// ARIMA(p,d,q) with AR coefficients `ar` (φ), MA coefficients `ma` (β) and
     /// innovation variance `sigma2`, in the paper's or the exact noise form.
+    // invariant: n ≥ c.len() = r, n ≥ q + 1 (paper) or n = max(r, 1) + q (exact), cols = n
+    // or 1: every index below is inside the n × n Φ and n × cols B.
+    #[allow(clippy::indexing_slicing)]
     pub fn from_arma(ar: &[f64], ma: &[f64], sigma2: f64, d: usize, form: NoiseForm) -> Result<ArimaStateSpace> {
         check_finite("ar", ar, 1)?;
         check_finite("ma", ma, 1)?;
@@ -305,6 +310,9 @@ struct Core<const N: usize> {
     first: bool,
 }
 
+// invariant: AnyCore::new builds Core<N> only for N = model.dim() with Φ and Q_d
+// checked N × N (check_companion); every i, j below is < N, and i − 1 is taken for i > 0.
+#[allow(clippy::indexing_slicing)]
 impl<const N: usize> Core<N> {
     fn new(model: &ArimaStateSpace, p0: f64, first: bool) -> Core<N> {
         Core {
@@ -399,7 +407,14 @@ impl<const N: usize> Core<N> {
 
 /// The filter relies on Φ having the form built by [`ArimaStateSpace::from_arma`]: a
 /// dense first row and, below it, rows that are zero or copy the previous state.
-fn check_companion(phi: &DMatrix<f64>) -> Result<()> {
+/// Φ and Q_d are checked square of one size here, which the fixed-size cores rely on.
+// invariant: i < nrows, j < ncols.
+#[allow(clippy::indexing_slicing)]
+fn check_companion(phi: &DMatrix<f64>, qd: &DMatrix<f64>) -> Result<()> {
+    let n = phi.nrows();
+    if phi.ncols() != n || qd.shape() != (n, n) {
+        return Err(invalid("model", format!("Φ ({}x{}) and Q_d ({}x{}) must be square of one size", n, phi.ncols(), qd.nrows(), qd.ncols())));
+    }
     for i in 1..phi.nrows() {
         for j in 0..phi.ncols() {
             let v = phi[(i, j)];
@@ -419,7 +434,7 @@ macro_rules! cores {
 
         impl AnyCore {
             fn new(model: &ArimaStateSpace, p0: f64, first: bool) -> Result<AnyCore> {
-                check_companion(&model.phi)?;
+                check_companion(&model.phi, &model.qd)?;
                 match model.dim() {
                     $($n => Ok(AnyCore::$v(Core::new(model, p0, first))),)*
                     n => Err(invalid("model", format!("state dimension {n} exceeds the supported maximum {MAX_DIM}"))),
@@ -483,9 +498,10 @@ pub fn kalman(omega: &[f64], model: &ArimaStateSpace, r0: f64, mode: RMode, x0: 
 
 /// Steady state of the fixed filter for measurement variance r: (K∞, P⁻∞, P⁺∞), by
 /// iterating the Riccati recursion to convergence.
+// invariant: Φ and Q_d are n × n with n = dim ≥ 1 (from_arma), so (0, 0) is in range.
+#[allow(clippy::indexing_slicing)]
 pub fn steady_state(model: &ArimaStateSpace, r: f64) -> Result<(Vec<f64>, DMatrix<f64>, DMatrix<f64>)> {
     check_positive("r", r)?;
-    let n = model.dim();
     let phi = &model.phi;
     let mut pm = phi * phi.transpose() + &model.qd;
     for _ in 0..1_000_000 {
@@ -494,12 +510,18 @@ pub fn steady_state(model: &ArimaStateSpace, r: f64) -> Result<(Vec<f64>, DMatri
         let pp = &pm - &k * pm.row(0);
         let next = phi * &pp * phi.transpose() + &model.qd;
         let diff = (&next - &pm).abs().max();
+        if !diff.is_finite() {
+            return Err(NavError::Numerical("steady_state: the Riccati iteration diverged (model not detectable?)".into()));
+        }
         pm = next;
         if diff <= 1e-15 * pm.abs().max() {
             let s = pm[(0, 0)] + r;
             let k = pm.column(0) / s;
             let pp = &pm - &k * pm.row(0);
-            return Ok(((0..n).map(|i| k[i]).collect(), pm, pp));
+            if !k.iter().chain(pm.iter()).chain(pp.iter()).all(|v| v.is_finite()) {
+                return Err(NavError::Numerical("steady_state: the Riccati solution overflows the floating-point range".into()));
+            }
+            return Ok((k.iter().copied().collect(), pm, pp));
         }
     }
     Err(NavError::Numerical("steady_state: Riccati iteration did not converge (model not detectable?)".into()))

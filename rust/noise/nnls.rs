@@ -5,6 +5,9 @@ use crate::error::{NavError, Result};
 use nalgebra::{DMatrix, DVector};
 
 /// min ‖A x − b‖₂ subject to x ≥ 0. `A` is m×n (small, dense).
+// invariant: x, w, z have n entries and passive n flags; idx holds indices j < n and
+// c < idx.len() = columns of ap and rows of zp.
+#[allow(clippy::indexing_slicing)]
 pub fn nnls(a: &DMatrix<f64>, b: &DVector<f64>) -> Result<DVector<f64>> {
     let (m, n) = a.shape();
     let norm1 = (0..n).map(|j| a.column(j).iter().map(|v| v.abs()).sum::<f64>()).fold(0.0, f64::max);

@@ -29,6 +29,8 @@ fn vec_to_py<'py>(py: Python<'py>, v: &Vec3) -> Bound<'py, PyArray1<f64>> {
     vec![v.x, v.y, v.z].into_pyarray(py)
 }
 
+// invariant: r has 3 rows of 3 (checked above), i, j < 3.
+#[allow(clippy::indexing_slicing)]
 fn mat3_arg(a: &PyReadonlyArray2<'_, f64>, field: &str) -> Result<Mat3, NavError> {
     let r = super::convert::rows::<3>(a, field)?;
     if r.len() != 3 {
@@ -63,6 +65,8 @@ fn astro_d1_d2<'py>(py: Python<'py>, beta: PyReadonlyArray2<'py, f64>) -> PyResu
 
 /// An (N, 3) array read in place when C-contiguous (copied otherwise). NaN/inf are left to
 /// the core's validation pass, which names the first bad row: no second pass here.
+// invariant: a 2-D array's shape has 2 entries; rows have 3 columns (checked above).
+#[allow(clippy::indexing_slicing)]
 fn rows3<'a>(a: &'a PyReadonlyArray2<'_, f64>, field: &str) -> Result<Cow<'a, [[f64; 3]]>, NavError> {
     let s = a.shape();
     if s[1] != 3 {

@@ -31,6 +31,8 @@ type Arr1<'py> = Bound<'py, PyArray1<f64>>;
 type Arr2<'py> = Bound<'py, PyArray2<f64>>;
 type Arr3<'py> = Bound<'py, PyArray3<f64>>;
 
+// invariant: r has 3 rows of 3 (checked above), i, j < 3.
+#[allow(clippy::indexing_slicing)]
 fn mat3(a: &PyReadonlyArray2<'_, f64>, field: &str) -> PyResult<Mat3> {
     let r = rows::<3>(a, field)?;
     if r.len() != 3 {
@@ -65,6 +67,8 @@ impl CaiChannels {
 
 /// An IMU array (N, 3) read without the finiteness check: NaN in the IMU stream is
 /// reported by the predictor with the shot that uses it.
+// invariant: a 2-D array's shape has 2 entries; rows have 3 columns (checked above).
+#[allow(clippy::indexing_slicing)]
 fn raw3(a: &PyReadonlyArray2<'_, f64>, field: &str) -> PyResult<Vec<Vec3>> {
     let s = a.shape();
     if s[1] != 3 {
@@ -408,6 +412,8 @@ impl CaiSensor {
 /// rad²) and, for each 15-state model f[k] (steps, 15, 15) held over a filter step of one
 /// shot, E[w δφ̂ᵀ] (steps, 15, channels) (`CaiConfig::in_shot_noise`).
 #[pyfunction]
+// invariant: a 3-D array's shape has 3 entries.
+#[allow(clippy::indexing_slicing)]
 fn cai_in_shot_noise<'py>(py: Python<'py>, sensor: &CaiSensor, dt: f64, q_a: f64, q_g: f64, f: PyReadonlyArray3<'py, f64>) -> PyResult<(Arr2<'py>, Arr3<'py>)> {
     let fs = mats(&f, "f")?;
     let (sigma, cross) = py.detach(|| sensor.0.in_shot_noise(dt, q_a, q_g, &fs))?;
@@ -506,6 +512,8 @@ impl CaiHybrid {
 /// laser phase steered inside the loop) or recorded (`population` + `laser_phase`).
 #[pyfunction]
 #[pyo3(signature = (ins, extra0, sensor, shots, data_kind, data_a, data_b))]
+// invariant: a 2-D array's shape has 2 entries.
+#[allow(clippy::indexing_slicing)]
 fn cai_aided_ins(
     ins: PyRef<'_, AidedSetup>,
     extra0: PyReadonlyArray1<'_, f64>,

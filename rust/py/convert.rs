@@ -75,6 +75,8 @@ fn type_name(obj: &Bound<'_, PyAny>) -> String {
 }
 
 /// A 2-D float array as a DMatrix, checked for NaN/inf (names the first bad row).
+// invariant: a 2-D array's shape has 2 entries and (i, j) < shape.
+#[allow(clippy::indexing_slicing)]
 pub fn mat(a: &PyReadonlyArray2<'_, f64>, field: &str) -> Result<DMatrix<f64>, NavError> {
     let s = a.shape();
     let v = a.as_array();
@@ -90,6 +92,9 @@ pub fn mat_to_py<'py, R: Dim, C: Dim, S: RawStorage<f64, R, C>>(py: Python<'py>,
 }
 
 /// The rows of an (N, W) float array, checked for shape and NaN/inf.
+// invariant: a 2-D array's shape has 2 entries; rows have W columns (checked
+// above), so every chunk converts to [f64; W] and j < W.
+#[allow(clippy::indexing_slicing, clippy::expect_used)]
 pub fn rows<const W: usize>(a: &PyReadonlyArray2<'_, f64>, field: &str) -> Result<Vec<[f64; W]>, NavError> {
     let shape = a.shape();
     if shape[1] != W {
@@ -135,6 +140,8 @@ pub fn vector(a: &PyReadonlyArray1<'_, f64>, field: &str) -> Result<Vec<f64>, Na
 }
 
 /// A length-3 vector argument.
+// invariant: v has 3 elements (checked above).
+#[allow(clippy::indexing_slicing)]
 pub fn vec3(a: &PyReadonlyArray1<'_, f64>, field: &str) -> Result<Vec3, NavError> {
     let v = vector(a, field)?;
     if v.len() != 3 {
@@ -155,6 +162,8 @@ pub fn rows_to_py<'py>(py: Python<'py>, n: usize, w: usize, values: impl Iterato
 }
 
 /// An (n, w) array that takes ownership of a row-major buffer (no copy).
+// invariant: callers pass n·w values (rows_to_py streams n rows of w).
+#[allow(clippy::expect_used)]
 pub fn flat_to_py<'py>(py: Python<'py>, n: usize, w: usize, flat: Vec<f64>) -> Bound<'py, PyArray2<f64>> {
     Array2::from_shape_vec((n, w), flat).expect("n·w values by construction").into_pyarray(py)
 }
@@ -233,6 +242,9 @@ pub fn each_item<'py>(d: &Bound<'py, PyDict>, field: &str, mut f: impl FnMut(&st
 
 /// The (R, C) blocks of an (N, R, C) array, checked for shape and NaN/inf (naming the
 /// first bad block).
+// invariant: a 3-D array's shape has 3 entries, (s[1], s[2]) = (R, C) checked
+// above, so [i, r, c] < shape.
+#[allow(clippy::indexing_slicing)]
 pub fn mats<const R: usize, const C: usize>(a: &numpy::PyReadonlyArray3<'_, f64>, field: &str) -> Result<Vec<nalgebra::SMatrix<f64, R, C>>, NavError> {
     let s = a.shape();
     if s[1] != R || s[2] != C {
@@ -251,6 +263,8 @@ pub fn mats<const R: usize, const C: usize>(a: &numpy::PyReadonlyArray3<'_, f64>
 }
 
 /// A stack of (R, C) matrices as an (N, R, C) array.
+// invariant: i < m.len() and (r, c) < (R, C) by the shape given to from_shape_fn.
+#[allow(clippy::indexing_slicing)]
 pub fn mats_to_py<'py, const R: usize, const C: usize>(py: Python<'py>, m: &[nalgebra::SMatrix<f64, R, C>]) -> Bound<'py, numpy::PyArray3<f64>> {
     numpy::ndarray::Array3::from_shape_fn((m.len(), R, C), |(i, r, c)| m[i][(r, c)]).into_pyarray(py)
 }

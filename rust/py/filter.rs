@@ -18,11 +18,15 @@ use numpy::ndarray::Array3;
 use numpy::{IntoPyArray, PyArray1, PyArray3, PyReadonlyArray1, PyReadonlyArray2, PyReadonlyArray3, PyUntypedArrayMethods};
 use pyo3::prelude::*;
 
+// invariant: callers pass n × n matrices (the core's state size), k < ms.len().
+#[allow(clippy::indexing_slicing)]
 pub(crate) fn stack_to_py<'py>(py: Python<'py>, ms: &[DMatrix<f64>], n: usize) -> Bound<'py, PyArray3<f64>> {
     Array3::from_shape_fn((ms.len(), n, n), |(k, i, j)| ms[k][(i, j)]).into_pyarray(py)
 }
 
 /// A stack (N, r, c) as N matrices, checked for NaN/inf.
+// invariant: a 3-D array's shape has 3 entries and (k, i, j) < shape.
+#[allow(clippy::indexing_slicing)]
 pub(crate) fn mats(a: &PyReadonlyArray3<'_, f64>, field: &str) -> Result<Vec<DMatrix<f64>>, NavError> {
     let s = a.shape();
     let v = a.as_array();
@@ -244,6 +248,8 @@ impl PyAidedIns {
 
 /// The rows of an (N, 3) array, shape-checked only: the aided engine checks finiteness
 /// itself and names the sample's index in the whole record, not in the chunk.
+// invariant: rows have 3 columns (checked above).
+#[allow(clippy::indexing_slicing)]
 fn unchecked_vec3_rows(a: &PyReadonlyArray2<'_, f64>, field: &str) -> Result<Vec<crate::math::Vec3>, NavError> {
     let v = a.as_array();
     if v.ncols() != 3 {

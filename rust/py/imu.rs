@@ -22,6 +22,8 @@ fn floats(v: &Bound<'_, PyAny>, field: &str, len: usize) -> PyResult<Vec<f64>> {
     Ok(x)
 }
 
+// invariant: floats(v, field, n) returns exactly n values or an error.
+#[allow(clippy::indexing_slicing)]
 pub(super) fn triad_from_dict(d: &Bound<'_, PyDict>, name: &str) -> PyResult<TriadErrors> {
     let mut t = TriadErrors::default();
     each_item(d, name, |key, v| {

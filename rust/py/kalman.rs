@@ -64,6 +64,8 @@ fn rows_mat(a: &PyReadonlyArray2<'_, f64>, field: &str) -> Result<Vec<DVector<f6
     Ok((0..m.nrows()).map(|k| m.row(k).transpose()).collect())
 }
 
+// invariant: callers pass vectors of n entries, k < v.len().
+#[allow(clippy::indexing_slicing)]
 fn vecs_to_py<'py>(py: Python<'py>, v: &[DVector<f64>], n: usize) -> Bound<'py, PyArray2<f64>> {
     Array2::from_shape_fn((v.len(), n), |(k, i)| v[k][i]).into_pyarray(py)
 }
@@ -217,6 +219,9 @@ impl Scenario {
     /// Runs `runs` (indices under `master_seed`) on all local cores:
     /// (error (R, E, n), sigma (R, E, n), nees (R, E), nis (R, E)).
     #[allow(clippy::type_complexity)]
+    // invariant: each run of Scenario::monte_carlo holds epochs × size errors and
+    // sigmas and one NEES and NIS per epoch; a < nr = res.len().
+    #[allow(clippy::indexing_slicing)]
     fn monte_carlo<'py>(
         &self,
         py: Python<'py>,

@@ -54,6 +54,8 @@ impl Strapdown {
     /// (nothing integrated); a divergence is the error beside the number of rows written
     /// before it.
     #[allow(clippy::too_many_arguments)]
+    // invariant: a 2-D array's shape has 2 entries.
+    #[allow(clippy::indexing_slicing)]
     fn run_chunk<'py>(
         &mut self,
         py: Python<'py>,
@@ -193,6 +195,8 @@ impl Strapdown {
 /// (no navigation-frame rotation); `dtheta_prev`: up to two earlier increments, oldest first.
 #[pyfunction]
 #[pyo3(signature = (q0, dtheta, dtheta_prev=None))]
+// invariant: q0 has exactly one row (checked before any other use).
+#[allow(clippy::indexing_slicing)]
 fn integrate_attitude_increments<'py>(
     py: Python<'py>,
     q0: PyReadonlyArray2<'py, f64>,

@@ -159,9 +159,11 @@ impl Strapdown {
     /// another core; the caller then sets `front` to that front).
     pub(crate) fn run_body(&mut self, t: &[f64], body: &[BodyStep], h_ref: Option<&[f64]>, first_index: usize, out: &mut Vec<NavState>) -> Result<()> {
         out.reserve(t.len());
-        for (k, b) in body.iter().enumerate() {
+        let mut h_ref = h_ref.map(|h| h.iter());
+        for (k, (b, &tk)) in body.iter().zip(t).enumerate() {
+            let hk = h_ref.as_mut().and_then(|h| h.next().copied());
             if let Some(b) = b {
-                self.integrate(t[k], b, h_ref.map(|h| h[k]));
+                self.integrate(tk, b, hk);
             }
             self.check_diverged(first_index + k)?;
             out.push(self.state);
@@ -332,8 +334,8 @@ impl SampleCheck {
             self.prev_t = tk;
         }
         for (name, data) in [("gyro", gyro), ("accel", accel)] {
-            if let Some(k) = data.iter().position(|v| !v.iter().all(|x| x.is_finite())) {
-                return Err(invalid_at(name, first_index + k, format!("non-finite value at index {}: {:?}", first_index + k, data[k].as_slice())));
+            if let Some((k, v)) = data.iter().enumerate().find(|(_, v)| !v.iter().all(|x| x.is_finite())) {
+                return Err(invalid_at(name, first_index + k, format!("non-finite value at index {}: {:?}", first_index + k, v.as_slice())));
             }
         }
         match h_ref {
@@ -392,6 +394,8 @@ struct History<T: Copy + Default> {
     len: usize,
 }
 
+// invariant: len ≤ 2 = items.len(): push drops the oldest item before len reaches 2.
+#[allow(clippy::indexing_slicing)]
 impl<T: Copy + Default> History<T> {
     fn push(&mut self, item: T) {
         if self.len == 2 {

@@ -55,6 +55,9 @@ impl<'a> Samples3<'a> {
     }
 
     /// Append rows `r` (within `0..rows`) to `out`.
+    // invariant: callers pass rows r within 0..rows, and new checked data to hold
+    // 3·rows values, so every range below lies inside data.
+    #[allow(clippy::indexing_slicing)]
     fn extend(&self, r: Range<usize>, out: &mut Vec<Vec3>) {
         if self.column_major {
             let n = self.rows;
@@ -136,6 +139,9 @@ pub fn nav_columns(states: &[NavState]) -> Vec<f64> {
 }
 
 /// Write states as rows `first`… of a column-by-column table with columns of `n` values.
+// invariant: buf holds NAV_WIDTH columns of n values and first + i < n (NavTable's
+// check_room, or n = s.len() with first = 0); c < NAV_WIDTH = row.len().
+#[allow(clippy::indexing_slicing)]
 fn write_columns(buf: &mut [f64], n: usize, first: usize, s: &[NavState]) {
     for (i, x) in s.iter().enumerate() {
         let e = euler_from_quat(&x.q_nb);
@@ -159,6 +165,9 @@ struct Block {
 }
 
 impl Block {
+    // invariant: callers pass rows within the record, whose t, gyro, accel and h_ref
+    // hold one entry per row (validated before the blocks are cut).
+    #[allow(clippy::indexing_slicing)]
     fn fill(&mut self, imu: &ImuSlices<'_>, rows: Range<usize>) {
         self.t.clear();
         self.t.extend_from_slice(&imu.t[rows.clone()]);

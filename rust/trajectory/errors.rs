@@ -46,9 +46,9 @@ impl NavSeries<'_> {
 pub fn nav_errors(ell: &Ellipsoid, est: NavSeries<'_>, reference: NavSeries<'_>) -> Result<Vec<[f64; 9]>> {
     est.check("nav", est.lla.len())?;
     reference.check("reference", est.lla.len())?;
-    Ok((0..est.lla.len())
-        .map(|i| nav_error(ell, (&est.lla[i], &est.vel[i], &est.q_nb[i]), (&reference.lla[i], &reference.vel[i], &reference.q_nb[i])))
-        .collect())
+    let e = est.lla.iter().zip(est.vel).zip(est.q_nb);
+    let r = reference.lla.iter().zip(reference.vel).zip(reference.q_nb);
+    Ok(e.zip(r).map(|(((p, v), q), ((rp, rv), rq))| nav_error(ell, (p, v, q), (rp, rv, rq))).collect())
 }
 
 #[cfg(test)]

@@ -16,6 +16,8 @@ fn sine(amp: f64, period: f64) -> Term {
 
 /// Sinusoidal motion about `origin`: NED displacement amplitude (m) and period (s) per
 /// axis, and roll/pitch/yaw oscillations (rad, s) about `heading`.
+// invariant: fixed-size 3-vectors indexed by i < 3.
+#[allow(clippy::indexing_slicing)]
 pub fn sinusoidal(origin: Vec3, duration: f64, amp_ned: Vec3, period_ned: Vec3, amp_euler: Vec3, period_euler: Vec3, heading: f64) -> Result<Motion> {
     for i in 0..3 {
         check_positive("period_ned", period_ned[i])?;
@@ -182,6 +184,9 @@ pub fn car(origin: Vec3, heading: f64, vibration: bool) -> Motion {
 /// `states` are (tilt, turntable) in rad; the stand holds each state and moves to the
 /// next at `move_starts[j]` (s) over `move_duration` s with the quintic profile
 /// 10x³ − 15x⁴ + 6x⁵.
+// invariant: states is non-empty and has move_starts.len() + 1 entries (checked
+// above), so j + 1 < states.len(); windows(2) yields pairs.
+#[allow(clippy::indexing_slicing)]
 pub fn rotary_stand(origin: Vec3, states: &[(f64, f64)], move_starts: &[f64], move_duration: f64, duration: f64) -> Result<Motion> {
     if states.is_empty() {
         return Err(invalid("states", "at least one stand state is needed"));

@@ -64,7 +64,7 @@ impl Motion {
     pub fn kinematics(&self, t: f64) -> Kinematics {
         let (s, c) = (self.speed.eval(t), self.course.eval(t));
         let (sc, cc) = c.v.sin_cos();
-        let d: Vec<Eval> = self.displacement.iter().map(|p| p.eval(t)).collect();
+        let d: [Eval; 3] = self.displacement.each_ref().map(|p| p.eval(t));
         let vel = Vec3::new(s.v * cc + d[0].d1, s.v * sc + d[1].d1, d[2].d1);
         let acc = Vec3::new(
             s.d1 * cc - s.v * c.d1 * sc + d[0].d2,
@@ -103,11 +103,8 @@ impl Motion {
     /// Check that `times` are increasing and inside [0, duration].
     pub fn check_times(&self, times: &[f64]) -> Result<()> {
         check_increasing("time", times)?;
-        if let Some(i) = times.iter().position(|&t| t < 0.0 || t > self.duration + 1e-9) {
-            return Err(invalid(
-                "time",
-                format!("time {} at index {i} is outside the motion '{}' span [0, {}] s", times[i], self.name, self.duration),
-            ));
+        if let Some((i, t)) = times.iter().enumerate().find(|(_, &t)| t < 0.0 || t > self.duration + 1e-9) {
+            return Err(invalid("time", format!("time {t} at index {i} is outside the motion '{}' span [0, {}] s", self.name, self.duration)));
         }
         Ok(())
     }
