@@ -146,7 +146,9 @@ def _params(obj, drop_self: bool) -> tuple[Param, ...] | None:
             continue
         if p.kind in (p.VAR_POSITIONAL, p.VAR_KEYWORD):
             continue
-        out.append(Param(p.name, p.default, p.kind == p.POSITIONAL_ONLY))
+        # a dataclass field with a default factory shows a sentinel: optional, default unknown
+        default = Ellipsis if repr(p.default) == "<factory>" else p.default
+        out.append(Param(p.name, default, p.kind == p.POSITIONAL_ONLY))
     return tuple(out)
 
 
@@ -980,7 +982,8 @@ def campaign(calls: int, seed: int, timeout: float = TIMEOUT_S, progress=None, o
     pick_target = st.integers(0, len(targets) - 1)
     pick_instance = st.integers(0, 2**16)
     pick_rows = st.sampled_from(ROWS)
-    factories = {owner: [f for f in TARGETS if f.name == owner or (f.kind == "static" and f.name.startswith(owner + "."))]
+    factories = {owner: [f for f in TARGETS if (f.name == owner and not _plain_dataclass(resolve(f.module, f.qualname)))
+                         or (f.kind == "static" and f.name.startswith(owner + "."))]
                  for owner in {t.owner for t in targets if t.owner}}
     hostile_of = {k: st.integers(-2, k - 1) for k in range(max(len(t.params) for t in targets) + 1)}
     passed = {True: st.sampled_from((True,) * 30 + (False,)), False: st.sampled_from((True, True, False))}

@@ -8,6 +8,7 @@ import numpy as np
 import pandas as pd
 
 from . import earth, strapdown, trajectory
+from ._validate import input_error, vector
 
 
 def stationary_errors(lat: float, hours: float, *, rate_hz: float = 10.0, h: float = 100.0, dv0=(0.0, 0.0, 0.0),
@@ -33,7 +34,9 @@ def stationary_errors(lat: float, hours: float, *, rate_hz: float = 10.0, h: flo
 def zero_crossing_periods(t: np.ndarray, v: np.ndarray) -> np.ndarray:
     """Oscillation periods (s) from the zero crossings of ``v(t)`` (linear interpolation):
     T = 2·Δt between successive crossings."""
-    t, v = np.asarray(t, float), np.asarray(v, float)
+    t, v = vector(t, None, "t"), vector(v, None, "v")
+    if v.size != t.size:
+        raise input_error("v", f"{v.size} values for {t.size} times")
     s = np.sign(v)
     idx = np.nonzero(s[:-1] * s[1:] < 0)[0]
     tc = t[idx] - v[idx] * (t[idx + 1] - t[idx]) / (v[idx + 1] - v[idx])

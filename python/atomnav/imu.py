@@ -46,7 +46,7 @@ import numpy as np
 import pandas as pd
 
 from . import _core, units
-from ._validate import choice, input_error, rows, vector
+from ._validate import as_floats, choice, input_error, instance, rows, vector
 
 KINDS = tuple(_core.OPTIONS["ImuKind"])
 _AXES = ("x", "y", "z")
@@ -96,7 +96,7 @@ class TriadErrors:
     flicker: Flicker | None = None
 
     def _to_core(self, name: str) -> dict:
-        m = np.asarray(self.misalignment, dtype=float)
+        m = as_floats(self.misalignment, f"{name}.misalignment")
         if m.shape != (3, 3):
             raise input_error(f"{name}.misalignment", f"expected shape (3, 3), got {m.shape}")
         gm, fl = self.gauss_markov, self.flicker
@@ -131,7 +131,7 @@ _USER_PRESETS: dict[str, "ImuErrors"] = {}
 
 @dataclass
 class ImuErrors:
-    """The error model of an IMU: ``accel`` and ``gyro`` triads. ``ImuErrors.preset(name)``
+    """The error model of an IMU: ``accel`` and ``gyro`` triads. ``ImuErrors.preset(preset)``
     gives a named grade; :func:`register_preset` adds user grades."""
 
     accel: TriadErrors = field(default_factory=TriadErrors)
@@ -146,16 +146,16 @@ class ImuErrors:
         return self
 
     @classmethod
-    def preset(cls, name: str) -> "ImuErrors":
-        """A copy of the named preset: built-in ``navigation`` (seed-003 RLG IMU),
+    def preset(cls, preset: str) -> "ImuErrors":
+        """A copy of the named ``preset``: built-in ``navigation`` (seed-003 RLG IMU),
         ``tactical`` (typical class values), ``mems`` (seed-000 hexapod MEMS),
         ``electrostatic_space`` / ``electrostatic_space_drift`` (seed-000 satellite
         accelerometer), ``precise`` / ``medium`` / ``coarse`` (Demidov 2009 classes), or a
         name added with :func:`register_preset`. Sources are in ``rust/imu/presets.rs``."""
-        choice(name, preset_names(), "preset")
-        if name in _USER_PRESETS:
-            return copy.deepcopy(_USER_PRESETS[name])
-        a, g = _core.imu_preset(name)
+        choice(preset, preset_names(), "preset")
+        if preset in _USER_PRESETS:
+            return copy.deepcopy(_USER_PRESETS[preset])
+        a, g = _core.imu_preset(preset)
         return cls(TriadErrors._from_core(a), TriadErrors._from_core(g))
 
     def summary(self) -> pd.DataFrame:
@@ -189,7 +189,7 @@ def register_preset(name: str, errors: ImuErrors) -> None:
     """Add a named user preset (validated; a built-in name cannot be replaced)."""
     if name in _core.imu_preset_names():
         raise input_error("name", f"{name!r} is a built-in preset and cannot be replaced")
-    _USER_PRESETS[str(name)] = copy.deepcopy(errors.validate())
+    _USER_PRESETS[str(name)] = copy.deepcopy(instance(errors, ImuErrors, "errors").validate())
 
 
 class ImuSimulator:

@@ -23,7 +23,7 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
-from .._validate import positive, vector
+from .._validate import instance, positive, vector
 from . import allan, arma, baselines, filters
 
 #: Row order of the comparison table.
@@ -132,6 +132,7 @@ def plot_allan(cmp: Comparison, methods=("raw", "fixed KF", "adaptive KF (differ
 
 def plot_psd(cmp: Comparison, tau0: float = 52.0, methods=("raw", "fixed KF", "adaptive KF (differenced)", "LPF", "WD")):
     """Welch power spectral density of each method's output (mean removed)."""
+    instance(cmp, Comparison, "cmp")
     import matplotlib.pyplot as plt
     from scipy.signal import welch
 

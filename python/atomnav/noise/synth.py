@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import numpy as np
 from .. import units
-from .._validate import input_error
+from .._validate import input_error, instance
 from .filters import PAPER_AR, PAPER_MA, PAPER_SIGMA2
 
 #: Niu et al. 2025: sample interval (s), record length, Table 2 raw mean (°/h).
@@ -28,6 +28,7 @@ def flicker(rng: np.random.Generator, n: int, sigma: float) -> np.ndarray:
     e ~ N(0, sigma²). Its Allan plateau is ≈ (2 ln 2/π)·sigma²."""
     from scipy.signal import fftconvolve
 
+    instance(rng, np.random.Generator, "rng")
     j = np.arange(1, n)
     h = np.concatenate([[1.0], np.cumprod((j - 0.5) / j)])
     e = rng.normal(0.0, sigma, n)
