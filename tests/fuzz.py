@@ -692,6 +692,7 @@ class Pool:
         self.workers = [Worker(timeout) for _ in range(jobs)]
         self.spare = Worker(timeout)
         self.restarts = 0
+        POOLS.append(self)
 
     def replace(self, i: int) -> None:
         self.workers[i].close()
@@ -701,6 +702,19 @@ class Pool:
     def close(self) -> None:
         for w in self.workers + [self.spare]:
             w.close()
+        if self in POOLS:
+            POOLS.remove(self)
+
+
+POOLS: list[Pool] = []  # open pools, closed on SIGTERM
+
+
+def _terminate(*_) -> None:
+    """SIGTERM: kill the workers (they run in sessions of their own) and exit at once
+    (hypothesis would treat a SystemExit raised inside a test as a failure to replay)."""
+    for pool in list(POOLS):
+        pool.close()
+    os._exit(143)
 
 
 # ----------------------------------------------------------------------------------------
@@ -1069,7 +1083,7 @@ def main(argv=None) -> int:
                 f.write(text)
         print(f"{c.calls} calls, {c.n_bad} bad, {c.seconds:.0f} s", file=sys.stderr, flush=True)
 
-    signal.signal(signal.SIGTERM, lambda *_: sys.exit(143))  # so the workers are killed too
+    signal.signal(signal.SIGTERM, _terminate)
     c = campaign(a.calls, a.seed, a.timeout, progress=write, only=only, budget=a.budget, jobs=a.jobs)
     write(c)
     if not a.out:

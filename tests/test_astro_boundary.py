@@ -105,3 +105,15 @@ def test_keyword_only_options():
         astro.calibrate(ds, ds, "axes")
     assert _core.OPTIONS["DiffForm"] == ["full", "paper"]
     assert _core.OPTIONS["CalibrationSolver"] == ["so3", "paper_euler"]
+
+
+def test_wrappers_name_their_own_parameters():
+    up = np.array([[0.0, 0.0, 1.0]])
+    _input_error("s", astro.refraction_apply, np.float64(3), up, 1.0003)
+    with pytest.raises(TypeError, match="^height_m: "):
+        astro.refractive_index("emulated")
+    with pytest.raises(TypeError, match="^catalog: "):
+        astro.simulate_observations(None, G[None], up, G[None], fov_half_rad=0.3, m_lim=5.0, sigma_s_rad=1e-5,
+                                    n_refr=1.0, seed=1)
+    with pytest.raises(TypeError, match="^dcm: "):
+        atomnav.rotation.quat_from_dcm("soft")
