@@ -107,6 +107,16 @@ def scalar(x, name: str) -> float:
     return float(as_floats(x, name))
 
 
+def integer(x, name: str, minimum: int = 0) -> int:
+    """``x`` as an int ≥ ``minimum`` (an integral float such as 2.0 is accepted); a
+    non-number is a ``TypeError`` naming ``name``."""
+    if isinstance(x, (bool, np.bool_)) or not isinstance(x, (int, float, np.integer, np.floating)):
+        raise TypeError(f"{name}: expected an int, got {type(x).__name__}")
+    if not (np.isfinite(x) and int(x) == x and x >= minimum):
+        raise input_error(name, f"must be an integer ≥ {minimum}, got {x}")
+    return int(x)
+
+
 def positive(x: float, name: str) -> float:
     x = scalar(x, name)
     if not np.isfinite(x) or x <= 0:

@@ -10,7 +10,7 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
-from .._validate import choice, input_error, vector
+from .._validate import choice, input_error, integer, scalar, vector
 
 
 def _series(x, name: str, min_len: int) -> np.ndarray:
@@ -24,18 +24,18 @@ def _series(x, name: str, min_len: int) -> np.ndarray:
 
 def difference(omega, d: int = 1) -> np.ndarray:
     """d-th difference (spec E2, D1): d_k = ω_k − ω_{k−1}, length N − d."""
-    if int(d) != d or d < 0:
-        raise input_error("d", f"must be an integer ≥ 0, got {d}")
+    d = integer(d, "d")
     x = vector(omega, None, "omega")
     if x.size <= d:
         raise input_error("omega", f"series of {x.size} samples is too short to difference {d} times")
-    return np.diff(x, n=int(d))
+    return np.diff(x, n=d)
 
 
 def undifference(diffs, initial) -> np.ndarray:
     """Inverse of :func:`difference` for d = 1: ω = [ω₁, ω₁ + cumsum(d)]."""
     dd = vector(diffs, None, "diffs")
-    return np.concatenate([[float(initial)], float(initial) + np.cumsum(dd)])
+    w0 = scalar(initial, "initial")
+    return np.concatenate([[w0], w0 + np.cumsum(dd)])
 
 
 @dataclass

@@ -32,8 +32,8 @@ METHODS = ("raw", "fixed KF", "adaptive KF (literal)", "adaptive KF (differenced
 
 def paper_tables() -> pd.DataFrame:
     """Niu et al. 2025 Tables 2–4. Table 4's BS entries for LPF and WD (0.7020,
-    0.6970) equal the bias, not BS (spec D18): kept in ``bs_table4_misprint`` and NaN
-    in ``bs_dph``."""
+    0.6970) equal the bias, not BS: kept in ``bs_table4_misprint`` and NaN in ``bs_dph``.
+    Entries the paper does not give are NaN, so the table may be non-finite."""
     return pd.DataFrame(
         {
             "method": ["raw", "fixed KF", "adaptive KF", "LPF", "WD"],
