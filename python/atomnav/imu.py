@@ -46,7 +46,7 @@ import numpy as np
 import pandas as pd
 
 from . import _core, units
-from ._validate import as_floats, choice, input_error, instance, rows, vector
+from ._validate import as_floats, choice, input_error, instance, rows, scalar, vector
 
 KINDS = tuple(_core.OPTIONS["ImuKind"])
 _AXES = ("x", "y", "z")
@@ -200,8 +200,9 @@ class ImuSimulator:
     def __init__(self, errors: ImuErrors | str, dt: float, kind: str = "rates", seed: int = 0):
         if isinstance(errors, str):
             errors = ImuErrors.preset(errors)
+        instance(errors, ImuErrors, "errors")
         self.kind = kind
-        self.dt = float(dt)
+        self.dt = scalar(dt, "dt")
         self.errors = copy.deepcopy(errors)
         self._sim = _core.ImuErrorSimulator(*errors._to_core(), self.dt, self.kind, seed)
         self._k = 0
@@ -244,45 +245,45 @@ def corrupt(accel, gyro=None, *, errors: ImuErrors | str, dt: float, kind: str =
 def white_sigma(density: float, dt: float, kind: str = "rates") -> float:
     """Per-sample σ of white noise of density N at interval Δt: N/√Δt (rate, m/s² or
     rad/s) or N·√Δt (increment, m/s or rad)."""
-    return _core.imu_white_sigma(float(density), float(dt), kind)
+    return _core.imu_white_sigma(scalar(density, "density"), scalar(dt, "dt"), kind)
 
 
 def white_density(sigma: float, dt: float, kind: str = "rates") -> float:
     """Density N (m/s/√s or rad/√s) of white noise with per-sample σ at Δt (inverse of
     :func:`white_sigma`)."""
-    return _core.imu_white_density(float(sigma), float(dt), kind)
+    return _core.imu_white_density(scalar(sigma, "sigma"), scalar(dt, "dt"), kind)
 
 
 def random_walk_step_sigma(density: float, dt: float) -> float:
     """σ of the per-sample bias step K·√Δt of a random walk of density K."""
-    return _core.imu_random_walk_step_sigma(float(density), float(dt))
+    return _core.imu_random_walk_step_sigma(scalar(density, "density"), scalar(dt, "dt"))
 
 
 def random_walk_density(step_sigma: float, dt: float) -> float:
     """Density K of a random walk whose per-sample step has σ ``step_sigma`` at Δt."""
-    return _core.imu_random_walk_density(float(step_sigma), float(dt))
+    return _core.imu_random_walk_density(scalar(step_sigma, "step_sigma"), scalar(dt, "dt"))
 
 
 def gauss_markov_driving_sigma(sigma: float, tau: float, dt: float) -> float:
     """Per-sample driving σ_u = σ√(1 − e^{−2Δt/τ}) of m_{k+1} = e^{−Δt/τ} m_k + u_k."""
-    return _core.imu_gauss_markov_driving_sigma(float(sigma), float(tau), float(dt))
+    return _core.imu_gauss_markov_driving_sigma(scalar(sigma, "sigma"), scalar(tau, "tau"), scalar(dt, "dt"))
 
 
 def gauss_markov_sigma(driving_sigma: float, tau: float, dt: float) -> float:
     """Stationary σ of the discrete Gauss–Markov with per-sample driving σ_u at Δt."""
-    return _core.imu_gauss_markov_sigma(float(driving_sigma), float(tau), float(dt))
+    return _core.imu_gauss_markov_sigma(scalar(driving_sigma, "driving_sigma"), scalar(tau, "tau"), scalar(dt, "dt"))
 
 
 def gauss_markov_low_freq_asd(sigma: float, tau: float) -> float:
     """Low-frequency amplitude spectral density σ√(2τ) of a Gauss–Markov process."""
-    return _core.imu_gauss_markov_low_freq_asd(float(sigma), float(tau))
+    return _core.imu_gauss_markov_low_freq_asd(scalar(sigma, "sigma"), scalar(tau, "tau"))
 
 
 def flicker_psd(b: float, f: float) -> float:
     """One-sided PSD B²/(πf) of flicker noise of bias instability B at f (Hz)."""
-    return _core.imu_flicker_psd(float(b), float(f))
+    return _core.imu_flicker_psd(scalar(b, "b"), scalar(f, "f"))
 
 
 def flicker_allan_floor(b: float) -> float:
     """Allan-deviation floor B·√(2 ln 2/π) of flicker noise."""
-    return _core.imu_flicker_allan_floor(float(b))
+    return _core.imu_flicker_allan_floor(scalar(b, "b"))

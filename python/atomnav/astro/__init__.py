@@ -194,7 +194,10 @@ def synthetic_catalog(m_lim: float = 5.6, seed: int = 1) -> Catalog:
 def load_catalog(path) -> Catalog:
     """A user catalog from a CSV file with header ``id,ra_deg,dec_deg,mag`` (GCRS right
     ascension and declination in degrees) or ``id,x,y,z,mag`` (unit vectors)."""
-    data = np.genfromtxt(Path(path), delimiter=",", names=True, dtype=float)
+    try:
+        data = np.genfromtxt(Path(path), delimiter=",", names=True, dtype=float)
+    except ValueError as e:  # a path with a NUL byte, or a file that is not such a CSV
+        raise input_error("path", str(e)) from None
     names = set(data.dtype.names or ())
     if {"ra_deg", "dec_deg"} <= names:
         ra, dec = np.radians(data["ra_deg"]), np.radians(data["dec_deg"])
@@ -269,6 +272,9 @@ def model_covariance(cal: Calibration, ds_imu, ds_avu, e_imu, p_avu, increments:
     CᵀE_n^imuC + E_n^avu and the E13 neighbour correlations — converted to Euler angles.
     With ``model.mode == "consistent"`` the constant-error cross terms use
     ``increments.j_m``/``j_b``; P_β^sys is their part (zero otherwise)."""
+    instance(cal, Calibration, "cal")
+    if model is not None:
+        instance(model, GyroErrorModel, "model")
     consistent = model is not None and model.mode == "consistent"
     if consistent and (increments is None or increments.j_m is None):
         raise input_error("increments", "the consistent gyro mode needs the Increments with j_m, j_b")

@@ -14,7 +14,7 @@ import numpy as np
 import pandas as pd
 
 from .. import _core, units
-from .._validate import as_floats, input_error, instance, positive, probability, vector
+from .._validate import as_floats, input_error, instance, integer, positive, probability, renamed, vector
 
 #: Option names, listed (and checked) by the Rust core.
 KINDS = tuple(_core.OPTIONS["AllanKind"])
@@ -175,7 +175,9 @@ def fit_allan(omega, tau0: float, terms=TERMS, tau_min: float | None = None, tau
     """Overlapping Allan variance of the rate series ``omega`` at ``m`` (default octave τ)
     and its five-term fit (:func:`fit_allan_table`)."""
     x = _series(omega, "omega")
-    return fit_allan_table(allan_variance(x, tau0, m=m), x.size, terms, tau_min, tau_max)
+    # too few Allan points in the τ range is a record too short unless the range was given
+    with renamed(data="omega", **{"tau_min/tau_max": "omega" if tau_min is None and tau_max is None else "tau_min"}):
+        return fit_allan_table(allan_variance(x, tau0, m=m), x.size, terms, tau_min, tau_max)
 
 
 def short_term_sensitivity(omega, tau0: float, **fit_kw) -> float:
@@ -204,9 +206,7 @@ def bias_stability(omega, window: int = 1) -> float:
     """Bias stability (spec E17, D17): standard deviation (ddof = 1) of the ⌊N/w⌋
     non-overlapping means of ``window`` samples (incomplete tail dropped), in the rate
     unit. Report ``window`` with the value."""
-    if int(window) != window or window < 1:
-        raise input_error("window", f"must be an integer ≥ 1, got {window}")
-    w = int(window)
+    w = integer(window, "window", 1)
     x = _series(omega, "omega", min_len=2 * w)
     k = x.size // w
     return float(np.std(x[: k * w].reshape(k, w).mean(axis=1), ddof=1))

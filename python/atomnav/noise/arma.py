@@ -147,9 +147,11 @@ def fit_arma(omega, order=(2, 1), differenced: bool = False, lags: int = 10) -> 
     """Fit ARMA(p, q) = ``order`` by exact ML to the first difference of ``omega`` (i.e.
     ARIMA(p,1,q) on ω), or to ``omega`` itself when ``differenced=True``.
     ``ARIMA(d, order=(p,0,q), trend='n')`` (spec D2)."""
-    p, q = (int(v) for v in order)
-    if p < 0 or q < 0:
-        raise input_error("order", f"p and q must be ≥ 0, got {order}")
+    try:
+        p, q = order
+    except (TypeError, ValueError):
+        raise TypeError(f"order: expected a pair of ints (p, q), got {order!r}") from None
+    p, q = integer(p, "order"), integer(q, "order")
     need = _min_len(p, q) + (0 if differenced else 1)
     w = _series(omega, "omega", need)
     d = w if differenced else np.diff(w)

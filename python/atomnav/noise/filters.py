@@ -150,7 +150,11 @@ class ArmaFilterConfig:
 
     @classmethod
     def from_json(cls, text: str) -> "ArmaFilterConfig":
-        return cls.from_dict(json.loads(text))
+        try:
+            d = json.loads(text)
+        except json.JSONDecodeError as e:
+            raise input_error("text", f"not JSON: {e}") from None
+        return cls.from_dict(d)
 
 
 @dataclass

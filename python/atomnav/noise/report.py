@@ -111,6 +111,7 @@ def _claims(t: pd.DataFrame, bs_windows) -> pd.DataFrame:
 def plot_allan(cmp: Comparison, methods=("raw", "fixed KF", "adaptive KF (differenced)", "LPF", "WD")):
     """Overlapping Allan deviation (points with EDF error bars) of each method with its
     five-term fit (lines)."""
+    instance(cmp, Comparison, "cmp")
     import matplotlib.pyplot as plt
 
     fig, ax = plt.subplots(figsize=(7, 5))
