@@ -527,7 +527,7 @@ def test_preset_errors_name_the_called_parameter():
 
 @pytest.mark.parametrize("call, parameter", [
     (lambda: imu.white_sigma(1.0, 5e-324), "dt"),
-    (lambda: imu.white_density(1.0, 5e-324, "increments"), "dt"),
+    (lambda: imu.gauss_markov_sigma(1.0, 1e300, 5e-324), "dt"),
     (lambda: imu.flicker_psd(1.0, 5e-324), "f"),
 ])
 def test_step_too_small_is_an_input_error(call, parameter):
