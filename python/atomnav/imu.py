@@ -152,6 +152,8 @@ class ImuErrors:
         ``electrostatic_space`` / ``electrostatic_space_drift`` (seed-000 satellite
         accelerometer), ``precise`` / ``medium`` / ``coarse`` (Demidov 2009 classes), or a
         name added with :func:`register_preset`. Sources are in ``rust/imu/presets.rs``."""
+        if not isinstance(preset, str):
+            raise TypeError(f"preset: expected a str, got {type(preset).__name__}")
         choice(preset, preset_names(), "preset")
         if preset in _USER_PRESETS:
             return copy.deepcopy(_USER_PRESETS[preset])
@@ -187,6 +189,8 @@ def preset_names() -> list[str]:
 
 def register_preset(name: str, errors: ImuErrors) -> None:
     """Add a named user preset (validated; a built-in name cannot be replaced)."""
+    if not isinstance(name, str):
+        raise TypeError(f"name: expected a str, got {type(name).__name__}")
     if name in _core.imu_preset_names():
         raise input_error("name", f"{name!r} is a built-in preset and cannot be replaced")
     _USER_PRESETS[str(name)] = copy.deepcopy(instance(errors, ImuErrors, "errors").validate())
