@@ -104,6 +104,7 @@ BATCH_LENGTH = 6_000  # ... or fewer, so an example stays within hypothesis' cho
 REPRO_KEEP = 3  # reproducers kept per bad (callable, class) pair
 SLOWEST = 15  # slowest calls listed in the report
 PROGRESS_S = 30.0  # seconds between progress reports
+IDLE_ROUNDS = 5  # top-up rounds in a row that made no call, after which a campaign stops
 IDLE_BATCHES = 50  # ... after which a campaign stops (every callable quarantined or over budget)
 
 
@@ -1045,11 +1046,14 @@ def campaign(calls: int, seed: int, timeout: float = TIMEOUT_S, progress=None, o
             per_batch = c.calls / run.batches if run.batches else BATCH
             examples = math.ceil((calls - c.calls) / max(per_batch, 1.0))
             before = c.calls
+            empty_rounds = 0 if round_ == 0 else empty_rounds
             settings(max_examples=examples, database=None, deadline=None, phases=[Phase.generate],
                      suppress_health_check=list(HealthCheck), report_multiple_bugs=False)(
                 hseed(seed if round_ == 0 else seed * 7919 + round_)(given(st.data())(one)))()
             run.collect()
-            if c.calls >= calls or c.calls == before or run.idle > IDLE_BATCHES:
+            empty_rounds = empty_rounds + 1 if c.calls == before else 0
+            # a short top-up round can draw only calls that are skipped: give up after a few
+            if c.calls >= calls or empty_rounds > IDLE_ROUNDS or run.idle > IDLE_BATCHES:
                 break
     finally:
         run.pool.close()
