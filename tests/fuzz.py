@@ -26,9 +26,21 @@ signal or exited), ``hang`` (no answer within the timeout; the worker is killed)
 ``non-finite`` (NaN/inf in the output of a call whose inputs are all finite, unless the
 function's docstring says its output "may be non-finite").
 
+Speed: each hypothesis example draws a batch of calls (``BATCH``); two persistent worker
+processes run batches while the next one is drawn and answer call by call, so an abort or
+a hang (no answer within ``TIMEOUT_S``) is pinned to its call, reported with the call that
+reproduces it, and the rest of the batch goes to a fresh worker (a warm spare). A callable
+whose calls used up ``TIME_BUDGET_S`` of worker time (slow defaults, e.g. a whole hybrid
+filter run) is not called again in that campaign.
+
 Usage::
 
     python tests/fuzz.py --calls 20000 --seed 1 --out report.md
+    python tests/fuzz.py --calls 5000 --seed 2 --only atomnav.noise,atomnav._core.allan_   # some modules
+    python tests/fuzz.py --calls 1000000 --out long.md                                    # the long campaign
+
+The report lists the calls made, outcome classes, the first reproducers of each bad
+(callable, class) pair, the slowest calls and the callables by worker time.
 
 The worker caps its address space (``RLIMIT_AS``, 4 GiB by default) so a huge allocation
 is a ``MemoryError`` or a dead worker, never a machine out of memory.
@@ -38,8 +50,11 @@ from __future__ import annotations
 
 import argparse
 import dataclasses
+import fnmatch
+import heapq
 import importlib
 import inspect
+import itertools
 import math
 import os
 import pickle
@@ -51,7 +66,7 @@ import subprocess
 import sys
 import tempfile
 import time
-from collections import Counter, defaultdict
+from collections import Counter, defaultdict, deque
 
 import numpy as np
 
@@ -76,11 +91,21 @@ SPECIAL_FLOATS = (math.nan, math.inf, -math.inf, 0.0, -0.0, 5e-324, 1e308, -1e30
 EXTREME_INTS = (0, -1, 1, 2**31, 2**63, 2**64, -(2**63), 2**32 + 1)
 INVALID_STRINGS = ("", "nope", "WGS-84", " rates", "RATES", "\x00", "ééé", "a" * 300)
 TIMEOUT_S = 10.0
+RECIPES = 12  # calls kept per class that built an instance of it
 RECIPE_MAX_S = 0.05  # a call that built an instance is reused (rebuilt for every use) if it took less
 TIME_BUDGET_S = 1.0  # worker seconds per callable in one campaign (hangs and aborts not counted)
 MEMORY_LIMIT = 4 << 30
 LITERAL_MAX = 24  # arrays up to this many elements are written out in a reproducer
 QUARANTINE = {"hang": 1, "abort": 2}  # failures of a kind after which a function is not called again
+CI_CALLS = 20_000  # the fixed-seed share CI runs; longer campaigns scale TIME_BUDGET_S with their length
+JOBS = 2  # worker processes running batches side by side
+BATCH = 64  # calls drawn by one hypothesis example and run by the worker in one go
+BATCH_LENGTH = 6_000  # ... or fewer, so an example stays within hypothesis' choice buffer (8 KiB)
+REPRO_KEEP = 3  # reproducers kept per bad (callable, class) pair
+SLOWEST = 15  # slowest calls listed in the report
+PROGRESS_S = 30.0  # seconds between progress reports
+IDLE_ROUNDS = 5  # top-up rounds in a row that made no call, after which a campaign stops
+IDLE_BATCHES = 50  # ... after which a campaign stops (every callable quarantined or over budget)
 
 
 # ----------------------------------------------------------------------------------------
@@ -122,7 +147,9 @@ def _params(obj, drop_self: bool) -> tuple[Param, ...] | None:
             continue
         if p.kind in (p.VAR_POSITIONAL, p.VAR_KEYWORD):
             continue
-        out.append(Param(p.name, p.default, p.kind == p.POSITIONAL_ONLY))
+        # a dataclass field with a default factory shows a sentinel: optional, default unknown
+        default = Ellipsis if repr(p.default) == "<factory>" else p.default
+        out.append(Param(p.name, default, p.kind == p.POSITIONAL_ONLY))
     return tuple(out)
 
 
@@ -364,9 +391,13 @@ INSTANCE_NAMES = ("ins", "eph", "sensor", "scenario", "motion", "res", "result",
                   "reference", "gravity", "obs", "noise", "aiding", "stream", "model", "calibration")
 
 
+ROWS = (1, 2, 3, 5, 8, 0, 13)
+"""Row counts N of one call (its arrays share N, so that lengths agree unless drawn not to)."""
+
+
 def strategies(targets: list[Target]):
-    """Option strings and the strategy factory for one campaign (hypothesis is imported
-    here so the worker does not need it)."""
+    """The strategy factory ``value(param, hostile, n)`` for one campaign (hypothesis is
+    imported here so the worker does not need it)."""
     from hypothesis import strategies as st
 
     import atomnav._core as core
@@ -381,7 +412,6 @@ def strategies(targets: list[Target]):
     npscalar = st.tuples(st.just("npscalar"), st.sampled_from(("float32", "int64", "float64", "bool")),
                          st.sampled_from((0, 1, 3)))
 
-    rows = st.shared(st.sampled_from((1, 2, 3, 5, 8, 0, 13)), key="rows")  # one N per call
     width = st.sampled_from((3, 3, 3, 4, 1, 2, 6, 7, 9, 15))
     form = st.sampled_from(("rows", "rows", "vector", "vector", "square", "stack", "scalar", "empty2", "matrix"))
     dtype = st.sampled_from(("float64",) * 8 + ("float32", "int64", "bool", "complex128", "object", "<U3"))
@@ -393,9 +423,8 @@ def strategies(targets: list[Target]):
              "any": st.sampled_from(("normal", "small", "zeros", "ints", "increasing", "unit", "eye"))}
 
     @st.composite
-    def array(d, fill):
-        n = d(rows)
-        k = d(st.one_of(st.just(n), st.just(n), st.sampled_from((0, 1, 2, n + 1, max(n - 1, 0), 30))))
+    def array(d, fill, n):
+        k = d(st.sampled_from((n,) * 12 + (0, 1, 2, n + 1, max(n - 1, 0), 30)))
         w, f = d(width), d(form)
         shape = {"rows": (k, w), "vector": (k,), "square": (w, w), "stack": (k, min(w, 6), min(w, 6)),
                  "scalar": (), "empty2": (0, w), "matrix": (w, d(width))}[f]
@@ -406,23 +435,26 @@ def strategies(targets: list[Target]):
         return ("time" if lname in TIME_NAMES else "quat" if lname in QUAT_NAMES else
                 "square" if lname in SQUARE_NAMES else "any")
 
-    clean = st.builds(lambda shape, fill, seed: ("arr", shape, "float64", "C", fill, seed, ()),
-                      st.one_of(st.tuples(rows, width), st.tuples(rows), st.tuples(width, width),
-                                st.tuples(rows, st.sampled_from((1, 2, 3, 6)), st.sampled_from((1, 2, 3, 6)))),
-                      st.sampled_from(("normal", "small", "increasing", "unit", "eye")), st.integers(0, 2**16))
+    def clean(n):
+        return st.builds(lambda shape, fill, seed: ("arr", shape, "float64", "C", fill, seed, ()),
+                         st.one_of(st.tuples(st.just(n), width), st.just((n,)), st.tuples(width, width),
+                                   st.tuples(st.just(n), st.sampled_from((1, 2, 3, 6)),
+                                             st.sampled_from((1, 2, 3, 6)))),
+                         st.sampled_from(("normal", "small", "increasing", "unit", "eye")), st.integers(0, 2**16))
+
     instance = st.tuples(st.just("instance"), st.integers(0, 2**16))
     valid_options = st.sampled_from(options)
     cache: dict = {}
 
-    def value(param: Param, hostile: bool):
-        """The strategy for one parameter (built once per name, default and mood): a
-        plausible value, or (``hostile``) anything."""
-        key = (param.name, repr(param.default), hostile)
+    def value(param: Param, hostile: bool, n: int):
+        """The strategy for one parameter (built once per name, default, mood and row
+        count ``n``): a plausible value, or (``hostile``) anything."""
+        key = (param.name, repr(param.default), hostile, n)
         if key not in cache:
-            cache[key] = _hostile(param) if hostile else _plausible(param)
+            cache[key] = _hostile(param, n) if hostile else _plausible(param, n)
         return cache[key]
 
-    def _plausible(param: Param):
+    def _plausible(param: Param, n: int):
         lname = param.name.lower()
         d = param.default
         if d is not inspect.Parameter.empty and d is not Ellipsis and d is not None:
@@ -435,12 +467,13 @@ def strategies(targets: list[Target]):
             return valid_options
         if lname in INSTANCE_NAMES:
             return instance
+        c = clean(n)
         if d is None:
-            return st.one_of(st.none(), clean, instance)
-        return st.one_of(clean, clean, clean.map(lambda s: ("list", s)), st.floats(1e-3, 100.0), instance)
+            return st.one_of(st.none(), c, instance)
+        return st.one_of(c, c, c.map(lambda s: ("list", s)), st.floats(1e-3, 100.0), instance)
 
-    def _hostile(param: Param):
-        arrays = array(fills[fill_of(param.name)])
+    def _hostile(param: Param, n: int):
+        arrays = array(fills[fill_of(param.name)], n)
         return st.one_of(arrays, arrays, arrays.map(lambda s: ("list", s)), floats, ints, st.none(), strings,
                          wrong, npscalar, st.booleans(), instance)
 
@@ -512,7 +545,8 @@ def classify(t: Target, fn, kwargs: dict) -> tuple[str, str, float, str | None]:
 
 
 def worker_main(out_fd: int) -> None:
-    """Serve calls read from stdin (length-prefixed pickles) until EOF."""
+    """Serve batches of calls read from stdin (length-prefixed pickles) until EOF,
+    answering each call as soon as it returns."""
     import resource
     import warnings
 
@@ -524,17 +558,27 @@ def worker_main(out_fd: int) -> None:
     inp = sys.stdin.buffer
     _send(out, "ready")
     while True:
-        call = _recv(inp)
-        if call is None:
+        batch = _recv(inp)
+        if batch is None:
             return
-        t = TARGETS_BY_NAME[call["target"]]
-        try:
-            instance = build(call["this"]) if call["this"] is not None else None
-            kwargs = {k: build(v) for k, v in call["kwargs"].items()}
-        except BaseException as e:  # noqa: BLE001 - building an instance is itself a call of the API
-            _send(out, ("setup", f"{type(e).__name__}: {e}"[:300], 0.0, None))
-            continue
-        _send(out, classify(t, callee(t, instance), kwargs))
+        for call in batch:
+            _send(out, _serve(call))
+
+
+def _serve(call: dict):
+    """(outcome class, message, seconds of the call, class name of an API instance it
+    returned, worker seconds in all: building the arguments and the instance too, seconds
+    building the instance)."""
+    start = time.perf_counter()
+    t = TARGETS_BY_NAME[call["target"]]
+    try:
+        instance = build(call["this"]) if call["this"] is not None else None
+        built = time.perf_counter() - start
+        kwargs = {k: build(v) for k, v in call["kwargs"].items()}
+    except BaseException as e:  # noqa: BLE001 - building an instance is itself a call of the API
+        took = time.perf_counter() - start
+        return "setup", f"{type(e).__name__}: {e}"[:300], 0.0, None, took, took
+    return *classify(t, callee(t, instance), kwargs), time.perf_counter() - start, built
 
 
 def _send(f, obj) -> None:
@@ -551,7 +595,8 @@ def _recv(f):
 
 
 class Worker:
-    """A worker subprocess; ``call`` returns its answer, or ``abort``/``hang``."""
+    """A worker subprocess running one batch of calls at a time: ``submit`` sends a batch,
+    ``answer`` returns the answer to its next call, or ``abort``/``hang``."""
 
     def __init__(self, timeout: float):
         self.timeout = timeout
@@ -593,35 +638,46 @@ class Worker:
                 raise RuntimeError(f"fuzz worker failed to start (exit code {self.proc.poll()})")
             self.ready = True
 
-    def call(self, call: dict):
+    def submit(self, batch: list[dict]) -> bool:
+        """Send a batch; False if the worker is already dead."""
         self.wait_ready()
+        data = pickle.dumps(batch)
         try:
-            data = pickle.dumps(call)
             self.proc.stdin.write(struct.pack("<I", len(data)) + data)
             self.proc.stdin.flush()
-            start = time.monotonic()
+        except (BrokenPipeError, OSError):
+            return False
+        return True
+
+    def answer(self):
+        """The answer to the next call of the batch. Waiting starts now, so a ``hang``
+        (no answer within the timeout) is a call that ran for at least that long."""
+        start = time.monotonic()
+        try:
             answer = self.receive(self.timeout)
         except TimeoutError:
             self.close()
-            return "hang", f"no answer within {self.timeout:g} s", self.timeout, None
-        except (BrokenPipeError, OSError):
-            answer, start = None, time.monotonic()
+            return "hang", f"no answer within {self.timeout:g} s", self.timeout, None, self.timeout, 0.0
+        except OSError:
+            answer = None
         if answer is None:
-            code = self.proc.wait()
-            self.close()
-            how = f"killed by signal {signal.Signals(-code).name}" if code < 0 else f"exited with code {code}"
-            return "abort", f"worker {how}", time.monotonic() - start, None
+            return self.died(time.monotonic() - start)
         return answer
+
+    def died(self, seconds: float):
+        code = self.proc.wait()
+        self.close()
+        how = f"killed by signal {signal.Signals(-code).name}" if code < 0 else f"exited with code {code}"
+        return "abort", f"worker {how}", seconds, None, seconds, 0.0
 
     def close(self) -> None:
         if self.proc.poll() is None:
             os.killpg(self.proc.pid, signal.SIGKILL)
             self.proc.wait()
-        for f in (self.proc.stdin,):
-            try:
-                f.close()
-            except OSError:
-                pass
+        try:
+            self.proc.stdin.close()
+        except OSError:
+            pass
         try:
             os.close(self.fd)
         except OSError:
@@ -630,24 +686,36 @@ class Worker:
 
 
 class Pool:
-    """The live worker and a warm spare, so a dead worker costs no import time."""
+    """``jobs`` live workers and a warm spare, so a dead worker costs no import time."""
 
-    def __init__(self, timeout: float):
+    def __init__(self, timeout: float, jobs: int):
         self.timeout = timeout
-        self.live = Worker(timeout)
+        self.workers = [Worker(timeout) for _ in range(jobs)]
         self.spare = Worker(timeout)
         self.restarts = 0
+        POOLS.append(self)
 
-    def call(self, call: dict):
-        answer = self.live.call(call)
-        if answer[0] in ("abort", "hang"):
-            self.live, self.spare = self.spare, Worker(self.timeout)
-            self.restarts += 1
-        return answer
+    def replace(self, i: int) -> None:
+        self.workers[i].close()
+        self.workers[i], self.spare = self.spare, Worker(self.timeout)
+        self.restarts += 1
 
     def close(self) -> None:
-        self.live.close()
-        self.spare.close()
+        for w in self.workers + [self.spare]:
+            w.close()
+        if self in POOLS:
+            POOLS.remove(self)
+
+
+POOLS: list[Pool] = []  # open pools, closed on SIGTERM
+
+
+def _terminate(*_) -> None:
+    """SIGTERM: kill the workers (they run in sessions of their own) and exit at once
+    (hypothesis would treat a SystemExit raised inside a test as a failure to replay)."""
+    for pool in list(POOLS):
+        pool.close()
+    os._exit(143)
 
 
 # ----------------------------------------------------------------------------------------
@@ -666,6 +734,14 @@ def _init_targets() -> None:
         CONSTRUCTIBLE.update(t.owner for t in TARGETS if t.owner)
 
 
+def select_targets(targets: list[Target], only: list[str] | None) -> list[Target]:
+    """The targets whose dotted name starts with one of ``only`` (or matches it as a
+    shell pattern, e.g. ``atomnav._core.*allan*``); all of them without ``only``."""
+    if not only:
+        return list(targets)
+    return [t for t in targets if any(t.name.startswith(o) or fnmatch.fnmatchcase(t.name, o) for o in only)]
+
+
 @dataclasses.dataclass
 class Record:
     target: str
@@ -677,43 +753,82 @@ class Record:
 
 @dataclasses.dataclass
 class Campaign:
+    """Outcome counts of every call made, the first reproducers of each bad (callable,
+    class) pair and the slowest calls. ``calls`` counts the calls made, not the ones
+    skipped (``SKIPPED``)."""
+
     seed: int
-    calls: int
-    records: list[Record]
     targets: list[Target]
-    seconds: float
-    restarts: int
+    calls: int = 0
+    seconds: float = 0.0
+    restarts: int = 0
+    waited: float = 0.0  # seconds the campaign waited for workers (the rest it spent drawing)
+    counts: Counter = dataclasses.field(default_factory=Counter)  # outcome -> calls (skipped too)
+    pairs: Counter = dataclasses.field(default_factory=Counter)  # (callable, outcome) -> calls
+    spent: Counter = dataclasses.field(default_factory=Counter)  # callable -> worker seconds in all
+    kept: list[Record] = dataclasses.field(default_factory=list)  # bad calls, REPRO_KEEP per pair
+    slowest: list = dataclasses.field(default_factory=list)  # (seconds, n, target, outcome, call spec)
+
+    def add(self, target: str, outcome: str, message: str = "", seconds: float = 0.0, call=None,
+            total: float = 0.0) -> None:
+        """One drawn call: its outcome, the seconds of the call itself and the worker
+        seconds in all (building its arguments and instance too)."""
+        self.counts[outcome] += 1
+        self.pairs[(target, outcome)] += 1
+        self.spent[target] += total
+        if outcome in SKIPPED:
+            return
+        self.calls += 1
+        if outcome not in GOOD and self.pairs[(target, outcome)] <= REPRO_KEEP:
+            self.kept.append(Record(target, outcome, message, seconds, render_call(*call)))
+        entry = (seconds, self.calls, target, outcome, call)
+        if len(self.slowest) < SLOWEST:
+            heapq.heappush(self.slowest, entry)
+        elif seconds > self.slowest[0][0]:
+            heapq.heapreplace(self.slowest, entry)
 
     def bad(self) -> list[Record]:
-        return [r for r in self.records if r.outcome not in GOOD + SKIPPED]
+        """The kept reproducers of bad calls (``REPRO_KEEP`` per pair; ``n_bad`` counts all)."""
+        return list(self.kept)
+
+    @property
+    def n_bad(self) -> int:
+        return sum(n for (_, cls), n in self.pairs.items() if cls not in GOOD + SKIPPED)
 
     def first_failures(self) -> dict[tuple[str, str], tuple[Record, int]]:
-        """First reproducing call and count per (function, bad class)."""
-        out: dict[tuple[str, str], list] = {}
-        for r in self.bad():
-            key = (r.target, r.outcome)
-            if key not in out:
-                out[key] = [r, 0]
-            out[key][1] += 1
-        return {k: (v[0], v[1]) for k, v in out.items()}
+        """First reproducing call and count per (callable, bad class)."""
+        out: dict[tuple[str, str], tuple[Record, int]] = {}
+        for r in self.kept:
+            out.setdefault((r.target, r.outcome), (r, self.pairs[(r.target, r.outcome)]))
+        return out
 
     def report(self) -> str:
-        counts = Counter(r.outcome for r in self.records)
+        skipped = sum(self.counts[s] for s in SKIPPED)
+        rate = self.calls / self.seconds if self.seconds else 0.0
         lines = [f"# atomnav fuzz campaign (seed {self.seed})", "",
-                 f"{self.calls} calls drawn over {len(self.targets)} public callables "
-                 f"({sum(counts[s] for s in SKIPPED)} not made: {', '.join(SKIPPED)}) in {self.seconds:.0f} s; "
-                 f"{self.restarts} worker restarts.", "", "## Outcomes", "", "| class | calls | bad |", "|---|---:|---|"]
-        for cls, n in sorted(counts.items(), key=lambda kv: -kv[1]):
+                 f"{self.calls} calls made over {len(self.targets)} public callables in {self.seconds:.0f} s "
+                 f"({rate:.0f} calls/s); {skipped} drawn calls not made ({', '.join(SKIPPED)}); "
+                 f"{self.restarts} worker restarts; {sum(self.spent.values()):.0f} worker seconds; "
+                 f"{self.waited:.0f} s waiting for workers.", "", "## Outcomes", "", "| class | calls | bad |",
+                 "|---|---:|---|"]
+        for cls, n in sorted(self.counts.items(), key=lambda kv: -kv[1]):
             lines.append(f"| {cls} | {n} | {'' if cls in GOOD + SKIPPED else 'yes'} |")
         fails = self.first_failures()
         funcs = sorted({k[0] for k in fails})
         lines += ["", f"## Failing callables ({len(funcs)}; {len(fails)} (callable, class) pairs)", ""]
         for (target, cls), (rec, n) in sorted(fails.items()):
             lines += [f"### `{target}` — {cls} ({n}×)", "", f"{_md(rec.message)}", "", "```python", rec.call, "```", ""]
-        slow = sorted((r for r in self.records if r.outcome not in SKIPPED), key=lambda r: -r.seconds)[:10]
-        lines += ["## Slowest calls", "", "| s | callable | class |", "|---:|---|---|"]
-        lines += [f"| {r.seconds:.2f} | `{r.target}` | {r.outcome} |" for r in slow]
-        never = sorted(t.name for t in self.targets if not any(r.target == t.name and r.outcome == "ok" for r in self.records))
+        lines += ["## Slowest calls", "", "| s | callable | class | call |", "|---:|---|---|---|"]
+        lines += [f"| {s:.2f} | `{target}` | {cls} | `{_md(render_call(*call))[:200]}` |"
+                  for s, _, target, cls, call in sorted(self.slowest, reverse=True)]
+        lines += ["", "## Callables by worker time", "", "| s | calls | callable |", "|---:|---:|---|"]
+        made = Counter()
+        for (target, cls), n in self.pairs.items():
+            if cls not in SKIPPED:
+                made[target] += n
+        lines += [f"| {s:.2f} | {made[target]} | `{target}` |" for target, s in self.spent.most_common(SLOWEST)]
+        ok = {target for (target, cls) in self.pairs if cls == "ok"}
+        never = sorted(t.name for t in self.targets if t.name not in ok)
         lines += ["", f"## Callables never answered ok ({len(never)})", "", ", ".join(f"`{n}`" for n in never), ""]
         return "\n".join(lines)
 
@@ -740,96 +855,244 @@ def _instances(spec, made: list):
 REPRO_HEADER = "import numpy as np, atomnav; from numpy import nan, inf; from fuzz import arr"
 
 
-def campaign(calls: int, seed: int, timeout: float = TIMEOUT_S, progress=None) -> Campaign:
-    """Draw ``calls`` calls (hypothesis, fixed ``seed``) and run them in worker processes;
-    ``progress(campaign so far)`` is called every 500 calls."""
+class _Runner:
+    """The state of one campaign: instance recipes, quarantine, time budgets, and the
+    batches the workers run while the next one is drawn."""
+
+    def __init__(self, c: Campaign, calls: int, timeout: float, budget: float, jobs: int):
+        self.c = c
+        self.target_calls = calls
+        self.budget = budget
+        self.recipes: dict[str, list] = defaultdict(list)  # class -> specs of calls that built one
+        self.failures: Counter = Counter()
+        self.slow_factories: set[str] = set()  # factories that took RECIPE_MAX_S or longer
+        self.submitted = 0  # calls made or in flight
+        self.pool = Pool(timeout, jobs)
+        self.running: deque = deque()  # (worker, [(target, kwargs, this)]) of the batches running
+        self.idle = 0  # drawn batches in a row of which no call was made
+        self.batches = 0
+
+    def prepare(self, drawn: list[tuple]) -> list[tuple]:
+        """The calls of a drawn batch that will be made; the others are recorded as skipped.
+        Instances and quarantine are looked up here, after every draw of the batch."""
+        made = [s for specs in self.recipes.values() for s in specs]
+        out = []
+        for t, pick, kwargs, factory in drawn:
+            if self.submitted + len(out) >= self.target_calls:
+                break
+            if any(self.failures[(t.name, k)] >= v for k, v in QUARANTINE.items()):
+                self.c.add(t.name, "quarantined")
+                continue
+            if self.c.spent[t.name] > self.budget:
+                self.c.add(t.name, "over time budget")
+                continue
+            this = None
+            if t.owner is not None:
+                if self.recipes[t.owner]:
+                    this = self.recipes[t.owner][pick % len(self.recipes[t.owner])]
+                elif factory and factory[1] not in self.slow_factories:
+                    this = ("call", factory[1], {k: _instances(v, made) for k, v in factory[2].items()}, None)
+                else:
+                    self.c.add(t.name, "no instance")
+                    continue
+            out.append((t.name, {k: _instances(v, made) for k, v in kwargs.items()}, this))
+        return out
+
+    def submit(self, batch: list[tuple]) -> None:
+        """Run a batch on a free worker (collecting the oldest running batch if none is)."""
+        if not batch:
+            return
+        if len(self.running) == len(self.pool.workers):
+            self.collect_oldest()
+        busy = {i for i, _ in self.running}
+        i = next(i for i in range(len(self.pool.workers)) if i not in busy)
+        self.submitted += len(batch)
+        self._send(i, batch)
+        self.running.append((i, batch))
+
+    def _send(self, i: int, batch: list[tuple]) -> None:
+        while not self.pool.workers[i].submit([{"target": a, "kwargs": k, "this": s} for a, k, s in batch]):
+            self.pool.replace(i)
+
+    def collect(self) -> None:
+        """The answers to every running batch."""
+        while self.running:
+            self.collect_oldest()
+
+    def collect_oldest(self) -> None:
+        """The answers to the oldest running batch. After an abort or a hang the rest of the
+        batch goes to a fresh worker."""
+        i, batch = self.running.popleft()
+        k = 0
+        while k < len(batch):
+            waiting = time.monotonic()
+            answer = self.pool.workers[i].answer()
+            self.c.waited += time.monotonic() - waiting
+            call = batch[k]
+            k += 1
+            self._record(call, *answer)
+            if answer[0] in ("abort", "hang"):
+                self.failures[(call[0], answer[0])] += 1
+                self.pool.replace(i)
+                rest = self.prepare_again(batch[k:])
+                self.submitted -= len(batch) - k - len(rest)
+                if rest:
+                    self._send(i, rest)
+                batch, k = rest, 0
+
+    def prepare_again(self, rest: list[tuple]) -> list[tuple]:
+        out = []
+        for call in rest:
+            if any(self.failures[(call[0], k)] >= v for k, v in QUARANTINE.items()):
+                self.c.add(call[0], "quarantined")
+            else:
+                out.append(call)
+        return out
+
+    def _record(self, call: tuple, outcome: str, message: str, secs: float, made, total: float,
+                built: float) -> None:
+        target, kwargs, this = call
+        if outcome == "setup":
+            self.submitted -= 1
+        self.c.add(target, outcome, message, secs, call, total)
+        t = TARGETS_BY_NAME[target]
+        if outcome == "ok" and made is not None and secs < RECIPE_MAX_S:
+            self._recipe(made, ("call", target, kwargs, this), t)
+        if t.owner is not None and this not in self.recipes[t.owner] and outcome not in ("abort", "hang"):
+            # an instance built by a factory (no earlier call had built one)
+            if outcome != "setup" and built < RECIPE_MAX_S:
+                self._recipe(t.owner, this, TARGETS_BY_NAME[this[1]])
+            elif built >= RECIPE_MAX_S:
+                self.slow_factories.add(this[1])
+
+    def _recipe(self, cls: str, spec: tuple, t: Target) -> None:
+        if len(self.recipes[cls]) < RECIPES and spec not in self.recipes[cls] \
+                and not (t.kind == "constructor" and _plain_dataclass(resolve(t.module, t.qualname))):
+            self.recipes[cls].append(spec)
+
+
+def campaign(calls: int, seed: int, timeout: float = TIMEOUT_S, progress=None, only=None,
+             budget: float | None = None, jobs: int = JOBS) -> Campaign:
+    """Make ``calls`` calls drawn by hypothesis (fixed ``seed``) in worker processes.
+
+    Each hypothesis example draws a batch of calls; ``jobs`` workers run batches while
+    the next one is drawn. ``only``: name prefixes or patterns of the callables to fuzz (all by
+    default). ``budget``: worker seconds per callable (default ``TIME_BUDGET_S``, scaled
+    up for campaigns longer than ``CI_CALLS``). ``progress(campaign so far)`` is called
+    about every ``PROGRESS_S`` seconds."""
     from hypothesis import HealthCheck, Phase, given, settings, strategies as st
     from hypothesis import seed as hseed
 
     _init_targets()
+    targets = select_targets(TARGETS, only)
+    if not targets:
+        raise ValueError(f"no public callable matches {only}")
     value = strategies(TARGETS)
-    recipes: dict[str, list] = defaultdict(list)  # class -> specs of calls that built one
-    failures: Counter = Counter()
-    spent: Counter = Counter()
-    records: list[Record] = []
-    pool = Pool(timeout)
+    c = Campaign(seed, targets)
+    if budget is None:
+        budget = TIME_BUDGET_S * max(1.0, calls / CI_CALLS)
+    run = _Runner(c, calls, timeout, budget, jobs)
     start = time.monotonic()
+    last = [start]
+    pick_target = st.integers(0, len(targets) - 1)
+    pick_instance = st.integers(0, 2**16)
+    pick_rows = st.sampled_from(ROWS)
+    factories = {owner: [f for f in TARGETS if (f.name == owner and not _plain_dataclass(resolve(f.module, f.qualname)))
+                         or (f.kind == "static" and f.name.startswith(owner + "."))]
+                 for owner in {t.owner for t in targets if t.owner}}
+    hostile_of = {k: st.integers(-2, k - 1) for k in range(max(len(t.params) for t in targets) + 1)}
+    passed = {True: st.sampled_from((True,) * 30 + (False,)), False: st.sampled_from((True, True, False))}
 
-    @settings(max_examples=calls, database=None, deadline=None, phases=[Phase.generate],
-              suppress_health_check=list(HealthCheck), report_multiple_bugs=False)
-    @hseed(seed)
-    @given(st.data())
+    def draw_kwargs(draw, t: Target, hostile: int, n: int) -> dict:
+        kwargs = {}
+        for i, p in enumerate(t.params):
+            if draw(passed[p.default is inspect.Parameter.empty]):
+                kwargs[p.name] = draw(value(p, hostile in (i, -2), n))
+        return kwargs
+
+    def draw_call(draw):
+        t = targets[draw(pick_target)]
+        pick, n = draw(pick_instance), draw(pick_rows)
+        # one hostile argument (or none, or all) among plausible ones
+        kwargs = draw_kwargs(draw, t, draw(hostile_of[len(t.params)]), n)
+        # a method also draws a plausible call of a factory of its class, its instance when
+        # no earlier call has built one
+        made = factories.get(t.owner)
+        if made:
+            f = made[draw(st.integers(0, len(made) - 1))]
+            made = ("call", f.name, draw_kwargs(draw, f, -1, n), None)
+        return t, pick, kwargs, made
+
     def one(data):
         # every draw is made whatever the state of the campaign (hypothesis replays choice
-        # sequences); instances and quarantine are looked up afterwards
-        t = TARGETS[data.draw(st.integers(0, len(TARGETS) - 1), label="callable")]
-        pick = data.draw(st.integers(0, 2**16), label="instance")
-        kwargs = {}
-        # one hostile argument (or none, or all) among plausible ones
-        hostile = data.draw(st.integers(-2, len(t.params) - 1), label="hostile")
-        for i, p in enumerate(t.params):
-            required = p.default is inspect.Parameter.empty
-            if data.draw(st.sampled_from((True,) * (30 if required else 2) + (False,)), label=f"pass {p.name}"):
-                kwargs[p.name] = data.draw(value(p, hostile in (i, -2)), label=p.name)
-        made = [s for specs in recipes.values() for s in specs]
-        kwargs = {k: _instances(v, made) for k, v in kwargs.items()}
-        if any(failures[(t.name, k)] >= v for k, v in QUARANTINE.items()):
-            records.append(Record(t.name, "quarantined", "", 0.0, ""))
-            return
-        if spent[t.name] > TIME_BUDGET_S:
-            records.append(Record(t.name, "over time budget", "", 0.0, ""))
-            return
-        this = None
-        if t.owner is not None:
-            if not recipes[t.owner]:
-                records.append(Record(t.name, "no instance", "", 0.0, ""))
-                return
-            this = recipes[t.owner][pick % len(recipes[t.owner])]
-        call = {"target": t.name, "kwargs": kwargs, "this": this}
-        outcome, message, secs, made = pool.call(call)
-        text = render_call(t.name, kwargs, this)
-        records.append(Record(t.name, outcome, message, secs, text))
-        if outcome in ("abort", "hang"):
-            failures[(t.name, outcome)] += 1
-        else:
-            spent[t.name] += secs
-        if outcome == "ok" and made is not None and len(recipes[made]) < 12 and secs < RECIPE_MAX_S \
-                and not (t.kind == "constructor" and _plain_dataclass(resolve(t.module, t.qualname))):
-            recipes[made].append(("call", t.name, kwargs, this))
-        if progress is not None and sum(r.outcome not in SKIPPED for r in records) % 500 == 0:
-            progress(Campaign(seed, len(records), list(records), TARGETS, time.monotonic() - start, pool.restarts))
+        # sequences); instances and quarantine are looked up once the batch is drawn, while
+        # the previous batch runs
+        cd = getattr(data, "conjecture_data", data)
+        drawn = []
+        while len(drawn) < BATCH and getattr(cd, "length", 0) < BATCH_LENGTH:
+            drawn.append(draw_call(cd.draw))
+        batch = run.prepare(drawn)
+        run.batches += 1
+        run.idle = 0 if batch else run.idle + 1
+        run.submit(batch)
+        if progress is not None and time.monotonic() - last[0] > PROGRESS_S:
+            last[0] = time.monotonic()
+            c.seconds, c.restarts = last[0] - start, run.pool.restarts
+            progress(c)
 
     try:
-        one()
+        for round_ in itertools.count():  # each round tops up the calls the previous ones did not make
+            # examples for the calls still to make, at the rate of made calls per batch so far
+            per_batch = c.calls / run.batches if run.batches else BATCH
+            examples = math.ceil((calls - c.calls) / max(per_batch, 1.0))
+            before = c.calls
+            empty_rounds = 0 if round_ == 0 else empty_rounds
+            settings(max_examples=examples, database=None, deadline=None, phases=[Phase.generate],
+                     suppress_health_check=list(HealthCheck), report_multiple_bugs=False)(
+                hseed(seed if round_ == 0 else seed * 7919 + round_)(given(st.data())(one)))()
+            run.collect()
+            empty_rounds = empty_rounds + 1 if c.calls == before else 0
+            # a short top-up round can draw only calls that are skipped: give up after a few
+            if c.calls >= calls or empty_rounds > IDLE_ROUNDS or run.idle > IDLE_BATCHES:
+                break
     finally:
-        pool.close()
-    return Campaign(seed, len(records), records, TARGETS, time.monotonic() - start, pool.restarts)
+        run.pool.close()
+    c.seconds, c.restarts = time.monotonic() - start, run.pool.restarts
+    return c
 
 
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("--calls", type=int, default=20_000)
+    ap.add_argument("--calls", type=int, default=CI_CALLS, help="calls to make (skipped draws not counted)")
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--timeout", type=float, default=TIMEOUT_S, help="seconds before a call counts as a hang")
+    ap.add_argument("--only", action="append", default=None, metavar="PREFIX",
+                    help="fuzz only the callables whose dotted name starts with PREFIX or matches it as a "
+                         "shell pattern (comma-separated or repeated), e.g. atomnav.noise,atomnav._core.allan*")
+    ap.add_argument("--budget", type=float, default=None,
+                    help=f"worker seconds per callable (default {TIME_BUDGET_S:g}, scaled up beyond {CI_CALLS} calls)")
+    ap.add_argument("--jobs", type=int, default=JOBS, help="worker processes")
     ap.add_argument("--out", default=None, help="markdown report (default: stdout)")
     ap.add_argument("--worker", type=int, default=None, help=argparse.SUPPRESS)
     a = ap.parse_args(argv)
     if a.worker is not None:
         worker_main(a.worker)
         return 0
+    only = [o.strip() for arg in a.only for o in arg.split(",") if o.strip()] if a.only else None
+
     def write(c: Campaign) -> None:
         text = c.report() + f"\nReproducers assume `{REPRO_HEADER}` (run from tests/).\n"
         if a.out:
             with open(a.out, "w") as f:
                 f.write(text)
-        print(f"{c.calls} calls, {len(c.bad())} bad, {c.seconds:.0f} s", file=sys.stderr, flush=True)
+        print(f"{c.calls} calls, {c.n_bad} bad, {c.seconds:.0f} s", file=sys.stderr, flush=True)
 
-    signal.signal(signal.SIGTERM, lambda *_: sys.exit(143))  # so the workers are killed too
-    c = campaign(a.calls, a.seed, a.timeout, progress=write)
+    signal.signal(signal.SIGTERM, _terminate)
+    c = campaign(a.calls, a.seed, a.timeout, progress=write, only=only, budget=a.budget, jobs=a.jobs)
     write(c)
     if not a.out:
         print(c.report())
-    return 1 if c.bad() else 0
+    return 1 if c.n_bad else 0
 
 
 if __name__ == "__main__":

@@ -29,7 +29,7 @@ def _input_error(parameter, fn, *args, index=None, **kw):
 def test_huge_epoch_count_is_checked_before_allocation():
     s, p, k = astro.star_attitudes(_obs(), 1, G[None], 16 * AS)
     assert s.shape == (1, 3, 3) and list(k) == [3]
-    e = _input_error("star_directions", astro.star_attitudes, _obs(), 2**62, G[None], 16 * AS)
+    e = _input_error("obs", astro.star_attitudes, _obs(), 2**62, G[None], 16 * AS)
     assert "epoch at index 1 has 0 stars" in str(e)
     for n in (2**64, -1, 0):
         _input_error("n_epochs", astro.star_attitudes, _obs(), n, G[None], 16 * AS)
@@ -42,7 +42,7 @@ def test_aberration_limit_in_the_core():
 
 
 def test_refraction_index_and_rotations_in_the_core():
-    _input_error("n_refr", astro.refraction_correct, G, G, 0.5)
+    _input_error("n", astro.refraction_correct, G, G, 0.5)
     bad = np.stack([G, np.diag([1.0, 1.0, -1.0])])
     _input_error("c", astro.euler_from_dcm, bad, index=1)
     _input_error("ds_avu", astro.observability, bad, index=1)
@@ -105,3 +105,15 @@ def test_keyword_only_options():
         astro.calibrate(ds, ds, "axes")
     assert _core.OPTIONS["DiffForm"] == ["full", "paper"]
     assert _core.OPTIONS["CalibrationSolver"] == ["so3", "paper_euler"]
+
+
+def test_wrappers_name_their_own_parameters():
+    up = np.array([[0.0, 0.0, 1.0]])
+    _input_error("s", astro.refraction_apply, np.float64(3), up, 1.0003)
+    with pytest.raises(TypeError, match="^height_m: "):
+        astro.refractive_index("emulated")
+    with pytest.raises(TypeError, match="^catalog: "):
+        astro.simulate_observations(None, G[None], up, G[None], fov_half_rad=0.3, m_lim=5.0, sigma_s_rad=1e-5,
+                                    n_refr=1.0, seed=1)
+    with pytest.raises(TypeError, match="^dcm: "):
+        atomnav.rotation.quat_from_dcm("soft")

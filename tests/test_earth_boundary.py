@@ -24,3 +24,21 @@ def test_bad_latitude_row_is_named():
     with pytest.raises(atomnav.InputError) as e:
         earth.lla_to_ecef([[0.1, 0.0, 0.0], [2.0, 0.0, 0.0]])
     assert (e.value.parameter, e.value.index) == ("lla", 1)
+
+
+def test_scalar_wrappers_name_their_own_parameters():
+    # gravity/radii/schuler_period stack lat and h into an lla array: the core's errors
+    # about it named "lla", not a parameter of the called function
+    for fn in (lambda: earth.gravity(float("-inf")), lambda: earth.radii([0.1, 3.0]),
+               lambda: earth.schuler_period(-float("inf")), lambda: earth.gravity(3.0, 0.0)):
+        with pytest.raises(atomnav.InputError) as e:
+            fn()
+        assert e.value.parameter == "lat", str(e.value)
+    with pytest.raises(atomnav.InputError) as e:
+        earth.gravity([0.1, 0.2], [1.0, 2.0, 3.0])
+    assert e.value.parameter == "h"
+    with pytest.raises(TypeError, match="^lat: "):
+        earth.gravity(None)
+    with pytest.raises(atomnav.InputError) as e:
+        earth.ellipsoid("WGS-84")
+    assert e.value.parameter == "name"

@@ -1,7 +1,7 @@
 """The public API never kills the user's Python process: a fixed-seed share of fuzzed
 calls (tests/fuzz.py: every public function, constructor and method of atomnav and
-atomnav._core, arguments drawn by hypothesis from the signatures, each call in a worker
-subprocess) ends in no bad outcome — no exception other than InputError (naming a real
+atomnav._core, arguments drawn by hypothesis from the signatures, batches of calls in
+worker subprocesses that may abort or hang without taking the suite down) ends in no bad outcome — no exception other than InputError (naming a real
 parameter), TypeError, MemoryError, NumericalError or OSError, no panic, no abort, no
 hang, no NaN/inf output from finite input."""
 

@@ -8,6 +8,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
+import atomnav
 from atomnav import imu
 
 DEG = math.pi / 180.0
@@ -510,3 +511,27 @@ def test_corrupts_a_trajectory_imu_table_and_feeds_the_strapdown():
     nav = an.strapdown.integrate(meas, **traj.initial_state())
     err = traj.errors(pd.concat([traj.df.iloc[:1], nav], ignore_index=True))
     assert err["dpos_n_m"].iloc[-1] == pytest.approx(0.5 * 1e-3 * 20.0**2, rel=2e-3)
+
+
+def test_preset_errors_name_the_called_parameter():
+    for fn in (lambda: imu.ImuErrors.preset("RATES"), lambda: atomnav._core.imu_preset("kinematic")):
+        with pytest.raises(atomnav.InputError) as e:
+            fn()
+        assert e.value.parameter == "preset", str(e.value)
+    with pytest.raises(atomnav.InputError) as e:
+        atomnav._core.ellipsoid_constants("WGS-84")
+    assert e.value.parameter == "ellipsoid"
+    with pytest.raises(TypeError, match="^errors: "):
+        imu.register_preset("mine", "tactical")
+
+
+@pytest.mark.parametrize("call, parameter", [
+    (lambda: imu.white_sigma(1.0, 5e-324), "dt"),
+    (lambda: imu.gauss_markov_sigma(1.0, 1e300, 5e-324), "dt"),
+    (lambda: imu.flicker_psd(1.0, 5e-324), "f"),
+])
+def test_step_too_small_is_an_input_error(call, parameter):
+    # dt = 5e-324 gave inf from finite input
+    with pytest.raises(atomnav.InputError) as e:
+        call()
+    assert e.value.parameter == parameter, str(e.value)

@@ -118,3 +118,30 @@ def test_filter_config_round_trips_and_runs():
     np.testing.assert_array_equal(np.concatenate([s.update(c).omega_hat for c in np.array_split(Y, 3)]), ref.omega_hat)
     with pytest.raises(TypeError):
         ArmaFilterConfig((0.1,), (), 1.0, 1)  # everything after sigma2 is keyword-only
+
+
+def test_confidence_outside_the_unit_interval():
+    # confidence = 1.5 gave NaN interval bounds from finite input
+    _input_error("confidence", allan.allan_variance, Y, 1.0, confidence=1.5)
+    _input_error("confidence", allan.AllanStream, [1, 2], 1.0, confidence=1.5)
+    _input_error("confidence", allan.allan_variance, Y, 1.0, confidence=0.0)
+
+
+def test_stream_factor_given_as_a_float_is_a_type_error():
+    with pytest.raises(TypeError, match="^m: "):
+        allan.AllanStream(m=1e9, tau0=1.0)
+
+
+@pytest.mark.parametrize("call", [
+    lambda: filters.kalman(Y, "identity"),
+    lambda: filters.sage_husa(Y, "navigation"),
+    lambda: filters.KalmanStream("identity"),
+    lambda: filters.steady_state_gain(4294967297, 1.0),
+    lambda: filters.filter_series(Y, ArimaStateSpace.paper()),
+    lambda: filters.KalmanStream.from_config(ArimaStateSpace.paper()),
+    lambda: allan.ss_deg_per_sqrt_hour("diagonal"),
+])
+def test_wrong_instances_are_type_errors(call):
+    # these raised AttributeError from inside the call
+    with pytest.raises(TypeError, match="^(model|config|fit): expected "):
+        call()

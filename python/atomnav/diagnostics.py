@@ -8,6 +8,7 @@ import numpy as np
 import pandas as pd
 
 from . import earth, strapdown, trajectory
+from ._validate import floats, input_error, positive, renamed, scalar, vector
 
 
 def stationary_errors(lat: float, hours: float, *, rate_hz: float = 10.0, h: float = 100.0, dv0=(0.0, 0.0, 0.0),
@@ -17,13 +18,18 @@ def stationary_errors(lat: float, hours: float, *, rate_hz: float = 10.0, h: flo
     velocity error ``dv0`` (m/s), with constant body-frame gyro (rad/s) and accelerometer
     (m/s²) biases. The vertical channel is held to the true height by default (baro loop).
     The vehicle is at rest, so a low ``rate_hz`` is exact."""
-    traj = trajectory.stationary(hours * 3600.0, rate_hz, origin=(lat, 0.4, h))
+    lat, h = float(floats(scalar(lat, "lat"), "lat")), float(floats(scalar(h, "h"), "h"))
+    hours, rate_hz = positive(hours, "hours"), positive(rate_hz, "rate_hz")
+    gyro_bias, accel_bias = vector(gyro_bias, 3, "gyro_bias"), vector(accel_bias, 3, "accel_bias")
+    dv0 = vector(dv0, 3, "dv0")
+    with renamed(origin="lat", duration="hours"):
+        traj = trajectory.stationary(hours * 3600.0, rate_hz, origin=(lat, 0.4, h))
     imu = traj.ideal_imu("increments")
     dt = 1.0 / rate_hz
-    imu[["dtheta_x_rad", "dtheta_y_rad", "dtheta_z_rad"]] += np.asarray(gyro_bias, float) * dt
-    imu[["dv_x_mps", "dv_y_mps", "dv_z_mps"]] += np.asarray(accel_bias, float) * dt
+    imu[["dtheta_x_rad", "dtheta_y_rad", "dtheta_z_rad"]] += gyro_bias * dt
+    imu[["dv_x_mps", "dv_y_mps", "dv_z_mps"]] += accel_bias * dt
     init = traj.initial_state()
-    init["vel_ned"] = init["vel_ned"] + np.asarray(dv0, float)
+    init["vel_ned"] = init["vel_ned"] + dv0
     h_ref = traj.df["h_m"].to_numpy()[1:] if vertical == "damped" else None
     nav = strapdown.integrate(imu, **init, vertical=vertical, h_ref=h_ref)
     first = strapdown.Strapdown(**init).state()  # the perturbed initial state
@@ -33,7 +39,9 @@ def stationary_errors(lat: float, hours: float, *, rate_hz: float = 10.0, h: flo
 def zero_crossing_periods(t: np.ndarray, v: np.ndarray) -> np.ndarray:
     """Oscillation periods (s) from the zero crossings of ``v(t)`` (linear interpolation):
     T = 2·Δt between successive crossings."""
-    t, v = np.asarray(t, float), np.asarray(v, float)
+    t, v = vector(t, None, "t"), vector(v, None, "v")
+    if v.size != t.size:
+        raise input_error("v", f"{v.size} values for {t.size} times")
     s = np.sign(v)
     idx = np.nonzero(s[:-1] * s[1:] < 0)[0]
     tc = t[idx] - v[idx] * (t[idx + 1] - t[idx]) / (v[idx + 1] - v[idx])
@@ -45,7 +53,7 @@ def schuler_test(lat: float = np.deg2rad(55.75), *, v0: float = 200.0, hours: fl
     Returns the error table and the measured quantities: zero-crossing periods of v_N
     (min), the Schuler period 2π√((√(MN)+h)/γ) (min), and the first-period peaks of the
     horizontal position error (m) and tilt (rad)."""
-    err = stationary_errors(lat, hours, dv0=(v0, 0.0, 0.0), h=h)
+    err = stationary_errors(lat, hours, dv0=(scalar(v0, "v0"), 0.0, 0.0), h=h)
     periods = zero_crossing_periods(err["time_s"].to_numpy(), err["dvel_n_mps"].to_numpy()) / 60.0
     ts = earth.schuler_period(lat, h)
     first = err["time_s"] < ts

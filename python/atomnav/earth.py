@@ -11,13 +11,14 @@ import numpy as np
 import pandas as pd
 
 from . import _core
-from ._validate import rows, vector
+from ._validate import floats, input_error, renamed, rows, scalar, vector
 
 
 def ellipsoid(name: str = "WGS84") -> dict:
     """Constants of an ellipsoid: a (m), f, gm (m³/s²), omega (rad/s), e2, b (m),
     gamma_e and gamma_p (m/s², closed-form normal gravity at equator and pole)."""
-    return _core.ellipsoid_constants(name)
+    with renamed(ellipsoid="name"):
+        return _core.ellipsoid_constants(name)
 
 
 def lla_to_ecef(lla, ellipsoid: str = "WGS84") -> np.ndarray:
@@ -51,7 +52,7 @@ def lla_to_ned(lla, origin_lla, ellipsoid: str = "WGS84") -> np.ndarray:
 
 def dcm_ned_to_ecef(lat: float, lon: float) -> np.ndarray:
     """C_n^e (3, 3): columns are the north, east, down axes in ECEF."""
-    return _core.dcm_ned_to_ecef_py(float(lat), float(lon))
+    return _core.dcm_ned_to_ecef_py(scalar(lat, "lat"), scalar(lon, "lon"))
 
 
 def parameters(lla, ellipsoid: str = "WGS84") -> pd.DataFrame:
@@ -67,23 +68,39 @@ def parameters(lla, ellipsoid: str = "WGS84") -> pd.DataFrame:
 def gravity(lat, h=0.0, ellipsoid: str = "WGS84") -> np.ndarray:
     """Normal gravity magnitude γ (m/s², positive down) at latitude(s) ``lat`` (rad) and
     height(s) ``h`` (m)."""
-    lat, h = np.broadcast_arrays(np.atleast_1d(np.asarray(lat, float)), np.atleast_1d(np.asarray(h, float)))
-    lla = np.column_stack([lat, np.zeros_like(lat), h])
-    g = _core.earth_params_rows(rows(lla, 3, "lla"), ellipsoid)[:, 2]
+    lat, h = _series(lat, "lat"), _series(h, "h")
+    try:
+        lat, h = np.broadcast_arrays(lat, h)
+    except ValueError:
+        raise input_error("h", f"{h.size} heights for {lat.size} latitudes") from None
+    with renamed(lla="lat"):
+        g = _core.earth_params_rows(np.column_stack([lat, np.zeros_like(lat), h]), ellipsoid)[:, 2]
     return g[0] if g.size == 1 else g
+
+
+def _series(x, name: str) -> np.ndarray:
+    """A scalar or 1-D series of finite numbers as a 1-D float64 array."""
+    a = np.atleast_1d(floats(x, name))
+    if a.ndim != 1:
+        raise input_error(name, f"expected a number or shape (N,), got {a.shape}")
+    return a
 
 
 def radii(lat, ellipsoid: str = "WGS84"):
     """Meridian M and prime-vertical N radii of curvature (m) at latitude(s) (rad)."""
-    lat = np.atleast_1d(np.asarray(lat, float))
-    p = _core.earth_params_rows(rows(np.column_stack([lat, 0 * lat, 0 * lat]), 3, "lla"), ellipsoid)
+    lat = _series(lat, "lat")
+    with renamed(lla="lat"):
+        p = _core.earth_params_rows(np.column_stack([lat, 0 * lat, 0 * lat]), ellipsoid)
     m, n = p[:, 0], p[:, 1]
     return (m[0], n[0]) if m.size == 1 else (m, n)
 
 
 def schuler_period(lat: float, h: float = 0.0, ellipsoid: str = "WGS84") -> float:
     """Schuler period 2π/ω_s (s) with ω_s = √(γ/R₀), R₀ = √(MN) + h."""
-    w = _core.earth_params_rows(rows([lat, 0.0, h], 3, "lla"), ellipsoid)[0, 4]
+    lla = np.array([[scalar(lat, "lat"), 0.0, scalar(h, "h")]])
+    floats(lla[:, 0], "lat"), floats(lla[:, 2], "h")
+    with renamed(lla="lat"):
+        w = _core.earth_params_rows(lla, ellipsoid)[0, 4]
     return 2 * np.pi / w
 
 
@@ -91,6 +108,7 @@ def navigation_rates(lla, vel_ned, ellipsoid: str = "WGS84") -> pd.DataFrame:
     """Earth rate ω_ie^n and transport rate ω_en^n (rad/s) in NED for each position and
     NED velocity (m/s)."""
     x = np.hstack([rows(lla, 3, "lla"), rows(vel_ned, 3, "vel_ned")])
-    r = _core.nav_rates_rows(np.ascontiguousarray(x), ellipsoid)
+    with renamed(lla_vel="lla"):
+        r = _core.nav_rates_rows(np.ascontiguousarray(x), ellipsoid)
     cols = [f"{w}_{a}_rad_s" for w in ("earth_rate", "transport_rate") for a in ("N", "E", "D")]
     return pd.DataFrame(r, columns=cols)

@@ -46,7 +46,7 @@ import numpy as np
 import pandas as pd
 
 from . import _core, units
-from ._validate import choice, input_error, rows, vector
+from ._validate import as_floats, choice, input_error, instance, rows, scalar, vector
 
 KINDS = tuple(_core.OPTIONS["ImuKind"])
 _AXES = ("x", "y", "z")
@@ -96,7 +96,7 @@ class TriadErrors:
     flicker: Flicker | None = None
 
     def _to_core(self, name: str) -> dict:
-        m = np.asarray(self.misalignment, dtype=float)
+        m = as_floats(self.misalignment, f"{name}.misalignment")
         if m.shape != (3, 3):
             raise input_error(f"{name}.misalignment", f"expected shape (3, 3), got {m.shape}")
         gm, fl = self.gauss_markov, self.flicker
@@ -131,7 +131,7 @@ _USER_PRESETS: dict[str, "ImuErrors"] = {}
 
 @dataclass
 class ImuErrors:
-    """The error model of an IMU: ``accel`` and ``gyro`` triads. ``ImuErrors.preset(name)``
+    """The error model of an IMU: ``accel`` and ``gyro`` triads. ``ImuErrors.preset(preset)``
     gives a named grade; :func:`register_preset` adds user grades."""
 
     accel: TriadErrors = field(default_factory=TriadErrors)
@@ -146,16 +146,18 @@ class ImuErrors:
         return self
 
     @classmethod
-    def preset(cls, name: str) -> "ImuErrors":
-        """A copy of the named preset: built-in ``navigation`` (seed-003 RLG IMU),
+    def preset(cls, preset: str) -> "ImuErrors":
+        """A copy of the named ``preset``: built-in ``navigation`` (seed-003 RLG IMU),
         ``tactical`` (typical class values), ``mems`` (seed-000 hexapod MEMS),
         ``electrostatic_space`` / ``electrostatic_space_drift`` (seed-000 satellite
         accelerometer), ``precise`` / ``medium`` / ``coarse`` (Demidov 2009 classes), or a
         name added with :func:`register_preset`. Sources are in ``rust/imu/presets.rs``."""
-        choice(name, preset_names(), "preset")
-        if name in _USER_PRESETS:
-            return copy.deepcopy(_USER_PRESETS[name])
-        a, g = _core.imu_preset(name)
+        if not isinstance(preset, str):
+            raise TypeError(f"preset: expected a str, got {type(preset).__name__}")
+        choice(preset, preset_names(), "preset")
+        if preset in _USER_PRESETS:
+            return copy.deepcopy(_USER_PRESETS[preset])
+        a, g = _core.imu_preset(preset)
         return cls(TriadErrors._from_core(a), TriadErrors._from_core(g))
 
     def summary(self) -> pd.DataFrame:
@@ -187,9 +189,11 @@ def preset_names() -> list[str]:
 
 def register_preset(name: str, errors: ImuErrors) -> None:
     """Add a named user preset (validated; a built-in name cannot be replaced)."""
+    if not isinstance(name, str):
+        raise TypeError(f"name: expected a str, got {type(name).__name__}")
     if name in _core.imu_preset_names():
         raise input_error("name", f"{name!r} is a built-in preset and cannot be replaced")
-    _USER_PRESETS[str(name)] = copy.deepcopy(errors.validate())
+    _USER_PRESETS[str(name)] = copy.deepcopy(instance(errors, ImuErrors, "errors").validate())
 
 
 class ImuSimulator:
@@ -200,8 +204,9 @@ class ImuSimulator:
     def __init__(self, errors: ImuErrors | str, dt: float, kind: str = "rates", seed: int = 0):
         if isinstance(errors, str):
             errors = ImuErrors.preset(errors)
+        instance(errors, ImuErrors, "errors")
         self.kind = kind
-        self.dt = float(dt)
+        self.dt = scalar(dt, "dt")
         self.errors = copy.deepcopy(errors)
         self._sim = _core.ImuErrorSimulator(*errors._to_core(), self.dt, self.kind, seed)
         self._k = 0
@@ -244,45 +249,45 @@ def corrupt(accel, gyro=None, *, errors: ImuErrors | str, dt: float, kind: str =
 def white_sigma(density: float, dt: float, kind: str = "rates") -> float:
     """Per-sample σ of white noise of density N at interval Δt: N/√Δt (rate, m/s² or
     rad/s) or N·√Δt (increment, m/s or rad)."""
-    return _core.imu_white_sigma(float(density), float(dt), kind)
+    return _core.imu_white_sigma(scalar(density, "density"), scalar(dt, "dt"), kind)
 
 
 def white_density(sigma: float, dt: float, kind: str = "rates") -> float:
     """Density N (m/s/√s or rad/√s) of white noise with per-sample σ at Δt (inverse of
     :func:`white_sigma`)."""
-    return _core.imu_white_density(float(sigma), float(dt), kind)
+    return _core.imu_white_density(scalar(sigma, "sigma"), scalar(dt, "dt"), kind)
 
 
 def random_walk_step_sigma(density: float, dt: float) -> float:
     """σ of the per-sample bias step K·√Δt of a random walk of density K."""
-    return _core.imu_random_walk_step_sigma(float(density), float(dt))
+    return _core.imu_random_walk_step_sigma(scalar(density, "density"), scalar(dt, "dt"))
 
 
 def random_walk_density(step_sigma: float, dt: float) -> float:
     """Density K of a random walk whose per-sample step has σ ``step_sigma`` at Δt."""
-    return _core.imu_random_walk_density(float(step_sigma), float(dt))
+    return _core.imu_random_walk_density(scalar(step_sigma, "step_sigma"), scalar(dt, "dt"))
 
 
 def gauss_markov_driving_sigma(sigma: float, tau: float, dt: float) -> float:
     """Per-sample driving σ_u = σ√(1 − e^{−2Δt/τ}) of m_{k+1} = e^{−Δt/τ} m_k + u_k."""
-    return _core.imu_gauss_markov_driving_sigma(float(sigma), float(tau), float(dt))
+    return _core.imu_gauss_markov_driving_sigma(scalar(sigma, "sigma"), scalar(tau, "tau"), scalar(dt, "dt"))
 
 
 def gauss_markov_sigma(driving_sigma: float, tau: float, dt: float) -> float:
     """Stationary σ of the discrete Gauss–Markov with per-sample driving σ_u at Δt."""
-    return _core.imu_gauss_markov_sigma(float(driving_sigma), float(tau), float(dt))
+    return _core.imu_gauss_markov_sigma(scalar(driving_sigma, "driving_sigma"), scalar(tau, "tau"), scalar(dt, "dt"))
 
 
 def gauss_markov_low_freq_asd(sigma: float, tau: float) -> float:
     """Low-frequency amplitude spectral density σ√(2τ) of a Gauss–Markov process."""
-    return _core.imu_gauss_markov_low_freq_asd(float(sigma), float(tau))
+    return _core.imu_gauss_markov_low_freq_asd(scalar(sigma, "sigma"), scalar(tau, "tau"))
 
 
 def flicker_psd(b: float, f: float) -> float:
     """One-sided PSD B²/(πf) of flicker noise of bias instability B at f (Hz)."""
-    return _core.imu_flicker_psd(float(b), float(f))
+    return _core.imu_flicker_psd(scalar(b, "b"), scalar(f, "f"))
 
 
 def flicker_allan_floor(b: float) -> float:
     """Allan-deviation floor B·√(2 ln 2/π) of flicker noise."""
-    return _core.imu_flicker_allan_floor(float(b))
+    return _core.imu_flicker_allan_floor(scalar(b, "b"))

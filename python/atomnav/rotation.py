@@ -11,7 +11,7 @@ from __future__ import annotations
 import numpy as np
 
 from . import _core
-from ._validate import input_error, rows
+from ._validate import as_floats, input_error, rows
 
 
 def _single(x, width):
@@ -41,7 +41,7 @@ def dcm_from_quat(q):
 
 def quat_from_dcm(dcm):
     """Quaternion(s) of rotation matrices (N, 3, 3) or (3, 3); scalar part ≥ 0."""
-    m = np.asarray(dcm, dtype=float)
+    m = as_floats(dcm, "dcm")
     single = m.shape == (3, 3)
     m = np.ascontiguousarray(m[None] if single else m)
     if m.ndim != 3 or m.shape[1:] != (3, 3):

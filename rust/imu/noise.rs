@@ -30,12 +30,22 @@ fn check_density(field: &str, x: f64) -> Result<()> {
     }
 }
 
+/// `value` if finite; otherwise an error naming `field`, the argument whose extreme value
+/// (e.g. Δt = 5e-324 s) made the result overflow.
+fn finite(field: &str, value: f64, args: &str) -> Result<f64> {
+    if value.is_finite() {
+        Ok(value)
+    } else {
+        Err(invalid(field, format!("the result overflows for {args}")))
+    }
+}
+
 /// Per-sample σ of white noise of density N at interval Δt: N/√Δt for a rate sample,
 /// N·√Δt for an increment (seed-003 spec (E33): σ_d² = q/Δt, q = N²).
 pub fn white_sigma(density: f64, dt: f64, kind: ImuKind) -> Result<f64> {
     check_density("density", density)?;
     check_positive("dt", dt)?;
-    Ok(density * dt.sqrt() * kind.per_increment(dt))
+    finite("dt", density * dt.sqrt() * kind.per_increment(dt), &format!("density = {density}, dt = {dt} s"))
 }
 
 /// Density N (rad/√s or m/s/√s) of white noise whose per-sample σ is `sigma` at Δt; the
@@ -43,7 +53,7 @@ pub fn white_sigma(density: f64, dt: f64, kind: ImuKind) -> Result<f64> {
 pub fn white_density(sigma: f64, dt: f64, kind: ImuKind) -> Result<f64> {
     check_density("sigma", sigma)?;
     check_positive("dt", dt)?;
-    Ok(sigma / (dt.sqrt() * kind.per_increment(dt)))
+    finite("dt", sigma / (dt.sqrt() * kind.per_increment(dt)), &format!("sigma = {sigma}, dt = {dt} s"))
 }
 
 /// σ of the per-sample bias step of a random walk of density K: K·√Δt (seed-003 spec (E34)).
@@ -57,7 +67,7 @@ pub fn random_walk_step_sigma(density: f64, dt: f64) -> Result<f64> {
 pub fn random_walk_density(step_sigma: f64, dt: f64) -> Result<f64> {
     check_density("step_sigma", step_sigma)?;
     check_positive("dt", dt)?;
-    Ok(step_sigma / dt.sqrt())
+    finite("dt", step_sigma / dt.sqrt(), &format!("step_sigma = {step_sigma}, dt = {dt} s"))
 }
 
 /// Per-sample driving σ_u of the discrete Gauss–Markov m_{k+1} = e^{−Δt/τ} m_k + u_k with
@@ -75,7 +85,7 @@ pub fn gauss_markov_sigma(driving_sigma: f64, tau: f64, dt: f64) -> Result<f64> 
     check_density("driving_sigma", driving_sigma)?;
     check_positive("tau", tau)?;
     check_positive("dt", dt)?;
-    Ok(driving_sigma / (-(-2.0 * dt / tau).exp_m1()).sqrt())
+    finite("dt", driving_sigma / (-(-2.0 * dt / tau).exp_m1()).sqrt(), &format!("driving_sigma = {driving_sigma}, tau = {tau} s, dt = {dt} s"))
 }
 
 /// Amplitude spectral density of a Gauss–Markov process at frequencies f ≪ 1/(2πτ):
@@ -90,7 +100,7 @@ pub fn gauss_markov_low_freq_asd(sigma: f64, tau: f64) -> Result<f64> {
 pub fn flicker_psd(b: f64, f: f64) -> Result<f64> {
     check_density("b", b)?;
     check_positive("f", f)?;
-    Ok(b * b / (PI * f))
+    finite("f", b * b / (PI * f), &format!("b = {b}, f = {f} Hz"))
 }
 
 /// Allan-deviation floor of flicker noise: B·√(2 ln 2/π) (IEEE Std 952, Table C.1).
@@ -263,6 +273,22 @@ impl Increment for Flicker {
 
 #[cfg(test)]
 mod tests {
+    #[test]
+    fn overflow_from_a_tiny_step_is_an_error_naming_it() {
+        use crate::error::NavError;
+        let field = |r: Result<f64>| match r {
+            Err(NavError::InvalidInput { field, .. }) => field,
+            other => panic!("expected InvalidInput, got {other:?}"),
+        };
+        assert_eq!(field(super::white_sigma(1.0, 5e-324, ImuKind::Rates)), "dt");
+        assert_eq!(field(super::white_density(1.0, 5e-324, ImuKind::Increments)), "dt");
+        assert_eq!(field(super::flicker_psd(1.0, 5e-324)), "f");
+        assert_eq!(field(super::gauss_markov_sigma(1.0, 1e300, 5e-324)), "dt");
+        // a small but representable step still gives the closed form N/√Δt
+        let s = super::white_sigma(2.0, 1e-6, ImuKind::Rates).unwrap_or(f64::NAN);
+        assert!((s / 2000.0 - 1.0).abs() < 1e-12, "{s}");
+    }
+
     use super::*;
     use rand::SeedableRng;
     use rand_chacha::ChaCha12Rng;

@@ -82,10 +82,10 @@ fn dcm_ned_to_ecef_py<'py>(py: Python<'py>, lat: f64, lon: f64) -> PyResult<Boun
 
 /// Ellipsoid constants as a dict (a, f, gm, omega, e2, b, gamma_e, gamma_p).
 #[pyfunction]
-fn ellipsoid_constants(py: Python<'_>, name: Wrap<Ellipsoid>) -> PyResult<Py<PyAny>> {
+fn ellipsoid_constants(py: Python<'_>, ellipsoid: Wrap<Ellipsoid>) -> PyResult<Py<PyAny>> {
     let d = pyo3::types::PyDict::new(py);
-    set_floats(&d, &name.0.constants())?;
-    d.set_item("name", name.0.name)?;
+    set_floats(&d, &ellipsoid.0.constants())?;
+    d.set_item("name", ellipsoid.0.name)?;
     Ok(d.into_any().unbind())
 }
 

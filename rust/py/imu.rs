@@ -73,8 +73,8 @@ fn imu_preset_names() -> Vec<&'static str> {
 
 /// (accel dict, gyro dict) of a built-in preset.
 #[pyfunction]
-fn imu_preset<'py>(py: Python<'py>, name: &str) -> PyResult<(Bound<'py, PyDict>, Bound<'py, PyDict>)> {
-    let m = preset(name)?;
+fn imu_preset<'py>(py: Python<'py>, preset: &str) -> PyResult<(Bound<'py, PyDict>, Bound<'py, PyDict>)> {
+    let m = self::preset(preset)?;
     Ok((triad_to_dict(py, &m.accel)?, triad_to_dict(py, &m.gyro)?))
 }
 

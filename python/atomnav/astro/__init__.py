@@ -23,7 +23,7 @@ from pathlib import Path
 import numpy as np
 
 from .. import _core
-from .._validate import input_error, positive, rows, vector
+from .._validate import as_floats, input_error, instance, positive, renamed, rows, scalar, vector
 from .results import D17_CAVEAT, Calibration, Observations
 from .scenario import Vasilyuk2024
 
@@ -31,7 +31,7 @@ NED_TO_ENU = np.array([[0.0, 1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, -1.0]])
 """T: NED→ENU and FRD→right-forward-up (T = Tᵀ = T⁻¹)."""
 
 def _mats(x, name: str) -> np.ndarray:
-    a = np.asarray(x, dtype=float)
+    a = as_floats(x, name)
     if a.ndim == 2:
         a = a[None]
     if a.ndim != 3 or a.shape[1:] != (3, 3):
@@ -42,14 +42,14 @@ def _mats(x, name: str) -> np.ndarray:
 def _rows3_unchecked(x, name: str) -> np.ndarray:
     """(N, 3) C-contiguous float64 with only the shape checked: the core's validation pass
     rejects NaN/inf naming the first bad row, so no second numpy pass over long records."""
-    a = np.ascontiguousarray(x, dtype=float)
+    a = np.ascontiguousarray(as_floats(x, name))
     if a.ndim != 2 or a.shape[1] != 3:
         raise input_error(name, f"expected shape (N, 3), got {a.shape}")
     return a
 
 
 def _single(fn, x):
-    a = np.asarray(x, dtype=float)
+    a = as_floats(x, "beta")
     out = fn(rows(a, 3, "beta"))
     return out[0] if a.ndim == 1 else out
 
@@ -61,7 +61,7 @@ def euler_dcm(beta) -> np.ndarray:
 
 def euler_from_dcm(c) -> np.ndarray:
     """Canonical (ψ ∈ [0, 2π), ϑ, γ) in rad of rotation matrices (spec D3)."""
-    c = np.asarray(c, dtype=float)
+    c = as_floats(c, "c")
     out = _core.astro_euler_from_dcm(_mats(c, "c"))
     return out[0] if c.ndim == 2 else out
 
@@ -123,16 +123,22 @@ def gyro_increments(t_start: float, period: float, rho, epochs, model: GyroError
     with T = ``period`` (s); ``epochs`` (N,) s strictly increasing inside the record.
     ``taylor_variant`` "corrected" (c = 1/8, default) or "paper_literal" (c = 1/4) (D1).
     """
-    q, cov, sens = _core.astro_increments(float(t_start), positive(period, "period"), _rows3_unchecked(rho, "gyro_increments"),
-                                            vector(epochs, None, "epochs"), model._sigmas(), model.mode, taylor_variant)
+    instance(model, GyroErrorModel, "model")
+    with renamed(gyro_increments="rho"):
+        q, cov, sens = _core.astro_increments(scalar(t_start, "t_start"), positive(period, "period"),
+                                              _rows3_unchecked(rho, "rho"), vector(epochs, None, "epochs"),
+                                              model._sigmas(), model.mode, taylor_variant)
     jm, jb = sens if sens is not None else (None, None)
     return Increments(q=q, dcm=_core.dcm_from_quat_rows(q) if len(q) else np.zeros((0, 3, 3)), cov=cov, j_m=jm, j_b=jb)
 
 
 def dead_reckoning_cov(t_start: float, period: float, rho, epochs, model: GyroErrorModel) -> np.ndarray:
     """P^imu at every epoch (rad², (N, 3, 3)): E7/E8 run from the first epoch (spec E20)."""
-    return _core.astro_dead_reckoning_cov(float(t_start), positive(period, "period"), _rows3_unchecked(rho, "gyro_increments"),
-                                          vector(epochs, None, "epochs"), model._sigmas(), model.mode)
+    instance(model, GyroErrorModel, "model")
+    with renamed(gyro_increments="rho"):
+        return _core.astro_dead_reckoning_cov(scalar(t_start, "t_start"), positive(period, "period"),
+                                              _rows3_unchecked(rho, "rho"), vector(epochs, None, "epochs"),
+                                              model._sigmas(), model.mode)
 
 
 def observability(ds_avu) -> dict:
@@ -160,7 +166,7 @@ def calibrate(ds_imu, ds_avu, *, init: str = "axes", c0=None, solver: str = "so3
     """
     c0 = None if c0 is None else rows(c0, 3, "c0")
     d = _core.astro_calibrate(_mats(ds_imu, "ds_imu"), _mats(ds_avu, "ds_avu"), init=init, c0=c0, solver=solver,
-                              max_iter=max_iter, tol=float(tol), residual_form=residual_form)
+                              max_iter=max_iter, tol=scalar(tol, "tol"), residual_form=residual_form)
     if d["observability"]["verdict"] == "warn":
         k = d["observability"]["weak_axis_vf"]
         warnings.warn(f"weakly observable mount: kappa = {d['observability']['kappa']:.3e} < 1e-4, "
@@ -182,13 +188,16 @@ class Catalog:
 def synthetic_catalog(m_lim: float = 5.6, seed: int = 1) -> Catalog:
     """Deterministic uniform sky (spec D4): round(10^(0.985 + 0.455 m_lim)) stars,
     xoshiro256** seeded through SplitMix64 (identical on every platform)."""
-    return Catalog(*_core.astro_synthetic_catalog(float(m_lim), seed))
+    return Catalog(*_core.astro_synthetic_catalog(scalar(m_lim, "m_lim"), seed))
 
 
 def load_catalog(path) -> Catalog:
     """A user catalog from a CSV file with header ``id,ra_deg,dec_deg,mag`` (GCRS right
     ascension and declination in degrees) or ``id,x,y,z,mag`` (unit vectors)."""
-    data = np.genfromtxt(Path(path), delimiter=",", names=True, dtype=float)
+    try:
+        data = np.genfromtxt(Path(path), delimiter=",", names=True, dtype=float)
+    except ValueError as e:  # a path with a NUL byte, or a file that is not such a CSV
+        raise input_error("path", str(e)) from None
     names = set(data.dtype.names or ())
     if {"ra_deg", "dec_deg"} <= names:
         ra, dec = np.radians(data["ra_deg"]), np.radians(data["dec_deg"])
@@ -206,19 +215,24 @@ def load_catalog(path) -> Catalog:
 
 
 def refractive_index(height_m: float) -> float:
-    """n(H) = 1 + 2.7783e-4 (1 − 2.25577e-5 H)^4.25588 (spec D13; H in m)."""
-    return _core.astro_refractive_index(float(height_m))
+    """n(H) = 1 + 2.7783e-4 (1 − 2.25577e-5 H)^4.25588 (Vasilyuk et al. 2024; H in m).
+    Above H = 1/2.25577e-5 ≈ 44.3 km the standard-atmosphere base turns negative and the
+    result may be non-finite."""
+    with renamed(height="height_m"):
+        return _core.astro_refractive_index(scalar(height_m, "height_m"))
 
 
 def refraction_correct(s, up, n: float) -> np.ndarray:
     """Remove refraction from observed unit directions about the local vertical ``up``
     (same frame, (N, 3)) (spec E10)."""
-    return _core.astro_refraction(rows(s, 3, "directions"), rows(up, 3, "up"), float(n), False)
+    with renamed(directions="s", n_refr="n"):
+        return _core.astro_refraction(rows(s, 3, "s"), rows(up, 3, "up"), scalar(n, "n"), False)
 
 
 def refraction_apply(s, up, n: float) -> np.ndarray:
     """Apparent directions of true unit directions (inverse of E10, for simulation)."""
-    return _core.astro_refraction(rows(s, 3, "directions"), rows(up, 3, "up"), float(n), True)
+    with renamed(directions="s", n_refr="n"):
+        return _core.astro_refraction(rows(s, 3, "s"), rows(up, 3, "up"), scalar(n, "n"), True)
 
 
 def star_attitudes(obs: Observations, n_epochs: int, cameras, sigma_s_rad: float, p_alpha=None,
@@ -232,14 +246,17 @@ def star_attitudes(obs: Observations, n_epochs: int, cameras, sigma_s_rad: float
 
     Returns (S_GCRS^VF (N, 3, 3), P^avu (N, 3, 3) rad², stars per epoch (N,)).
     """
+    instance(obs, Observations, "obs")
     cams = _mats(cameras, "cameras")
     pa = np.zeros_like(cams) if p_alpha is None else _mats(p_alpha, "p_alpha")
     up = None if up_gcrs is None else rows(up_gcrs, 3, "up_gcrs")
-    return _core.astro_star_attitudes(np.ascontiguousarray(obs.epoch, dtype=np.int64),
+    # the observations' fields are checked by the core under their own names: errors name ``obs``
+    with renamed(epoch="obs", camera="obs", star_directions="obs", catalog_directions="obs"):
+        return _core.astro_star_attitudes(np.ascontiguousarray(obs.epoch, dtype=np.int64),
                                       np.ascontiguousarray(obs.camera, dtype=np.int64),
                                       rows(obs.s_cf, 3, "star_directions"), rows(obs.g, 3, "catalog_directions"),
-                                      n_epochs, cameras=cams, p_alpha=pa, sigma_s=float(sigma_s_rad), up_gcrs=up,
-                                      n_refr=float(n_refr), p_avu=None if p_avu is None else _mats(p_avu, "p_avu"))
+                                      n_epochs, cameras=cams, p_alpha=pa, sigma_s=scalar(sigma_s_rad, "sigma_s_rad"), up_gcrs=up,
+                                      n_refr=scalar(n_refr, "n_refr"), p_avu=None if p_avu is None else _mats(p_avu, "p_avu"))
 
 
 def astro_increments(s_vf, p_avu):
@@ -255,6 +272,9 @@ def model_covariance(cal: Calibration, ds_imu, ds_avu, e_imu, p_avu, increments:
     CᵀE_n^imuC + E_n^avu and the E13 neighbour correlations — converted to Euler angles.
     With ``model.mode == "consistent"`` the constant-error cross terms use
     ``increments.j_m``/``j_b``; P_β^sys is their part (zero otherwise)."""
+    instance(cal, Calibration, "cal")
+    if model is not None:
+        instance(model, GyroErrorModel, "model")
     consistent = model is not None and model.mode == "consistent"
     if consistent and (increments is None or increments.j_m is None):
         raise input_error("increments", "the consistent gyro mode needs the Increments with j_m, j_b")
@@ -276,10 +296,12 @@ def simulate_observations(catalog: Catalog, s_gcrs_vf, up_gcrs, cameras, *, fov_
     """Camera simulator: stars brighter than ``m_lim``, above the horizon, within
     ``fov_half_rad`` of each camera's +z after refraction (index ``n_refr`` ≥ 1), with
     isotropic tangent noise ``sigma_s_rad``; ``seed`` any integer in [0, 2**64)."""
+    instance(catalog, Catalog, "catalog")
     d = _core.astro_simulate_observations(rows(catalog.dirs, 3, "catalog_directions"),
                                           vector(catalog.mags, None, "magnitudes"), _mats(s_gcrs_vf, "s_gcrs_vf"),
-                                          rows(up_gcrs, 3, "up_gcrs"), _mats(cameras, "cameras"), fov_half=float(fov_half_rad),
-                                          m_lim=float(m_lim), sigma_s=float(sigma_s_rad), n_refr=float(n_refr), seed=seed)
+                                          rows(up_gcrs, 3, "up_gcrs"), _mats(cameras, "cameras"), fov_half=scalar(fov_half_rad, "fov_half_rad"),
+                                          m_lim=scalar(m_lim, "m_lim"), sigma_s=scalar(sigma_s_rad, "sigma_s_rad"),
+                                          n_refr=scalar(n_refr, "n_refr"), seed=seed)
     return Observations(**d)
 
 

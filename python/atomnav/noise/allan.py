@@ -14,7 +14,7 @@ import numpy as np
 import pandas as pd
 
 from .. import _core, units
-from .._validate import input_error, positive, vector
+from .._validate import as_floats, input_error, instance, integer, positive, probability, renamed, vector
 
 #: Option names, listed (and checked) by the Rust core.
 KINDS = tuple(_core.OPTIONS["AllanKind"])
@@ -82,6 +82,7 @@ def allan_variance(data, tau0: float, m="octave", kind: str = "allan", data_type
     ``confidence``.
     """
     tau0 = positive(tau0, "tau0")
+    confidence = probability(confidence, "confidence")
     x = _series(data, "data", check_finite=False)
     ms = _m_list(m, taus, tau0)
     mm, tau, var, n = _core.allan_var(x, tau0, data_type, kind, **({"set": m} if ms is None else {"m": ms}))
@@ -102,7 +103,7 @@ class AllanStream:
         self.tau0 = positive(tau0, "tau0")
         self.data_type = data_type
         self.noise = noise
-        self.confidence = confidence
+        self.confidence = probability(confidence, "confidence")
         ms = _m_list(m, None, self.tau0)
         if ms is None:
             raise input_error("m", "give explicit averaging factors for a stream (the record length is unknown)")
@@ -144,7 +145,7 @@ class AllanFit:
 
     def curve(self, tau) -> np.ndarray:
         """Fitted Allan variance at ``tau`` (s)."""
-        t = np.asarray(tau, dtype=float)
+        t = as_floats(tau, "tau")
         return sum(self.coeffs[k] * t ** (k - 2) for k in range(5))
 
     def arw_in(self, rate_unit: float, arw_unit: float) -> float:
@@ -174,7 +175,9 @@ def fit_allan(omega, tau0: float, terms=TERMS, tau_min: float | None = None, tau
     """Overlapping Allan variance of the rate series ``omega`` at ``m`` (default octave τ)
     and its five-term fit (:func:`fit_allan_table`)."""
     x = _series(omega, "omega")
-    return fit_allan_table(allan_variance(x, tau0, m=m), x.size, terms, tau_min, tau_max)
+    # too few Allan points in the τ range is a record too short unless the range was given
+    with renamed(data="omega", **{"tau_min/tau_max": "omega" if tau_min is None and tau_max is None else "tau_min"}):
+        return fit_allan_table(allan_variance(x, tau0, m=m), x.size, terms, tau_min, tau_max)
 
 
 def short_term_sensitivity(omega, tau0: float, **fit_kw) -> float:
@@ -189,7 +192,8 @@ def long_term_stability(omega, tau0: float, **fit_kw) -> float:
 
 
 def ss_deg_per_sqrt_hour(fit: AllanFit) -> float:
-    """SS of a fit to a rate in °/h with τ in s, in °/√h (spec D16: √A₋₁/60)."""
+    """SS of a fit to a rate in °/h with τ in s, in °/√h (Niu et al. 2025 Eq. 20: √A₋₁/60)."""
+    instance(fit, AllanFit, "fit")
     return fit.arw_in(units.DEG_PER_HOUR, units.DEG_PER_SQRT_HOUR)
 
 
@@ -202,9 +206,7 @@ def bias_stability(omega, window: int = 1) -> float:
     """Bias stability (spec E17, D17): standard deviation (ddof = 1) of the ⌊N/w⌋
     non-overlapping means of ``window`` samples (incomplete tail dropped), in the rate
     unit. Report ``window`` with the value."""
-    if int(window) != window or window < 1:
-        raise input_error("window", f"must be an integer ≥ 1, got {window}")
-    w = int(window)
+    w = integer(window, "window", 1)
     x = _series(omega, "omega", min_len=2 * w)
     k = x.size // w
     return float(np.std(x[: k * w].reshape(k, w).mean(axis=1), ddof=1))
@@ -214,8 +216,8 @@ def improvement_ratio(before, after, absolute: bool = False):
     """Improvement ratio in percent (Niu et al. 2025 Eq. 18): (M_raw − M_filt)/M_raw·100, signed
     by default (spec D11: negative means the filter made the metric worse);
     ``absolute=True`` gives the paper's |M_raw − M_filt|/M_raw·100."""
-    b = np.asarray(before, dtype=float)
-    a = np.asarray(after, dtype=float)
+    b = as_floats(before, "before")
+    a = as_floats(after, "after")
     if np.any(b == 0):
         raise input_error("before", "metric is zero, the ratio is undefined")
     r = (b - a) / b * 100.0

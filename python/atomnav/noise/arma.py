@@ -10,7 +10,7 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
-from .._validate import choice, input_error, vector
+from .._validate import choice, input_error, integer, scalar, vector
 
 
 def _series(x, name: str, min_len: int) -> np.ndarray:
@@ -24,18 +24,18 @@ def _series(x, name: str, min_len: int) -> np.ndarray:
 
 def difference(omega, d: int = 1) -> np.ndarray:
     """d-th difference (spec E2, D1): d_k = ω_k − ω_{k−1}, length N − d."""
-    if int(d) != d or d < 0:
-        raise input_error("d", f"must be an integer ≥ 0, got {d}")
+    d = integer(d, "d")
     x = vector(omega, None, "omega")
     if x.size <= d:
         raise input_error("omega", f"series of {x.size} samples is too short to difference {d} times")
-    return np.diff(x, n=int(d))
+    return np.diff(x, n=d)
 
 
 def undifference(diffs, initial) -> np.ndarray:
     """Inverse of :func:`difference` for d = 1: ω = [ω₁, ω₁ + cumsum(d)]."""
     dd = vector(diffs, None, "diffs")
-    return np.concatenate([[float(initial)], float(initial) + np.cumsum(dd)])
+    w0 = scalar(initial, "initial")
+    return np.concatenate([[w0], w0 + np.cumsum(dd)])
 
 
 @dataclass
@@ -147,9 +147,11 @@ def fit_arma(omega, order=(2, 1), differenced: bool = False, lags: int = 10) -> 
     """Fit ARMA(p, q) = ``order`` by exact ML to the first difference of ``omega`` (i.e.
     ARIMA(p,1,q) on ω), or to ``omega`` itself when ``differenced=True``.
     ``ARIMA(d, order=(p,0,q), trend='n')`` (spec D2)."""
-    p, q = (int(v) for v in order)
-    if p < 0 or q < 0:
-        raise input_error("order", f"p and q must be ≥ 0, got {order}")
+    try:
+        p, q = order
+    except (TypeError, ValueError):
+        raise TypeError(f"order: expected a pair of ints (p, q), got {order!r}") from None
+    p, q = integer(p, "order"), integer(q, "order")
     need = _min_len(p, q) + (0 if differenced else 1)
     w = _series(omega, "omega", need)
     d = w if differenced else np.diff(w)

@@ -36,6 +36,8 @@ def wavelet_denoise(omega, wavelet: str = "db4", level: int = 5, threshold: str 
     import pywt
 
     x = vector(omega, None, "omega")
+    if not isinstance(wavelet, str):
+        raise TypeError(f"wavelet: expected a str (a PyWavelets name), got {type(wavelet).__name__}")
     choice(threshold, ("universal",), "threshold")
     choice(mode, ("soft", "hard"), "mode")
     max_level = pywt.dwt_max_level(x.size, pywt.Wavelet(wavelet).dec_len)

@@ -17,7 +17,7 @@ from dataclasses import KW_ONLY, dataclass, field, fields
 import numpy as np
 
 from .. import _core
-from .._validate import finite, input_error, positive, vector
+from .._validate import as_floats, finite, input_error, instance, positive, vector
 
 #: The default reading of Eq. 17 (spec D7, binding).
 DEFAULT_READING = "differenced"
@@ -46,7 +46,7 @@ class ArimaStateSpace:
 
     def __post_init__(self):
         for name in ("ar", "ma"):
-            v = np.asarray(getattr(self, name), dtype=float).reshape(-1)
+            v = as_floats(getattr(self, name), name).reshape(-1)
             finite(v, name)
             object.__setattr__(self, name, tuple(float(c) for c in v))
         object.__setattr__(self, "_m", _core.arima_state_space(list(self.ar), list(self.ma), positive(self.sigma2, "sigma2"), self.d, self.noise_form))
@@ -127,12 +127,13 @@ class ArmaFilterConfig:
 
     def __post_init__(self):
         for name in ("ar", "ma"):
-            object.__setattr__(self, name, tuple(float(c) for c in np.asarray(getattr(self, name), dtype=float).reshape(-1)))
+            object.__setattr__(self, name, tuple(float(c) for c in as_floats(getattr(self, name), name).reshape(-1)))
         object.__setattr__(self, "_core", _core.ArmaFilterConfig(**self.to_dict()))
 
     @classmethod
     def for_model(cls, model: ArimaStateSpace, **options) -> "ArmaFilterConfig":
         """The configuration of a filter on ``model`` with the given filter ``options``."""
+        instance(model, ArimaStateSpace, "model")
         return cls(model.ar, model.ma, model.sigma2, d=model.d, noise_form=model.noise_form, **options)
 
     def to_dict(self) -> dict:
@@ -149,7 +150,11 @@ class ArmaFilterConfig:
 
     @classmethod
     def from_json(cls, text: str) -> "ArmaFilterConfig":
-        return cls.from_dict(json.loads(text))
+        try:
+            d = json.loads(text)
+        except json.JSONDecodeError as e:
+            raise input_error("text", f"not JSON: {e}") from None
+        return cls.from_dict(d)
 
 
 @dataclass
@@ -173,6 +178,7 @@ def _mode(adaptive) -> str:
 def filter_series(omega, config: ArmaFilterConfig, *, record: bool = True) -> KalmanResult:
     """Kalman filter of the rate series ``omega`` as ``config`` describes (Niu et al.
     2025, Eq. 15); the R and gain histories only when ``record``."""
+    instance(config, ArmaFilterConfig, "config")
     w = vector(omega, None, "omega")
     if w.size == 0:
         raise input_error("omega", "empty series")
@@ -200,6 +206,7 @@ def sage_husa(omega, model: ArimaStateSpace, b: float = 0.98, *, adapt_q: bool =
 def steady_state_gain(model: ArimaStateSpace, r: float):
     """Steady state of the fixed filter with measurement variance ``r``:
     (K∞ (n,), P⁻∞ (n, n), P⁺∞ (n, n))."""
+    instance(model, ArimaStateSpace, "model")
     return _core.steady_state_gain(*model._args()[:3], r=positive(r, "r"), d=model.d, noise_form=model.noise_form)
 
 
@@ -216,6 +223,7 @@ class KalmanStream:
 
     @classmethod
     def from_config(cls, config: ArmaFilterConfig, *, record: bool = True) -> "KalmanStream":
+        instance(config, ArmaFilterConfig, "config")
         s = cls.__new__(cls)
         s._f, s.config = _core.KalmanStream(config._core, record=record), config
         return s

@@ -23,7 +23,7 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
-from .._validate import positive, vector
+from .._validate import instance, positive, vector
 from . import allan, arma, baselines, filters
 
 #: Row order of the comparison table.
@@ -32,8 +32,8 @@ METHODS = ("raw", "fixed KF", "adaptive KF (literal)", "adaptive KF (differenced
 
 def paper_tables() -> pd.DataFrame:
     """Niu et al. 2025 Tables 2–4. Table 4's BS entries for LPF and WD (0.7020,
-    0.6970) equal the bias, not BS (spec D18): kept in ``bs_table4_misprint`` and NaN
-    in ``bs_dph``."""
+    0.6970) equal the bias, not BS: kept in ``bs_table4_misprint`` and NaN in ``bs_dph``.
+    Entries the paper does not give are NaN, so the table may be non-finite."""
     return pd.DataFrame(
         {
             "method": ["raw", "fixed KF", "adaptive KF", "LPF", "WD"],
@@ -111,6 +111,7 @@ def _claims(t: pd.DataFrame, bs_windows) -> pd.DataFrame:
 def plot_allan(cmp: Comparison, methods=("raw", "fixed KF", "adaptive KF (differenced)", "LPF", "WD")):
     """Overlapping Allan deviation (points with EDF error bars) of each method with its
     five-term fit (lines)."""
+    instance(cmp, Comparison, "cmp")
     import matplotlib.pyplot as plt
 
     fig, ax = plt.subplots(figsize=(7, 5))
@@ -132,6 +133,7 @@ def plot_allan(cmp: Comparison, methods=("raw", "fixed KF", "adaptive KF (differ
 
 def plot_psd(cmp: Comparison, tau0: float = 52.0, methods=("raw", "fixed KF", "adaptive KF (differenced)", "LPF", "WD")):
     """Welch power spectral density of each method's output (mean removed)."""
+    instance(cmp, Comparison, "cmp")
     import matplotlib.pyplot as plt
     from scipy.signal import welch
 

@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import numpy as np
 from .. import units
-from .._validate import input_error
+from .._validate import input_error, instance, scalar
 from .filters import PAPER_AR, PAPER_MA, PAPER_SIGMA2
 
 #: Niu et al. 2025: sample interval (s), record length, Table 2 raw mean (°/h).
@@ -28,6 +28,7 @@ def flicker(rng: np.random.Generator, n: int, sigma: float) -> np.ndarray:
     e ~ N(0, sigma²). Its Allan plateau is ≈ (2 ln 2/π)·sigma²."""
     from scipy.signal import fftconvolve
 
+    instance(rng, np.random.Generator, "rng")
     j = np.arange(1, n)
     h = np.concatenate([[1.0], np.cumprod((j - 0.5) / j)])
     e = rng.normal(0.0, sigma, n)
@@ -52,6 +53,8 @@ def model_b(seed: int = 105, n: int = N_SAMPLES, tau0: float = TAU0, arw: float 
     random walk (``rrw`` °/h/√h) + trend (``ramp`` °/h per h), drawn in that order, then
     shifted to ``mean``. Per-sample σ of the white part: arw/√(τ₀/h)."""
     n = _n(n)
+    tau0, arw, flicker_b, rrw, ramp, mean = (scalar(v, k) for k, v in (
+        ("tau0", tau0), ("arw", arw), ("flicker_b", flicker_b), ("rrw", rrw), ("ramp", ramp), ("mean", mean)))
     rng = np.random.default_rng(seed)
     hours = tau0 / units.HOUR
     white = rng.normal(0.0, arw / np.sqrt(hours), n)
