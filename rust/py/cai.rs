@@ -3,7 +3,7 @@
 //! sensor, the aided INS and the Monte-Carlo scenarios. Conversion only: every check and
 //! loop is in `crate::cai`.
 
-use super::convert::{count, register_choices, rows, to_py_rows, vec3, vec3_rows, vec3_to_py, vec_to_py, vector, Wrap};
+use super::convert::{count, counts, register_choices, seed as seed_arg, rows, to_py_rows, vec3, vec3_rows, vec3_to_py, vec_to_py, vector, Wrap};
 use super::filter::{mats, AidedSetup, PyAidedIns};
 use super::imu::triad_from_dict;
 use super::trajectory::Motion;
@@ -276,8 +276,9 @@ fn cai_steer_mid_fringe<'py>(py: Python<'py>, phi_hat: PyReadonlyArray1<'py, f64
 
 /// Shot start times (s) from t0, one per `period` (≥ 2T), the last ending by t_end.
 #[pyfunction]
-fn cai_shot_times<'py>(py: Python<'py>, t0: f64, t_end: f64, t_sep: f64, period: f64) -> PyResult<Arr1<'py>> {
-    Ok(vec_to_py(py, shot_times(t0, t_end, t_sep, period)?))
+#[allow(non_snake_case)]
+fn cai_shot_times<'py>(py: Python<'py>, t0: f64, t_end: f64, T: f64, shot_period: f64) -> PyResult<Arr1<'py>> {
+    Ok(vec_to_py(py, shot_times(t0, t_end, T, shot_period)?))
 }
 
 /// The Earth model (`Ellipsoid` name) of a scenario gravity ("kinematic", "earth").
@@ -472,7 +473,9 @@ impl CaiHybrid {
     /// Runs `runs` under `seed`: dict of arrays, each (runs, epochs, ...) except
     /// `phase_error` (runs, shots, channels), `accel_error` (runs, samples, 3), `time`
     /// (epochs) and `imu_time` (samples).
-    fn monte_carlo<'py>(&self, py: Python<'py>, seed: u64, runs: Vec<u64>) -> PyResult<Bound<'py, PyDict>> {
+    fn monte_carlo<'py>(&self, py: Python<'py>, seed: &Bound<'py, PyAny>, runs: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyDict>> {
+        let seed = seed_arg(seed, "seed")?;
+        let runs: Vec<u64> = counts(runs, "runs", 0, usize::MAX)?.into_iter().map(|r| r as u64).collect();
         let r = py.detach(|| self.0.monte_carlo_tables(seed, &runs))?;
         let (nr, ne) = (r.runs, r.epochs);
         let d = PyDict::new(py);
