@@ -104,7 +104,7 @@ impl KalmanFilter {
 
     /// `steps` predictions with the same (Φ, Q_d) in one call (the multirate / benchmark path).
     fn predict_many(&mut self, py: Python<'_>, phi: PyReadonlyArray2<'_, f64>, qd: PyReadonlyArray2<'_, f64>, steps: &Bound<'_, PyAny>) -> PyResult<()> {
-        let steps = count(steps, "steps", 0, usize::MAX)?;
+        let steps = count(steps, "steps", 0, riccati::MAX_RECURSION_STEPS)?;
         let (phi, qd) = (mat(&phi, "phi")?, mat(&qd, "qd")?);
         let kf = &mut self.inner;
         Ok(py.detach(|| kf.predict_many(&phi, &qd, steps))?)
