@@ -93,16 +93,16 @@ impl CaiSetup {
 #[pymethods]
 impl CaiSetup {
     #[new]
-    #[allow(clippy::too_many_arguments)]
-    #[pyo3(signature = (t, f, w, shots, channels, t_sep, *, omega_dot, angular_acceleration, savgol_half_width, interpolation, substeps,
+    #[allow(clippy::too_many_arguments, non_snake_case)]
+    #[pyo3(signature = (t, specific_force, angular_rate, shots, channels, T, *, omega_dot, angular_acceleration, savgol_half_width, interpolation, substeps,
         gradient, bias_a, bias_g))]
     fn new(
         t: PyReadonlyArray1<'_, f64>,
-        f: PyReadonlyArray2<'_, f64>,
-        w: PyReadonlyArray2<'_, f64>,
+        specific_force: PyReadonlyArray2<'_, f64>,
+        angular_rate: PyReadonlyArray2<'_, f64>,
         shots: PyReadonlyArray1<'_, f64>,
         channels: &CaiChannels,
-        t_sep: f64,
+        T: f64,
         omega_dot: Wrap<OmegaDotKind>,
         angular_acceleration: Option<PyReadonlyArray2<'_, f64>>,
         savgol_half_width: &Bound<'_, PyAny>,
@@ -116,12 +116,12 @@ impl CaiSetup {
         let omega_dot = OmegaDot::new(omega_dot.0, count(savgol_half_width, "savgol_half_width", 0, MAX_SAVGOL_HALF_WIDTH)?, given)?;
         Ok(CaiSetup {
             t: t.as_array().iter().copied().collect(),
-            f: raw3(&f, "specific_force")?,
-            w: raw3(&w, "angular_rate")?,
+            f: raw3(&specific_force, "specific_force")?,
+            w: raw3(&angular_rate, "angular_rate")?,
             shots: shots.as_array().iter().copied().collect(),
             channels: channels.0.clone(),
             cfg: PredictorConfig {
-                t_sep,
+                t_sep: T,
                 substeps: count(substeps, "substeps", 1, MAX_SUBSTEPS)?,
                 gradient: gradient_tensor(gradient)?,
                 bias_a: vec3(&bias_a, "bias_a")?,
@@ -198,9 +198,10 @@ impl CaiMotion {
     }
 
     /// Oracle phases (shots · channels).
-    fn oracle<'py>(&self, py: Python<'py>, shots: PyReadonlyArray1<'py, f64>, t_sep: f64, channels: &CaiChannels, gravity: &CaiGravity) -> PyResult<Arr1<'py>> {
+    #[allow(non_snake_case)]
+    fn oracle<'py>(&self, py: Python<'py>, shots: PyReadonlyArray1<'py, f64>, T: f64, channels: &CaiChannels, gravity: &CaiGravity) -> PyResult<Arr1<'py>> {
         let shots = vector(&shots, "shots")?;
-        let out = py.detach(|| oracle_phase(self.0.as_ref(), &shots, t_sep, &channels.0, &gravity.0))?;
+        let out = py.detach(|| oracle_phase(self.0.as_ref(), &shots, T, &channels.0, &gravity.0))?;
         Ok(vec_to_py(py, out))
     }
 }
@@ -257,8 +258,9 @@ fn cai_response_area(t_dark: f64, tau: f64) -> PyResult<f64> {
 
 /// The ideal transfer 4 sin²(ωT/2)/ω² at angular frequencies ω (rad/s).
 #[pyfunction]
-fn cai_ideal_transfer<'py>(py: Python<'py>, t_sep: f64, omega: PyReadonlyArray1<'py, f64>) -> PyResult<Arr1<'py>> {
-    Ok(vec_to_py(py, ideal_transfers(t_sep, &vector(&omega, "omega")?)?))
+#[allow(non_snake_case)]
+fn cai_ideal_transfer<'py>(py: Python<'py>, T: f64, omega: PyReadonlyArray1<'py, f64>) -> PyResult<Arr1<'py>> {
+    Ok(vec_to_py(py, ideal_transfers(T, &vector(&omega, "omega")?)?))
 }
 
 /// Populations o − (C/2) cos(φ) of total phases φ (rad) with contrasts C (same length).
@@ -355,12 +357,12 @@ pub struct CaiSensor(CaiConfig);
 #[pymethods]
 impl CaiSensor {
     #[new]
-    #[allow(clippy::too_many_arguments)]
-    #[pyo3(signature = (channels, t_sep, *, offset, contrast, sigma_p, inflation, omega_dot, savgol_half_width, interpolation, substeps,
+    #[allow(clippy::too_many_arguments, non_snake_case)]
+    #[pyo3(signature = (channels, T, *, offset, contrast, sigma_p, inflation, omega_dot, savgol_half_width, interpolation, substeps,
         jacobian_euler, misalignment, lever_arm, force, force_tau, force_sigma))]
     fn new(
         channels: &CaiChannels,
-        t_sep: f64,
+        T: f64,
         offset: f64,
         contrast: f64,
         sigma_p: f64,
@@ -378,7 +380,7 @@ impl CaiSensor {
     ) -> PyResult<Self> {
         let cfg = CaiConfig {
             channels: channels.0.clone(),
-            t_sep,
+            t_sep: T,
             shots: Vec::new(),
             offset,
             contrast,

@@ -1,7 +1,7 @@
 //! Bindings of filter/: state layouts, the INS error model and the aided INS (the linear
 //! Kalman machinery is bound in kalman.rs).
 
-use super::convert::{count, register_choices, Wrap, mat, quat_rows, vec3_rows, vector};
+use super::convert::{count, index_count, register_choices, Wrap, mat, quat_rows, vec3_rows, vector};
 use crate::earth::Ellipsoid;
 use crate::error::{check_finite, invalid, NavError};
 use pyo3::exceptions::PyTypeError;
@@ -42,13 +42,19 @@ pub(super) fn floats<const N: usize>(obj: &Bound<'_, PyAny>, field: &str) -> PyR
     Ok(a)
 }
 
-fn blocks_of(blocks: Vec<(String, Option<usize>)>) -> Result<Layout, NavError> {
-    Layout::new(&blocks)
+/// A layout from [(name, size or None)]; a size that is no integer in [0, 2⁶⁴) is an
+/// `InputError` naming `blocks` (not an `OverflowError`).
+fn blocks_of(blocks: Vec<(String, Option<Bound<'_, PyAny>>)>) -> PyResult<Layout> {
+    let spec = blocks
+        .into_iter()
+        .map(|(name, size)| Ok((name, size.map(|s| index_count(&s, "blocks", 0, usize::MAX)).transpose()?)))
+        .collect::<PyResult<Vec<_>>>()?;
+    Ok(Layout::new(&spec)?)
 }
 
 /// (name, start, stop) of every block of a layout given as [(name, size or None)].
 #[pyfunction]
-fn layout_ranges(blocks: Vec<(String, Option<usize>)>) -> PyResult<Vec<(String, usize, usize)>> {
+fn layout_ranges(blocks: Vec<(String, Option<Bound<'_, PyAny>>)>) -> PyResult<Vec<(String, usize, usize)>> {
     let l = blocks_of(blocks)?;
     Ok(l.blocks().iter().map(|(n, r)| (n.clone(), r.start, r.end)).collect())
 }
@@ -60,7 +66,7 @@ fn layout_ranges(blocks: Vec<(String, Option<usize>)>) -> PyResult<Vec<(String, 
 #[allow(clippy::too_many_arguments, clippy::type_complexity)]
 fn ins_error_dynamics<'py>(
     py: Python<'py>,
-    blocks: Vec<(String, Option<usize>)>,
+    blocks: Vec<(String, Option<Bound<'py, PyAny>>)>,
     lla: PyReadonlyArray2<'py, f64>,
     vel_ned: PyReadonlyArray2<'py, f64>,
     q_nb: PyReadonlyArray2<'py, f64>,
