@@ -145,3 +145,19 @@ def generator(seed, name: str) -> np.random.Generator:
         return np.random.default_rng(seed)
     integer(seed, name, 0, 2**64 - 1)
     return np.random.default_rng(int(seed))
+
+
+def json_object(text, name: str) -> dict:
+    """The JSON object (a dict) in ``text``; text that is no JSON object is an
+    :class:`InputError` naming ``name``."""
+    import json
+
+    if not isinstance(text, (str, bytes)):
+        raise TypeError(f"{name}: expected a JSON str, got {type(text).__name__}")
+    try:
+        d = json.loads(text)
+    except json.JSONDecodeError as e:
+        raise input_error(name, f"not JSON: {e}") from None
+    if not isinstance(d, dict):
+        raise input_error(name, f"expected a JSON object, got {type(d).__name__}")
+    return d

@@ -10,7 +10,7 @@ use super::trajectory::Motion;
 use crate::cai::aiding::{shot_times, CaiAiding, CaiConfig, CaiData, DataKind, ForceKind, ForceMode};
 use crate::cai::closed_form::{closed_form_phases, ClosedForm};
 use crate::cai::hybrid::{GravityModel, HybridConfig, HybridScenario, PhaseSourceKind};
-use crate::cai::noise_id::{fringe_track, ml_windows, FringeEkf, Method, MlConfig};
+use crate::cai::noise_id::{fringe_track, ml_windows, FringeEkf, Method, MlConfig, MAX_ML_ITER};
 use crate::cai::oracle::{imu_from_motion, oracle_phase, BodyMotion, Gravity, SineMotion, YawDrive};
 use crate::cai::predictor::{
     channels_from_rows, jacobian, jacobian_fd, predict, Channel, Imu, Interpolation, OmegaDot, OmegaDotKind, PredictorConfig, JACOBIAN_PARAMS,
@@ -325,7 +325,7 @@ fn cai_ml_identify<'py>(
     sliding: bool,
 ) -> PyResult<Bound<'py, PyDict>> {
     let th = vec3(&theta0, "theta0")?;
-    let cfg = MlConfig { method: method.0, free, theta0: [th.x, th.y, th.z], max_iter: count(max_iter, "max_iter", 0, usize::MAX)?, tol };
+    let cfg = MlConfig { method: method.0, free, theta0: [th.x, th.y, th.z], max_iter: count(max_iter, "max_iter", 0, MAX_ML_ITER)?, tol };
     let batch = count(batch, "batch", 0, usize::MAX)?;
     let (x, phi, amp) = (x.as_array().to_vec(), phi.as_array().to_vec(), amp.as_array().to_vec());
     let res = py.detach(|| ml_windows(&x, &phi, &amp, &cfg, batch, sliding))?;

@@ -32,6 +32,7 @@ def run_campaign(name: str, motion, config, *, runs: int = 1, seed: int = 0, pro
     instance(motion, _core.Motion, "motion")
     instance(config, ScenarioConfig, "config")
     runs, seed = integer(runs, "runs", 1, MAX_RUNS), integer(seed, "seed", 0, 2**64 - 1)
+    instance(progress, (bool, np.bool_), "progress")
     if params is not None:
         instance(params, dict, "params")
     sensor, setup = config.sensor, config.setup

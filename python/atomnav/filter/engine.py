@@ -14,7 +14,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .. import _core
-from .._validate import as_floats, finite_scalar, input_error, instance, integer, rows
+from .._validate import as_floats, finite_scalar, input_error, instance, integer, json_object, rows
 from .riccati import _mat
 
 #: Standard blocks and their sizes (read from the core, ``rust/filter/layout.rs``); extra
@@ -68,13 +68,7 @@ class Config:
     @classmethod
     def from_json(cls, text: str):
         """The configuration of :meth:`to_json`'s text."""
-        try:
-            d = json.loads(instance(text, (str, bytes), "text"))
-        except json.JSONDecodeError as e:
-            raise input_error("text", f"not JSON: {e}") from None
-        if not isinstance(d, dict):
-            raise input_error("text", f"expected a JSON object, got {type(d).__name__}")
-        return cls.from_dict(d)
+        return cls.from_dict(json_object(text, "text"))
 
 
 def _floats(x) -> tuple:
