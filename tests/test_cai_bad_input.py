@@ -131,3 +131,17 @@ def test_invert_readout_of_none_is_not_nan():
     # None became a NaN readout and a NaN phase
     with pytest.raises((InputError, TypeError)):
         cai.invert_readout(None, 0.0, contrast=1.0, flank="rising")
+
+
+def test_a_bad_sensor_field_is_named_through_the_argument():
+    sensor = cai.accelerometer_sensor(T=-65.2)
+    with pytest.raises(InputError) as e:
+        cai.in_shot_noise(sensor, 0.005, 1e-11, 1e-12)
+    assert e.value.parameter == "sensor.T"
+
+
+@pytest.mark.parametrize("call", [lambda: cai.acceleration_noise(1, T=5e-324, k=5e-324),
+                                  lambda: cai.readout_jacobian(np.float32(1), None, None)])
+def test_no_zero_division_or_nan_from_tiny_or_missing_values(call):
+    with pytest.raises(InputError):
+        call()

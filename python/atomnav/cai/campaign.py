@@ -36,9 +36,10 @@ def run_campaign(name: str, motion, config, *, runs: int = 1, seed: int = 0, pro
     if params is not None:
         instance(params, dict, "params")
     sensor, setup = config.sensor, config.setup
+    native = sensor._checked("config.sensor")
     shots = sensor.shots(sensor.first_shot, motion.duration)
     reference = None if config.reference is None else ImuErrors.preset(config.reference)._to_core()
-    core = _core.CaiHybrid(motion, sensor._native(), shots, *ImuErrors.preset(config.imu)._to_core(), reference,
+    core = _core.CaiHybrid(motion, native, shots, *ImuErrors.preset(config.imu)._to_core(), reference,
                            setup.p0(sensor.n_extra()), gravity=config.gravity, rate_hz=float(config.rate_hz),
                            truth_rate_hz=None if config.truth_rate_hz is None else float(config.truth_rate_hz),
                            phase_source=config.phase_source, accel_psd=float(setup.accel_psd), gyro_psd=float(setup.gyro_psd),

@@ -15,7 +15,7 @@ import numpy as np
 import pandas as pd
 
 from .. import _core
-from .._validate import as_floats, broadcast, finite_scalar, input_error, instance, nonnegative, positive, rows, shaped, vector
+from .._validate import as_floats, broadcast, finite, finite_scalar, input_error, instance, nonnegative, positive, rows, shaped, vector
 from ._config import ConfigMixin
 
 #: ⁸⁷Rb D2 wavelength (m) and the two-photon effective wave number 4π/λ (rad/m).
@@ -186,6 +186,8 @@ def readout_jacobian(phase_jac, phi_hat, phi0, contrast: float = 1.0) -> np.ndar
     at mid-fringe (φ̂ + φ0 = π/2) it is (C/2) ∂φ/∂θ. Shapes broadcast over (shots, channels)."""
     jac = as_floats(phase_jac, "phase_jac")
     phi_hat, phi0 = as_floats(phi_hat, "phi_hat"), as_floats(phi0, "phi0")
+    for a, name in ((jac, "phase_jac"), (phi_hat, "phi_hat"), (phi0, "phi0")):
+        finite(a.reshape(-1), name)
     s = 0.5 * finite_scalar(contrast, "contrast") * np.sin(broadcast(phi_hat, jac.shape[:-1], "phi_hat")
                                                           + broadcast(phi0, jac.shape[:-1], "phi0"))
     return s[..., None] * jac
@@ -314,10 +316,15 @@ def scale_factors(T: float, k: float = K_RB87, v0: float = 2.8) -> dict:
 
 def dynamic_range(T: float, k: float = K_RB87) -> float:
     """Acceleration span of one fringe flank, π/(kT²) (m/s²) (spec (E3))."""
+    return np.pi / _kt2(k, T)
+
+
+def _kt2(k: float, T: float) -> float:
+    """The acceleration scale factor kT² (rad per m/s²), checked to be a positive float."""
     scale = positive(k, "k") * positive(T, "T") ** 2
     if not 0 < scale < np.inf:
         raise input_error("T", f"kT² = {scale} rad/(m/s²) is outside the range of floats")
-    return np.pi / scale
+    return scale
 
 
 def capture_limits(T: float, k: float = K_RB87, v0: float = 2.8) -> dict:
@@ -344,4 +351,4 @@ def phase_noise(sigma_p: float, contrast: float = 1.0) -> float:
 
 def acceleration_noise(sigma_phi: float, T: float, k: float = K_RB87) -> float:
     """Acceleration noise (m/s²) of a phase noise σ_φ (rad): σ_φ/(kT²)."""
-    return finite_scalar(sigma_phi, "sigma_phi") / scale_factors(T, k)["acceleration"]
+    return finite_scalar(sigma_phi, "sigma_phi") / _kt2(k, T)

@@ -121,8 +121,14 @@ def slalom(runs: int = 100, seed: int = 2024, *, gravity: str = "kinematic", dur
     the same filter without CAI updates; ``sensor`` / ``setup`` replace the paper's CAI and
     filter (e.g. :func:`accelerometer_sensor`, the 21-state filter with misalignment and
     lever-arm states, or option a)."""
+    if sensor is not None:
+        instance(sensor, CaiSensor, "sensor")._checked("sensor")
+    if setup is not None:
+        instance(setup, FilterSetup, "setup")
+    instance(aiding, (bool, np.bool_), "aiding")
     motion = _core.Motion.slalom(vector(HANNOVER, 3, "origin"), 5.0, 2.0, 10.0, positive(duration, "duration"))
-    config = ScenarioConfig(sensor or seed003_sensor(lever), setup or seed003_filter(), gravity=gravity, aiding=aiding)
+    config = ScenarioConfig(seed003_sensor(lever) if sensor is None else sensor, seed003_filter() if setup is None else setup,
+                            gravity=gravity, aiding=bool(aiding))
     return run_campaign("slalom", motion, config, runs=runs, seed=seed, progress=progress,
                         params={"gravity": gravity, "lever_m": tuple(lever), "duration_s": duration})
 

@@ -16,6 +16,7 @@ from dataclasses import KW_ONLY, dataclass
 import numpy as np
 
 from .. import _core
+from .._core import InputError
 from .._validate import as_floats, finite_scalar, input_error, instance, integer, nonnegative, positive, vector
 from ._config import ConfigMixin
 from .predictor import Channels
@@ -79,6 +80,14 @@ class CaiSensor(ConfigMixin):
         """Number of extra filter states (misalignment, lever arm, force error)."""
         return 3 * ((self.misalignment_psd is not None) + (self.lever_arm_psd is not None) + (self.force == "direct"))
 
+    def _checked(self, name: str):
+        """:meth:`_native` for the argument ``name`` of a call: a bad field is an
+        :class:`atomnav.InputError` naming ``name.field`` (e.g. ``sensor.T``)."""
+        try:
+            return self._native()
+        except InputError as e:
+            raise input_error(f"{name}.{e.parameter}", str(e), e.index) from None
+
     def _native(self):
         """The checked core sensor (``_core.CaiSensor``) that the Monte Carlo, :func:`cai_aided_ins`
         and :func:`in_shot_noise` take together with their shots."""
@@ -129,7 +138,7 @@ def in_shot_noise(sensor: CaiSensor, dt: float, q_accel: float, q_gyro: float, f
     f = np.zeros((0, 15, 15)) if f is None else np.ascontiguousarray(as_floats(f, "f"))
     if f.ndim != 3:
         raise input_error("f", f"expected an (S, 15, 15) stack, got shape {f.shape}")
-    return _core.cai_in_shot_noise(sensor._native(), positive(dt, "dt"), nonnegative(q_accel, "q_accel"),
+    return _core.cai_in_shot_noise(sensor._checked("sensor"), positive(dt, "dt"), nonnegative(q_accel, "q_accel"),
                                    nonnegative(q_gyro, "q_gyro"), f)
 
 
@@ -192,6 +201,6 @@ def cai_aided_ins(t0: float, lla0, vel0, q0, sensor: CaiSensor, shots, *, phase=
                    ellipsoid=ellipsoid)
     extra0 = vector(np.zeros(n_extra) if extra0 is None else extra0, n_extra, "extra0")
     shots = vector(shots, None, "shots")
-    core = _core.cai_aided_ins(ins=ins.native, extra0=extra0, sensor=sensor._native(), shots=shots,
+    core = _core.cai_aided_ins(ins=ins.native, extra0=extra0, sensor=sensor._checked("sensor"), shots=shots,
                                data_kind="emulated" if emulated else "recorded", data_a=tables[0], data_b=tables[1])
     return AidedIns(core, ins)
