@@ -66,6 +66,7 @@ class GnssOptions(Config):
 
 def split_options(options: GnssOptions | None, kw: dict) -> tuple[GnssOptions, dict]:
     """``options`` with the fields among the keywords ``kw`` replaced, and the other keywords."""
+    instance(kw, dict, "kw")
     names = set(GnssOptions.__dataclass_fields__)
     mine = {k: v for k, v in kw.items() if k in names}
     rest = {k: v for k, v in kw.items() if k not in names}
