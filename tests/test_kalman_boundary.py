@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 from atomnav import InputError, _core
-from atomnav.filter import (BiasModel, KalmanFilter, Layout, Scenario, chi2_band, closed_loop_matrix, covariance_analysis, discretize,
+from atomnav.filter import (BiasModel, KalmanFilter, dare, Layout, Scenario, chi2_band, closed_loop_matrix, covariance_analysis, discretize,
                             kalman_recursion, monte_carlo, riccati_scalar, rts_smooth)
 from atomnav.filter.analysis import true_error_analysis
 
@@ -180,3 +180,16 @@ def test_fuzz_findings_name_the_parameter(call, error, parameter):
         call()
     if error is InputError:
         assert e.value.parameter == parameter
+
+
+def test_closed_loop_matrix_of_none_is_not_nan():
+    with pytest.raises(InputError) as e:
+        closed_loop_matrix(None, 1.0, 1.0)
+    assert e.value.parameter == "phi"
+
+
+def test_undetectable_dare_names_phi():
+    # an unobserved unstable mode (h = 0, phi = 95): the error names a real parameter
+    with pytest.raises(InputError) as e:
+        dare(95.09288499673711, 95.09288499673711, np.float32(0), 95.09288499673711)
+    assert e.value.parameter == "phi"

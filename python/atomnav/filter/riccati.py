@@ -19,7 +19,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .. import _core
-from .._validate import as_floats, finite_scalar, input_error
+from .._validate import as_floats, finite, finite_scalar, input_error
 
 
 def _mat(x, name: str) -> np.ndarray:
@@ -29,6 +29,7 @@ def _mat(x, name: str) -> np.ndarray:
         a = a.reshape(1, 1)
     if a.ndim != 2:
         raise input_error(name, f"expected a 2-D array, got shape {a.shape}")
+    finite(a, name)
     return np.ascontiguousarray(a)
 
 
