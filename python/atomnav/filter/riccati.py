@@ -29,7 +29,6 @@ def _mat(x, name: str) -> np.ndarray:
         a = a.reshape(1, 1)
     if a.ndim != 2:
         raise input_error(name, f"expected a 2-D array, got shape {a.shape}")
-    finite(a, name)
     return np.ascontiguousarray(a)
 
 
@@ -92,6 +91,8 @@ def closed_loop_matrix(phi, h, gain) -> np.ndarray:
     (n, n) ndarray
     """
     phi, h, gain = _mat(phi, "phi"), _mat(h, "h"), _mat(gain, "gain")
+    for a, name in ((phi, "phi"), (h, "h"), (gain, "gain")):
+        finite(a, name)
     n, m = phi.shape[0], h.shape[0]
     if phi.shape != (n, n):
         raise input_error("phi", f"expected a square matrix, got shape {phi.shape}")
