@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from atomnav import cai
+from atomnav import InputError, cai
 
 N = 201
 T_IMU = np.arange(N) * 1e-3
@@ -63,3 +63,85 @@ def test_unidentifiable_noise_triple_is_reported():
     p, psi = cai.simulate_fringe(300, seed=3)
     with pytest.raises(ValueError, match="jointly unidentifiable"):
         cai.identify_noise(p - 0.5, psi, np.full(300, 0.15), free=("p0", "phi", "A"))
+
+
+# --- regressions of the boundary fuzz (exact arguments of the reports) --------------------
+
+
+@pytest.mark.parametrize("substeps", [2**31, 2**63, 2**64, -1])
+def test_huge_substep_count_is_checked_before_allocation(substeps):
+    # 2**31 RK4 substeps per interval once allocated their grid and aborted the process
+    with pytest.raises(InputError) as e:
+        predict(substeps=substeps)
+    assert e.value.parameter == "substeps"
+
+
+@pytest.mark.parametrize("half_width", [2**63, 2**64, 2**31])
+def test_huge_savgol_half_width_is_checked_not_wrapped(half_width):
+    # 2**63 wrapped around in 2m + 1 and the stencil loop never ended
+    with pytest.raises(InputError) as e:
+        predict(omega_dot="savgol", savgol_half_width=half_width)
+    assert e.value.parameter == "savgol_half_width"
+
+
+@pytest.mark.parametrize("call, parameter", [
+    (lambda: cai.in_shot_noise(cai.seed003_sensor(), 5e-324, 1e-11, 1e-12), "dt"),
+    (lambda: cai.expected_phase_exceedance(cai.seed003_sensor(), 5e-324, 1e-11, 1e-12), "dt"),
+    (lambda: cai.dynamic_range(5e-324), "T"),
+])
+def test_denormal_step_is_rejected_not_a_nan(call, parameter):
+    with pytest.raises(InputError) as e:
+        call()
+    assert e.value.parameter == parameter
+
+
+@pytest.mark.parametrize("call, parameter", [
+    (lambda: cai.in_shot_noise({"a": 1}, 0.005, 1e-11, 1e-12), "sensor"),
+    (lambda: cai.expected_phase_exceedance(np.zeros(3), 0.005, 1e-11, 1e-12), "sensor"),
+    (lambda: cai.motion_imu(np.zeros(3), [0.0, 1.0]), "motion"),
+    (lambda: cai.run_campaign(np.zeros(3), None, None), "name"),
+    (lambda: cai.satellite_psd(None), "res"),
+    (lambda: cai.satellite_steady_state("1.0"), "res"),
+    (lambda: cai.readout([0.1], offset="x"), "offset"),
+    (lambda: cai.convolution_phase(np.nan, 69.4, 1e-9, t_dark="paper", tau=841.6, k=" rates"), "t_dark"),
+])
+def test_wrong_types_are_type_errors_naming_the_parameter(call, parameter):
+    with pytest.raises(TypeError, match=parameter):
+        call()
+
+
+@pytest.mark.parametrize("call, parameter", [
+    (lambda: cai.readout_variance("nope", np.zeros((2, 3)), []), None),
+    (lambda: cai.sagnac_phase(0.3, 0.3, 0.3, -1), "k"),
+    (lambda: cai.invert_readout(np.zeros((5, 9)), contrast=np.full((15, 3), 9.0).tolist()), "contrast"),
+    (lambda: cai.invert_readout(np.zeros(3), flank="up"), "flank"),
+    (lambda: cai.simulate_fringe(-1), "n"),
+    (lambda: cai.Channels(np.eye(3), 0.0, np.eye(3), 0.0, ["x"]), "names"),
+    (lambda: cai.seed003_filter().p0(2), "n_extra"),
+    (lambda: cai.capture_limits(0.025, v0=0.0), "v0"),
+])
+def test_bad_values_name_a_parameter_of_the_call(call, parameter):
+    with pytest.raises((InputError, TypeError)) as e:
+        call()
+    if parameter is not None:
+        assert e.type is InputError and e.value.parameter == parameter
+
+
+def test_invert_readout_of_none_is_not_nan():
+    # None became a NaN readout and a NaN phase
+    with pytest.raises((InputError, TypeError)):
+        cai.invert_readout(None, 0.0, contrast=1.0, flank="rising")
+
+
+def test_a_bad_sensor_field_is_named_through_the_argument():
+    sensor = cai.accelerometer_sensor(T=-65.2)
+    with pytest.raises(InputError) as e:
+        cai.in_shot_noise(sensor, 0.005, 1e-11, 1e-12)
+    assert e.value.parameter == "sensor.T"
+
+
+@pytest.mark.parametrize("call", [lambda: cai.acceleration_noise(1, T=5e-324, k=5e-324),
+                                  lambda: cai.readout_jacobian(np.float32(1), None, None)])
+def test_no_zero_division_or_nan_from_tiny_or_missing_values(call):
+    with pytest.raises(InputError):
+        call()

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 import atomnav as an
-from atomnav import cai
+from atomnav import InputError, cai
 
 T = 0.025
 
@@ -65,8 +65,12 @@ def test_mismatched_number_of_shots(record):
 
 def test_recorded_and_emulated_data_are_exclusive(record):
     init, _ = record
-    with pytest.raises(ValueError, match=r"data: give either"):
+    with pytest.raises(InputError, match=r"population: give either") as e:
         cai.cai_aided_ins(*init, cai.seed003_sensor(), [0.1], phase=np.zeros((1, 6)), noise=np.zeros((1, 6)), population=np.zeros((1, 6)))
+    assert e.value.parameter == "population"
+    with pytest.raises(InputError, match=r"phase: give either") as e:
+        cai.cai_aided_ins(*init, cai.seed003_sensor(), [0.1])
+    assert e.value.parameter == "phase"
 
 
 def test_shot_period_shorter_than_the_shot():
@@ -77,8 +81,9 @@ def test_shot_period_shorter_than_the_shot():
 
 
 def test_zero_runs():
-    with pytest.raises(ValueError, match=r"runs: must be >= 1"):
+    with pytest.raises(InputError, match=r"runs: must be an integer in \[1, ") as e:
         cai.slalom(0, progress=False)
+    assert e.value.parameter == "runs"
 
 
 def test_in_shot_noise_rejects_a_non_positive_sample_interval():

@@ -39,10 +39,11 @@ BAD = {
     "omega_dot (predictor)": (lambda: _predict(omega_dot="spline"), "omega_dot"),
     "interpolation (predictor)": (lambda: _predict(interpolation="quintic"), "interpolation"),
     "savgol_half_width (predictor)": (lambda: _predict(savgol_half_width=-1), "savgol_half_width"),
-    "omega_dot (sensor)": (lambda: _sensor(omega_dot="spline"), "omega_dot"),
-    "omega_dot given (sensor)": (lambda: _sensor(omega_dot="given"), "omega_dot"),
-    "interpolation (sensor)": (lambda: _sensor(interpolation="quintic"), "interpolation"),
-    "force (sensor)": (lambda: _sensor(force="both"), "force"),
+    # a field of the sensor argument is named through it (sensor.<field>)
+    "omega_dot (sensor)": (lambda: _sensor(omega_dot="spline"), "sensor.omega_dot"),
+    "omega_dot given (sensor)": (lambda: _sensor(omega_dot="given"), "sensor.omega_dot"),
+    "interpolation (sensor)": (lambda: _sensor(interpolation="quintic"), "sensor.interpolation"),
+    "force (sensor)": (lambda: _sensor(force="both"), "sensor.force"),
     "closed form kind": (lambda: _core.cai_phase_closed_form("taylor", np.eye(3), np.zeros((3, 3)), np.zeros(3), np.zeros(3),
                                                              np.zeros(3), None, 0.025), "kind"),
     "noise identification method": (lambda: cai.identify_noise(np.zeros(10), np.zeros(10), np.ones(10), method="bfgs"), "method"),
@@ -90,10 +91,10 @@ def test_sensor_and_scenario_round_trip_through_json():
 def test_direct_force_needs_its_parameters():
     with pytest.raises(an.InputError) as e:
         _sensor(force="direct")
-    assert e.value.parameter == "force"
+    assert e.value.parameter == "sensor.force"
     with pytest.raises(an.InputError) as e:
         _sensor(force="direct", force_tau=-1.0, force_sigma=1e-4)
-    assert e.value.parameter == "force_tau"
+    assert e.value.parameter == "sensor.force_tau"
 
 
 def test_shot_schedule_is_the_cores():

@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from atomnav import earth
+from atomnav import InputError, earth
 from atomnav.filter import BiasModel, chi2_band, position_aided_ins
 
 LAT, LON, H = 0.8, 0.2, 100.0
@@ -65,8 +65,9 @@ def _args():
 def test_bad_fix_time_outside_imu_span():
     kw, imu = _args()
     kw["fix_time"] = [1.5]
-    with pytest.raises(ValueError, match=r"measurements: time 1.5 s at index 0 is outside the IMU span \[0, 1\] s"):
+    with pytest.raises(InputError, match=r"time: the measurement at 1.5 s \(index 0\) is outside the IMU span \[0, 1\] s") as e:
         position_aided_ins(**kw).run(*imu, progress=False)
+    assert (e.value.parameter, e.value.index) == ("time", 0)
 
 
 def test_bad_fix_before_streamed_record():

@@ -1,10 +1,11 @@
 """RINEX through georinex: a small simulated RINEX 3 observation and navigation file pair
-is written, read back and solved; malformed files give ValueError."""
+is written, read back and solved; malformed files give InputError naming the path."""
 
 import numpy as np
 import pytest
 
 import atomnav.gnss as g
+from atomnav import InputError
 from atomnav.gnss import rinex
 
 LLA = np.array([np.radians(55.75), np.radians(37.6), 200.0])
@@ -37,8 +38,9 @@ def test_rinex_round_trip_gives_the_same_solution(files):
 def test_malformed_navigation_file_is_rejected(tmp_path):
     p = tmp_path / "bad.nav"
     p.write_text("this is not a RINEX file\n")
-    with pytest.raises(ValueError, match="nav: malformed RINEX file"):
+    with pytest.raises(InputError, match="malformed RINEX nav file") as e:
         rinex.read_nav(p)
+    assert e.value.parameter == "path"
 
 
 def test_malformed_observation_file_is_rejected(files, tmp_path):
@@ -46,5 +48,16 @@ def test_malformed_observation_file_is_rejected(files, tmp_path):
     lines = obs_path.read_text().splitlines()
     p = tmp_path / "bad.obs"
     p.write_text("\n".join(["garbage" * 10] + lines[1:]) + "\n")      # no RINEX VERSION / TYPE line
-    with pytest.raises(ValueError, match="obs: malformed RINEX file|obs: .* has no C1C"):
+    with pytest.raises(InputError, match="malformed RINEX obs file|has no C1C") as e:
         rinex.read_obs(p, eph)
+    assert e.value.parameter == "path"
+
+
+def test_missing_file_is_an_os_error(tmp_path):
+    with pytest.raises(FileNotFoundError):
+        rinex.read_nav(tmp_path / "absent.nav")
+
+
+def test_path_of_the_wrong_type_names_path():
+    with pytest.raises(TypeError, match="path"):
+        rinex.read_nav(1.0)

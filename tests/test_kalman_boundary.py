@@ -5,7 +5,9 @@ import numpy as np
 import pytest
 
 from atomnav import InputError, _core
-from atomnav.filter import KalmanFilter, Scenario, discretize, kalman_recursion, monte_carlo, riccati_scalar, rts_smooth
+from atomnav.filter import (BiasModel, KalmanFilter, dare, Layout, Scenario, chi2_band, closed_loop_matrix, covariance_analysis, discretize,
+                            kalman_recursion, monte_carlo, riccati_scalar, rts_smooth)
+from atomnav.filter.analysis import true_error_analysis
 
 
 def test_kalman_recursion_huge_steps_is_checked_before_allocation():
@@ -113,3 +115,81 @@ def test_core_scenario_takes_at_most_8_positional_arguments():
     with pytest.raises(TypeError):
         _core.Scenario(*a, "van_loan", False)
     assert _core.Scenario(*a, method="first_order", sequential=True) is not None
+
+
+def test_covariance_analysis_of_an_empty_scenario_does_not_panic():
+    # no steps, one epoch: the analysis of the start alone (it panicked on an empty stack)
+    z = np.zeros((0, 2, 2))
+    df = covariance_analysis(Scenario(z, z, np.zeros(0), np.eye(2), np.eye(2), np.eye(2), [False]))
+    assert df.shape == (1, 3)
+    np.testing.assert_array_equal(df.iloc[0, 1:].to_numpy(), [1.0, 1.0])
+
+
+def test_discretize_with_a_denormal_step_is_finite():
+    phi, qd = discretize([[0.0, 1.0], [0.0, 0.0]], np.eye(2), 5e-324)
+    assert np.isfinite(phi).all() and np.isfinite(qd).all()
+    np.testing.assert_array_equal(phi, [[1.0, 5e-324], [0.0, 1.0]])  # exp(F dt) of the double integrator
+
+
+@pytest.mark.parametrize("steps", [2**31, 2**62])
+def test_predict_many_huge_steps_is_checked(steps):
+    # 2**62 predictions would have run for centuries
+    kf = KalmanFilter(np.eye(2), mode="open")
+    with pytest.raises(InputError) as e:
+        kf.predict(np.eye(2), np.eye(2), steps=steps)
+    assert e.value.parameter == "steps"
+
+
+@pytest.mark.parametrize("blocks, error", [([["x"]], TypeError), ([("clock", 2**64)], InputError), ([("clock", -1)], InputError),
+                                           ([("a", 10_000), ("b", 1)], InputError)])
+def test_layout_sizes_are_checked(blocks, error):
+    with pytest.raises(error, match="blocks"):
+        Layout(blocks)
+
+
+@pytest.mark.parametrize("blocks", [[("clock", 2**64)], [("clock", -1)]])
+def test_core_layout_sizes_are_input_errors_not_overflow(blocks):
+    with pytest.raises(InputError) as e:
+        _core.layout_ranges(blocks)
+    assert e.value.parameter == "blocks"
+
+
+@pytest.mark.parametrize("kw, parameter", [(dict(dof=0.000113, runs=0), "dof"), (dict(dof=3, runs=0), "runs"),
+                                           (dict(dof=3, runs=10, p=1.5), "p"), (dict(dof=3, runs=10, p=0.0), "p")])
+def test_chi2_band_rejects_what_would_be_nan(kw, parameter):
+    with pytest.raises((InputError, TypeError)) as e:
+        chi2_band(**kw)
+    if e.type is InputError:
+        assert e.value.parameter == parameter
+
+
+@pytest.mark.parametrize("call, error, parameter", [
+    (lambda: covariance_analysis(np.zeros(2)), TypeError, "scenario"),
+    (lambda: true_error_analysis(19, np.eye(1), np.zeros(1)), TypeError, "scenario"),
+    (lambda: monte_carlo(None, runs=2, seed=0), TypeError, "scenario"),
+    (lambda: closed_loop_matrix(77.7, np.zeros((6, 6)), 77.7), InputError, "h"),
+    (lambda: rts_smooth([[[0.8, 0.9, 1.2]]] * 5, np.zeros((5, 3)), [[1.0, [2.0]]], np.zeros((5, 3)), np.zeros((5, 3, 3))),
+     TypeError, "p_prior"),
+    (lambda: BiasModel.from_json("pz90_02_to_wgs84"), InputError, "text"),
+    (lambda: Scenario([[[1.0]], [[1.0, 2.0]]], np.zeros((2, 1, 1)), [1.0, 1.0], 1.0, 1.0, 1.0, [True] * 3), TypeError, "f"),
+    (lambda: _core.Scenario(np.zeros((1, 1, 1)), np.ones((1, 1, 1)), np.ones(1), np.eye(1), np.eye(1), np.eye(1),
+                            [True, True]).monte_carlo(-1, [0], "closed"), InputError, "master_seed"),
+])
+def test_fuzz_findings_name_the_parameter(call, error, parameter):
+    with pytest.raises(error, match=parameter) as e:
+        call()
+    if error is InputError:
+        assert e.value.parameter == parameter
+
+
+def test_closed_loop_matrix_of_none_is_not_nan():
+    with pytest.raises(InputError) as e:
+        closed_loop_matrix(None, 1.0, 1.0)
+    assert e.value.parameter == "phi"
+
+
+def test_undetectable_dare_names_phi():
+    # an unobserved unstable mode (h = 0, phi = 95): the error names a real parameter
+    with pytest.raises(InputError) as e:
+        dare(95.09288499673711, 95.09288499673711, np.float32(0), 95.09288499673711)
+    assert e.value.parameter == "phi"

@@ -4,7 +4,9 @@ import numpy as np
 import pytest
 
 import atomnav as an
+from atomnav import InputError, trajectory
 from atomnav import rotation as R
+from atomnav.trajectory import Trajectory
 
 
 def _at(traj, t):
@@ -89,3 +91,41 @@ def test_car_vibration_amplitude():
     moving = (t > 6.0) & (t < 12.0)
     dev = np.abs(fz[moving] + g)
     assert 0.05 < dev.max() <= 0.15 + 0.01
+
+
+# --- boundary fuzz findings: a wrong type is a TypeError naming the parameter, a bad value an
+# InputError naming a real parameter of the call ------------------------------------------
+
+
+@pytest.mark.parametrize("call, parameter", [
+    (lambda: Trajectory(np.zeros((1, 3))), "df"),
+    (lambda: Trajectory.from_dataframe(np.nan), "df"),
+    (lambda: Trajectory.from_motion(34.8, 1.0), "motion"),
+    (lambda: Trajectory.from_csv({1.0, 2.0}), "path"),
+])
+def test_wrong_types_are_type_errors_naming_the_parameter(call, parameter):
+    with pytest.raises(TypeError, match=parameter):
+        call()
+
+
+def test_trajectory_methods_check_their_arguments():
+    traj = trajectory.stationary(1.0, 10.0)
+    with pytest.raises(TypeError, match="nav"):
+        traj.errors({"a": 1})
+    with pytest.raises(TypeError, match="path"):
+        traj.to_csv(np.zeros(3))
+    with pytest.raises(TypeError, match="ax"):
+        traj.plot(ax=np.zeros(3))
+    with pytest.raises(InputError) as e:
+        Trajectory(traj.df[["time_s"]])
+    assert e.value.parameter == "df"
+    with pytest.raises(InputError) as e:
+        Trajectory.from_dataframe(traj.df).ideal_imu("increments")
+    assert e.value.parameter == "kind"
+
+
+@pytest.mark.parametrize("rate_hz", [1e308, 1e300])
+def test_sample_count_is_checked_before_allocation(rate_hz):
+    with pytest.raises(InputError) as e:
+        trajectory.stationary(10.0, rate_hz)
+    assert e.value.parameter == "rate_hz"

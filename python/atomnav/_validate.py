@@ -91,13 +91,15 @@ def finite(a: np.ndarray, name: str) -> None:
         raise input_error(name, f"non-finite value {a[tuple(idx)]} at index {idx[0]}", idx[0])
 
 
-def increasing(t: np.ndarray, name: str) -> None:
+def increasing(t: np.ndarray, name: str, what: str = "time") -> None:
+    """``t`` strictly increasing; else an :class:`InputError` naming ``name`` (``what``: the
+    quantity in the message, e.g. a column) and the first offending index."""
     d = np.diff(t)
     bad = np.nonzero(d <= 0)[0]
     if bad.size:
         k = bad[0] + 1
-        what = "duplicated" if t[k] == t[k - 1] else "decreasing"
-        raise input_error(name, f"time not strictly increasing: {what} stamp {t[k]} at index {k}", k)
+        kind = "duplicated" if t[k] == t[k - 1] else "decreasing"
+        raise input_error(name, f"{what} not strictly increasing: {kind} stamp {t[k]} at index {k}", k)
 
 
 def scalar(x, name: str) -> float:
@@ -136,3 +138,80 @@ def choice(value: str, options, name: str) -> str:
     if value not in options:
         raise input_error(name, f"unknown option {value!r}; choose one of {sorted(options)}")
     return value
+
+
+def instance(x, cls, name: str):
+    """``x`` if it is an instance of ``cls`` (a class or tuple of classes), else a
+    ``TypeError`` naming ``name``."""
+    if not isinstance(x, cls):
+        want = " or ".join(c.__name__ for c in (cls if isinstance(cls, tuple) else (cls,)))
+        raise TypeError(f"{name}: expected {want}, got {type(x).__name__}")
+    return x
+
+
+def integer(x, name: str, low: int = 0, high: int = 2**31 - 1) -> int:
+    """``x`` as an int in [low, high]; a non-integer is a ``TypeError`` naming ``name``."""
+    if isinstance(x, (bool, np.bool_)) or not isinstance(x, (int, np.integer)):
+        raise TypeError(f"{name}: expected an int, got {type(x).__name__}")
+    if not low <= int(x) <= high:
+        raise input_error(name, f"must be an integer in [{low}, {high}], got {x}")
+    return int(x)
+
+
+def nonnegative(x, name: str) -> float:
+    """``x`` as a finite float >= 0."""
+    x = scalar(x, name)
+    if not np.isfinite(x) or x < 0:
+        raise input_error(name, f"must be finite and >= 0, got {x}")
+    return x
+
+
+def finite_scalar(x, name: str) -> float:
+    """``x`` as a finite float."""
+    x = scalar(x, name)
+    if not np.isfinite(x):
+        raise input_error(name, f"must be finite, got {x}")
+    return x
+
+
+def broadcast(x, shape: tuple, name: str) -> np.ndarray:
+    """``x`` as a C-contiguous float64 array broadcast to ``shape``."""
+    a = as_floats(x, name)
+    try:
+        return np.ascontiguousarray(np.broadcast_to(a, shape))
+    except ValueError:
+        raise input_error(name, f"expected shape {shape} or one that broadcasts to it, got {a.shape}") from None
+
+
+def shaped(x, shape: tuple, name: str) -> np.ndarray:
+    """``x`` (``prod(shape)`` finite numbers in any shape) as a C-contiguous float64 array of ``shape``."""
+    a = as_floats(x, name)
+    if a.size != int(np.prod(shape)):
+        raise input_error(name, f"expected {int(np.prod(shape))} values (shape {shape}), got shape {a.shape}")
+    a = np.ascontiguousarray(a.reshape(shape))
+    finite(a.reshape(-1), name)
+    return a
+
+
+def generator(seed, name: str) -> np.random.Generator:
+    """The numpy generator of ``seed`` (None, an int >= 0 or a ``numpy.random.Generator``)."""
+    if seed is None or isinstance(seed, np.random.Generator):
+        return np.random.default_rng(seed)
+    integer(seed, name, 0, 2**64 - 1)
+    return np.random.default_rng(int(seed))
+
+
+def json_object(text, name: str) -> dict:
+    """The JSON object (a dict) in ``text``; text that is no JSON object is an
+    :class:`InputError` naming ``name``."""
+    import json
+
+    if not isinstance(text, (str, bytes)):
+        raise TypeError(f"{name}: expected a JSON str, got {type(text).__name__}")
+    try:
+        d = json.loads(text)
+    except json.JSONDecodeError as e:
+        raise input_error(name, f"not JSON: {e}") from None
+    if not isinstance(d, dict):
+        raise input_error(name, f"expected a JSON object, got {type(d).__name__}")
+    return d

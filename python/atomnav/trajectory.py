@@ -14,7 +14,7 @@ import numpy as np
 import pandas as pd
 
 from . import _core
-from ._validate import choice, increasing, positive, rows, vector
+from ._validate import as_floats, choice, finite_scalar, increasing, input_error, instance, positive, rows, vector
 from .rotation import euler_from_quat, quat_from_euler
 
 #: Column names of a trajectory table (units in the names).
@@ -26,6 +26,8 @@ IMU_COLUMNS = {
 }
 #: Default site: Moscow, 55.75°N 37.6°E, 200 m (spec gnss-ins-tight §3).
 MOSCOW = (np.deg2rad(55.75), np.deg2rad(37.6), 200.0)
+#: Most samples of a generated trajectory (a table of 14 float columns: 11 GB).
+MAX_SAMPLES = 100_000_000
 
 
 def nav_table(time, lla, vel_ned, q_nb) -> pd.DataFrame:
@@ -44,16 +46,25 @@ class Trajectory:
     generators of this module (:func:`sinusoidal`, :func:`hexapod`, ...)."""
 
     def __init__(self, df: pd.DataFrame, motion: _core.Motion | None = None, ellipsoid: str = "WGS84"):
+        missing = [c for c in COLUMNS if c not in instance(df, pd.DataFrame, "df").columns]
+        if missing:
+            raise input_error("df", f"missing column(s) {missing} (a table of nav_table, columns {COLUMNS})")
+        if motion is not None:
+            instance(motion, _core.Motion, "motion")
         self.df = df
         self.motion = motion
-        self.ellipsoid = ellipsoid
+        self.ellipsoid = instance(ellipsoid, str, "ellipsoid")
 
     # ---- construction -------------------------------------------------------------
     @classmethod
     def from_motion(cls, motion: _core.Motion, rate_hz: float, ellipsoid: str = "WGS84") -> "Trajectory":
         """Sample a motion model at ``rate_hz`` over its whole duration."""
+        instance(motion, _core.Motion, "motion")
         rate_hz = positive(rate_hz, "rate_hz")
-        n = int(np.floor(motion.duration * rate_hz + 1e-9)) + 1
+        n = np.floor(motion.duration * rate_hz + 1e-9) + 1
+        if not n <= MAX_SAMPLES:
+            raise input_error("rate_hz", f"{motion.duration} s at {rate_hz} Hz is more than {MAX_SAMPLES} samples")
+        n = int(n)
         t = np.arange(n) / rate_hz
         tr = motion.truth(t, ellipsoid)
         return cls(nav_table(tr["time"], tr["lla"], tr["vel_ned"], tr["q_nb"]), motion, ellipsoid)
@@ -64,30 +75,40 @@ class Trajectory:
         either ``qw, qx, qy, qz`` or ``roll_rad, pitch_rad, yaw_rad``. Validated: finite
         values, strictly increasing time, latitude within ±π/2."""
         need = ["time_s", "lat_rad", "lon_rad", "h_m", "vn_mps", "ve_mps", "vd_mps"]
-        missing = [c for c in need if c not in df.columns]
+        missing = [c for c in need if c not in instance(df, pd.DataFrame, "df").columns]
         if missing:
-            raise ValueError(f"trajectory: missing column(s) {missing}; expected {need} plus quaternion or Euler columns")
+            raise input_error("df", f"missing column(s) {missing}; expected {need} plus quaternion or Euler columns")
+
+        def cols(names):
+            return as_floats(df[names].to_numpy(), "df")
+
         if all(c in df.columns for c in ("qw", "qx", "qy", "qz")):
-            q = df[["qw", "qx", "qy", "qz"]].to_numpy(float)
+            q = cols(["qw", "qx", "qy", "qz"])
         elif all(c in df.columns for c in ("roll_rad", "pitch_rad", "yaw_rad")):
-            q = quat_from_euler(rows(df[["roll_rad", "pitch_rad", "yaw_rad"]].to_numpy(float), 3, "euler"))
+            q = quat_from_euler(rows(cols(["roll_rad", "pitch_rad", "yaw_rad"]), 3, "df"))
         else:
-            raise ValueError("trajectory: needs attitude columns qw, qx, qy, qz or roll_rad, pitch_rad, yaw_rad")
-        t = vector(df["time_s"].to_numpy(float), None, "time_s")
-        increasing(t, "time_s")
-        lla = rows(df[["lat_rad", "lon_rad", "h_m"]].to_numpy(float), 3, "lla")
+            raise input_error("df", "needs attitude columns qw, qx, qy, qz or roll_rad, pitch_rad, yaw_rad")
+        t = vector(cols("time_s"), None, "df")
+        increasing(t, "df", "time_s")
+        lla = rows(cols(["lat_rad", "lon_rad", "h_m"]), 3, "df")
         bad = np.nonzero(np.abs(lla[:, 0]) > np.pi / 2)[0]
         if bad.size:
-            raise ValueError(f"lat_rad: latitude {lla[bad[0], 0]} rad at index {bad[0]} is outside [-pi/2, pi/2]")
-        return cls(nav_table(t, lla, df[["vn_mps", "ve_mps", "vd_mps"]].to_numpy(float), q), None, ellipsoid)
+            raise input_error("df", f"lat_rad: latitude {lla[bad[0], 0]} rad at index {bad[0]} is outside [-pi/2, pi/2]", bad[0])
+        return cls(nav_table(t, lla, cols(["vn_mps", "ve_mps", "vd_mps"]), q), None, ellipsoid)
 
     @classmethod
     def from_csv(cls, path, ellipsoid: str = "WGS84", **read_csv_kwargs) -> "Trajectory":
         """Read a CSV with the columns of :meth:`from_dataframe`."""
-        return cls.from_dataframe(pd.read_csv(path, **read_csv_kwargs), ellipsoid)
+        instance(path, (str, Path), "path")
+        try:
+            df = pd.read_csv(path, **read_csv_kwargs)
+        except (pd.errors.ParserError, pd.errors.EmptyDataError, UnicodeDecodeError) as e:
+            raise input_error("path", f"not a readable CSV table: {e}") from None
+        return cls.from_dataframe(df, ellipsoid)
 
     def to_csv(self, path) -> Path:
-        self.df.to_csv(path, index=False)
+        """Write the table as CSV (the columns :meth:`from_csv` reads)."""
+        self.df.to_csv(instance(path, (str, Path), "path"), index=False)
         return Path(path)
 
     # ---- access -------------------------------------------------------------------
@@ -129,7 +150,7 @@ class Trajectory:
         Earth rate, transport rate and normal gravity. Needs a generated trajectory."""
         choice(kind, IMU_COLUMNS, "kind")
         if self.motion is None:
-            raise ValueError("ideal_imu: this trajectory was built from data and has no motion model; use a generator")
+            raise input_error("kind", "no ideal IMU output: this trajectory was built from data and has no motion model; use a generator")
         out = self.motion.ideal_imu(self.time, kind, self.ellipsoid)
         t = self.time if kind == "rates" else self.time[1:]
         df = pd.DataFrame(np.column_stack([t, out["gyro"], out["accel"]]), columns=IMU_COLUMNS[kind])
@@ -145,14 +166,17 @@ class Trajectory:
         C_nb(true)), one row per solution row. Every solution time stamp must be one of
         the trajectory's (an increments-driven solution, which starts one step after the
         initial state, is fine)."""
-        tn = nav["time_s"].to_numpy()
+        lla, vel, q = (["lat_rad", "lon_rad", "h_m"], ["vn_mps", "ve_mps", "vd_mps"], ["qw", "qx", "qy", "qz"])
+        missing = [c for c in ["time_s", *lla, *vel, *q] if c not in instance(nav, pd.DataFrame, "nav").columns]
+        if missing:
+            raise input_error("nav", f"missing column(s) {missing}")
+        tn = vector(as_floats(nav["time_s"].to_numpy(), "nav"), None, "nav")
         idx = np.clip(np.searchsorted(self.time, tn), 0, len(self.time) - 1)
         off = np.nonzero(np.abs(self.time[idx] - tn) > 1e-9)[0]
         if off.size:
-            raise ValueError(f"nav: time stamp {tn[off[0]]} at index {off[0]} is not a time stamp of the trajectory")
+            raise input_error("nav", f"time stamp {tn[off[0]]} at index {off[0]} is not a time stamp of the trajectory", off[0])
         truth, est = self.df.iloc[idx], nav
-        lla, vel, q = (["lat_rad", "lon_rad", "h_m"], ["vn_mps", "ve_mps", "vd_mps"], ["qw", "qx", "qy", "qz"])
-        arrays = [np.ascontiguousarray(df[c].to_numpy(float)) for df in (est, truth) for c in (lla, vel, q)]
+        arrays = [np.ascontiguousarray(as_floats(df[c].to_numpy(), "nav")) for df in (est, truth) for c in (lla, vel, q)]
         err = _core.nav_errors(*arrays, ellipsoid=self.ellipsoid)
         return pd.DataFrame(np.column_stack([tn, err]), columns=["time_s", *_core.NAV_ERROR_COLUMNS])
 
@@ -161,8 +185,11 @@ class Trajectory:
         import matplotlib.pyplot as plt
         from .earth import lla_to_ned
 
+        from matplotlib.axes import Axes
+
         if ax is None:
             _, ax = plt.subplots(figsize=(5, 5))
+        instance(ax, Axes, "ax")
         ned = lla_to_ned(self.lla, self.lla[0], self.ellipsoid)
         sc = ax.scatter(ned[:, 1], ned[:, 0], c=self.time, s=2)
         ax.set_xlabel("east (m)")
@@ -180,29 +207,31 @@ def _origin(origin):
 
 def stationary(duration: float, rate_hz: float = 100.0, origin=MOSCOW, euler=(0.0, 0.0, 0.0), ellipsoid: str = "WGS84") -> Trajectory:
     """At rest at ``origin`` (lat rad, lon rad, h m) with constant (roll, pitch, yaw) rad."""
-    return Trajectory.from_motion(_core.Motion.stationary(_origin(origin), float(duration), vector(euler, 3, "euler")), rate_hz, ellipsoid)
+    return Trajectory.from_motion(_core.Motion.stationary(_origin(origin), finite_scalar(duration, "duration"), vector(euler, 3, "euler")), rate_hz, ellipsoid)
 
 
 def sinusoidal(duration: float, rate_hz: float = 100.0, *, origin=MOSCOW, amp_ned=(20.0, 15.0, 2.0), period_ned=(60.0, 45.0, 30.0),
                amp_euler=(0.1, 0.08, 0.3), period_euler=(20.0, 25.0, 40.0), heading: float = 0.5, ellipsoid: str = "WGS84") -> Trajectory:
     """Sinusoidal motion: NED displacement amplitudes (m) and periods (s), roll/pitch/yaw
     oscillation amplitudes (rad) and periods (s) about ``heading`` (rad)."""
-    m = _core.Motion.sinusoidal(_origin(origin), float(duration), vector(amp_ned, 3, "amp_ned"), vector(period_ned, 3, "period_ned"),
-                                vector(amp_euler, 3, "amp_euler"), vector(period_euler, 3, "period_euler"), float(heading))
+    m = _core.Motion.sinusoidal(_origin(origin), finite_scalar(duration, "duration"), vector(amp_ned, 3, "amp_ned"), vector(period_ned, 3, "period_ned"),
+                                vector(amp_euler, 3, "amp_euler"), vector(period_euler, 3, "period_euler"), finite_scalar(heading, "heading"))
     return Trajectory.from_motion(m, rate_hz, ellipsoid)
 
 
 def hexapod(rate_hz: float = 1000.0, origin=MOSCOW, max_tilt: float = 0.0654, pitch_delay: float = 5.0, heading: float = 0.0, ellipsoid: str = "WGS84") -> Trajectory:
     """Seed 000 §5.3 hexapod: 170 s of roll/pitch tilt steps up to ``max_tilt`` rad
     (0.0654 rad = 3.75°), pitch delayed by ``pitch_delay`` s (spec cai-ekf decision 13)."""
-    return Trajectory.from_motion(_core.Motion.hexapod(_origin(origin), float(max_tilt), float(pitch_delay), float(heading)), rate_hz, ellipsoid)
+    return Trajectory.from_motion(_core.Motion.hexapod(_origin(origin), finite_scalar(max_tilt, "max_tilt"), finite_scalar(pitch_delay, "pitch_delay"),
+                                                      finite_scalar(heading, "heading")), rate_hz, ellipsoid)
 
 
 def drive_with_yaw(rate_hz: float = 200.0, origin=MOSCOW, speed: float = 1.0, yaw_rate_amp: float = 0.05, period: float = 50.0,
                    duration: float = 50.0, heading: float = 0.0, ellipsoid: str = "WGS84") -> Trajectory:
     """Seed 003 Fig. 7: straight drive at ``speed`` m/s with yaw rate
     ``yaw_rate_amp``·sin(2πt/``period``) rad/s."""
-    m = _core.Motion.drive_with_yaw(_origin(origin), float(speed), float(yaw_rate_amp), float(period), float(duration), float(heading))
+    m = _core.Motion.drive_with_yaw(_origin(origin), finite_scalar(speed, "speed"), finite_scalar(yaw_rate_amp, "yaw_rate_amp"),
+                                    finite_scalar(period, "period"), finite_scalar(duration, "duration"), finite_scalar(heading, "heading"))
     return Trajectory.from_motion(m, rate_hz, ellipsoid)
 
 
@@ -210,20 +239,22 @@ def slalom(rate_hz: float = 200.0, origin=MOSCOW, speed: float = 5.0, amp: float
            ellipsoid: str = "WGS84") -> Trajectory:
     """Seed 003 smooth slalom: north = speed·t, east = amp·sin(2πt/period), level, heading
     along the path."""
-    return Trajectory.from_motion(_core.Motion.slalom(_origin(origin), float(speed), float(amp), float(period), float(duration)), rate_hz, ellipsoid)
+    return Trajectory.from_motion(_core.Motion.slalom(_origin(origin), finite_scalar(speed, "speed"), finite_scalar(amp, "amp"),
+                                                     finite_scalar(period, "period"), finite_scalar(duration, "duration")), rate_hz, ellipsoid)
 
 
 def car(rate_hz: float = 200.0, origin=MOSCOW, heading: float = 0.0, vibration: bool = True, ellipsoid: str = "WGS84") -> Trajectory:
     """Seed 003 Fig. 9 car-like 40 s profile: static, accelerating, sliding and
     coordinated turns, a shock at 26 s, vibration at 4.3/9.7/15.1 Hz."""
-    return Trajectory.from_motion(_core.Motion.car(_origin(origin), float(heading), bool(vibration)), rate_hz, ellipsoid)
+    return Trajectory.from_motion(_core.Motion.car(_origin(origin), finite_scalar(heading, "heading"), bool(instance(vibration, (bool, np.bool_), "vibration"))), rate_hz, ellipsoid)
 
 
 def rotary_stand(states, move_starts, move_duration: float, duration: float, rate_hz: float = 200.0, origin=MOSCOW, ellipsoid: str = "WGS84") -> Trajectory:
     """Two-axis stand, C_nb = R_y(tilt) R_z(turntable): holds at ``states`` (K, 2) of
     (tilt, turntable) rad, moving to the next state at ``move_starts`` (K − 1) s over
     ``move_duration`` s with the quintic profile."""
-    m = _core.Motion.rotary_stand(_origin(origin), rows(states, 2, "states"), vector(move_starts, None, "move_starts"), float(move_duration), float(duration))
+    m = _core.Motion.rotary_stand(_origin(origin), rows(states, 2, "states"), vector(move_starts, None, "move_starts"),
+                                  finite_scalar(move_duration, "move_duration"), finite_scalar(duration, "duration"))
     return Trajectory.from_motion(m, rate_hz, ellipsoid)
 
 

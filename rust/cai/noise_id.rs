@@ -87,6 +87,10 @@ impl crate::options::Choice for Method {
     const CHOICES: &'static [(&'static str, Self)] = &[("gradient", Method::Gradient), ("newton", Method::Newton)];
 }
 
+/// Most iterations of one ML estimate (Newton converges in tens; the gradient method in
+/// hundreds to thousands).
+pub const MAX_ML_ITER: usize = 100_000;
+
 #[derive(Clone, Debug)]
 pub struct MlConfig {
     pub method: Method,

@@ -39,6 +39,9 @@ pub struct Layout {
     blocks: Vec<(String, Range<usize>)>,
 }
 
+/// Most states of a layout (its covariance, 10⁴ × 10⁴ floats, is 800 MB).
+pub const MAX_STATES: usize = 10_000;
+
 impl Layout {
     /// Blocks in order; a standard block takes its standard size (`None`), an extra
     /// block (lever arm, clock, ...) must give its size.
@@ -68,6 +71,9 @@ impl Layout {
                     ))
                 }
             };
+            if len > MAX_STATES - n {
+                return Err(invalid("blocks", format!("more than {MAX_STATES} states (block {name:?} at index {i} has size {len})")));
+            }
             blocks.push((name.clone(), n..n + len));
             n += len;
         }
@@ -136,6 +142,17 @@ mod tests {
         assert_eq!(l.size(), 11);
         assert!(l.range("velocity").is_err());
         assert_eq!(Layout::ins15().range("gyro_bias").unwrap(), 12..15);
+    }
+
+    #[test]
+    fn oversized_blocks_are_rejected_not_wrapped() {
+        for spec in [vec![("clock".to_string(), Some(usize::MAX))], vec![("a".into(), Some(MAX_STATES)), ("b".into(), Some(1))]] {
+            match Layout::new(&spec) {
+                Err(crate::error::NavError::InvalidInput { field, .. }) => assert_eq!(field, "blocks"),
+                other => panic!("expected InvalidInput on blocks, got {other:?}"),
+            }
+        }
+        assert_eq!(Layout::new(&[("a".into(), Some(MAX_STATES))]).unwrap().size(), MAX_STATES);
     }
 
     #[test]

@@ -117,7 +117,7 @@ pub fn dare_using(phi: &DMatrix<f64>, q: &DMatrix<f64>, h: &DMatrix<f64>, r: &DM
     }
     .ok_or_else(|| {
         invalid(
-            "phi, h",
+            "phi",
             "no stabilising DARE solution: (phi, h) is not detectable or (phi, q) is not stabilisable \
              (unobservable unstable mode, or an undamped mode driven by q); the doubling iteration diverged",
         )

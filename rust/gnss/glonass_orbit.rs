@@ -77,8 +77,16 @@ pub fn propagate_checked(pos: Vec3, vel: Vec3, acc_ls: &Vec3, dt: f64, max_step:
     for (field, x) in [("dt", dt), ("j2", j2)] {
         crate::error::check_finite(field, &[x], 1)?;
     }
+    let steps = (dt.abs() / max_step).ceil();
+    if !(steps <= MAX_RK4_STEPS as f64) {
+        return Err(invalid("step", format!("|dt| / step = {steps} RK4 steps, at most {MAX_RK4_STEPS}")));
+    }
     Ok(propagate(pos, vel, acc_ls, dt, max_step, j2))
 }
+
+/// Most RK4 steps of one checked propagation (a broadcast set is valid for ±15 min, 30 steps
+/// of 30 s; 10⁷ steps take about a second).
+pub const MAX_RK4_STEPS: usize = 10_000_000;
 
 /// Classical RK4 of (r, v) over `dt` seconds in equal steps no longer than `max_step`.
 pub fn propagate(pos: Vec3, vel: Vec3, acc_ls: &Vec3, dt: f64, max_step: f64, j2: f64) -> (Vec3, Vec3) {
@@ -128,6 +136,18 @@ impl GloEphemeris {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn step_count_is_checked_before_the_loop() {
+        let (r, v) = circular(0.3);
+        for (dt, step) in [(1.0, 5e-324), (1e308, 1.0), (1e9, 1e-3)] {
+            match propagate_checked(r, v, &Vec3::zeros(), dt, step, J2_GLO) {
+                Err(crate::error::NavError::InvalidInput { field, .. }) => assert_eq!(field, "step"),
+                other => panic!("dt {dt}, step {step}: expected InvalidInput on step, got {other:?}"),
+            }
+        }
+        assert!(propagate_checked(r, v, &Vec3::zeros(), 900.0, 30.0, J2_GLO).is_ok());
+    }
 
     fn circular(u: f64) -> (Vec3, Vec3) {
         // a = 25508 km, i = 64.8°, node at 0: inertial circular state expressed in ECEF at t = 0

@@ -3,14 +3,14 @@
 //! sensor, the aided INS and the Monte-Carlo scenarios. Conversion only: every check and
 //! loop is in `crate::cai`.
 
-use super::convert::{count, register_choices, rows, to_py_rows, vec3, vec3_rows, vec3_to_py, vec_to_py, vector, Wrap};
+use super::convert::{count, counts, register_choices, seed as seed_arg, rows, to_py_rows, vec3, vec3_rows, vec3_to_py, vec_to_py, vector, Wrap};
 use super::filter::{mats, AidedSetup, PyAidedIns};
 use super::imu::triad_from_dict;
 use super::trajectory::Motion;
 use crate::cai::aiding::{shot_times, CaiAiding, CaiConfig, CaiData, DataKind, ForceKind, ForceMode};
 use crate::cai::closed_form::{closed_form_phases, ClosedForm};
 use crate::cai::hybrid::{GravityModel, HybridConfig, HybridScenario, PhaseSourceKind};
-use crate::cai::noise_id::{fringe_track, ml_windows, FringeEkf, Method, MlConfig};
+use crate::cai::noise_id::{fringe_track, ml_windows, FringeEkf, Method, MlConfig, MAX_ML_ITER};
 use crate::cai::oracle::{imu_from_motion, oracle_phase, BodyMotion, Gravity, SineMotion, YawDrive};
 use crate::cai::predictor::{
     channels_from_rows, jacobian, jacobian_fd, predict, Channel, Imu, Interpolation, OmegaDot, OmegaDotKind, PredictorConfig, JACOBIAN_PARAMS,
@@ -97,16 +97,16 @@ impl CaiSetup {
 #[pymethods]
 impl CaiSetup {
     #[new]
-    #[allow(clippy::too_many_arguments)]
-    #[pyo3(signature = (t, f, w, shots, channels, t_sep, *, omega_dot, angular_acceleration, savgol_half_width, interpolation, substeps,
+    #[allow(clippy::too_many_arguments, non_snake_case)]
+    #[pyo3(signature = (t, specific_force, angular_rate, shots, channels, T, *, omega_dot, angular_acceleration, savgol_half_width, interpolation, substeps,
         gradient, bias_a, bias_g))]
     fn new(
         t: PyReadonlyArray1<'_, f64>,
-        f: PyReadonlyArray2<'_, f64>,
-        w: PyReadonlyArray2<'_, f64>,
+        specific_force: PyReadonlyArray2<'_, f64>,
+        angular_rate: PyReadonlyArray2<'_, f64>,
         shots: PyReadonlyArray1<'_, f64>,
         channels: &CaiChannels,
-        t_sep: f64,
+        T: f64,
         omega_dot: Wrap<OmegaDotKind>,
         angular_acceleration: Option<PyReadonlyArray2<'_, f64>>,
         savgol_half_width: &Bound<'_, PyAny>,
@@ -120,12 +120,12 @@ impl CaiSetup {
         let omega_dot = OmegaDot::new(omega_dot.0, count(savgol_half_width, "savgol_half_width", 0, MAX_SAVGOL_HALF_WIDTH)?, given)?;
         Ok(CaiSetup {
             t: t.as_array().iter().copied().collect(),
-            f: raw3(&f, "specific_force")?,
-            w: raw3(&w, "angular_rate")?,
+            f: raw3(&specific_force, "specific_force")?,
+            w: raw3(&angular_rate, "angular_rate")?,
             shots: shots.as_array().iter().copied().collect(),
             channels: channels.0.clone(),
             cfg: PredictorConfig {
-                t_sep,
+                t_sep: T,
                 substeps: count(substeps, "substeps", 1, MAX_SUBSTEPS)?,
                 gradient: gradient_tensor(gradient)?,
                 bias_a: vec3(&bias_a, "bias_a")?,
@@ -202,9 +202,10 @@ impl CaiMotion {
     }
 
     /// Oracle phases (shots · channels).
-    fn oracle<'py>(&self, py: Python<'py>, shots: PyReadonlyArray1<'py, f64>, t_sep: f64, channels: &CaiChannels, gravity: &CaiGravity) -> PyResult<Arr1<'py>> {
+    #[allow(non_snake_case)]
+    fn oracle<'py>(&self, py: Python<'py>, shots: PyReadonlyArray1<'py, f64>, T: f64, channels: &CaiChannels, gravity: &CaiGravity) -> PyResult<Arr1<'py>> {
         let shots = vector(&shots, "shots")?;
-        let out = py.detach(|| oracle_phase(self.0.as_ref(), &shots, t_sep, &channels.0, &gravity.0))?;
+        let out = py.detach(|| oracle_phase(self.0.as_ref(), &shots, T, &channels.0, &gravity.0))?;
         Ok(vec_to_py(py, out))
     }
 }
@@ -261,8 +262,9 @@ fn cai_response_area(t_dark: f64, tau: f64) -> PyResult<f64> {
 
 /// The ideal transfer 4 sin²(ωT/2)/ω² at angular frequencies ω (rad/s).
 #[pyfunction]
-fn cai_ideal_transfer<'py>(py: Python<'py>, t_sep: f64, omega: PyReadonlyArray1<'py, f64>) -> PyResult<Arr1<'py>> {
-    Ok(vec_to_py(py, ideal_transfers(t_sep, &vector(&omega, "omega")?)?))
+#[allow(non_snake_case)]
+fn cai_ideal_transfer<'py>(py: Python<'py>, T: f64, omega: PyReadonlyArray1<'py, f64>) -> PyResult<Arr1<'py>> {
+    Ok(vec_to_py(py, ideal_transfers(T, &vector(&omega, "omega")?)?))
 }
 
 /// Populations o − (C/2) cos(φ) of total phases φ (rad) with contrasts C (same length).
@@ -280,8 +282,9 @@ fn cai_steer_mid_fringe<'py>(py: Python<'py>, phi_hat: PyReadonlyArray1<'py, f64
 
 /// Shot start times (s) from t0, one per `period` (≥ 2T), the last ending by t_end.
 #[pyfunction]
-fn cai_shot_times<'py>(py: Python<'py>, t0: f64, t_end: f64, t_sep: f64, period: f64) -> PyResult<Arr1<'py>> {
-    Ok(vec_to_py(py, shot_times(t0, t_end, t_sep, period)?))
+#[allow(non_snake_case)]
+fn cai_shot_times<'py>(py: Python<'py>, t0: f64, t_end: f64, T: f64, shot_period: f64) -> PyResult<Arr1<'py>> {
+    Ok(vec_to_py(py, shot_times(t0, t_end, T, shot_period)?))
 }
 
 /// The Earth model (`Ellipsoid` name) of a scenario gravity ("kinematic", "earth").
@@ -326,7 +329,7 @@ fn cai_ml_identify<'py>(
     sliding: bool,
 ) -> PyResult<Bound<'py, PyDict>> {
     let th = vec3(&theta0, "theta0")?;
-    let cfg = MlConfig { method: method.0, free, theta0: [th.x, th.y, th.z], max_iter: count(max_iter, "max_iter", 0, usize::MAX)?, tol };
+    let cfg = MlConfig { method: method.0, free, theta0: [th.x, th.y, th.z], max_iter: count(max_iter, "max_iter", 0, MAX_ML_ITER)?, tol };
     let batch = count(batch, "batch", 0, usize::MAX)?;
     let (x, phi, amp) = (x.as_array().to_vec(), phi.as_array().to_vec(), amp.as_array().to_vec());
     let res = py.detach(|| ml_windows(&x, &phi, &amp, &cfg, batch, sliding))?;
@@ -358,12 +361,12 @@ pub struct CaiSensor(CaiConfig);
 #[pymethods]
 impl CaiSensor {
     #[new]
-    #[allow(clippy::too_many_arguments)]
-    #[pyo3(signature = (channels, t_sep, *, offset, contrast, sigma_p, inflation, omega_dot, savgol_half_width, interpolation, substeps,
+    #[allow(clippy::too_many_arguments, non_snake_case)]
+    #[pyo3(signature = (channels, T, *, offset, contrast, sigma_p, inflation, omega_dot, savgol_half_width, interpolation, substeps,
         jacobian_euler, misalignment, lever_arm, force, force_tau, force_sigma))]
     fn new(
         channels: &CaiChannels,
-        t_sep: f64,
+        T: f64,
         offset: f64,
         contrast: f64,
         sigma_p: f64,
@@ -381,7 +384,7 @@ impl CaiSensor {
     ) -> PyResult<Self> {
         let cfg = CaiConfig {
             channels: channels.0.clone(),
-            t_sep,
+            t_sep: T,
             shots: Vec::new(),
             offset,
             contrast,
@@ -478,7 +481,9 @@ impl CaiHybrid {
     /// Runs `runs` under `seed`: dict of arrays, each (runs, epochs, ...) except
     /// `phase_error` (runs, shots, channels), `accel_error` (runs, samples, 3), `time`
     /// (epochs) and `imu_time` (samples).
-    fn monte_carlo<'py>(&self, py: Python<'py>, seed: u64, runs: Vec<u64>) -> PyResult<Bound<'py, PyDict>> {
+    fn monte_carlo<'py>(&self, py: Python<'py>, seed: &Bound<'py, PyAny>, runs: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyDict>> {
+        let seed = seed_arg(seed, "seed")?;
+        let runs: Vec<u64> = counts(runs, "runs", 0, usize::MAX)?.into_iter().map(|r| r as u64).collect();
         let r = py.detach(|| self.0.monte_carlo_tables(seed, &runs))?;
         let (nr, ne) = (r.runs, r.epochs);
         let d = PyDict::new(py);

@@ -1,9 +1,10 @@
 //! Bindings of filter/: state layouts, the INS error model and the aided INS (the linear
 //! Kalman machinery is bound in kalman.rs).
 
-use super::convert::{register_choices, Wrap, mat, quat_rows, vec3_rows, vector};
+use super::convert::{count, index_count, register_choices, Wrap, mat, quat_rows, vec3_rows, vector};
 use crate::earth::Ellipsoid;
-use crate::error::{invalid, NavError};
+use crate::error::{check_finite, invalid, NavError};
+use pyo3::exceptions::PyTypeError;
 use crate::filter::aided::{AidedConfig, AidedIns, AidedOutput, Aiding, DampedVertical, InsSetup, PositionAiding, PositionFix};
 use crate::strapdown::Vertical;
 use crate::filter::discretize::Discretization;
@@ -36,13 +37,28 @@ pub(crate) fn mats(a: &PyReadonlyArray3<'_, f64>, field: &str) -> Result<Vec<DMa
     Ok((0..s[0]).map(|k| DMatrix::from_fn(s[1], s[2], |i, j| v[(k, i, j)])).collect())
 }
 
-fn blocks_of(blocks: Vec<(String, Option<usize>)>) -> Result<Layout, NavError> {
-    Layout::new(&blocks)
+/// A fixed number of floats (a position, velocity, quaternion, bias) from any sequence: a
+/// non-sequence is a `TypeError`, a wrong length or a NaN/inf an `InputError` naming `field`.
+pub(super) fn floats<const N: usize>(obj: &Bound<'_, PyAny>, field: &str) -> PyResult<[f64; N]> {
+    let v: Vec<f64> = obj.extract().map_err(|_| PyTypeError::new_err(format!("{field}: expected a sequence of {N} numbers")))?;
+    let a: [f64; N] = v.try_into().map_err(|v: Vec<f64>| invalid(field, format!("expected {N} values, got {}", v.len())))?;
+    check_finite(field, &a, 1)?;
+    Ok(a)
+}
+
+/// A layout from [(name, size or None)]; a size that is no integer in [0, 2⁶⁴) is an
+/// `InputError` naming `blocks` (not an `OverflowError`).
+fn blocks_of(blocks: Vec<(String, Option<Bound<'_, PyAny>>)>) -> PyResult<Layout> {
+    let spec = blocks
+        .into_iter()
+        .map(|(name, size)| Ok((name, size.map(|s| index_count(&s, "blocks", 0, usize::MAX)).transpose()?)))
+        .collect::<PyResult<Vec<_>>>()?;
+    Ok(Layout::new(&spec)?)
 }
 
 /// (name, start, stop) of every block of a layout given as [(name, size or None)].
 #[pyfunction]
-fn layout_ranges(blocks: Vec<(String, Option<usize>)>) -> PyResult<Vec<(String, usize, usize)>> {
+fn layout_ranges(blocks: Vec<(String, Option<Bound<'_, PyAny>>)>) -> PyResult<Vec<(String, usize, usize)>> {
     let l = blocks_of(blocks)?;
     Ok(l.blocks().iter().map(|(n, r)| (n.clone(), r.start, r.end)).collect())
 }
@@ -54,7 +70,7 @@ fn layout_ranges(blocks: Vec<(String, Option<usize>)>) -> PyResult<Vec<(String, 
 #[allow(clippy::too_many_arguments, clippy::type_complexity)]
 fn ins_error_dynamics<'py>(
     py: Python<'py>,
-    blocks: Vec<(String, Option<usize>)>,
+    blocks: Vec<(String, Option<Bound<'py, PyAny>>)>,
     lla: PyReadonlyArray2<'py, f64>,
     vel_ned: PyReadonlyArray2<'py, f64>,
     q_nb: PyReadonlyArray2<'py, f64>,
@@ -109,18 +125,18 @@ impl AidedSetup {
     #[allow(clippy::too_many_arguments)]
     fn new(
         t0: f64,
-        lla0: [f64; 3],
-        vel0: [f64; 3],
-        q0: [f64; 4],
+        lla0: &Bound<'_, PyAny>,
+        vel0: &Bound<'_, PyAny>,
+        q0: &Bound<'_, PyAny>,
         kind: Wrap<ImuKind>,
         p0: PyReadonlyArray2<'_, f64>,
         accel_psd: f64,
         gyro_psd: f64,
         accel_bias: (String, f64, f64),
         gyro_bias: (String, f64, f64),
-        ba0: [f64; 3],
-        bg0: [f64; 3],
-        predict_every: usize,
+        ba0: &Bound<'_, PyAny>,
+        bg0: &Bound<'_, PyAny>,
+        predict_every: &Bound<'_, PyAny>,
         method: &str,
         mode: &str,
         sequential: bool,
@@ -133,6 +149,9 @@ impl AidedSetup {
         baro_bias: Option<(String, f64, f64)>,
         baro_bias_sigma0: Option<f64>,
     ) -> PyResult<Self> {
+        let (lla0, vel0, q0) = (floats::<3>(lla0, "lla0")?, floats::<3>(vel0, "vel0")?, floats::<4>(q0, "q0")?);
+        let (ba0, bg0) = (floats::<3>(ba0, "ba0")?, floats::<3>(bg0, "bg0")?);
+        let predict_every = count(predict_every, "predict_every", 1, usize::MAX)?;
         let initial = NavState { t: t0, lla: lla0.into(), vel: vel0.into(), q_nb: crate::math::quat(q0[0], q0[1], q0[2], q0[3]) };
         let noise = ins_noise(accel_psd, gyro_psd, &accel_bias, &gyro_bias)?;
         let cfg = AidedConfig { noise, predict_every, method: <Discretization as crate::options::Choice>::parse(method)?, mode: <LoopMode as crate::options::Choice>::parse(mode)?, sequential, gate };
@@ -280,8 +299,9 @@ fn position_aided_ins(ins: PyRef<'_, AidedSetup>, fix_t: PyReadonlyArray1<'_, f6
 #[pyo3(signature = (lla, vel_ned, q_nb, p0, normals, ellipsoid=Wrap(crate::earth::WGS84)))]
 #[allow(clippy::type_complexity)]
 fn initial_error<'py>(
-    py: Python<'py>, lla: [f64; 3], vel_ned: [f64; 3], q_nb: [f64; 4], p0: PyReadonlyArray2<'py, f64>, normals: PyReadonlyArray1<'py, f64>, ellipsoid: Wrap<Ellipsoid>,
+    py: Python<'py>, lla: &Bound<'py, PyAny>, vel_ned: &Bound<'py, PyAny>, q_nb: &Bound<'py, PyAny>, p0: PyReadonlyArray2<'py, f64>, normals: PyReadonlyArray1<'py, f64>, ellipsoid: Wrap<Ellipsoid>,
 ) -> PyResult<(Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<f64>>)> {
+    let (lla, vel_ned, q_nb) = (floats::<3>(lla, "lla")?, floats::<3>(vel_ned, "vel_ned")?, floats::<4>(q_nb, "q_nb")?);
     let truth = NavState { t: 0.0, lla: lla.into(), vel: vel_ned.into(), q_nb: crate::math::quat(q_nb[0], q_nb[1], q_nb[2], q_nb[3]) };
     let s = perturbed_start(&ellipsoid.0, &truth, &mat(&p0, "p0")?, &vector(&normals, "normals")?)?;
     let q = [s.q_nb.w, s.q_nb.i, s.q_nb.j, s.q_nb.k];

@@ -2,8 +2,8 @@
 //! simulation, single-point positioning and the tightly coupled aided INS, over numpy
 //! arrays, with one options object ([`PyGnssOptions`]) for all of them.
 
-use super::convert::{register_choices, rows, to_py_rows, vec3, vec3_rows, vector, Wrap};
-use super::filter::{AidedSetup, PyAidedIns};
+use super::convert::{register_choices, rows, seed as seed_arg, to_py_rows, vec3, vec3_rows, vector, Wrap};
+use super::filter::{floats, AidedSetup, PyAidedIns};
 use crate::earth::Helmert;
 use crate::error::invalid;
 use crate::gnss::constellation::{nominal, ConstellationConfig};
@@ -46,9 +46,10 @@ impl PyEphemerides {
 
     /// The nominal constellations over GPS times [t_start, t_end].
     #[staticmethod]
-    #[pyo3(signature = (t_start, t_end, gps=true, glonass=true, tau_gps=0.0, n_leap=18.0, clocks=true, seed=0))]
+    #[pyo3(signature = (t_start, t_end, gps=true, glonass=true, tau_gps=0.0, n_leap=18.0, clocks=true, seed=None))]
     #[allow(clippy::too_many_arguments)]
-    fn nominal(t_start: f64, t_end: f64, gps: bool, glonass: bool, tau_gps: f64, n_leap: f64, clocks: bool, seed: u64) -> PyResult<Self> {
+    fn nominal(t_start: f64, t_end: f64, gps: bool, glonass: bool, tau_gps: f64, n_leap: f64, clocks: bool, seed: Option<&Bound<'_, PyAny>>) -> PyResult<Self> {
+        let seed = seed.map(|s| seed_arg(s, "seed")).transpose()?.unwrap_or_default();
         let cfg = ConstellationConfig { gps, glonass, t_start, t_end, tau_gps, time: TimeScales { n_leap }, clocks, seed };
         Ok(PyEphemerides { inner: nominal(&cfg)? })
     }
@@ -108,9 +109,11 @@ impl PyGnssOptions {
     #[allow(clippy::too_many_arguments)]
     fn new(
         sigma_code: f64, sigma_code_glonass: Option<f64>, sigma_rate: f64, iono: bool, tropo: bool, use_tau: bool, elevation_weight: bool,
-        formulation: Wrap<Formulation>, lever_arm: [f64; 3], use_rate: bool, tau0: f64, sigma_tau0: f64, tau_psd: f64, clock0: [f64; 2],
-        sigma_clock0: [f64; 2], clock_h0: f64, clock_hm2: f64,
+        formulation: Wrap<Formulation>, lever_arm: &Bound<'_, PyAny>, use_rate: bool, tau0: f64, sigma_tau0: f64, tau_psd: f64,
+        clock0: &Bound<'_, PyAny>, sigma_clock0: &Bound<'_, PyAny>, clock_h0: f64, clock_hm2: f64,
     ) -> PyResult<Self> {
+        let (lever_arm, clock0) = (floats::<3>(lever_arm, "lever_arm")?, floats::<2>(clock0, "clock0")?);
+        let sigma_clock0 = floats::<2>(sigma_clock0, "sigma_clock0")?;
         let inner = GnssOptions {
             sigma_code_gps: sigma_code,
             sigma_code_glo: sigma_code_glonass.unwrap_or(sigma_code),
@@ -140,13 +143,14 @@ impl PyGnssOptions {
 /// `clock_bias` + `clock_drift`·t (s); visibility: elevation `mask` (rad), `only` a
 /// satellite subset, `outages` (K, 2) GPS-time windows, `sat_outages` [(sat, start, end)].
 #[pyfunction]
-#[pyo3(signature = (eph, t, lla, vel_ned, options, *, tau_gps=0.0, clock_bias=0.0, clock_drift=0.0, mask=0.0, only=None, outages=None, sat_outages=Vec::new(), seed=0))]
+#[pyo3(signature = (eph, t, lla, vel_ned, options, *, tau_gps=0.0, clock_bias=0.0, clock_drift=0.0, mask=0.0, only=None, outages=None, sat_outages=Vec::new(), seed=None))]
 #[allow(clippy::too_many_arguments)]
 fn gnss_simulate<'py>(
     py: Python<'py>, eph: &PyEphemerides, t: PyReadonlyArray1<'py, f64>, lla: PyReadonlyArray2<'py, f64>, vel_ned: PyReadonlyArray2<'py, f64>,
     options: &PyGnssOptions, tau_gps: f64, clock_bias: f64, clock_drift: f64, mask: f64, only: Option<Vec<String>>,
-    outages: Option<PyReadonlyArray2<'py, f64>>, sat_outages: Vec<(String, f64, f64)>, seed: u64,
+    outages: Option<PyReadonlyArray2<'py, f64>>, sat_outages: Vec<(String, f64, f64)>, seed: Option<&Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyDict>> {
+    let seed = seed.map(|s| seed_arg(s, "seed")).transpose()?.unwrap_or_default();
     let t = vector(&t, "t")?;
     let (lla, vel) = (vec3_rows(&lla, "lla")?, vec3_rows(&vel_ned, "vel_ned")?);
     let names: Vec<String> = sat_outages.iter().map(|x| x.0.clone()).collect();

@@ -2,7 +2,7 @@
 //! discretisation, the streaming Kalman filter, the RTS smoother and the covariance
 //! analysis / Monte Carlo of a linearised scenario.
 
-use super::convert::{count, mat, mat_to_py, register_choices, vector, Wrap};
+use super::convert::{count, counts, mat, mat_to_py, register_choices, seed, vector, Wrap};
 use super::filter::{mats, stack_to_py};
 use crate::error::NavError;
 use crate::filter::analysis::Scenario as CoreScenario;
@@ -106,7 +106,7 @@ impl KalmanFilter {
 
     /// `steps` predictions with the same (Φ, Q_d) in one call (the multirate / benchmark path).
     fn predict_many(&mut self, py: Python<'_>, phi: PyReadonlyArray2<'_, f64>, qd: PyReadonlyArray2<'_, f64>, steps: &Bound<'_, PyAny>) -> PyResult<()> {
-        let steps = count(steps, "steps", 0, usize::MAX)?;
+        let steps = count(steps, "steps", 0, riccati::MAX_RECURSION_STEPS)?;
         let (phi, qd) = (mat(&phi, "phi")?, mat(&qd, "qd")?);
         let kf = &mut self.inner;
         Ok(py.detach(|| kf.predict_many(&phi, &qd, steps))?)
@@ -225,11 +225,12 @@ impl Scenario {
     fn monte_carlo<'py>(
         &self,
         py: Python<'py>,
-        master_seed: u64,
-        runs: Vec<u64>,
+        master_seed: &Bound<'py, PyAny>,
+        runs: &Bound<'py, PyAny>,
         mode: Wrap<LoopMode>,
     ) -> PyResult<(Bound<'py, PyArray3<f64>>, Bound<'py, PyArray3<f64>>, Bound<'py, PyArray2<f64>>, Bound<'py, PyArray2<f64>>)> {
-        let mode = mode.0;
+        let (mode, master_seed) = (mode.0, seed(master_seed, "master_seed")?);
+        let runs: Vec<u64> = counts(runs, "runs", 0, usize::MAX)?.into_iter().map(|r| r as u64).collect();
         let res = py.detach(|| self.inner.monte_carlo(master_seed, &runs, mode))?;
         let (nr, ne, n) = (res.len(), self.inner.epochs(), self.inner.size());
         let cube = |sel: fn(&crate::filter::analysis::RunResult) -> &Vec<f64>| {

@@ -9,6 +9,8 @@ import json
 
 import numpy as np
 
+from .._validate import instance, json_object
+
 
 def _plain(value):
     """A JSON-ready copy of a field value: nested configurations as dicts, arrays and
@@ -44,6 +46,7 @@ class ConfigMixin:
     def from_dict(cls, d: dict):
         """The configuration of a dict written by :meth:`to_dict`; unknown keys are a
         ``TypeError`` naming them."""
+        instance(d, dict, "d")
         names = {f.name for f in dataclasses.fields(cls)}
         unknown = sorted(set(d) - names)
         if unknown:
@@ -65,4 +68,4 @@ class ConfigMixin:
     @classmethod
     def from_json(cls, text: str):
         """The configuration of a JSON string written by :meth:`to_json`."""
-        return cls.from_dict(json.loads(text))
+        return cls.from_dict(json_object(text, "text"))

@@ -10,9 +10,12 @@ import os
 import numpy as np
 
 from .. import _core
-from .._validate import input_error
+from .._validate import instance, integer
 from ..imu import ImuErrors
 from .results import HybridResult
+
+#: Largest number of Monte-Carlo runs of one campaign (each keeps its whole error history).
+MAX_RUNS = 100_000
 
 
 def run_campaign(name: str, motion, config, *, runs: int = 1, seed: int = 0, progress: bool = True,
@@ -23,12 +26,20 @@ def run_campaign(name: str, motion, config, *, runs: int = 1, seed: int = 0, pro
     the scenario's parameters kept with the result beside ``config.to_dict()``."""
     from tqdm.auto import tqdm
 
-    if isinstance(runs, bool) or not isinstance(runs, (int, np.integer)) or runs < 1:
-        raise input_error("runs", f"must be >= 1, got {runs}")
+    from .scenarios import ScenarioConfig
+
+    instance(name, str, "name")
+    instance(motion, _core.Motion, "motion")
+    instance(config, ScenarioConfig, "config")
+    runs, seed = integer(runs, "runs", 1, MAX_RUNS), integer(seed, "seed", 0, 2**64 - 1)
+    instance(progress, (bool, np.bool_), "progress")
+    if params is not None:
+        instance(params, dict, "params")
     sensor, setup = config.sensor, config.setup
+    native = sensor._checked("config.sensor")
     shots = sensor.shots(sensor.first_shot, motion.duration)
     reference = None if config.reference is None else ImuErrors.preset(config.reference)._to_core()
-    core = _core.CaiHybrid(motion, sensor._native(), shots, *ImuErrors.preset(config.imu)._to_core(), reference,
+    core = _core.CaiHybrid(motion, native, shots, *ImuErrors.preset(config.imu)._to_core(), reference,
                            setup.p0(sensor.n_extra()), gravity=config.gravity, rate_hz=float(config.rate_hz),
                            truth_rate_hz=None if config.truth_rate_hz is None else float(config.truth_rate_hz),
                            phase_source=config.phase_source, accel_psd=float(setup.accel_psd), gyro_psd=float(setup.gyro_psd),

@@ -4,7 +4,7 @@ Readout p_i = p0 + A cos(φ + ψ_i) with noise on offset (σ_p0), phase (σ_φ, 
 amplitude (σ_A); ψ_i is the known phase of shot i (from a vibration sensor). The residual
 variance is a + b sin²φ_i with a = σ_p0² + σ_A², b = A²σ_φ² − σ_A²: only (a, b) are
 identifiable, so (σ_p0, σ_φ, σ_A) are estimated with at least one of them fixed; asking
-for all three raises a ``ValueError`` that says so.
+for all three raises an :class:`atomnav.InputError` that says so.
 """
 
 from __future__ import annotations
@@ -13,7 +13,7 @@ import numpy as np
 import pandas as pd
 
 from .. import _core
-from .._validate import choice, vector
+from .._validate import as_floats, choice, finite_scalar, generator, input_error, instance, integer, nonnegative, vector
 
 _NAMES = ("p0", "phi", "A")
 
@@ -22,7 +22,11 @@ def simulate_fringe(n: int, *, p0: float = 0.5, phi: float = 1.0, amplitude: flo
                     sigma_phi: float = 0.23, sigma_A: float = 0.02, seed=None):
     """n readouts of the nonlinear model (P-17) p = (p0 + n_p0) + (A + n_A) cos(φ + ψ + n_φ)
     with ψ uniform on [0, 2π) (fringe scanned by vibration). Returns (p, ψ)."""
-    rng = np.random.default_rng(seed)
+    n = integer(n, "n", 0, 100_000_000)
+    p0, phi, amplitude = (finite_scalar(v, name) for name, v in (("p0", p0), ("phi", phi), ("amplitude", amplitude)))
+    sigma_p0, sigma_phi, sigma_A = (nonnegative(v, name) for name, v in (
+        ("sigma_p0", sigma_p0), ("sigma_phi", sigma_phi), ("sigma_A", sigma_A)))
+    rng = generator(seed, "seed")
     psi = rng.uniform(0.0, 2 * np.pi, n)
     p = (p0 + rng.normal(0, sigma_p0, n)) + (amplitude + rng.normal(0, sigma_A, n)) * np.cos(phi + psi + rng.normal(0, sigma_phi, n))
     return p, psi
@@ -34,15 +38,20 @@ def fringe_track(p, psi, *, zeta0=(0.5, 0.0, 0.1), sigma0=(0.1, 1.0, 0.1), q=(1e
     after each readout (A kept > 0, φ wrapped to (−π, π]). q: random-walk variance per
     shot, r: readout variance."""
     z = _core.cai_fringe_track(vector(p, None, "p"), vector(psi, None, "psi"), vector(zeta0, 3, "zeta0"),
-                               vector(sigma0, 3, "sigma0"), vector(q, 3, "q"), float(r))
+                               vector(sigma0, 3, "sigma0"), vector(q, 3, "q"), finite_scalar(r, "r"))
     return pd.DataFrame({"p0": z[:, 0], "phi_rad": z[:, 1], "A": z[:, 2]})
 
 
 def residuals(p, psi, track: pd.DataFrame):
     """Residuals x_i = p_i − (p̂0 + Â cos φ_i), fringe phases φ_i = φ̂ + ψ_i and amplitudes Â."""
-    phase = track["phi_rad"].to_numpy() + np.asarray(psi, float)
-    amp = track["A"].to_numpy()
-    return np.asarray(p, float) - (track["p0"].to_numpy() + amp * np.cos(phase)), phase, amp
+    instance(track, pd.DataFrame, "track")
+    missing = [c for c in ("p0", "phi_rad", "A") if c not in track.columns]
+    if missing:
+        raise input_error("track", f"missing columns {missing} (a frame of fringe_track)")
+    n = len(track)
+    phase = track["phi_rad"].to_numpy(dtype=float) + vector(psi, n, "psi")
+    amp = track["A"].to_numpy(dtype=float)
+    return vector(p, n, "p") - (track["p0"].to_numpy(dtype=float) + amp * np.cos(phase)), phase, amp
 
 
 def identify_noise(x, phi, amplitude, *, free=("p0", "phi"), theta0=(0.02, 0.2, 0.02), method: str = "newton",
@@ -59,13 +68,15 @@ def identify_noise(x, phi, amplitude, *, free=("p0", "phi"), theta0=(0.02, 0.2, 
     mid-fringe), ``iterations``, ``converged``, ``log_likelihood`` and ``hessian_eig_ratio``
     (smallest / largest eigenvalue magnitude of the Hessian of ln L in the three variances,
     ≈ 0: the unidentifiable direction)."""
+    if isinstance(free, str) or not isinstance(free, (list, tuple)) or not all(isinstance(f, str) for f in free):
+        raise TypeError(f"free: expected a list of names from {_NAMES}, got {type(free).__name__}")
     for f in free:
         choice(f, _NAMES, "free")
     x = vector(x, None, "x")
     mask = [n in free for n in _NAMES]
     n = len(x)
     res = _core.cai_ml_identify(x, vector(phi, n, "phi"), vector(amplitude, n, "amplitude"), method=method, free=mask,
-                                theta0=vector(theta0, 3, "theta0"), max_iter=max_iter, tol=float(tol), batch=batch or n,
+                                theta0=vector(theta0, 3, "theta0"), max_iter=max_iter, tol=finite_scalar(tol, "tol"), batch=n if batch is None else batch,
                                 sliding=bool(sliding))
     th = res["theta"]
     return pd.DataFrame({
@@ -78,4 +89,8 @@ def identify_noise(x, phi, amplitude, *, free=("p0", "phi"), theta0=(0.02, 0.2, 
 
 def readout_variance(a: float, b: float, phi) -> np.ndarray:
     """Readout variance σ_p²(φ) = a + b sin²φ (E21), the measurement variance R."""
-    return a + b * np.sin(np.asarray(phi, float)) ** 2
+    a, b, phi = as_floats(a, "a"), as_floats(b, "b"), as_floats(phi, "phi")
+    try:
+        return a + b * np.sin(phi) ** 2
+    except ValueError:
+        raise input_error("phi", f"shape {phi.shape} does not broadcast with a {a.shape} and b {b.shape}") from None

@@ -15,7 +15,7 @@ import numpy as np
 import pandas as pd
 
 from .. import _core
-from .._validate import input_error, positive, rows, vector
+from .._validate import as_floats, broadcast, finite, finite_scalar, input_error, instance, nonnegative, positive, rows, shaped, vector
 from ._config import ConfigMixin
 
 #: ⁸⁷Rb D2 wavelength (m) and the two-photon effective wave number 4π/λ (rad/m).
@@ -52,14 +52,15 @@ class Channels(ConfigMixin):
     def __post_init__(self):
         self.k = rows(self.k, 3, "k")
         n = len(self.k)
-        self.lever = rows(np.broadcast_to(np.asarray(self.lever, float), (n, 3)), 3, "lever")
-        self.v0 = rows(np.broadcast_to(np.asarray(self.v0, float), (n, 3)), 3, "v0")
-        c = np.asarray(self.c_sb, float)
-        self.c_sb = np.ascontiguousarray(np.broadcast_to(c, (n, 3, 3)))
-        if not self.names:
+        self.lever = rows(broadcast(self.lever, (n, 3), "lever"), 3, "lever")
+        self.v0 = rows(broadcast(self.v0, (n, 3), "v0"), 3, "v0")
+        self.c_sb = broadcast(self.c_sb, (n, 3, 3), "c_sb")
+        if self.names is None or (isinstance(self.names, (list, tuple)) and not self.names):
             self.names = [f"ch{j}" for j in range(n)]
+        if not isinstance(self.names, (list, tuple)) or not all(isinstance(x, str) for x in self.names):
+            raise TypeError(f"names: expected a list of str, got {type(self.names).__name__}")
         if len(self.names) != n:
-            raise ValueError(f"names: expected {n} names, got {len(self.names)}")
+            raise input_error("names", f"expected {n} names, got {len(self.names)}")
 
     def __len__(self) -> int:
         return len(self.k)
@@ -72,6 +73,7 @@ class Channels(ConfigMixin):
     def cyclic(cls, k: float = K_RB87, v0: float = 2.8, lever=(0.0, 0.0, 0.0), c_sb=None) -> "Channels":
         """Six channels of the seed-003 multi-axis sensor (spec §2.2): k along e_j, ensembles
         A/B with v0 = ±v0 e_{(j+1) mod 3}; names x_A, x_B, y_A, ..."""
+        k, v0 = finite_scalar(k, "k"), finite_scalar(v0, "v0")
         ks, vs, names = [], [], []
         for j, ax in enumerate("xyz"):
             for s, ab in ((1.0, "A"), (-1.0, "B")):
@@ -83,7 +85,7 @@ class Channels(ConfigMixin):
 
 def _gradient(gradient):
     """Gravity-gradient tensor (3, 3) 1/s² as the core takes it; None = no gradient."""
-    return None if gradient is None else np.ascontiguousarray(np.asarray(gradient, float).reshape(3, 3))
+    return None if gradient is None else shaped(gradient, (3, 3), "gradient")
 
 
 def _setup(t, specific_force, angular_rate, shots, T, channels, angular_acceleration, omega_dot,
@@ -91,23 +93,24 @@ def _setup(t, specific_force, angular_rate, shots, T, channels, angular_accelera
     """Validated shot start times (s) and the core predictor set up on them."""
     if omega_dot is None:
         omega_dot = "savgol" if angular_acceleration is None else "given"
+    instance(channels, Channels, "channels")
     t = vector(t, None, "t")
-    f = np.ascontiguousarray(np.asarray(specific_force, float))
-    w = np.ascontiguousarray(np.asarray(angular_rate, float))
+    f = np.ascontiguousarray(as_floats(specific_force, "specific_force"))
+    w = np.ascontiguousarray(as_floats(angular_rate, "angular_rate"))
     for name, a in (("specific_force", f), ("angular_rate", w)):
         if a.shape != (len(t), 3):
             raise input_error(name, f"expected shape ({len(t)}, 3), got {a.shape}")
     wd = None
     if angular_acceleration is not None:
-        wd = np.ascontiguousarray(np.asarray(angular_acceleration, float))
+        wd = np.ascontiguousarray(as_floats(angular_acceleration, "angular_acceleration"))
         if wd.shape != (len(t), 3):
             raise input_error("angular_acceleration", f"expected shape ({len(t)}, 3), got {wd.shape}")
-    shots = np.ascontiguousarray(np.atleast_1d(np.asarray(shots, float)))
-    return shots, _core.CaiSetup(t, f, w, shots, channels._native(), float(T), omega_dot=omega_dot, angular_acceleration=wd,
+    shots = np.ascontiguousarray(np.atleast_1d(as_floats(shots, "shots")))
+    return shots, _core.CaiSetup(t, f, w, shots, channels._native(), finite_scalar(T, "T"), omega_dot=omega_dot, angular_acceleration=wd,
                                  savgol_half_width=savgol_half_width, interpolation=interpolation, substeps=substeps,
                                  gradient=_gradient(gradient),
-                                 bias_a=vector(np.broadcast_to(np.asarray(bias_a, float), 3).copy(), 3, "bias_a"),
-                                 bias_g=vector(np.broadcast_to(np.asarray(bias_g, float), 3).copy(), 3, "bias_g"))
+                                 bias_a=vector(broadcast(bias_a, (3,), "bias_a"), 3, "bias_a"),
+                                 bias_g=vector(broadcast(bias_g, (3,), "bias_g"), 3, "bias_g"))
 
 
 @dataclass
@@ -181,8 +184,13 @@ def check_jacobian(*args, fd_steps=(1e-3, 1e-4, 1e-3, 1e-4), **kwargs) -> dict:
 def readout_jacobian(phase_jac, phi_hat, phi0, contrast: float = 1.0) -> np.ndarray:
     """∂p/∂θ of p = o − (C/2) cos(φ̂ + φ0) (seed 000 (P-10)): (C/2) sin(φ̂ + φ0) ∂φ/∂θ;
     at mid-fringe (φ̂ + φ0 = π/2) it is (C/2) ∂φ/∂θ. Shapes broadcast over (shots, channels)."""
-    s = 0.5 * contrast * np.sin(np.asarray(phi_hat) + np.asarray(phi0))
-    return s[..., None] * np.asarray(phase_jac)
+    jac = as_floats(phase_jac, "phase_jac")
+    phi_hat, phi0 = as_floats(phi_hat, "phi_hat"), as_floats(phi0, "phi0")
+    for a, name in ((jac, "phase_jac"), (phi_hat, "phi_hat"), (phi0, "phi0")):
+        finite(a.reshape(-1), name)
+    s = 0.5 * finite_scalar(contrast, "contrast") * np.sin(broadcast(phi_hat, jac.shape[:-1], "phi_hat")
+                                                          + broadcast(phi0, jac.shape[:-1], "phi0"))
+    return s[..., None] * jac
 
 
 # --- analytic motions and the inertial oracle ------------------------------------------
@@ -204,9 +212,9 @@ class SineMotion:
 
     def _native(self):
         return _core.CaiMotion.sine(rows(self.position_poly, 3, "position_poly"),
-                                    np.ascontiguousarray(np.asarray(self.position_sines, float).reshape(-1, 4)),
+                                    rows(self.position_sines, 4, "position_sines"),
                                     rows(self.attitude_poly, 3, "attitude_poly"),
-                                    np.ascontiguousarray(np.asarray(self.attitude_sines, float).reshape(-1, 4)))
+                                    rows(self.attitude_sines, 4, "attitude_sines"))
 
 
 @dataclass
@@ -219,12 +227,13 @@ class YawDrive:
     period: float = 50.0
 
     def _native(self):
-        return _core.CaiMotion.yaw_drive(float(self.speed), float(self.yaw_rate_amplitude), float(self.period))
+        return _core.CaiMotion.yaw_drive(finite_scalar(self.speed, "speed"), finite_scalar(self.yaw_rate_amplitude, "yaw_rate_amplitude"),
+                                         positive(self.period, "period"))
 
 
 def _gravity(gravity, gradient, t_ref):
     """The core gravity model: uniform g (m/s²) and gradient (1/s²) about the IMU at t_ref (s)."""
-    return _core.CaiGravity(vector(np.asarray(gravity, float), 3, "gravity"), _gradient(gradient), float(t_ref))
+    return _core.CaiGravity(vector(gravity, 3, "gravity"), _gradient(gradient), finite_scalar(t_ref, "t_ref"))
 
 
 def motion_imu(motion, t, *, gravity=(0.0, 0.0, 0.0), gradient=None, t_ref: float = 0.0):
@@ -232,17 +241,20 @@ def motion_imu(motion, t, *, gravity=(0.0, 0.0, 0.0), gradient=None, t_ref: floa
     angular rate (N, 3) rad/s and angular acceleration (N, 3) rad/s², body frame.
     gravity: uniform g (m/s², inertial; zero = kinematic mode); gradient Γ_i (3, 3) 1/s²
     about the IMU position at ``t_ref``."""
+    instance(motion, (SineMotion, YawDrive), "motion")
     g = _gravity(gravity, gradient, t_ref)
-    return motion._native().imu(vector(t, None, "t"), g)
+    return motion._native().imu(vector(np.atleast_1d(as_floats(t, "t")), None, "t"), g)
 
 
 def oracle_phase(motion, shots, T: float, channels: Channels, *, gravity=(0.0, 0.0, 0.0), gradient=None,
                  t_ref: float = 0.0) -> np.ndarray:
     """Exact phase (rad) (n_shots, n_channels) from the inertial oracle (spec (E8)): ballistic
     atom in the inertial frame, transformed into the rotating sensor frame at the pulses."""
+    instance(motion, (SineMotion, YawDrive), "motion")
+    instance(channels, Channels, "channels")
     g = _gravity(gravity, gradient, t_ref)
-    shots = np.atleast_1d(np.asarray(shots, float))
-    out = motion._native().oracle(vector(shots, None, "shots"), float(T), channels._native(), g)
+    shots = np.atleast_1d(as_floats(shots, "shots"))
+    out = motion._native().oracle(vector(shots, None, "shots"), finite_scalar(T, "T"), channels._native(), g)
     return out.reshape(len(shots), len(channels))
 
 
@@ -251,11 +263,11 @@ def oracle_phase(motion, shots, T: float, channels: Channels, *, gravity=(0.0, 0
 
 def _closed(kind, k, v0, angular_rate, specific_force, T, angular_acceleration=(0, 0, 0), gradient=None):
     k = rows(k, 3, "k")
-    v0 = rows(np.broadcast_to(np.asarray(v0, float), k.shape), 3, "v0")
+    v0 = rows(broadcast(v0, k.shape, "v0"), 3, "v0")
     return _core.cai_phase_closed_form(kind, k, v0, vector(angular_rate, 3, "angular_rate"),
                                        vector(specific_force, 3, "specific_force"),
                                        vector(angular_acceleration, 3, "angular_acceleration"),
-                                       _gradient(gradient), float(T))
+                                       _gradient(gradient), finite_scalar(T, "T"))
 
 
 def phase_constant(k, v0, angular_rate, specific_force, T: float) -> np.ndarray:
@@ -279,7 +291,10 @@ def phase_seed000(k, vbar, angular_rate, specific_force, T_total: float) -> np.n
 
 def sagnac_phase(k, v0, angular_rate, T: float) -> np.ndarray:
     """Sagnac (Coriolis) term −2T² k·(ω×v0) (rad)."""
-    return -2.0 * T**2 * np.einsum("ij,ij->i", np.atleast_2d(k), np.cross(np.asarray(angular_rate, float), np.atleast_2d(v0)))
+    k = rows(np.atleast_2d(as_floats(k, "k")), 3, "k")
+    v0 = rows(broadcast(v0, k.shape, "v0"), 3, "v0")
+    w = vector(angular_rate, 3, "angular_rate")
+    return -2.0 * finite_scalar(T, "T") ** 2 * np.einsum("ij,ij->i", k, np.cross(w, v0))
 
 
 def t_sep_from_total(T_total: float) -> float:
@@ -295,19 +310,27 @@ def total_from_t_sep(T: float) -> float:
 def scale_factors(T: float, k: float = K_RB87, v0: float = 2.8) -> dict:
     """Phase scale factors: ``acceleration`` kT² (rad per m/s²), ``sagnac`` 2kv0T² (rad per
     rad/s), ``euler`` kv0T³ (rad per rad/s²)."""
-    T = positive(T, "T")
+    T, k, v0 = positive(T, "T"), finite_scalar(k, "k"), finite_scalar(v0, "v0")
     return {"acceleration": k * T**2, "sagnac": 2 * k * v0 * T**2, "euler": k * v0 * T**3}
 
 
 def dynamic_range(T: float, k: float = K_RB87) -> float:
     """Acceleration span of one fringe flank, π/(kT²) (m/s²) (spec (E3))."""
-    return np.pi / (positive(k, "k") * positive(T, "T") ** 2)
+    return np.pi / _kt2(k, T)
+
+
+def _kt2(k: float, T: float) -> float:
+    """The acceleration scale factor kT² (rad per m/s²), checked to be a positive float."""
+    scale = positive(k, "k") * positive(T, "T") ** 2
+    if not 0 < scale < np.inf:
+        raise input_error("T", f"kT² = {scale} rad/(m/s²) is outside the range of floats")
+    return scale
 
 
 def capture_limits(T: float, k: float = K_RB87, v0: float = 2.8) -> dict:
     """Largest bias errors keeping the phase error below π/2: accelerometer π/(2kT²) (m/s²),
     gyro π/(2·2kv0T²) (rad/s) (seed 000 spec §2.8)."""
-    s = scale_factors(T, k, v0)
+    s = scale_factors(T, positive(k, "k"), positive(v0, "v0"))
     return {"accelerometer": 0.5 * np.pi / s["acceleration"], "gyro": 0.5 * np.pi / s["sagnac"]}
 
 
@@ -316,9 +339,8 @@ def in_shot_noise_phase(q_accel: float, q_gyro: float, T: float, k: float = K_RB
     spec (E38)): ``accel`` k√(2q_a/3) T^{3/2} and ``gyro`` (Sagnac) 2kv0√(2q_g/3) T^{3/2},
     with q the white-noise PSDs (m²/s³, rad²/s), from Var = q k² ∫w² dt, ∫w² = 2T³/3."""
     T = positive(T, "T")
-    for name, q in (("q_accel", q_accel), ("q_gyro", q_gyro)):
-        if not (np.isfinite(q) and q >= 0):
-            raise ValueError(f"{name}: must be finite and >= 0, got {q}")
+    q_accel, q_gyro = nonnegative(q_accel, "q_accel"), nonnegative(q_gyro, "q_gyro")
+    k, v0 = finite_scalar(k, "k"), finite_scalar(v0, "v0")
     return {"accel": k * np.sqrt(2 * q_accel / 3) * T**1.5, "gyro": 2 * k * v0 * np.sqrt(2 * q_gyro / 3) * T**1.5}
 
 
@@ -329,4 +351,4 @@ def phase_noise(sigma_p: float, contrast: float = 1.0) -> float:
 
 def acceleration_noise(sigma_phi: float, T: float, k: float = K_RB87) -> float:
     """Acceleration noise (m/s²) of a phase noise σ_φ (rad): σ_φ/(kT²)."""
-    return sigma_phi / scale_factors(T, k)["acceleration"]
+    return finite_scalar(sigma_phi, "sigma_phi") / _kt2(k, T)

@@ -6,15 +6,15 @@ from __future__ import annotations
 import numpy as np
 
 from .. import _core
-from .._validate import finite
+from .._validate import as_floats, finite, finite_scalar, generator, input_error, nonnegative
 
 
 def _contrast(contrast) -> np.ndarray:
-    c = np.asarray(contrast, float)
-    bad = ~((c > 0) & (c <= 1)) | ~np.isfinite(c)
+    c = as_floats(contrast, "contrast")
+    bad = np.atleast_1d(~((c > 0) & (c <= 1)) | ~np.isfinite(c)).reshape(-1)
     if bad.any():
-        i = np.argwhere(np.atleast_1d(bad))[0][0]
-        raise ValueError(f"contrast: must be in (0, 1], got {np.atleast_1d(c)[i]} at index {i}")
+        i = int(np.argmax(bad))
+        raise input_error("contrast", f"must be in (0, 1], got {np.atleast_1d(c).reshape(-1)[i]} at index {i}", i)
     return c
 
 
@@ -22,25 +22,30 @@ def readout(phi, phi0=0.0, *, offset=0.5, contrast=1.0, sigma_p: float = 0.0, si
             sigma_contrast: float = 0.0, seed=None) -> np.ndarray:
     """Population p = o − (C/2) cos(φ + φ0 + n_φ) + n_p with C → C + n_C; noise σ's are
     per-shot standard deviations (population, rad, contrast), drawn with ``seed``."""
-    phi = np.asarray(phi, float)
-    finite(np.atleast_1d(phi), "phi")
+    phi = as_floats(phi, "phi")
+    finite(np.atleast_1d(phi).reshape(-1), "phi")
+    phi0 = as_floats(phi0, "phi0")
+    finite(np.atleast_1d(phi0).reshape(-1), "phi0")
+    offset = finite_scalar(offset, "offset")
     c = _contrast(contrast)
-    for name, s in (("sigma_p", sigma_p), ("sigma_phi", sigma_phi), ("sigma_contrast", sigma_contrast)):
-        if not (np.isfinite(s) and s >= 0):
-            raise ValueError(f"{name}: must be finite and >= 0, got {s}")
-    rng = np.random.default_rng(seed)
-    shape = np.broadcast(phi, np.asarray(phi0), c).shape
+    sigma_p, sigma_phi, sigma_contrast = (nonnegative(s, name) for name, s in (
+        ("sigma_p", sigma_p), ("sigma_phi", sigma_phi), ("sigma_contrast", sigma_contrast)))
+    rng = generator(seed, "seed")
+    try:
+        shape = np.broadcast(phi, phi0, c).shape
+    except ValueError:
+        raise input_error("phi0", f"shape {phi0.shape} does not broadcast with phi {phi.shape} and contrast {c.shape}") from None
     n_phi = rng.normal(0.0, sigma_phi, shape) if sigma_phi else 0.0
     n_c = rng.normal(0.0, sigma_contrast, shape) if sigma_contrast else 0.0
     n_p = rng.normal(0.0, sigma_p, shape) if sigma_p else 0.0
     total, c_eff = (np.ascontiguousarray(np.broadcast_to(x, shape), dtype=float).ravel() for x in (phi + phi0 + n_phi, c + n_c))
-    p = _core.cai_readout(float(offset), c_eff, total).reshape(shape) + n_p
+    p = _core.cai_readout(offset, c_eff, total).reshape(shape) + n_p
     return p[()] if np.ndim(p) == 0 else p
 
 
 def steer_mid_fringe(phi_hat) -> np.ndarray:
     """Laser phase φ0 = (π/2 − φ̂) mod 2π (rad) putting the predicted phase at mid-fringe."""
-    phi_hat = np.asarray(phi_hat, float)
+    phi_hat = as_floats(phi_hat, "phi_hat")
     phi0 = _core.cai_steer_mid_fringe(np.ascontiguousarray(phi_hat).ravel()).reshape(phi_hat.shape)
     return phi0[()] if phi0.ndim == 0 else phi0
 
@@ -48,21 +53,31 @@ def steer_mid_fringe(phi_hat) -> np.ndarray:
 def invert_readout(p, phi0=0.0, *, offset=0.5, contrast=1.0, flank: str = "rising") -> np.ndarray:
     """Phase φ (rad) of a readout on a known flank: φ + φ0 ∈ [0, π] ("rising", p grows with
     φ) or [−π, 0] ("falling"). Readouts beyond the fringe extremes are clipped to them."""
-    if flank not in ("rising", "falling"):
-        raise ValueError(f"flank: unknown option {flank!r}; choose 'falling', 'rising'")
+    if not isinstance(flank, str) or flank not in ("rising", "falling"):
+        raise input_error("flank", f"unknown option {flank!r}; choose 'falling', 'rising'")
     c = _contrast(contrast)
-    u = np.clip(2.0 * (offset - np.asarray(p, float)) / c, -1.0, 1.0)
-    psi = np.arccos(u)
-    return (psi if flank == "rising" else -psi) - phi0
+    p = as_floats(p, "p")
+    finite(np.atleast_1d(p).reshape(-1), "p")
+    phi0 = as_floats(phi0, "phi0")
+    finite(np.atleast_1d(phi0).reshape(-1), "phi0")
+    try:
+        u = np.clip(2.0 * (finite_scalar(offset, "offset") - p) / c, -1.0, 1.0)
+        psi = np.arccos(u)
+        return (psi if flank == "rising" else -psi) - phi0
+    except ValueError:
+        raise input_error("contrast", f"shape {c.shape} does not broadcast with p {p.shape} and phi0 {phi0.shape}") from None
 
 
 def fringes_crossed(phi) -> np.ndarray:
     """Number of whole fringes (2π) between zero phase and each predicted phase (rad)."""
-    return np.floor(np.abs(np.asarray(phi, float)) / (2 * np.pi)).astype(int)
+    phi = as_floats(phi, "phi")
+    finite(np.atleast_1d(phi).reshape(-1), "phi")
+    return np.floor(np.abs(phi) / (2 * np.pi)).astype(np.int64)
 
 
 def capture_region(delta) -> np.ndarray:
     """Capture region of a true-minus-predicted phase Δ (rad) (seed 000 Fig. 3):
     "A" |Δ| < π/2 (correct update), "B" π/2 ≤ |Δ| < π (right sign, too small), "slip"."""
-    a = np.abs(np.asarray(delta, float))
+    a = np.abs(as_floats(delta, "delta"))
+    finite(np.atleast_1d(a).reshape(-1), "delta")
     return np.where(a < np.pi / 2, "A", np.where(a < np.pi, "B", "slip"))

@@ -14,7 +14,7 @@ import numpy as np
 import pandas as pd
 
 from .. import _core
-from .._validate import choice
+from .._validate import as_floats, choice, finite, finite_scalar, input_error, instance, integer, scalar
 from .predictor import K_RB87
 
 #: Error columns of every run: NED position (m), NED velocity (m/s), ψ (rad) (from the core).
@@ -57,7 +57,7 @@ class HybridResult:
 
     def epoch(self, t: float) -> int:
         """Index of the output epoch nearest to t (s)."""
-        return int(np.argmin(np.abs(self.time - t)))
+        return int(np.argmin(np.abs(self.time - finite_scalar(t, "t"))))
 
     def errors(self, which: str = "hybrid") -> pd.DataFrame:
         """Long table run, time_s and :data:`ERROR_COLUMNS` of ``"hybrid"`` or ``"free"``."""
@@ -84,7 +84,9 @@ class HybridResult:
         """IMU-only / hybrid RMS-over-runs error ratio at each time (s): one row per (time,
         quantity, axis ∈ n, e, d, norm)."""
         rows = []
-        for t in np.atleast_1d(times):
+        times = np.atleast_1d(as_floats(times, "times")).reshape(-1)
+        finite(times, "times")
+        for t in times:
             k = self.epoch(float(t))
             for q, sl in _QUANTITIES.items():
                 f, h = self.free[:, k, sl], self.hybrid[:, k, sl]
@@ -112,18 +114,30 @@ class HybridResult:
         """Share of (run, epoch) NEES values inside the two-sided p band of χ²(15)."""
         from scipy.stats import chi2
 
+        p = scalar(p, "p")
+        if not 0 < p < 1:
+            raise input_error("p", f"must be a probability in (0, 1), got {p}")
         lo, hi = chi2.ppf([(1 - p) / 2, (1 + p) / 2], 15)
         return float(np.mean((self.nees >= lo) & (self.nees <= hi)))
 
     def phase_exceedance(self, limit: float = np.pi / 2) -> float:
         """Share of shot-channels with |true − predicted phase| > limit (rad)."""
-        return float(np.mean(np.abs(self.phase_error) > limit))
+        return float(np.mean(np.abs(self.phase_error) > scalar(limit, "limit")))
 
     def phase_errors(self) -> pd.DataFrame:
         """Long table run, shot_start_s, channel, phase_error_rad."""
         r, s, c = self.phase_error.shape
         return pd.DataFrame({"run": np.repeat(np.arange(r), s * c), "shot_start_s": np.tile(np.repeat(self.shots, c), r),
                              "channel": np.tile(self.channel_names or list(range(c)), r * s), "phase_error_rad": self.phase_error.ravel()})
+
+
+def _satellite_params(res) -> dict:
+    """The parameters of a result of :func:`atomnav.cai.satellite`."""
+    instance(res, HybridResult, "res")
+    need = ("shot_period_s", "q_rw", "sigma_p", "contrast", "T")
+    if not isinstance(res.params, dict) or any(k not in res.params for k in need):
+        raise input_error("res", f"expected a result of atomnav.cai.satellite (params {need})")
+    return res.params
 
 
 def satellite_steady_state(res: HybridResult) -> dict:
@@ -133,7 +147,7 @@ def satellite_steady_state(res: HybridResult) -> dict:
     empirical σ of the tracking error b̂ − b (bias truth = random walk + Gauss–Markov)."""
     from ..filter import riccati_scalar
 
-    p = res.params
+    p = _satellite_params(res)
     t_shot, q, r, h = p["shot_period_s"], p["q_rw"] * p["shot_period_s"], p["sigma_p"] ** 2, 0.5 * p["contrast"] * K_RB87 * p["T"] ** 2
     upd = np.isclose(np.mod(res.time, t_shot), 0.0) & (res.time > 0)
     half = upd & (res.time >= res.time[-1] / 2)
@@ -150,7 +164,8 @@ def satellite_psd(res: HybridResult, nperseg: int = 2**15) -> pd.DataFrame:
     level of the CAI alone: σ_a √Δt_shot with σ_a = σ_p/((C/2) k T²) (Tennstedt et al. 2021, §4)."""
     from scipy.signal import welch
 
-    p = res.params
+    p = _satellite_params(res)
+    nperseg = integer(nperseg, "nperseg", 2, 2**31 - 1)
     t = res.imu_time
     fs = 1.0 / float(np.median(np.diff(t)))
     e = res.accel_error[0, :, 0]

@@ -11,7 +11,7 @@ import numpy as np
 import pandas as pd
 
 from .. import _core
-from .._validate import positive, vector
+from .._validate import input_error, instance, positive, vector
 from ..imu import ImuErrors
 from ._config import ConfigMixin
 from .campaign import run_campaign
@@ -25,6 +25,8 @@ HANNOVER = (np.deg2rad(52.38), np.deg2rad(9.72), 60.0)
 #: Option names the core accepts (read from the core, which checks them).
 GRAVITY_OPTIONS = tuple(_core.OPTIONS["Gravity"])
 PHASE_SOURCE_OPTIONS = tuple(_core.OPTIONS["PhaseSource"])
+#: Longest satellite record (days at 1 Hz; the core holds every sample of a run).
+MAX_SATELLITE_DAYS = 1000.0
 
 
 @dataclass
@@ -105,7 +107,7 @@ def car_mc(runs: int = 100, seed: int = 2023, *, gravity: str = "kinematic", lev
     phase (2Tq_g(kl)², :func:`in_shot_noise`). Measured (100 runs, lead's reproduce run): the
     25 s velocity gain drops from 36.3 to 26.6 (< 30 required) and fringe slips rise from
     1.84 % to 5.83 %; the reproduce section reports both."""
-    motion = _core.Motion.car(vector(HANNOVER, 3, "origin"), 0.0, bool(vibration))
+    motion = _core.Motion.car(vector(HANNOVER, 3, "origin"), 0.0, bool(instance(vibration, (bool, np.bool_), "vibration")))
     config = ScenarioConfig(seed003_sensor(lever), seed003_filter(), gravity=gravity)
     return run_campaign("car_mc", motion, config, runs=runs, seed=seed, progress=progress,
                         params={"gravity": gravity, "lever_m": tuple(lever), "vibration": vibration})
@@ -119,8 +121,14 @@ def slalom(runs: int = 100, seed: int = 2024, *, gravity: str = "kinematic", dur
     the same filter without CAI updates; ``sensor`` / ``setup`` replace the paper's CAI and
     filter (e.g. :func:`accelerometer_sensor`, the 21-state filter with misalignment and
     lever-arm states, or option a)."""
+    if sensor is not None:
+        instance(sensor, CaiSensor, "sensor")._checked("sensor")
+    if setup is not None:
+        instance(setup, FilterSetup, "setup")
+    instance(aiding, (bool, np.bool_), "aiding")
     motion = _core.Motion.slalom(vector(HANNOVER, 3, "origin"), 5.0, 2.0, 10.0, positive(duration, "duration"))
-    config = ScenarioConfig(sensor or seed003_sensor(lever), setup or seed003_filter(), gravity=gravity, aiding=aiding)
+    config = ScenarioConfig(seed003_sensor(lever) if sensor is None else sensor, seed003_filter() if setup is None else setup,
+                            gravity=gravity, aiding=bool(aiding))
     return run_campaign("slalom", motion, config, runs=runs, seed=seed, progress=progress,
                         params={"gravity": gravity, "lever_m": tuple(lever), "duration_s": duration})
 
@@ -132,8 +140,12 @@ def satellite(days: float = 4.0, seed: int = 2021, *, drift: bool = True, progre
     q_rw = 1e-21 m²/s⁵), one CAI shot every 10 s with T0 = 10 s (T = 5 s), |A| = 0.15
     (C = 0.3), R = 1.024e-3; the filter's bias model is the random walk q_rw
     (Q = 1e-20 (m/s²)² per shot, Table 1 case A). Kinematic frame (drag-free, no
-    gravity); one run; output at every shot."""
-    motion = _core.Motion.stationary(vector(HANNOVER, 3, "origin"), positive(days, "days") * 86400.0, np.zeros(3))
+    gravity); one run; output at every shot; at most ``MAX_SATELLITE_DAYS`` days."""
+    days = positive(days, "days")
+    if days > MAX_SATELLITE_DAYS:
+        raise input_error("days", f"must be <= {MAX_SATELLITE_DAYS} (one IMU sample per second), got {days}")
+    instance(drift, (bool, np.bool_), "drift")
+    motion = _core.Motion.stationary(vector(HANNOVER, 3, "origin"), days * 86400.0, np.zeros(3))
     ch = Channels(np.array([[K_RB87, 0.0, 0.0]]), np.zeros(3), np.eye(3), np.zeros(3), ["x"])
     sensor = CaiSensor(ch, 5.0, contrast=0.3, sigma_p=0.032, inflation=(1e-20, 0.0), omega_dot="zero")
     setup = FilterSetup(1e-20, 1e-30, 1e-21, 0.0, 10, sigma0=(1e-6, 1e-9, 1e-9, 1e-9, 1e-12))

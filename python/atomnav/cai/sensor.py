@@ -16,7 +16,8 @@ from dataclasses import KW_ONLY, dataclass
 import numpy as np
 
 from .. import _core
-from .._validate import input_error, positive, vector
+from .._core import InputError
+from .._validate import as_floats, finite_scalar, input_error, instance, integer, nonnegative, positive, vector
 from ._config import ConfigMixin
 from .predictor import Channels
 
@@ -73,11 +74,19 @@ class CaiSensor(ConfigMixin):
     def shots(self, t0: float, t_end: float) -> np.ndarray:
         """Shot start times (s) from t0, one per ``shot_period``, the last ending by t_end."""
         period = 2 * self.T if self.shot_period is None else self.shot_period
-        return _core.cai_shot_times(float(t0), float(t_end), float(self.T), float(period))
+        return _core.cai_shot_times(finite_scalar(t0, "t0"), finite_scalar(t_end, "t_end"), float(self.T), float(period))
 
     def n_extra(self) -> int:
         """Number of extra filter states (misalignment, lever arm, force error)."""
         return 3 * ((self.misalignment_psd is not None) + (self.lever_arm_psd is not None) + (self.force == "direct"))
+
+    def _checked(self, name: str):
+        """:meth:`_native` for the argument ``name`` of a call: a bad field is an
+        :class:`atomnav.InputError` naming ``name.field`` (e.g. ``sensor.T``)."""
+        try:
+            return self._native()
+        except InputError as e:
+            raise input_error(f"{name}.{e.parameter}", str(e), e.index) from None
 
     def _native(self):
         """The checked core sensor (``_core.CaiSensor``) that the Monte Carlo, :func:`cai_aided_ins`
@@ -106,10 +115,11 @@ class FilterSetup(ConfigMixin):
 
     def p0(self, n_extra: int) -> np.ndarray:
         """Diagonal P0 of the 15 INS states and ``n_extra`` extra states."""
-        s = np.repeat(np.asarray(self.sigma0, float), 3)
-        extra = np.asarray(self.sigma0_extra, float)
+        n_extra = integer(n_extra, "n_extra", 0, 2**20)
+        s = np.repeat(vector(self.sigma0, 5, "sigma0"), 3)
+        extra = vector(self.sigma0_extra, None, "sigma0_extra")
         if len(extra) != n_extra:
-            raise input_error("sigma0_extra", f"expected {n_extra} values for the extra CAI states, got {len(extra)}")
+            raise input_error("n_extra", f"{n_extra} extra CAI states but {len(extra)} values in sigma0_extra")
         return np.diag(np.concatenate([s, extra]) ** 2)
 
 
@@ -124,10 +134,12 @@ def in_shot_noise(sensor: CaiSensor, dt: float, q_accel: float, q_gyro: float, f
     15-state model ``f`` (S, 15, 15) held over a filter step of one shot, the
     cross-covariance E[w δφ̂ᵀ] (S, 15, C) of the step's process noise with the shot's phase
     noise (the readout senses the same IMU noise that drives the error)."""
-    f = np.zeros((0, 15, 15)) if f is None else np.ascontiguousarray(np.asarray(f, dtype=float))
+    instance(sensor, CaiSensor, "sensor")
+    f = np.zeros((0, 15, 15)) if f is None else np.ascontiguousarray(as_floats(f, "f"))
     if f.ndim != 3:
         raise input_error("f", f"expected an (S, 15, 15) stack, got shape {f.shape}")
-    return _core.cai_in_shot_noise(sensor._native(), positive(dt, "dt"), float(q_accel), float(q_gyro), f)
+    return _core.cai_in_shot_noise(sensor._checked("sensor"), positive(dt, "dt"), nonnegative(q_accel, "q_accel"),
+                                   nonnegative(q_gyro, "q_gyro"), f)
 
 
 def expected_phase_exceedance(sensor: CaiSensor, dt: float, q_accel: float, q_gyro: float, limit: float = np.pi / 2) -> float:
@@ -139,8 +151,9 @@ def expected_phase_exceedance(sensor: CaiSensor, dt: float, q_accel: float, q_gy
     term adds 0.37 rad of gyro noise (→ 4.4e-3, 2.0 % on channel y-A)."""
     from scipy.stats import norm
 
+    limit = positive(limit, "limit")
     sigma, _ = in_shot_noise(sensor, dt, q_accel, q_gyro)
-    return float(np.mean(2 * norm.sf(positive(limit, "limit") / np.sqrt(np.diag(sigma)))))
+    return float(np.mean(2 * norm.sf(limit / np.sqrt(np.diag(sigma)))))
 
 
 def cai_aided_ins(t0: float, lla0, vel0, q0, sensor: CaiSensor, shots, *, phase=None, noise=None, population=None, laser_phase=None,
@@ -160,9 +173,13 @@ def cai_aided_ins(t0: float, lla0, vel0, q0, sensor: CaiSensor, shots, *, phase=
     from ..filter.engine import BiasModel
     from .scenarios import seed003_filter
 
+    instance(sensor, CaiSensor, "sensor")
+    if setup is not None:
+        instance(setup, FilterSetup, "setup")
     emulated = phase is not None or noise is not None
     if emulated == (population is not None or laser_phase is not None):
-        raise input_error("data", "give either phase and noise (emulated instrument) or population and laser_phase (recorded)")
+        raise input_error("population" if emulated else "phase",
+                          "give either phase and noise (emulated instrument) or population and laser_phase (recorded)")
     a, b = (phase, noise) if emulated else (population, laser_phase)
     names = ("phase", "noise") if emulated else ("population", "laser_phase")
     if a is None or b is None:
@@ -170,7 +187,7 @@ def cai_aided_ins(t0: float, lla0, vel0, q0, sensor: CaiSensor, shots, *, phase=
         raise input_error(missing, f"required together with {given}")
     tables = []
     for x, name in zip((a, b), names):
-        x = np.asarray(x, float)
+        x = as_floats(x, name)
         if x.ndim != 2:
             raise input_error(name, f"expected a (shots, interferometers) array, got shape {x.shape}")
         tables.append(np.ascontiguousarray(x))
@@ -184,6 +201,6 @@ def cai_aided_ins(t0: float, lla0, vel0, q0, sensor: CaiSensor, shots, *, phase=
                    ellipsoid=ellipsoid)
     extra0 = vector(np.zeros(n_extra) if extra0 is None else extra0, n_extra, "extra0")
     shots = vector(shots, None, "shots")
-    core = _core.cai_aided_ins(ins=ins.native, extra0=extra0, sensor=sensor._native(), shots=shots,
+    core = _core.cai_aided_ins(ins=ins.native, extra0=extra0, sensor=sensor._checked("sensor"), shots=shots,
                                data_kind="emulated" if emulated else "recorded", data_a=tables[0], data_b=tables[1])
     return AidedIns(core, ins)

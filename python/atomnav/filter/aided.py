@@ -18,7 +18,7 @@ import pandas as pd
 from tqdm.auto import tqdm
 
 from .. import _core
-from .._validate import input_error, positive, rows
+from .._validate import as_floats, finite_scalar, input_error, instance, integer, positive, rows
 from ..strapdown import _table
 from .engine import BiasModel, Config, _floats
 from .riccati import _mat
@@ -87,21 +87,24 @@ class InsSetup(Config):
 
     def __post_init__(self):
         for name, n in (("lla0", 3), ("vel0", 3), ("q0", 4), ("ba0", 3), ("bg0", 3)):
-            v = np.asarray(getattr(self, name), dtype=float)
+            v = as_floats(getattr(self, name), name)
             if v.shape != (n,):
                 raise input_error(name, f"expected shape ({n},), got {v.shape}")
             object.__setattr__(self, name, _floats(v))
         p0 = _mat(self.p0, "p0")
         object.__setattr__(self, "p0", _floats(p0))
+        for name in ("accel_bias", "gyro_bias") + (() if self.baro_bias is None else ("baro_bias",)):
+            instance(getattr(self, name), BiasModel, name)
+        opt = {name: None if getattr(self, name) is None else finite_scalar(getattr(self, name), name)
+               for name in ("gate", "zeta", "omega", "baro_bias_sigma0")}
         native = _core.AidedSetup(
-            t0=float(self.t0), lla0=list(self.lla0), vel0=list(self.vel0), q0=list(self.q0), kind=self.kind, p0=p0,
-            accel_psd=float(self.accel_psd), gyro_psd=float(self.gyro_psd), accel_bias=self.accel_bias._parts(),
-            gyro_bias=self.gyro_bias._parts(), ba0=list(self.ba0), bg0=list(self.bg0), predict_every=int(self.predict_every),
-            method=self.method, mode=self.mode, sequential=bool(self.sequential),
-            gate=None if self.gate is None else float(self.gate), ellipsoid=self.ellipsoid, vertical=self.vertical,
-            zeta=None if self.zeta is None else float(self.zeta), omega=None if self.omega is None else float(self.omega), baro_psd=float(self.baro_psd),
-            baro_bias=None if self.baro_bias is None else self.baro_bias._parts(),
-            baro_bias_sigma0=None if self.baro_bias_sigma0 is None else float(self.baro_bias_sigma0))
+            t0=finite_scalar(self.t0, "t0"), lla0=list(self.lla0), vel0=list(self.vel0), q0=list(self.q0), kind=self.kind, p0=p0,
+            accel_psd=finite_scalar(self.accel_psd, "accel_psd"), gyro_psd=finite_scalar(self.gyro_psd, "gyro_psd"),
+            accel_bias=self.accel_bias._parts(), gyro_bias=self.gyro_bias._parts(), ba0=list(self.ba0), bg0=list(self.bg0),
+            predict_every=integer(self.predict_every, "predict_every", 1, 2**63 - 1),
+            method=self.method, mode=self.mode, sequential=bool(self.sequential), ellipsoid=self.ellipsoid, vertical=self.vertical,
+            baro_psd=finite_scalar(self.baro_psd, "baro_psd"),
+            baro_bias=None if self.baro_bias is None else self.baro_bias._parts(), **opt)
         object.__setattr__(self, "_native", native)
 
     @property
@@ -134,7 +137,8 @@ class AidedIns:
     """A running aided INS; build it with a sensor's factory function."""
 
     def __init__(self, core: _core.AidedIns, setup: InsSetup):
-        self._core = core
+        self._core = instance(core, _core.AidedIns, "core")
+        instance(setup, InsSetup, "setup")
         #: The INS configuration (save it beside the results: ``setup.to_json()``).
         self.setup = setup
         self.kind = setup.kind
@@ -200,7 +204,7 @@ class AidedIns:
         outside = np.nonzero((mt < t[0]) | (mt > t[-1]))[0]
         if outside.size:
             i = outside[0]
-            raise input_error("measurements", f"time {mt[i]:g} s at index {i} is outside the IMU span [{t[0]:g}, {t[-1]:g}] s", i)
+            raise input_error("time", f"the measurement at {mt[i]:g} s (index {i}) is outside the IMU span [{t[0]:g}, {t[-1]:g}] s", i)
         # chunks of a fixed sample count from the mean step (one chunk when the end times
         # are not usable; the engine then names the bad sample)
         step = (t[-1] - t[0]) / (n - 1)
@@ -222,7 +226,7 @@ class AidedIns:
 def _imu(time, gyro, accel, h_ref):
     """Shapes of an IMU chunk; finiteness and time order are the engine's checks."""
     def arr(x, width, name):
-        a = np.ascontiguousarray(np.asarray(x, dtype=float))
+        a = np.ascontiguousarray(as_floats(x, name))
         want = (width is None and a.ndim == 1) or (width is not None and a.ndim == 2 and a.shape[1] == width)
         if not want:
             raise input_error(name, f"expected shape {'(N,)' if width is None else f'(N, {width})'}, got {a.shape}")
@@ -260,7 +264,10 @@ def position_aided_ins(t0: float, lla0, vel0, q0, kind: str, fix_time, fix_lla, 
     """
     setup = InsSetup(t0=t0, lla0=lla0, vel0=vel0, q0=q0, kind=kind, p0=p0, accel_psd=accel_psd, gyro_psd=gyro_psd,
                      **options)
+    cov = as_floats(fix_cov, "fix_cov")
+    if cov.size % 9:
+        raise input_error("fix_cov", f"expected an (M, 3, 3) stack, got shape {cov.shape}")
     core = _core.position_aided_ins(
-        setup.native, np.ascontiguousarray(np.asarray(fix_time, float).ravel()), rows(fix_lla, 3, "fix_lla"),
-        np.ascontiguousarray(np.asarray(fix_cov, float).reshape(-1, 3, 3)))
+        setup.native, np.ascontiguousarray(as_floats(fix_time, "fix_time").ravel()), rows(fix_lla, 3, "fix_lla"),
+        np.ascontiguousarray(cov.reshape(-1, 3, 3)))
     return AidedIns(core, setup)

@@ -16,7 +16,7 @@ import pandas as pd
 from scipy.stats import chi2
 
 from .. import _core
-from .._validate import input_error
+from .._validate import as_floats, input_error, instance, scalar
 from .riccati import _mat
 
 
@@ -33,25 +33,30 @@ class Scenario:
 
     def __init__(self, f, qc, dt, p0, h, r, measure, *, times=None, labels=None,
                  method: str = "van_loan", sequential: bool = False):
+        flags = np.asarray(measure, dtype=object).ravel()
+        if not all(isinstance(m, (bool, np.bool_)) for m in flags):
+            raise TypeError("measure: expected a sequence of bools (a measurement at epoch k or not)")
         self._args = dict(
-            f=np.ascontiguousarray(np.asarray(f, dtype=float)),
-            qc=np.ascontiguousarray(np.asarray(qc, dtype=float)),
-            dt=np.ascontiguousarray(np.asarray(dt, dtype=float).ravel()),
+            f=np.ascontiguousarray(as_floats(f, "f")),
+            qc=np.ascontiguousarray(as_floats(qc, "qc")),
+            dt=np.ascontiguousarray(as_floats(dt, "dt").ravel()),
             p0=_mat(p0, "p0"), h=_mat(h, "h"), r=_mat(r, "r"),
-            measure=[bool(m) for m in np.asarray(measure).ravel()],
-            method=str(method), sequential=bool(sequential),
+            measure=[bool(m) for m in flags],
+            method=instance(method, str, "method"), sequential=bool(sequential),
         )
         for name in ("f", "qc"):
             if self._args[name].ndim != 3:
-                raise ValueError(f"{name}: expected an (N, n, n) stack, got shape {self._args[name].shape}")
+                raise input_error(name, f"expected an (N, n, n) stack, got shape {self._args[name].shape}")
         self._core = self._build()
         n = self._args["p0"].shape[0]
-        self.times = np.concatenate([[0.0], np.cumsum(self._args["dt"])]) if times is None else np.asarray(times, float)
+        self.times = np.concatenate([[0.0], np.cumsum(self._args["dt"])]) if times is None else as_floats(times, "times")
         if self.times.shape != (len(self._args["measure"]),):
-            raise ValueError(f"times: expected {len(self._args['measure'])} epochs, got shape {self.times.shape}")
+            raise input_error("times", f"expected {len(self._args['measure'])} epochs, got shape {self.times.shape}")
+        if labels is not None and (isinstance(labels, (str, bytes)) or not isinstance(labels, (list, tuple))):
+            raise TypeError(f"labels: expected a list of state names, got {type(labels).__name__}")
         self.labels = list(labels) if labels is not None else [f"x[{i}]" for i in range(n)]
         if len(self.labels) != n:
-            raise ValueError(f"labels: expected {n} names, got {len(self.labels)}")
+            raise input_error("labels", f"expected {n} names, got {len(self.labels)}")
 
     def _build(self):
         a = self._args
@@ -72,7 +77,7 @@ class Scenario:
 def covariance_analysis(scenario: Scenario) -> pd.DataFrame:
     """σ of every state after each epoch (no noise simulated): columns time_s and one
     column per state label (units of the state)."""
-    s = scenario._core.sigmas()
+    s = instance(scenario, Scenario, "scenario")._core.sigmas()
     df = pd.DataFrame(s, columns=scenario.labels)
     df.insert(0, "time_s", scenario.times)
     return df
@@ -85,9 +90,10 @@ def true_error_analysis(scenario: Scenario, r_true, cross) -> pd.DataFrame:
     each measurement, ``cross`` (steps, n, m) = E[w_{k−1} v_kᵀ] (e.g. a CAI readout that
     also senses the IMU noise of its shot). With ``r_true`` = R and zero ``cross`` it equals
     :func:`covariance_analysis`. Columns as there."""
-    cross = np.ascontiguousarray(np.asarray(cross, dtype=float))
+    instance(scenario, Scenario, "scenario")
+    cross = np.ascontiguousarray(as_floats(cross, "cross"))
     if cross.ndim != 3:
-        raise ValueError(f"cross: expected a (steps, n, m) stack, got shape {cross.shape}")
+        raise input_error("cross", f"expected a (steps, n, m) stack, got shape {cross.shape}")
     s = scenario._core.true_sigmas(_mat(r_true, "r_true"), cross)
     df = pd.DataFrame(s, columns=scenario.labels)
     df.insert(0, "time_s", scenario.times)
@@ -97,6 +103,10 @@ def true_error_analysis(scenario: Scenario, r_true, cross) -> pd.DataFrame:
 def chi2_band(dof: int, runs: int, p: float = 0.95) -> tuple[float, float]:
     """Two-sided p band of the run-average of ``runs`` χ²(dof) variables (NEES or NIS):
     χ²_{runs·dof} quantiles / runs."""
+    dof, runs = _integer(dof, "dof", 1, 2**32), _integer(runs, "runs", 1, 2**32)
+    p = scalar(p, "p")
+    if not 0 < p < 1:
+        raise input_error("p", f"must be a probability in (0, 1), got {p}")
     lo, hi = chi2.ppf([(1 - p) / 2, (1 + p) / 2], runs * dof)
     return float(lo / runs), float(hi / runs)
 
@@ -147,6 +157,7 @@ def _integer(x, name: str, low: int, high: int) -> int:
 
 
 def _runs(scenario: Scenario, seed: int, runs: list[int], mode: str):
+    instance(scenario, Scenario, "scenario")
     return scenario._core.monte_carlo(int(seed), [int(r) for r in runs], mode)
 
 

@@ -14,7 +14,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .. import _core
-from .._validate import input_error, rows
+from .._validate import as_floats, finite_scalar, input_error, instance, integer, json_object, rows
 from .riccati import _mat
 
 #: Standard blocks and their sizes (read from the core, ``rust/filter/layout.rs``); extra
@@ -53,6 +53,7 @@ class Config:
     def from_dict(cls, d: dict):
         """The configuration of :meth:`to_dict`'s dict; an unknown key is an
         :class:`atomnav.InputError` naming it."""
+        instance(d, dict, "d")
         names = {f.name for f in dataclasses.fields(cls)}
         unknown = sorted(set(d) - names)
         if unknown:
@@ -67,23 +68,26 @@ class Config:
     @classmethod
     def from_json(cls, text: str):
         """The configuration of :meth:`to_json`'s text."""
-        return cls.from_dict(json.loads(text))
+        return cls.from_dict(json_object(text, "text"))
 
 
 def _floats(x) -> tuple:
     """A vector or matrix as (nested) tuples of floats: hashable, comparable, JSON-ready."""
-    a = np.asarray(x, dtype=float)
+    a = as_floats(x, "x")
     return tuple(map(float, a)) if a.ndim <= 1 else tuple(_floats(r) for r in a)
 
 
 def _block_spec(blocks) -> list[tuple[str, int | None]]:
+    if isinstance(blocks, (str, bytes)) or not isinstance(blocks, (list, tuple)):
+        raise TypeError(f"blocks: expected a sequence of block names or (name, size) pairs, got {type(blocks).__name__}")
     out = []
-    for b in blocks:
+    for i, b in enumerate(blocks):
         if isinstance(b, str):
             out.append((b, None))
+        elif isinstance(b, (list, tuple)) and len(b) == 2 and isinstance(b[0], str):
+            out.append((b[0], integer(b[1], "blocks", 0, 2**20)))
         else:
-            name, size = b
-            out.append((str(name), int(size)))
+            raise TypeError(f"blocks: element {i} is not a block name or a (name, size) pair: {b!r}")
     return out
 
 
@@ -99,7 +103,7 @@ class Layout:
         self._ranges = {n: slice(a, b) for n, a, b in _core.layout_ranges(self._spec)}
 
     def __getitem__(self, name: str) -> slice:
-        if name not in self._ranges:
+        if not isinstance(name, str) or name not in self._ranges:
             raise input_error("block", f"unknown block name {name!r} (layout has: {', '.join(self._ranges)})")
         return self._ranges[name]
 
@@ -122,7 +126,7 @@ def discretize(f, qc, dt: float, method: str = "van_loan") -> tuple[np.ndarray, 
 
     method "van_loan" (exact for constant F) or "first_order" (Φ = I + FΔt, Q_d = Q_cΔt).
     """
-    return _core.discretize_model(_mat(f, "f"), _mat(qc, "qc"), float(dt), method)
+    return _core.discretize_model(_mat(f, "f"), _mat(qc, "qc"), finite_scalar(dt, "dt"), method)
 
 
 @dataclass(frozen=True)
@@ -139,8 +143,8 @@ class BiasModel(Config):
 
     def _parts(self) -> tuple[str, float, float]:
         if self.kind == "gauss_markov":
-            return (self.kind, float(self.tau), float(self.sigma))
-        return (self.kind, float(self.psd), 0.0)
+            return (self.kind, finite_scalar(self.tau, "tau"), finite_scalar(self.sigma, "sigma"))
+        return (self.kind, finite_scalar(self.psd, "psd"), 0.0)
 
 
 def ins_error_model(lla, vel_ned, q_nb, f_b, accel_psd: float, gyro_psd: float,
@@ -152,10 +156,12 @@ def ins_error_model(lla, vel_ned, q_nb, f_b, accel_psd: float, gyro_psd: float,
     force m/s²; accel_psd ((m/s²)²/Hz = VRW²) and gyro_psd (rad²/s = ARW²) white noise.
     Returns (F, Q_c) stacks of shape (N, n, n) for ``layout`` (default 15 states).
     """
-    layout = layout or Layout()
+    layout = Layout() if layout is None else instance(layout, Layout, "layout")
+    instance(accel_bias, BiasModel, "accel_bias")
+    instance(gyro_bias, BiasModel, "gyro_bias")
     return _core.ins_error_dynamics(layout.spec, rows(lla, 3, "lla"), rows(vel_ned, 3, "vel_ned"),
-                                    rows(q_nb, 4, "q_nb"), rows(f_b, 3, "f_b"), accel_psd=float(accel_psd),
-                                    gyro_psd=float(gyro_psd), accel_bias=accel_bias._parts(),
+                                    rows(q_nb, 4, "q_nb"), rows(f_b, 3, "f_b"), accel_psd=finite_scalar(accel_psd, "accel_psd"),
+                                    gyro_psd=finite_scalar(gyro_psd, "gyro_psd"), accel_bias=accel_bias._parts(),
                                     gyro_bias=gyro_bias._parts(), ellipsoid=ellipsoid)
 
 
@@ -173,10 +179,10 @@ class KalmanFilter:
     def predict(self, phi, qd, steps: int = 1) -> None:
         """P ← ΦPΦᵀ + Q_d (and δx̂ ← Φδx̂ in open loop), ``steps`` times (multirate: pass
         Φ(ΔT), Q_d(ΔT) for ΔT = MΔt and steps=1)."""
-        if steps == 1:
+        if isinstance(steps, (int, np.integer)) and not isinstance(steps, (bool, np.bool_)) and steps == 1:
             self._core.predict(_mat(phi, "phi"), _mat(qd, "qd"))
         else:
-            self._core.predict_many(_mat(phi, "phi"), _mat(qd, "qd"), int(steps))
+            self._core.predict_many(_mat(phi, "phi"), _mat(qd, "qd"), integer(steps, "steps", 0, 2**64 - 1))
 
     def update(self, z, h, r, sequential: bool = False, gate: float | None = None):
         """Update with z = Hδx + v (z = predicted − measured), R = cov(v).
@@ -185,8 +191,10 @@ class KalmanFilter:
         Eq. 40); gate: χ² threshold (per row when sequential, else on the whole NIS).
         Returns (innovation, nis, rejected_rows).
         """
-        z = np.atleast_1d(np.asarray(z, dtype=float))
-        return self._core.update(z, _mat(h, "h"), _mat(r, "r"), bool(sequential), None if gate is None else float(gate))
+        z = np.ascontiguousarray(np.atleast_1d(as_floats(z, "z")))
+        if z.ndim != 1:
+            raise input_error("z", f"expected a vector, got shape {z.shape}")
+        return self._core.update(z, _mat(h, "h"), _mat(r, "r"), bool(sequential), None if gate is None else finite_scalar(gate, "gate"))
 
     def take_correction(self) -> np.ndarray:
         return self._core.take_correction()
@@ -210,5 +218,9 @@ def rts_smooth(phi, x_prior, p_prior, x_post, p_post) -> tuple[np.ndarray, np.nd
     phi (N, n, n): transition into epoch k (phi[0] unused); x_prior/x_post (N, n);
     p_prior/p_post (N, n, n). Returns smoothed (x (N, n), P (N, n, n)).
     """
-    a = [np.ascontiguousarray(np.asarray(v, dtype=float)) for v in (phi, x_prior, p_prior, x_post, p_post)]
+    a = [np.ascontiguousarray(as_floats(v, name)) for v, name in
+         ((phi, "phi"), (x_prior, "x_prior"), (p_prior, "p_prior"), (x_post, "x_post"), (p_post, "p_post"))]
+    for v, name, nd in zip(a, ("phi", "x_prior", "p_prior", "x_post", "p_post"), (3, 2, 3, 2, 3)):
+        if v.ndim != nd:
+            raise input_error(name, f"expected a {nd}-D array, got shape {v.shape}")
     return _core.rts(*a)

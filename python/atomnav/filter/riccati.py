@@ -19,7 +19,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .. import _core
-from .._validate import as_floats, input_error
+from .._validate import as_floats, finite, finite_scalar, input_error
 
 
 def _mat(x, name: str) -> np.ndarray:
@@ -91,7 +91,16 @@ def closed_loop_matrix(phi, h, gain) -> np.ndarray:
     (n, n) ndarray
     """
     phi, h, gain = _mat(phi, "phi"), _mat(h, "h"), _mat(gain, "gain")
-    return (np.eye(phi.shape[0]) - gain @ h) @ phi
+    for a, name in ((phi, "phi"), (h, "h"), (gain, "gain")):
+        finite(a, name)
+    n, m = phi.shape[0], h.shape[0]
+    if phi.shape != (n, n):
+        raise input_error("phi", f"expected a square matrix, got shape {phi.shape}")
+    if h.shape != (m, n):
+        raise input_error("h", f"expected shape ({m}, {n}) to match phi {phi.shape}, got {h.shape}")
+    if gain.shape != (n, m):
+        raise input_error("gain", f"expected shape ({n}, {m}) to match phi and h, got {gain.shape}")
+    return (np.eye(n) - gain @ h) @ phi
 
 
 def riccati_scalar(q: float, r: float, h: float) -> tuple[float, float]:
@@ -117,7 +126,7 @@ def riccati_scalar(q: float, r: float, h: float) -> tuple[float, float]:
         A non-finite or out-of-range argument, or an ``h`` so small that the steady state
         exceeds the floating-point range.
     """
-    return _core.riccati_scalar(float(q), float(r), float(h))
+    return _core.riccati_scalar(finite_scalar(q, "q"), finite_scalar(r, "r"), finite_scalar(h, "h"))
 
 
 def kalman_recursion(phi, q, h, r, p0, steps: int) -> tuple[np.ndarray, np.ndarray]:

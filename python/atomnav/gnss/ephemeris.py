@@ -11,7 +11,7 @@ import numpy as np
 import pandas as pd
 
 from .. import _core
-from .._validate import rows, vector
+from .._validate import as_floats, finite_scalar, input_error, instance, integer, rows, vector
 
 #: Columns of a GPS ephemeris table (angles rad, times GPS s, clock s, s/s, s/s²).
 GPS_COLUMNS = ["prn", "toe", "sqrt_a", "e", "m0", "delta_n", "omega0", "i0", "omega", "omega_dot", "idot",
@@ -26,9 +26,10 @@ def _table(df, columns, name) -> np.ndarray:
     if isinstance(df, pd.DataFrame):
         missing = [c for c in columns if c not in df.columns]
         if missing:
-            raise ValueError(f"{name}: missing columns {missing}")
-        df = df[columns].to_numpy(float)
-    return rows(df, len(columns), name) if len(df) else np.zeros((0, len(columns)))
+            raise input_error(name, f"missing columns {missing}")
+        df = df[columns].to_numpy()
+    a = as_floats(df, name)
+    return rows(a, len(columns), name) if a.size else np.zeros((0, len(columns)))
 
 
 class Ephemerides:
@@ -39,8 +40,8 @@ class Ephemerides:
         """``gps``/``glonass``: tables with :data:`GPS_COLUMNS` / :data:`GLONASS_COLUMNS`;
         ``n_leap`` GPS−UTC leap seconds (15 in 2009, 18 since 2017); ``datum`` PZ-90 → WGS-84
         transformation ``"identity"`` or ``"pz90_02_to_wgs84"``."""
-        self._core = _core_obj if _core_obj is not None else _core.GnssEphemerides(
-            _table(gps, GPS_COLUMNS, "gps"), _table(glonass, GLONASS_COLUMNS, "glonass"), float(n_leap), datum)
+        self._core = instance(_core_obj, _core.GnssEphemerides, "_core_obj") if _core_obj is not None else _core.GnssEphemerides(
+            _table(gps, GPS_COLUMNS, "gps"), _table(glonass, GLONASS_COLUMNS, "glonass"), finite_scalar(n_leap, "n_leap"), datum)
 
     @classmethod
     def nominal(cls, t_start: float, t_end: float, gps: bool = True, glonass: bool = True, tau_gps: float = 0.0,
@@ -49,8 +50,9 @@ class Ephemerides:
         constellations covering GPS times [t_start, t_end] s; ``tau_gps`` (s) is the true
         GPS−GLONASS offset used to reference the GLONASS sets; ``clocks``: random satellite
         clocks (b ~ U(±0.5 ms), drift ~ N(0, 1e-11²)) from ``seed``."""
-        return cls(_core_obj=_core.GnssEphemerides.nominal(float(t_start), float(t_end), gps, glonass, float(tau_gps),
-                                                           float(n_leap), clocks, int(seed)))
+        return cls(_core_obj=_core.GnssEphemerides.nominal(
+            finite_scalar(t_start, "t_start"), finite_scalar(t_end, "t_end"), gps, glonass, finite_scalar(tau_gps, "tau_gps"),
+            finite_scalar(n_leap, "n_leap"), clocks, integer(seed, "seed", 0, 2**64 - 1)))
 
     def tables(self) -> tuple[pd.DataFrame, pd.DataFrame]:
         """The GPS and GLONASS sets as DataFrames (:data:`GPS_COLUMNS`, :data:`GLONASS_COLUMNS`)."""
@@ -69,20 +71,22 @@ class Ephemerides:
     def state(self, sat: str, t, tau_gps: float = 0.0) -> pd.DataFrame:
         """Satellite position ``x_m, y_m, z_m`` and velocity (WGS-84 ECEF) and clock
         ``clock_s``, ``clock_rate`` at GPS times ``t`` (GLONASS at t − ΔT_leap − tau_gps)."""
-        t = np.atleast_1d(np.asarray(t, float))
-        s = self._core.state(sat, vector(t, None, "t"), float(tau_gps))
+        t = np.atleast_1d(as_floats(t, "t"))
+        s = self._core.state(sat, vector(t, None, "t"), finite_scalar(tau_gps, "tau_gps"))
         return pd.DataFrame(s, columns=["x_m", "y_m", "z_m", "vx_mps", "vy_mps", "vz_mps", "clock_s", "clock_rate"])
 
     def look_angles(self, sat: str, t, lla) -> pd.DataFrame:
         """Elevation and azimuth (rad) of ``sat`` from geodetic ``lla`` at GPS times ``t``."""
-        t = np.atleast_1d(np.asarray(t, float))
+        t = np.atleast_1d(as_floats(t, "t"))
         a = self._core.look_angles(sat, vector(t, None, "t"), vector(lla, 3, "lla"))
         return pd.DataFrame(a, columns=["elevation_rad", "azimuth_rad"])
 
     def top(self, n: int, t: float, lla, mask_deg: float = 10.0) -> list[str]:
         """The ``n`` highest satellites above the mask at time ``t`` (fixed subsets, spec §4 row 13)."""
+        n, t, lla = integer(n, "n", 0), finite_scalar(t, "t"), vector(lla, 3, "lla")
+        mask = np.radians(finite_scalar(mask_deg, "mask_deg"))
         el = {s: self.look_angles(s, [t], lla)["elevation_rad"].iloc[0] for s in self.satellites}
-        up = sorted((s for s in el if el[s] >= np.radians(mask_deg)), key=lambda s: -el[s])
+        up = sorted((s for s in el if el[s] >= mask), key=lambda s: -el[s])
         return up[:n]
 
 
@@ -91,4 +95,4 @@ def glonass_propagate(pos, vel, acc, dt: float, step: float = 30.0, j2: float = 
     acceleration ``acc`` (m/s²) over ``dt`` s in steps ≤ ``step`` s (spec Eq. 10).
     Returns [x, y, z, vx, vy, vz]."""
     return _core.glonass_propagate(vector(pos, 3, "pos"), vector(vel, 3, "vel"), vector(acc, 3, "acc"),
-                                   float(dt), float(step), float(j2))
+                                   finite_scalar(dt, "dt"), finite_scalar(step, "step"), finite_scalar(j2, "j2"))

@@ -8,7 +8,7 @@ import numpy as np
 import pandas as pd
 
 from .. import _core
-from .._validate import input_error, rows, vector
+from .._validate import as_floats, finite, finite_scalar, input_error, instance, integer, rows, vector
 from .ephemeris import Ephemerides
 from .options import GnssOptions, split_options
 
@@ -29,23 +29,37 @@ def simulate(eph: Ephemerides, time, lla, vel_ned, options: GnssOptions | None =
     ``only`` a fixed satellite subset, ``outages`` [(start, end)] s of all satellites,
     ``sat_outages`` [(sat, start, end)]. Seeded. The table also carries the true
     ``elevation_rad``."""
+    instance(eph, Ephemerides, "eph")
     opts, rest = split_options(options, option_fields)
     if rest:
         raise TypeError(f"simulate() got an unexpected keyword argument {sorted(rest)[0]!r}")
     t = vector(time, None, "time")
-    out = np.asarray(outages, float).reshape(-1, 2)
+    out = as_floats(outages, "outages")
+    out = rows(out.reshape(-1, 2) if out.size % 2 == 0 else out, 2, "outages")
+    if isinstance(sat_outages, (str, bytes)) or not all(isinstance(o, (tuple, list)) and len(o) == 3 for o in sat_outages):
+        raise TypeError("sat_outages: expected a list of (sat, start, end) tuples")
+    sat_out = [(str(s), finite_scalar(a, "sat_outages"), finite_scalar(b, "sat_outages")) for s, a, b in sat_outages]
     d = _core.gnss_simulate(eph._core, t, rows(lla, 3, "lla"), rows(vel_ned, 3, "vel_ned"), opts.native,
-                            tau_gps=float(tau_gps), clock_bias=float(clock_bias), clock_drift=float(clock_drift),
-                            mask=float(np.radians(mask_deg)), only=only, outages=np.ascontiguousarray(out),
-                            sat_outages=[(str(s), float(a), float(b)) for s, a, b in sat_outages], seed=int(seed))
+                            tau_gps=finite_scalar(tau_gps, "tau_gps"), clock_bias=finite_scalar(clock_bias, "clock_bias"),
+                            clock_drift=finite_scalar(clock_drift, "clock_drift"),
+                            mask=float(np.radians(finite_scalar(mask_deg, "mask_deg"))), only=only, outages=out,
+                            sat_outages=sat_out, seed=integer(seed, "seed", 0, 2**64 - 1))
     return pd.DataFrame({c: d[c] for c in OBS_COLUMNS + ["elevation_rad"]})
 
 
 def doppler_to_rate(doppler_hz, sat, channel) -> np.ndarray:
     """Pseudorange rate (m/s) = −λ·D with the per-channel GLONASS wavelength (spec Eq. 16)."""
-    d = np.asarray(doppler_hz, float)
-    sys = np.array([str(s)[0] for s in np.atleast_1d(sat)])
-    k = np.asarray(channel, float)
+    d = np.atleast_1d(as_floats(doppler_hz, "doppler_hz")).reshape(-1)
+    finite(d, "doppler_hz")
+    sats = np.atleast_1d(np.asarray(sat, dtype=object)).reshape(-1)
+    if not all(isinstance(s, str) and s for s in sats):
+        raise TypeError("sat: expected satellite names such as 'G01' or 'R05'")
+    sys = np.array([s[0] for s in sats])
+    k = np.atleast_1d(as_floats(channel, "channel")).reshape(-1)
+    finite(k, "channel")
+    for name, a in (("sat", sys), ("channel", k)):
+        if len(a) != len(d):
+            raise input_error(name, f"expected {len(d)} values (one per Doppler), got {len(a)}")
     if np.any((sys == "R") & ((k < -7) | (k > 6))):
         i = int(np.nonzero((sys == "R") & ((k < -7) | (k > 6)))[0][0])
         raise input_error("channel", f"unknown GLONASS frequency channel {k[i]:g} at index {i} (valid: -7..6)", i)
@@ -55,9 +69,15 @@ def doppler_to_rate(doppler_hz, sat, channel) -> np.ndarray:
 
 def obs_arrays(obs: pd.DataFrame) -> tuple:
     """The observation table as the arrays the core takes."""
+    instance(obs, pd.DataFrame, "obs")
     missing = [c for c in OBS_COLUMNS if c not in obs.columns]
     if missing:
         raise input_error("obs", f"missing columns {missing}")
-    return (np.ascontiguousarray(obs["time_s"].to_numpy(float)), [str(s) for s in obs["sat"]],
-            np.ascontiguousarray(obs["channel"].to_numpy(np.int64)), np.ascontiguousarray(obs["code_m"].to_numpy(float)),
-            np.ascontiguousarray(obs["rate_mps"].to_numpy(float)))
+    cols = {c: np.ascontiguousarray(as_floats(obs[c].to_numpy(), "obs")) for c in ("time_s", "channel", "code_m", "rate_mps")}
+    for c, a in cols.items():
+        bad = np.nonzero(~np.isfinite(a))[0]
+        if bad.size:
+            raise input_error("obs", f"column {c}: non-finite value {a[bad[0]]} at index {bad[0]}", bad[0])
+    if np.any(cols["channel"] != np.round(cols["channel"])) or np.any(np.abs(cols["channel"]) > 2**31):
+        raise input_error("obs", "column channel: expected integer FDMA channels")
+    return (cols["time_s"], [str(s) for s in obs["sat"]], cols["channel"].astype(np.int64), cols["code_m"], cols["rate_mps"])

@@ -9,6 +9,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from .. import _core
+from .._validate import instance
 from ..filter.engine import Config, _floats
 
 #: Names of the tight-coupling formulations (from the core).
@@ -65,8 +66,9 @@ class GnssOptions(Config):
 
 def split_options(options: GnssOptions | None, kw: dict) -> tuple[GnssOptions, dict]:
     """``options`` with the fields among the keywords ``kw`` replaced, and the other keywords."""
+    instance(kw, dict, "kw")
     names = set(GnssOptions.__dataclass_fields__)
     mine = {k: v for k, v in kw.items() if k in names}
     rest = {k: v for k, v in kw.items() if k not in names}
-    base = options or GnssOptions()
+    base = GnssOptions() if options is None else instance(options, GnssOptions, "options")
     return (GnssOptions.from_dict({**base.to_dict(), **mine}) if mine else base), rest

@@ -14,10 +14,21 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from .._validate import input_error, instance
 from .ephemeris import GLONASS_COLUMNS, GPS_COLUMNS, Ephemerides
-from .observations import C_LIGHT, doppler_to_rate
+from .observations import C_LIGHT, doppler_to_rate, obs_arrays
 
 WEEK_START = datetime(2017, 1, 1)   # a Sunday: GPS week 1930
+
+
+def _path(path) -> Path:
+    """``path`` (a str or path-like) as a Path."""
+    instance(path, (str, Path), "path")
+    return Path(path)
+
+
+def _week_start(week_start) -> datetime:
+    return instance(week_start, datetime, "week_start")
 
 
 def _num(x: float) -> str:
@@ -30,6 +41,8 @@ def _stamp(t: datetime) -> str:
 
 def write_nav(path, eph: Ephemerides, n_leap: float = 18.0, week_start: datetime = WEEK_START) -> Path:
     """Write the broadcast sets of ``eph`` as a RINEX 3.04 mixed navigation file."""
+    path, week_start = _path(path), _week_start(week_start)
+    instance(eph, Ephemerides, "eph")
     gps, glo = eph.tables()
     lines = [f"{3.04:9.2f}{'':11}{'N: GNSS NAV DATA':20}{'M: Mixed':20}RINEX VERSION / TYPE",
              f"{'atomnav':20}{'':20}{'':20}PGM / RUN BY / DATE", f"{'':60}END OF HEADER"]
@@ -52,6 +65,10 @@ def write_nav(path, eph: Ephemerides, n_leap: float = 18.0, week_start: datetime
 def write_obs(path, obs: pd.DataFrame, week_start: datetime = WEEK_START) -> Path:
     """Write an observation table (``time_s, sat, channel, code_m, rate_mps``) as a RINEX
     3.04 file with C1C (m) and D1C (Hz, D = −rate/λ_k)."""
+    path, week_start = _path(path), _week_start(week_start)
+    obs_arrays(obs)
+    if not len(obs):
+        raise input_error("obs", "no observations to write")
     lines = [f"{3.04:9.2f}{'':11}{'OBSERVATION DATA':20}{'M: Mixed':20}RINEX VERSION / TYPE",
              f"{'atomnav':20}{'':20}{'':20}PGM / RUN BY / DATE",
              f"{'G    2 C1C D1C':60}SYS / # / OBS TYPES", f"{'R    2 C1C D1C':60}SYS / # / OBS TYPES"]
@@ -70,6 +87,9 @@ def write_obs(path, obs: pd.DataFrame, week_start: datetime = WEEK_START) -> Pat
 
 
 def _load(path, what: str):
+    path = _path(path)
+    if not path.is_file():
+        raise FileNotFoundError(f"{what}: no RINEX file {path}")
     try:
         import georinex
     except ImportError as e:  # pragma: no cover - the extra is part of the test environment
@@ -80,7 +100,7 @@ def _load(path, what: str):
             warnings.simplefilter("ignore", FutureWarning)      # xarray defaults inside georinex
             return georinex.load(str(path))
     except Exception as e:  # georinex raises many types on malformed input
-        raise ValueError(f"{what}: malformed RINEX file {path}: {e}") from None
+        raise input_error("path", f"malformed RINEX {what} file {path}: {e}") from None
 
 
 def _seconds(times, week_start: datetime) -> np.ndarray:
@@ -89,9 +109,10 @@ def _seconds(times, week_start: datetime) -> np.ndarray:
 
 def read_nav(path, n_leap: float = 18.0, datum: str = "identity", week_start: datetime = WEEK_START) -> Ephemerides:
     """Broadcast ephemerides from a RINEX 3 navigation file (GPS and GLONASS records)."""
+    week_start = _week_start(week_start)
     nav = _load(path, "nav")
     if "sv" not in nav.coords or not len(nav.sv):
-        raise ValueError(f"nav: no satellite records in {path}")
+        raise input_error("path", f"no satellite records in {path}")
     gps, glo = [], []
     for sv in nav.sv.values:
         d = nav.sel(sv=sv).dropna(dim="time", how="all")
@@ -118,9 +139,11 @@ def read_nav(path, n_leap: float = 18.0, datum: str = "identity", week_start: da
 def read_obs(path, eph: Ephemerides, week_start: datetime = WEEK_START) -> pd.DataFrame:
     """Observation table (``time_s, sat, channel, code_m, rate_mps``) from a RINEX 3
     observation file with C1C and D1C; GLONASS channels come from ``eph``."""
+    week_start = _week_start(week_start)
+    instance(eph, Ephemerides, "eph")
     ds = _load(path, "obs")
     if "C1C" not in ds:
-        raise ValueError(f"obs: {path} has no C1C pseudoranges (found {sorted(ds.data_vars)})")
+        raise input_error("path", f"{path} has no C1C pseudoranges (found {sorted(ds.data_vars)})")
     df = ds[["C1C", "D1C"] if "D1C" in ds else ["C1C"]].to_dataframe().reset_index().dropna(subset=["C1C"])
     df = df[df.sv.str[0].isin(["G", "R"])]
     sat = df.sv.to_numpy()

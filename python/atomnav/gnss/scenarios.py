@@ -20,7 +20,8 @@ import numpy as np
 import pandas as pd
 
 from .. import _core, imu, trajectory, units
-from .._validate import input_error
+from .._validate import finite_scalar, input_error, instance, vector
+from ..filter.aided import AidedResult
 from ..filter.engine import BiasModel
 from .ephemeris import Ephemerides
 from .observations import simulate
@@ -78,12 +79,22 @@ def _trajectory(sc: Scenario) -> trajectory.Trajectory:
     raise input_error("motion", f"unknown {sc.motion!r} (known: 'STAT', 'MOVE')")
 
 
+def _scenario(sc) -> Scenario:
+    """A :class:`Scenario`, or the one of :data:`SCENARIOS` of that name."""
+    if isinstance(sc, str):
+        if sc not in SCENARIOS:
+            raise input_error("sc", f"unknown scenario {sc!r} (known: {', '.join(SCENARIOS)})")
+        return SCENARIOS[sc]
+    return instance(sc, Scenario, "sc")
+
+
 def build(sc: Scenario | str, clock=(0.0, 0.0)) -> dict:
     """Truth trajectory, corrupted IMU increments with their bias truth, ephemerides and
     observations (receiver clock ``clock`` = (bias s, drift s/s)), the barometric
     reference altitude per IMU sample (``h_ref``, m), and the filter factory arguments
     with an initial error drawn from P0."""
-    sc = SCENARIOS[sc] if isinstance(sc, str) else sc
+    sc = _scenario(sc)
+    clock = vector(clock, 2, "clock")
     rng = np.random.default_rng(sc.seed)
     traj = _trajectory(sc)
     dt = 1.0 / sc.rate_hz
@@ -127,6 +138,9 @@ def errors_and_nees(setup: dict, result) -> pd.DataFrame:
     over the 15 INS states from the reported σ: Σ(e_i/σ_i)². The engine reports σ, not the
     full covariance, so cross-correlations are ignored (the mean is still 15 for a
     consistent filter; the spread is wider than χ²₁₅)."""
+    if not isinstance(setup, dict) or any(k not in setup for k in ("trajectory", "imu")):
+        raise TypeError("setup: expected the dict of build()")
+    instance(result, AidedResult, "result")
     traj, meas = setup["trajectory"], setup["imu"]
     nav = result.nav
     err = traj.errors(nav)
@@ -145,8 +159,7 @@ def errors_and_nees(setup: dict, result) -> pd.DataFrame:
 def run(sc: Scenario | str, progress: bool = False, clock=(0.0, 0.0), **overrides) -> dict:
     """Build and run a scenario; ``overrides`` replace Scenario fields. Returns the setup,
     the :class:`AidedResult` and the error/NEES table."""
-    sc = SCENARIOS[sc] if isinstance(sc, str) else sc
-    sc = replace(sc, **overrides)
+    sc = replace(_scenario(sc), **overrides)
     setup = build(sc, clock)
     ins = tight_ins(setup["eph"], setup["obs"], **setup["args"])
     m = setup["imu"]
@@ -160,17 +173,32 @@ def _rms(x) -> float:
     return float(np.sqrt(np.mean(np.square(x)))) if len(x) else float("nan")
 
 
+def _horizontal(err) -> tuple[np.ndarray, np.ndarray]:
+    """Times (s) and horizontal errors (m) of a table of :func:`errors_and_nees`."""
+    instance(err, pd.DataFrame, "err")
+    if any(c not in err.columns for c in ("time_s", "horizontal_m")):
+        raise input_error("err", "expected a table of errors_and_nees (columns time_s, horizontal_m)")
+    if not len(err):
+        raise input_error("err", "no epochs")
+    return (np.asarray(err["time_s"].to_numpy(), dtype=float), np.asarray(err["horizontal_m"].to_numpy(), dtype=float))
+
+
 def outage_summary(err: pd.DataFrame, start: float, length: float) -> dict:
     """Horizontal error around an outage [start, start + length) s: RMS over the 5 min
     before (``pre``), the error at its end (``end``), RMS 60–600 s after reacquisition
-    (``post``) and RMS over 240–300 s after it (``at5``, the 5-minute recovery check)."""
-    t, e = err["time_s"].to_numpy(), err["horizontal_m"].to_numpy()
+    (``post``) and RMS over 240–300 s after it (``at5``, the 5-minute recovery check).
+    An RMS over a window without epochs is NaN: the output may be non-finite."""
+    t, e = _horizontal(err)
+    start, length = finite_scalar(start, "start"), finite_scalar(length, "length")
     b = start + length
+    if not np.any(t < b):
+        raise input_error("start", f"no epoch before the end of the outage at {b} s")
     return dict(pre=_rms(e[(t > start - 300) & (t < start)]), end=float(e[t < b][-1]),
                 post=_rms(e[(t > b + 60) & (t < b + 600)]), at5=_rms(e[(t > b + 240) & (t <= b + 300)]))
 
 
 def last_rms(err: pd.DataFrame, window: float = 600.0) -> float:
-    """Horizontal RMS error over the last ``window`` seconds."""
-    t = err["time_s"].to_numpy()
-    return _rms(err["horizontal_m"].to_numpy()[t > t.max() - window])
+    """Horizontal RMS error over the last ``window`` seconds (NaN when no epoch falls in
+    it: the output may be non-finite)."""
+    t, e = _horizontal(err)
+    return _rms(e[t > t.max() - finite_scalar(window, "window")])

@@ -7,6 +7,7 @@ from __future__ import annotations
 import pandas as pd
 
 from .. import _core
+from .._validate import instance
 from .ephemeris import Ephemerides
 from .observations import obs_arrays
 from .options import GnssOptions, split_options
@@ -25,6 +26,7 @@ def solve(eph: Ephemerides, obs: pd.DataFrame, options: GnssOptions | None = Non
     :data:`SPP_COLUMNS`: ECEF and geodetic antenna position, ``clock_m`` = c·δt_r,
     τ_GPS and its σ (s, NaN when not estimated), the residual metric Σ|r_i|/(N − n) (m),
     DOP values, Doppler velocity (ECEF m/s) and c·δṫ_r (m/s)."""
+    instance(eph, Ephemerides, "eph")
     opts, rest = split_options(options, option_fields)
     if rest:
         raise TypeError(f"solve() got an unexpected keyword argument {sorted(rest)[0]!r}")

@@ -9,6 +9,7 @@ import pandas as pd
 
 from .. import _core
 from ..filter.aided import AidedIns, InsSetup
+from .._validate import instance
 from .ephemeris import Ephemerides
 from .observations import obs_arrays
 from .options import GnssOptions, split_options
@@ -29,9 +30,12 @@ def tight_ins(eph: Ephemerides, obs: pd.DataFrame, options: GnssOptions | None =
     c·τ_GPS and ``clock`` = (c·δt_r, c·δṫ_r); the nominal clock bias follows the drift
     between epochs. A barometric altimeter damps the vertical channel through the
     ``vertical`` fields of :class:`InsSetup` (then ``run(..., h_ref=...)``)."""
+    instance(eph, Ephemerides, "eph")
     opts, ins_fields = split_options(options, fields)
     if "p0_ins" in ins_fields:
         ins_fields["p0"] = ins_fields.pop("p0_ins")
+    if setup is not None:
+        instance(setup, InsSetup, "setup")
     if setup is None:
         setup = InsSetup(**{"sequential": True, "gate": 10.83, **ins_fields})
     elif ins_fields:
