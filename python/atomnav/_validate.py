@@ -53,14 +53,6 @@ def as_floats(x, name: str) -> np.ndarray:
         raise TypeError(f"{name}: expected numbers, got {type(x).__name__} ({e})") from None
 
 
-def instance(x, cls, name: str):
-    """``x`` itself if it is a ``cls``; otherwise a ``TypeError`` naming ``name`` (instead of
-    an ``AttributeError`` from deep inside the call)."""
-    if not isinstance(x, cls):
-        raise TypeError(f"{name}: expected {cls.__name__}, got {type(x).__name__}")
-    return x
-
-
 def rows(x, width: int, name: str) -> np.ndarray:
     """``x`` as a C-contiguous float64 array of shape (N, width); a single row of length
     ``width`` is promoted to (1, width)."""
@@ -109,16 +101,6 @@ def scalar(x, name: str) -> float:
     return float(as_floats(x, name))
 
 
-def integer(x, name: str, minimum: int = 0) -> int:
-    """``x`` as an int ≥ ``minimum`` (an integral float such as 2.0 is accepted); a
-    non-number is a ``TypeError`` naming ``name``."""
-    if isinstance(x, (bool, np.bool_)) or not isinstance(x, (int, float, np.integer, np.floating)):
-        raise TypeError(f"{name}: expected an int, got {type(x).__name__}")
-    if not (np.isfinite(x) and int(x) == x and x >= minimum):
-        raise input_error(name, f"must be an integer ≥ {minimum}, got {x}")
-    return int(x)
-
-
 def positive(x: float, name: str) -> float:
     x = scalar(x, name)
     if not np.isfinite(x) or x <= 0:
@@ -142,17 +124,21 @@ def choice(value: str, options, name: str) -> str:
 
 def instance(x, cls, name: str):
     """``x`` if it is an instance of ``cls`` (a class or tuple of classes), else a
-    ``TypeError`` naming ``name``."""
+    ``TypeError`` naming ``name`` (instead of an ``AttributeError`` from deep inside the
+    call)."""
     if not isinstance(x, cls):
         want = " or ".join(c.__name__ for c in (cls if isinstance(cls, tuple) else (cls,)))
         raise TypeError(f"{name}: expected {want}, got {type(x).__name__}")
     return x
 
 
-def integer(x, name: str, low: int = 0, high: int = 2**31 - 1) -> int:
-    """``x`` as an int in [low, high]; a non-integer is a ``TypeError`` naming ``name``."""
-    if isinstance(x, (bool, np.bool_)) or not isinstance(x, (int, np.integer)):
-        raise TypeError(f"{name}: expected an int, got {type(x).__name__}")
+def integer(x, name: str, low: int = 0, high: int = 2**63 - 1) -> int:
+    """``x`` as an int in [low, high] (an integral float such as 2.0 is accepted); a
+    non-number is a ``TypeError``, a fraction or a value out of range an
+    :class:`InputError`, both naming ``name``."""
+    integral = isinstance(x, (int, np.integer)) or (isinstance(x, (float, np.floating)) and np.isfinite(x) and x == int(x))
+    if isinstance(x, (bool, np.bool_)) or not integral:
+        raise TypeError(f"{name}: expected an integer, got {type(x).__name__} {x!r}")
     if not low <= int(x) <= high:
         raise input_error(name, f"must be an integer in [{low}, {high}], got {x}")
     return int(x)

@@ -16,7 +16,7 @@ import pandas as pd
 from scipy.stats import chi2
 
 from .. import _core
-from .._validate import as_floats, input_error, instance, scalar
+from .._validate import as_floats, input_error, instance, integer, scalar
 from .riccati import _mat
 
 
@@ -103,7 +103,7 @@ def true_error_analysis(scenario: Scenario, r_true, cross) -> pd.DataFrame:
 def chi2_band(dof: int, runs: int, p: float = 0.95) -> tuple[float, float]:
     """Two-sided p band of the run-average of ``runs`` χ²(dof) variables (NEES or NIS):
     χ²_{runs·dof} quantiles / runs."""
-    dof, runs = _integer(dof, "dof", 1, 2**32), _integer(runs, "runs", 1, 2**32)
+    dof, runs = integer(dof, "dof", 1, 2**32), integer(runs, "runs", 1, 2**32)
     p = scalar(p, "p")
     if not 0 < p < 1:
         raise input_error("p", f"must be a probability in (0, 1), got {p}")
@@ -142,18 +142,6 @@ class MonteCarloIncomplete(RuntimeError):
         super().__init__(f"{len(missing)} of {len(missing) + len(partial.runs)} Monte-Carlo runs not computed "
                          f"(runs {missing[:10]}{' …' if len(missing) > 10 else ''}); last error: {errors[-1]!r}")
         self.partial, self.missing, self.errors = partial, missing, errors
-
-
-def _integer(x, name: str, low: int, high: int) -> int:
-    """``x`` as an int in [low, high]: a non-integer is a ``TypeError``, one out of range
-    an :class:`atomnav.InputError`, both naming ``name``."""
-    if isinstance(x, (bool, np.bool_)) or not isinstance(x, (int, np.integer)):
-        raise TypeError(f"{name}: expected an integer, got {type(x).__name__}")
-    if x < low:
-        raise input_error(name, f"must be >= {low}, got {x}")
-    if x > high:
-        raise input_error(name, f"must be <= {high}, got {x}")
-    return int(x)
 
 
 def _runs(scenario: Scenario, seed: int, runs: list[int], mode: str):
@@ -257,8 +245,8 @@ def monte_carlo(scenario: Scenario, runs: int, seed: int, mode: str = "closed", 
     ``timeout`` seconds (none came back) or a finished result could not be fetched within
     ``timeout`` s; ``timeout=None`` waits for workers without bound.
     """
-    runs, seed = _integer(runs, "runs", 1, 2**32), _integer(seed, "seed", 0, 2**64 - 1)
-    chunk, retries = _integer(chunk, "chunk", 1, 2**32), _integer(retries, "retries", 0, 1000)
+    runs, seed = integer(runs, "runs", 1, 2**32), integer(seed, "seed", 0, 2**64 - 1)
+    chunk, retries = integer(chunk, "chunk", 1, 2**32), integer(retries, "retries", 0, 1000)
     ids = list(range(runs))
     if client is None:
         return _result(scenario, ids, [_runs(scenario, seed, ids, mode)])
