@@ -14,7 +14,7 @@ import numpy as np
 import pandas as pd
 
 from . import _core
-from ._validate import as_floats, choice, finite_scalar, increasing, input_error, instance, positive, rows, vector
+from ._validate import as_floats, finite_scalar, increasing, input_error, instance, positive, rows, vector
 from .rotation import euler_from_quat, quat_from_euler
 
 #: Column names of a trajectory table (units in the names).
@@ -148,7 +148,6 @@ class Trajectory:
         acceleration (rad/s²) at each sample (N rows). ``kind="increments"``: Δθ (rad) and
         Δv (m/s) over each interval (t_{k−1}, t_k], N − 1 rows stamped with t_k. Includes
         Earth rate, transport rate and normal gravity. Needs a generated trajectory."""
-        choice(kind, IMU_COLUMNS, "kind")
         if self.motion is None:
             raise input_error("kind", "no ideal IMU output: this trajectory was built from data and has no motion model; use a generator")
         out = self.motion.ideal_imu(self.time, kind, self.ellipsoid)
