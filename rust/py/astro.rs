@@ -286,7 +286,7 @@ fn astro_model_covariance<'py>(
 
 #[pyfunction]
 fn astro_aberration<'py>(py: Python<'py>, s: PyReadonlyArray2<'py, f64>, v: PyReadonlyArray2<'py, f64>) -> PyResult<Bound<'py, PyArray2<f64>>> {
-    let (s, v) = (vec3_rows(&s, "directions")?, vec3_rows(&v, "velocity")?);
+    let (s, v) = (vec3_rows(&s, "s")?, vec3_rows(&v, "v")?);
     Ok(vec3_to_py(py, &stars::aberration_rows(&s, &v)?))
 }
 

@@ -250,6 +250,8 @@ def monte_carlo(scenario: Scenario, runs: int, seed: int, mode: str = "closed", 
     ids = list(range(runs))
     if client is None:
         return _result(scenario, ids, [_runs(scenario, seed, ids, mode)])
+    if not callable(getattr(client, "submit", None)):
+        raise TypeError(f"client: expected a dask.distributed Client or None, got {type(client).__name__}")
     groups = [ids[i:i + chunk] for i in range(0, len(ids), chunk)]
     if timeout is not None:
         if isinstance(timeout, (bool, np.bool_)) or not isinstance(timeout, (int, float, np.integer, np.floating)):

@@ -14,7 +14,7 @@ import numpy as np
 import pandas as pd
 
 from .. import _core, units
-from .._validate import as_floats, input_error, instance, integer, positive, probability, renamed, vector
+from .._validate import as_floats, input_error, instance, integer, positive, probability, renamed, scalar, vector
 
 #: Option names, listed (and checked) by the Rust core.
 KINDS = tuple(_core.OPTIONS["AllanKind"])
@@ -164,8 +164,8 @@ def fit_allan_table(table: pd.DataFrame, n_samples: int, terms=TERMS, tau_min: f
     if bad:
         raise input_error("terms", f"unknown term {bad[0]!r}; choose from {TERMS}")
     mask = [t in terms for t in TERMS]
-    lo = 0.0 if tau_min is None else float(tau_min)
-    hi = np.inf if tau_max is None else float(tau_max)
+    lo = 0.0 if tau_min is None else scalar(tau_min, "tau_min")
+    hi = np.inf if tau_max is None else scalar(tau_max, "tau_max")
     d = _core.allan_fit(table["m"].to_numpy().tolist(), np.ascontiguousarray(table["tau_s"], dtype=float), np.ascontiguousarray(table["var"], dtype=float), n_samples, mask, lo, hi)
     return AllanFit(coeffs=np.asarray(d["coeffs"]), quantization=d["quantization"], arw=d["arw"], bias_instability=d["bias_instability"],
                     rrw=d["rrw"], ramp=d["ramp"], points=d["points"], tau_min=lo, tau_max=hi, table=table)

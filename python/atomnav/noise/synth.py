@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import numpy as np
 from .. import units
-from .._validate import input_error, instance, scalar
+from .._validate import instance, integer, scalar
 from .filters import PAPER_AR, PAPER_MA, PAPER_SIGMA2
 
 #: Niu et al. 2025: sample interval (s), record length, Table 2 raw mean (°/h).
@@ -18,9 +18,7 @@ MEAN = 0.6851
 
 
 def _n(n: int) -> int:
-    if int(n) != n or n < 1:
-        raise input_error("n", f"must be an integer ≥ 1, got {n}")
-    return int(n)
+    return integer(n, "n", 1)
 
 
 def flicker(rng: np.random.Generator, n: int, sigma: float) -> np.ndarray:
