@@ -37,7 +37,7 @@ def test_huge_epoch_count_is_checked_before_allocation():
 
 def test_aberration_limit_in_the_core():
     v = np.array([[0.0, 0.0, 3e4], [0.0, 0.0, 3.1e5]])
-    e = _input_error("velocity", astro.aberration, np.vstack([G[:2]]), v, index=1)
+    e = _input_error("velocity_mps", astro.aberration, np.vstack([G[:2]]), v, index=1)
     assert "1e-3 c" in str(e)
 
 

@@ -285,8 +285,8 @@ fn astro_model_covariance<'py>(
 }
 
 #[pyfunction]
-fn astro_aberration<'py>(py: Python<'py>, s: PyReadonlyArray2<'py, f64>, v: PyReadonlyArray2<'py, f64>) -> PyResult<Bound<'py, PyArray2<f64>>> {
-    let (s, v) = (vec3_rows(&s, "s")?, vec3_rows(&v, "v")?);
+fn astro_aberration<'py>(py: Python<'py>, directions: PyReadonlyArray2<'py, f64>, velocity: PyReadonlyArray2<'py, f64>) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    let (s, v) = (vec3_rows(&directions, "directions")?, vec3_rows(&velocity, "velocity")?);
     Ok(vec3_to_py(py, &stars::aberration_rows(&s, &v)?))
 }
 

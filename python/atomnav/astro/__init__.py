@@ -288,7 +288,8 @@ def aberration(directions, velocity_mps) -> np.ndarray:
     with geometric unit directions ``directions`` (N, 3) seen by an observer moving with
     ``velocity_mps`` ((3,) or (N, 3), m/s, same frame, |v| < 1e-3 c); exact special
     relativity differs by O((v/c)²) ≈ 1e-8 rad at Earth's orbital 30 km/s (spec §7)."""
-    return _core.astro_aberration(rows(directions, 3, "directions"), rows(velocity_mps, 3, "velocity_mps"))
+    with renamed(velocity="velocity_mps"):
+        return _core.astro_aberration(rows(directions, 3, "directions"), rows(velocity_mps, 3, "velocity_mps"))
 
 
 def simulate_observations(catalog: Catalog, s_gcrs_vf, up_gcrs, cameras, *, fov_half_rad: float, m_lim: float,

@@ -218,6 +218,8 @@ def improvement_ratio(before, after, absolute: bool = False):
     ``absolute=True`` gives the paper's |M_raw − M_filt|/M_raw·100."""
     b = as_floats(before, "before")
     a = as_floats(after, "after")
+    if a.shape != b.shape and a.size != 1 and b.size != 1:
+        raise input_error("after", f"expected the shape of before {b.shape}, got {a.shape}")
     if np.any(b == 0):
         raise input_error("before", "metric is zero, the ratio is undefined")
     r = (b - a) / b * 100.0

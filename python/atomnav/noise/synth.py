@@ -43,7 +43,7 @@ def model_a(seed: int = 20250226, n: int = N_SAMPLES, ar=PAPER_AR, ma=PAPER_MA, 
     a = rng.normal(0.0, np.sqrt(sigma2), n + burn_in)
     d = lfilter(np.r_[1.0, ma], np.r_[1.0, -np.asarray(ar, dtype=float)], a)[burn_in:]
     w = np.cumsum(d)
-    return w - w.mean() + mean
+    return w - w.mean() + scalar(mean, "mean")
 
 
 def model_b(seed: int = 105, n: int = N_SAMPLES, tau0: float = TAU0, arw: float = 0.015, flicker_b: float = 0.01, rrw: float = 0.01, ramp: float = 0.0042, mean: float = MEAN) -> np.ndarray:
@@ -60,4 +60,4 @@ def model_b(seed: int = 105, n: int = N_SAMPLES, tau0: float = TAU0, arw: float 
     rw = np.cumsum(rng.normal(0.0, rrw * np.sqrt(hours), n))
     trend = ramp * hours * np.arange(n)
     w = white + fl + rw + trend
-    return w - w.mean() + mean
+    return w - w.mean() + scalar(mean, "mean")
