@@ -250,14 +250,14 @@ def monte_carlo(scenario: Scenario, runs: int, seed: int, mode: str = "closed", 
     ids = list(range(runs))
     if client is None:
         return _result(scenario, ids, [_runs(scenario, seed, ids, mode)])
-    if not callable(getattr(client, "submit", None)):
-        raise TypeError(f"client: expected a dask.distributed Client or None, got {type(client).__name__}")
     groups = [ids[i:i + chunk] for i in range(0, len(ids), chunk)]
     if timeout is not None:
         if isinstance(timeout, (bool, np.bool_)) or not isinstance(timeout, (int, float, np.integer, np.floating)):
             raise TypeError(f"timeout: expected a number of seconds or None, got {type(timeout).__name__}")
         if not 0 < timeout < np.inf:  # also rejects NaN
             raise input_error("timeout", f"must be a finite number of seconds > 0, or None; got {timeout}")
+    if not callable(getattr(client, "submit", None)):
+        raise TypeError(f"client: expected a dask.distributed Client or None, got {type(client).__name__}")
     done, errors = _distributed(client, scenario, seed, groups, mode, retries, timeout)
     order = sorted(done)
     e, n = len(scenario.times), scenario.size
