@@ -67,7 +67,7 @@ fn sorted_eigen(m: &Mat3) -> (Vec3, Mat3) {
     (vals, vecs)
 }
 
-/// Identifiability of the mount from the astro increments (spec E15, D16).
+/// Identifiability of the mount from the astro increments.
 pub fn observability(ds_avu: &[Mat3]) -> Observability {
     let mut g = Mat3::zeros();
     let mut axes = Vec::with_capacity(ds_avu.len());
@@ -106,7 +106,7 @@ pub fn observability(ds_avu: &[Mat3]) -> Observability {
     Observability { axes_vf: axes, angles, cluster, n_clusters: reps.len(), eigenvalues: vals, eigenvectors: vecs, kappa, verdict }
 }
 
-/// f_n = vee(ΔS_n^avuᵀ Cᵀ ΔS_n^imu C − I) (spec E16).
+/// f_n = vee(ΔS_n^avuᵀ Cᵀ ΔS_n^imu C − I).
 pub fn residual(c: &Mat3, ds_imu: &Mat3, ds_avu: &Mat3) -> Vec3 {
     vee(&(ds_avu.transpose() * c.transpose() * ds_imu * c - Mat3::identity()))
 }
@@ -130,7 +130,7 @@ pub fn initial_alignment(ds_imu: &[Mat3], ds_avu: &[Mat3]) -> Mat3 {
     nearest_rotation(&b)
 }
 
-/// Start of Gauss–Newton (spec D5).
+/// Start of Gauss–Newton.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Init {
     /// Closed-form alignment of rotation axes (default).
@@ -187,7 +187,7 @@ impl Choice for ResidualForm {
     const CHOICES: &'static [(&'static str, Self)] = &[("full", ResidualForm::Full), ("diagonal", ResidualForm::Diagonal)];
 }
 
-/// Gauss–Newton parametrisation (spec E17, D3, D8).
+/// Gauss–Newton parametrisation.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Solver {
     /// C_j = C_{j−1} exp([Δθ×]) with the analytic Jacobian (default).
@@ -413,7 +413,7 @@ pub struct ConstantGyroErrors<'a> {
     pub sigma_b: f64,
 }
 
-/// Model-form covariance of β (spec E18): P_β^model = (HᵀH)⁻¹HᵀΣ_fH(HᵀH)⁻¹ with Σ_f from the
+/// Model-form covariance of β: P_β^model = (HᵀH)⁻¹HᵀΣ_fH(HᵀH)⁻¹ with Σ_f from the
 /// error models — diagonal blocks CᵀE_n^imuC + E_n^avu, the E13 neighbour blocks
 /// cov(ε_n, ε_{n+1}) = −P_n^avu ΔS_{n+1}, and with constant gyro errors the cross blocks
 /// Cᵀ(J_m,n P_m J_m,pᵀ + J_b,n P_b J_b,pᵀ)C — and its systematic part
@@ -466,7 +466,7 @@ pub fn p_mfa(c: &Mat3, p_avu: &Mat3, p_clb: &Mat3) -> Mat3 {
     c * p_avu * c.transpose() + p_clb
 }
 
-/// Form of P^diff (spec D10).
+/// Form of P^diff.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum DiffForm {
     /// C P_n Cᵀ + Φ_nᵀ C P_1 Cᵀ Φ_n + (Φ_nᵀ − I) P^clb (Φ_n − I) + P_n^imu.

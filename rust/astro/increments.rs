@@ -1,9 +1,9 @@
 //! Gyro attitude increments between asynchronous camera epochs and their covariance
-//! (Vasilyuk et al. 2024 §2.2; spec E1–E8).
+//! (Vasilyuk et al. 2024 §2.2).
 //!
 //! IMU record: increment `rho[j]` (rad, MF axes) covers [t_start + jT, t_start + (j+1)T].
 //! Interval n runs from epoch t_{E,n−1} to t_{E,n}; its increment q_n maps MF at t_{E,n}
-//! into MF at t_{E,n−1}: R(q_n) = ΔS_n^imu = S_{MF,n−1}^{MF,n} (spec E6).
+//! into MF at t_{E,n−1}: R(q_n) = ΔS_n^imu = S_{MF,n−1}^{MF,n}.
 
 use crate::error::{check_increasing, check_positive, invalid, Result};
 use crate::options::Choice;
@@ -11,7 +11,7 @@ use crate::math::{dcm_from_quat, quat, quat_normalize, skew, Mat3, Quat, Vec3};
 use nalgebra::SMatrix;
 use rayon::prelude::*;
 
-/// Scalar-part coefficient c of the E4 intra-sample quaternion (spec D1).
+/// Scalar-part coefficient c of the E4 intra-sample quaternion.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum TaylorVariant {
     /// c = 1/8: the third-order Picard expansion (project default).
@@ -34,7 +34,7 @@ impl TaylorVariant {
     }
 }
 
-/// How the constant gyro errors (M_G, δb_G) are propagated (spec D2).
+/// How the constant gyro errors (M_G, δb_G) are propagated.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum GyroErrorMode {
     /// White from sample to sample (paper, E2/E7).
@@ -62,7 +62,7 @@ pub struct GyroErrorModel {
 pub type Mat39 = SMatrix<f64, 3, 9>;
 
 impl GyroErrorModel {
-    /// The paper's budget (spec §4): 3″, 1e-5, 0.0012 °/√h, 0.007 °/h.
+    /// The paper's budget: 3″, 1e-5, 0.0012 °/√h, 0.007 °/h.
     pub fn vasilyuk2024(mode: GyroErrorMode) -> Self {
         use crate::units::{ARCSEC, DEG_PER_HOUR, DEG_PER_SQRT_HOUR};
         Self { sigma_phi: 3.0 * ARCSEC, sigma_k: 1e-5, sigma_w: 0.0012 * DEG_PER_SQRT_HOUR, sigma_b: 0.007 * DEG_PER_HOUR, mode }
@@ -218,7 +218,7 @@ impl<R: Copy + Into<Vec3> + Sync> ImuRecord<'_, R> {
         (j, u - j as f64)
     }
 
-    /// Epochs strictly increasing and bracketed by IMU samples (spec D18).
+    /// Epochs strictly increasing and bracketed by IMU samples.
     fn check_epochs(&self, epochs: &[f64]) -> Result<()> {
         check_increasing("epochs", epochs)?;
         let end = self.t_start + self.rho.len() as f64 * self.period;
@@ -260,7 +260,7 @@ impl<R: Copy + Into<Vec3> + Sync> ImuRecord<'_, R> {
     }
 }
 
-/// Intra-sample quaternion r(x), x = τ/T ∈ [0, 1], of the linear-rate model (spec E4):
+/// Intra-sample quaternion r(x), x = τ/T ∈ [0, 1], of the linear-rate model:
 /// r0 = 1 − |ρ|²x²/8 − c(ρ·Δρ)(x³ − x²),
 /// r_v = (ρ/2)(x − |ρ|²x³/24) + (Δρ/4)(x² − x) + (ρ×Δρ)x³/24.
 pub fn intra_sample(rho: &Vec3, drho: &Vec3, x: f64, variant: TaylorVariant) -> Quat {
@@ -308,7 +308,7 @@ pub fn integrate_increments<R: Copy + Into<Vec3> + Sync>(rec: &ImuRecord<R>, epo
     Ok(epochs.par_windows(2).filter_map(|w| if let &[a, b] = w { Some(rec.interval(a, b, model, variant)) } else { None }).collect())
 }
 
-/// Continuous dead-reckoning covariance P_n^imu at every epoch (spec E20): E7/E8 run from
+/// Continuous dead-reckoning covariance P_n^imu at every epoch: E7/E8 run from
 /// the start of the sample holding the first epoch, linearly interpolated at t_En.
 pub fn dead_reckoning_cov<R: Copy + Into<Vec3> + Sync>(rec: &ImuRecord<R>, epochs: &[f64], model: &GyroErrorModel) -> Result<Vec<Mat3>> {
     rec.validate()?;
@@ -396,7 +396,7 @@ mod tests {
     #[test]
     fn static_sigma_matches_spec_row13() {
         // Level, 21 s, Earth rate at 55.6°, paper budget: σ_ε = √tr E = 0.5716″ (paper),
-        // 0.6258″ (consistent) (spec §5.2 row 13).
+        // 0.6258″ (consistent).
         let (lat, om, period) = (55.6f64.to_radians(), 7.292115e-5, 0.005);
         let w = Vec3::new(0.0, om * lat.cos(), om * lat.sin()); // ENU, level MF
         let rho = vec![w * period; 4400];

@@ -1,7 +1,7 @@
 //! Astro-inertial calibration of the star-camera (virtual camera VF) to IMU (MF) mount from
-//! attitude increments (Vasilyuk et al. 2024, Vasilyuk et al. 2024; spec astro-calibration-vasilyuk2024).
+//! attitude increments (Vasilyuk et al. 2024).
 //!
-//! Internally everything is in the paper's conventions (spec §2): ENU navigation frame,
+//! Internally everything is in the paper's conventions: ENU navigation frame,
 //! right-forward-up body axes, right-multiplicative body-frame small errors
 //! S = S̆ (I + [θ×]). `S_X2^X1` maps X1 coordinates into X2. Conversion to the project's
 //! NED/FRD frames happens in `scenario.rs` (the only place that touches `trajectory`).
@@ -13,13 +13,13 @@ pub mod stars;
 
 use crate::math::{Mat3, Vec3};
 
-/// vee(M) = ½(M32 − M23, M13 − M31, M21 − M12) (spec §2).
+/// vee(M) = ½(M32 − M23, M13 − M31, M21 − M12).
 pub fn vee(m: &Mat3) -> Vec3 {
     0.5 * Vec3::new(m[(2, 1)] - m[(1, 2)], m[(0, 2)] - m[(2, 0)], m[(1, 0)] - m[(0, 1)])
 }
 
 /// The paper's Euler matrix C(ψ, ϑ, γ) = R_ψ(ψ) R_ϑ(ϑ) R_γ(γ) with R_ψ = R_z(−ψ),
-/// R_ϑ = R_x(ϑ), R_γ = R_y(γ) (spec §2, recovered from the printed D1/D2).
+/// R_ϑ = R_x(ϑ), R_γ = R_y(γ).
 pub fn euler_dcm(b: &Vec3) -> Mat3 {
     let (sp, cp) = b.x.sin_cos();
     let (st, ct) = b.y.sin_cos();
@@ -30,8 +30,8 @@ pub fn euler_dcm(b: &Vec3) -> Mat3 {
     rpsi * rth * rg
 }
 
-/// Canonical angles of C: ϑ = asin(C32), ψ = atan2(C12, C22) ∈ [0, 2π), γ = atan2(−C31, C33)
-/// (spec §2 "Inverse", D3). Singular at |ϑ| = 90°.
+/// Canonical angles of C: ϑ = asin(C32), ψ = atan2(C12, C22) ∈ [0, 2π), γ = atan2(−C31, C33).
+/// Singular at |ϑ| = 90°.
 pub fn euler_from_dcm(c: &Mat3) -> Vec3 {
     let th = c[(2, 1)].clamp(-1.0, 1.0).asin();
     let psi = c[(0, 1)].atan2(c[(1, 1)]).rem_euclid(2.0 * std::f64::consts::PI);
@@ -39,14 +39,14 @@ pub fn euler_from_dcm(c: &Mat3) -> Vec3 {
     Vec3::new(psi, th, g)
 }
 
-/// D1(β): θ^clb = D1 δβ with C(β + δβ) ≈ C(β)(I + [θ^clb×]) (Vasilyuk et al. 2024, Eq. 8; spec E19).
+/// D1(β): θ^clb = D1 δβ with C(β + δβ) ≈ C(β)(I + [θ^clb×]) (Vasilyuk et al. 2024, Eq. 8).
 pub fn d1(b: &Vec3) -> Mat3 {
     let (st, ct) = b.y.sin_cos();
     let (sg, cg) = b.z.sin_cos();
     Mat3::new(sg * ct, cg, 0.0, -st, 0.0, 1.0, -cg * ct, sg, 0.0)
 }
 
-/// D2(β) = C(β) D1(β) (spec E19).
+/// D2(β) = C(β) D1(β).
 pub fn d2(b: &Vec3) -> Mat3 {
     let (sp, cp) = b.x.sin_cos();
     let (st, ct) = b.y.sin_cos();
@@ -58,12 +58,12 @@ pub fn check_rotations(field: &str, r: &[Mat3]) -> crate::Result<()> {
     r.iter().enumerate().try_for_each(|(i, m)| check_rotation(field, i, m))
 }
 
-/// Rotation angle of a rotation matrix by atan2 (spec E20, D15): accurate for small angles.
+/// Rotation angle of a rotation matrix by atan2: accurate for small angles.
 pub fn rotation_angle(s: &Mat3) -> f64 {
     (2.0 * vee(s).norm()).atan2(s.trace() - 1.0)
 }
 
-/// Nearest rotation matrix U diag(1, 1, det U det V) Vᵀ of B = U Σ Vᵀ (Wahba, spec E11).
+/// Nearest rotation matrix U diag(1, 1, det U det V) Vᵀ of B = U Σ Vᵀ (the solution of Wahba's problem).
 // invariant: svd(true, true) always computes u and v_t.
 #[allow(clippy::expect_used)]
 pub fn nearest_rotation(b: &Mat3) -> Mat3 {
@@ -93,7 +93,7 @@ mod tests {
 
     #[test]
     fn d1_matches_finite_differences_and_d2_is_c_d1() {
-        // Cᵀ ∂C/∂β_i = [d_i×] (spec §2); central differences h = 1e-6.
+        // Cᵀ ∂C/∂β_i = [d_i×]; central differences h = 1e-6.
         let h = 1e-6;
         for k in 0..200 {
             let x = k as f64;

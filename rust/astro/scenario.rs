@@ -1,4 +1,4 @@
-//! The synthetic reproduction `vasilyuk2024_like` (spec §5.1) and its Monte-Carlo runner.
+//! The synthetic reproduction `vasilyuk2024_like` and its Monte-Carlo runner.
 //!
 //! Frame boundary: the stand motion of `trajectory::generators::vasilyuk2024_stand` is in
 //! NED/FRD (C_nb = R_y(tilt) R_z(turntable)); the paper's ENU/right-forward-up frames are
@@ -62,7 +62,7 @@ pub fn vasilyuk2024_like(catalog_seed: u64, mode: GyroErrorMode) -> Result<Scena
     let (_, dth) = ideal_increments(&motion, &WGS84, &truth);
     let rho_true: Vec<Vec3> = dth.iter().map(|r| T_SWAP * r).collect();
     let epochs: Vec<f64> = (0..73).map(|n| 0.5023 + 21.0007 * n as f64).collect();
-    // S_GCRS^ENU(t) = R_z(Ωt)[E N U]_ECEF (spec §5.1)
+    // S_GCRS^ENU(t) = R_z(Ωt)[E N U]_ECEF
     let ned = dcm_ned_to_ecef(lat, lon);
     let enu = Mat3::from_columns(&[ned.column(1).into_owned(), ned.column(0).into_owned(), -ned.column(2)]);
     let s_gcrs_enu = |t: f64| {
@@ -93,7 +93,7 @@ pub fn vasilyuk2024_like(catalog_seed: u64, mode: GyroErrorMode) -> Result<Scena
     })
 }
 
-/// Measured increments ρ = ρ̆ + M_G ρ̆ + δb T + w (spec E1): M_G and δb redrawn every
+/// Measured increments ρ = ρ̆ + M_G ρ̆ + δb T + w: M_G and δb redrawn every
 /// sample (`Paper` truth) or once (`Consistent` truth); w ~ N(0, σ_w² T) white.
 pub fn corrupt_gyro<R: Rng>(rho: &[Vec3], model: &GyroErrorModel, period: f64, rng: &mut R) -> Vec<Vec3> {
     let mut n = || rng.sample::<f64, _>(StandardNormal);
@@ -135,7 +135,7 @@ pub struct Run {
     pub p_diff: Vec<Mat3>,
 }
 
-/// The full chain of one run with noise seed `seed` (spec §5.1 pipeline).
+/// The full chain of one run with noise seed `seed`.
 pub fn run(scn: &Scenario, seed: u64, opt: &Options, diff_form: DiffForm) -> Result<Run> {
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     let rho = corrupt_gyro(&scn.rho_true, &scn.gyro, scn.period, &mut rng);

@@ -1,4 +1,4 @@
-//! Star-camera front end (Vasilyuk et al. 2024 §2.1; spec E9–E13, D4, D13): a deterministic synthetic
+//! Star-camera front end (Vasilyuk et al. 2024 §2.1): a deterministic synthetic
 //! catalog, a camera simulator, refraction, bundle merging into the virtual camera VF,
 //! Wahba/SVD attitudes with their covariance, and the astro increments.
 
@@ -15,7 +15,7 @@ const REFRACTION_PASSES: usize = 3;
 /// Largest accepted |‖s‖ − 1| of an input direction vector.
 pub const UNIT_TOLERANCE: f64 = 1e-9;
 
-/// xoshiro256** seeded through SplitMix64 (spec D4): the same catalog on every platform.
+/// xoshiro256** seeded through SplitMix64: the same catalog on every platform.
 pub struct Xoshiro256 {
     s: [u64; 4],
 }
@@ -46,7 +46,7 @@ impl Xoshiro256 {
         out
     }
 
-    /// Uniform in (0, 1): ((x >> 11) + 0.5)·2⁻⁵³ (spec D4).
+    /// Uniform in (0, 1): ((x >> 11) + 0.5)·2⁻⁵³.
     pub fn uniform(&mut self) -> f64 {
         ((self.next_u64() >> 11) as f64 + 0.5) * (1.0 / 9_007_199_254_740_992.0)
     }
@@ -71,7 +71,7 @@ impl Catalog {
         Ok(Self { dirs, mags, ids })
     }
 
-    /// Uniform synthetic sky (spec D4): N = round(10^(0.985 + 0.455 m_lim)),
+    /// Uniform synthetic sky: N = round(10^(0.985 + 0.455 m_lim)),
     /// z = 2u₁ − 1, λ = 2πu₂, m = m_lim + log10(u₃)/0.455.
     pub fn synthetic(m_lim: f64, seed: u64) -> Result<Self> {
         if !(m_lim.is_finite() && (0.0..=12.0).contains(&m_lim)) {
@@ -143,12 +143,12 @@ pub fn refraction_rows(s: &[Vec3], u: &[Vec3], n: f64, apply: bool) -> Result<Ve
     Ok(s.iter().zip(u).map(|(s, u)| f(s, u, n)).collect())
 }
 
-/// n(H) = 1 + 2.7783e-4 (1 − 2.25577e-5 H)^4.25588 (spec D13; H in m).
+/// n(H) = 1 + 2.7783e-4 (1 − 2.25577e-5 H)^4.25588.
 pub fn refractive_index(height: f64) -> f64 {
     1.0 + 2.7783e-4 * (1.0 - 2.25577e-5 * height).powf(4.25588)
 }
 
-/// Remove refraction: s^rfc = n(I − uuᵀ)s + u√(1 − n²(1 − (uᵀs)²)) (spec E10).
+/// Remove refraction: s^rfc = n(I − uuᵀ)s + u√(1 − n²(1 − (uᵀs)²)).
 pub fn refraction_correct(s: &Vec3, u: &Vec3, n: f64) -> Vec3 {
     let c = u.dot(s);
     (s - u * c) * n + u * (1.0 - n * n * (1.0 - c * c)).max(0.0).sqrt()
@@ -162,7 +162,7 @@ pub fn refraction_apply(s: &Vec3, u: &Vec3, n: f64) -> Vec3 {
 
 /// First-order (classical) stellar aberration: the apparent direction of a star of geometric
 /// unit direction `s` seen by an observer moving with velocity `v` (m/s, same frame),
-/// s' = normalize(s + v/c) = s + (v/c − (s·v/c) s) + O((v/c)²) (spec §7; Explanatory
+/// s' = normalize(s + v/c) = s + (v/c − (s·v/c) s) + O((v/c)²) (Explanatory
 /// Supplement to the Astronomical Almanac, 1992, Eq. 3.252-1 to first order). The
 /// exact (relativistic) form differs by O((v/c)²): ≈ 1e-8 rad for Earth's 30 km/s orbit.
 pub fn aberration(s: &Vec3, v: &Vec3) -> Vec3 {
@@ -170,7 +170,7 @@ pub fn aberration(s: &Vec3, v: &Vec3) -> Vec3 {
 }
 
 /// A rigid camera of the set: C_VF^CFⁱ (maps camera into VF) and the covariance P_aⁱ of
-/// its Euler angles αⁱ (rad², zero for camera 1 which defines VF) (spec E9, E12).
+/// its Euler angles αⁱ (rad², zero for camera 1 which defines VF).
 #[derive(Debug, Clone, Copy)]
 pub struct Camera {
     pub c_vf_cf: Mat3,
@@ -316,7 +316,7 @@ pub fn star_attitudes(
     Ok(out)
 }
 
-/// ΔS_n^avu = S_{n−1}ᵀ S_n and E_n^avu = P_n + ΔS_nᵀ P_{n−1} ΔS_n (spec E13).
+/// ΔS_n^avu = S_{n−1}ᵀ S_n and E_n^avu = P_n + ΔS_nᵀ P_{n−1} ΔS_n.
 pub fn astro_increments(s: &[Mat3], p: &[Mat3]) -> (Vec<Mat3>, Vec<Mat3>) {
     (s.windows(2).zip(p.windows(2)))
         .filter_map(|pair| {
