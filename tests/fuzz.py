@@ -112,6 +112,7 @@ BATCH_LENGTH = 6_000  # ... or fewer, so an example stays within hypothesis' cho
 REPRO_KEEP = 3  # reproducers kept per bad (callable, class) pair
 SLOWEST = 15  # slowest calls listed in the report
 PROGRESS_S = 30.0  # seconds between progress reports
+TOPUP_EXAMPLES = 20  # fewest examples a top-up round draws
 IDLE_ROUNDS = 5  # top-up rounds in a row that made no call, after which a campaign stops
 IDLE_BATCHES = 50  # ... after which a campaign stops (every callable quarantined or over budget)
 
@@ -1050,7 +1051,8 @@ def campaign(calls: int, seed: int, timeout: float = TIMEOUT_S, progress=None, o
         for round_ in itertools.count():  # each round tops up the calls the previous ones did not make
             # examples for the calls still to make, at the rate of made calls per batch so far
             per_batch = c.calls / run.batches if run.batches else BATCH
-            examples = math.ceil((calls - c.calls) / max(per_batch, 1.0))
+            # (at least TOPUP_EXAMPLES: a few draws can all be skipped; prepare() stops at `calls`)
+            examples = max(math.ceil((calls - c.calls) / max(per_batch, 1.0)), TOPUP_EXAMPLES)
             before = c.calls
             empty_rounds = 0 if round_ == 0 else empty_rounds
             settings(max_examples=examples, database=None, deadline=None, phases=[Phase.generate],

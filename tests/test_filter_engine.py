@@ -210,3 +210,27 @@ def test_bad_mode_name():
 def test_bad_bias_model_name():
     with pytest.raises(ValueError, match='accel_bias: unknown bias model "flicker"'):
         ins_error_model([[0.5, 0, 0]], [[0, 0, 0]], [[1, 0, 0, 0]], [[0, 0, -9.8]], 0.0, 0.0, accel_bias=BiasModel("flicker"))
+
+
+def test_layout_is_indexed_by_name_only():
+    """A Layout is not a sequence: an integer index is a TypeError, so a Layout passed where
+    block pairs are expected is a wrong type, not an error about some other parameter."""
+    with pytest.raises(TypeError, match="name: a Layout is indexed by block name"):
+        Layout()[0]
+    with pytest.raises(TypeError):
+        atomnav._core.ins_error_dynamics(Layout(), np.zeros((1, 3)), np.zeros((1, 3)), np.array([[1.0, 0, 0, 0]]),
+                                         np.zeros((1, 3)), accel_psd=0.0, gyro_psd=0.0,
+                                         accel_bias=("random_constant", 0.0, 0.0), gyro_bias=("random_constant", 0.0, 0.0))
+
+
+def test_error_model_names_the_layout_missing_a_navigation_block():
+    """The core's INS error model needs position, velocity and attitude blocks: a layout
+    without them is rejected naming ``layout`` (``blocks`` in the core)."""
+    one = (np.array([[0.9, 0.1, 100.0]]), np.zeros((1, 3)), np.array([[1.0, 0, 0, 0]]), np.array([[0, 0, -9.8]]))
+    with pytest.raises(atomnav.InputError, match='no block "attitude"') as e:
+        ins_error_model(*one, 1e-6, 1e-10, layout=Layout(["position", "velocity"]))
+    assert e.value.parameter == "layout"
+    with pytest.raises(atomnav.InputError) as e:
+        atomnav._core.ins_error_dynamics([("position", None), ("velocity", None)], *one, accel_psd=0.0, gyro_psd=0.0,
+                                         accel_bias=("random_constant", 0.0, 0.0), gyro_bias=("random_constant", 0.0, 0.0))
+    assert e.value.parameter == "blocks"

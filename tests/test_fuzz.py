@@ -11,10 +11,6 @@ import fuzz
 
 CALLS = 20_000
 SEED = 20261202
-#: The outcomes that kill or crash a user's session; the default run guards these while the
-#: full contract (every exception an InputError naming a real parameter, no NaN) is the
-#: fuzz_long campaign's.
-FATAL = ("abort", "PanicException")
 
 
 def _failures(c: fuzz.Campaign) -> str:
@@ -28,20 +24,12 @@ def _failures(c: fuzz.Campaign) -> str:
 
 def _run(calls: int, seed: int) -> None:
     c = fuzz.campaign(calls, seed)
-    assert c.calls == calls
+    assert c.calls == calls, f"the campaign made {c.calls} of {calls} calls"
     assert not c.bad(), _failures(c)
 
 
-def test_fuzz_never_aborts_or_panics():
-    """A fixed-seed share of 2,000 calls: no call aborts the process or panics."""
-    c = fuzz.campaign(2_000, SEED)
-    fatal = [r for r in c.bad() if r.outcome in FATAL]
-    assert not fatal, "\n".join(f"{r.target}: {r.outcome}: {r.call}" for r in fatal)
-
-
-@pytest.mark.fuzz_long
 def test_fuzz_public_api():
-    """≥ 20,000 calls with the whole contract (run with -m fuzz_long)."""
+    """The fixed-seed share CI runs: 20,000 calls with the whole contract."""
     _run(CALLS, SEED)
 
 

@@ -106,11 +106,12 @@ impl Layout {
         self.blocks.last().map_or(0, |(_, r)| r.end)
     }
 
-    /// Index range of a block; unknown names are rejected with the list of known ones.
+    /// Index range of a block. A missing block is a fault of the layout the caller built,
+    /// so the error names `blocks` and lists the blocks the layout has.
     pub fn range(&self, name: &str) -> Result<Range<usize>> {
         self.get(name).ok_or_else(|| {
             let known: Vec<&str> = self.blocks.iter().map(|(b, _)| b.as_str()).collect();
-            invalid("block", format!("unknown block name {name:?} (layout has: {})", known.join(", ")))
+            invalid("blocks", format!("the layout has no block {name:?} (it has: {})", known.join(", ")))
         })
     }
 

@@ -57,17 +57,19 @@ const GL_WEIGHTS: [f64; 5] = [
 
 /// Exact increments (Δv = ∫f^b dt in m/s, Δθ = ∫ω_ib^b dt in rad) over each interval
 /// (t_{k−1}, t_k] of consecutive truth samples: N − 1 rows. Each interval is cut into
-/// pieces of at most 0.01 s, each integrated by 5-point Gauss–Legendre (exact for
-/// polynomials of degree 9). Position enters only through gravity and the Earth and
+/// pieces of at most 0.01 s (one piece for a motion at rest, whose integrand is
+/// constant), each integrated by 5-point Gauss–Legendre (exact for polynomials of
+/// degree 9). Position enters only through gravity and the Earth and
 /// transport rates, so at the nodes it is interpolated linearly between the samples
 /// (≤ 1e-6 m for vehicle motion, i.e. < 1e-11 m/s² of gravity).
 pub fn ideal_increments(motion: &Motion, ell: &Ellipsoid, truth: &[TruthState]) -> (Vec<Vec3>, Vec<Vec3>) {
+    let max_piece = if motion.is_at_rest() { f64::INFINITY } else { 0.01 };
     let mut dv = Vec::with_capacity(truth.len().saturating_sub(1));
     let mut dth = Vec::with_capacity(truth.len().saturating_sub(1));
     for pair in truth.windows(2) {
         let [a, b] = pair else { continue };
         let span = b.t - a.t;
-        let pieces = (span / 0.01).ceil().max(1.0) as usize;
+        let pieces = (span / max_piece).ceil().max(1.0) as usize;
         let h = span / pieces as f64;
         let (mut sv, mut sth) = (Vec3::zeros(), Vec3::zeros());
         for p in 0..pieces {

@@ -82,9 +82,22 @@ impl Motion {
         Kinematics { vel, acc, c_nb, w_nb_b: w }
     }
 
+    /// True when the vehicle neither moves nor turns relative to the Earth: zero speed,
+    /// constant displacement and constant attitude. Its position, specific force and body
+    /// rate are then constant, so integrals over time need no subdivision.
+    pub fn is_at_rest(&self) -> bool {
+        self.speed.constant_value() == Some(0.0)
+            && self.displacement.iter().all(|d| d.constant_value().is_some())
+            && self.attitude.iter().all(|r| r.angle.constant_value().is_some())
+    }
+
     /// (lat, lon, h) at `t1` from (lat, lon, h) at `t0` by RK4 on
-    /// φ̇ = v_N/R_M, λ̇ = v_E/(R_P cos φ), ḣ = −v_D, with steps of at most `max_step`.
+    /// φ̇ = v_N/R_M, λ̇ = v_E/(R_P cos φ), ḣ = −v_D, with steps of at most `max_step`
+    /// (exactly `lla` for a motion at rest).
     pub fn propagate_lla(&self, ell: &Ellipsoid, lla: Vec3, t0: f64, t1: f64, max_step: f64) -> Vec3 {
+        if self.is_at_rest() {
+            return lla;
+        }
         let n = ((t1 - t0).abs() / max_step).ceil().max(1.0) as usize;
         let h = (t1 - t0) / n as f64;
         let rate = |p: &Vec3, t: f64| ell.lla_rate(p.x, p.z, &self.kinematics(t).vel);

@@ -132,6 +132,13 @@ impl Profile {
     pub fn eval(&self, t: f64) -> Eval {
         self.0.iter().fold(Eval::default(), |acc, term| acc + term.eval(t))
     }
+    /// The value of a profile made only of constant terms, or None when it varies.
+    pub fn constant_value(&self) -> Option<f64> {
+        self.0.iter().try_fold(0.0, |sum, term| match term {
+            Term::Linear { c, r } if *r == 0.0 => Some(sum + c),
+            _ => None,
+        })
+    }
 }
 
 #[cfg(test)]

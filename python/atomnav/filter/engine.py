@@ -14,7 +14,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .. import _core
-from .._validate import as_floats, finite_scalar, input_error, instance, integer, json_object, rows
+from .._validate import as_floats, finite_scalar, input_error, instance, integer, json_object, renamed, rows
 from .riccati import _mat
 
 #: Standard blocks and their sizes (read from the core, ``rust/filter/layout.rs``); extra
@@ -103,8 +103,10 @@ class Layout:
         self._ranges = {n: slice(a, b) for n, a, b in _core.layout_ranges(self._spec)}
 
     def __getitem__(self, name: str) -> slice:
-        if not isinstance(name, str) or name not in self._ranges:
-            raise input_error("block", f"unknown block name {name!r} (layout has: {', '.join(self._ranges)})")
+        if not isinstance(name, str):
+            raise TypeError(f"name: a Layout is indexed by block name (str), got {type(name).__name__}")
+        if name not in self._ranges:
+            raise input_error("name", f"unknown block name {name!r} (layout has: {', '.join(self._ranges)})")
         return self._ranges[name]
 
     @property
@@ -150,7 +152,7 @@ class BiasModel(Config):
 def ins_error_model(lla, vel_ned, q_nb, f_b, accel_psd: float, gyro_psd: float,
                     accel_bias: BiasModel = BiasModel(), gyro_bias: BiasModel = BiasModel(), *,
                     layout: Layout | None = None, ellipsoid: str = "WGS84") -> tuple[np.ndarray, np.ndarray]:
-    """Continuous INS error model F, Q_c (spec gnss-ins-tight Eq. 28) along a trajectory.
+    """Continuous INS error model F, Q_c (Demidov 2009, Eq. 28) along a trajectory.
 
     lla (N, 3) rad/rad/m, vel_ned (N, 3) m/s, q_nb (N, 4), f_b (N, 3) compensated specific
     force m/s²; accel_psd ((m/s²)²/Hz = VRW²) and gyro_psd (rad²/s = ARW²) white noise.
@@ -159,10 +161,12 @@ def ins_error_model(lla, vel_ned, q_nb, f_b, accel_psd: float, gyro_psd: float,
     layout = Layout() if layout is None else instance(layout, Layout, "layout")
     instance(accel_bias, BiasModel, "accel_bias")
     instance(gyro_bias, BiasModel, "gyro_bias")
-    return _core.ins_error_dynamics(layout.spec, rows(lla, 3, "lla"), rows(vel_ned, 3, "vel_ned"),
-                                    rows(q_nb, 4, "q_nb"), rows(f_b, 3, "f_b"), accel_psd=finite_scalar(accel_psd, "accel_psd"),
-                                    gyro_psd=finite_scalar(gyro_psd, "gyro_psd"), accel_bias=accel_bias._parts(),
-                                    gyro_bias=gyro_bias._parts(), ellipsoid=ellipsoid)
+    with renamed(blocks="layout"):
+        return _core.ins_error_dynamics(layout.spec, rows(lla, 3, "lla"), rows(vel_ned, 3, "vel_ned"),
+                                        rows(q_nb, 4, "q_nb"), rows(f_b, 3, "f_b"),
+                                        accel_psd=finite_scalar(accel_psd, "accel_psd"),
+                                        gyro_psd=finite_scalar(gyro_psd, "gyro_psd"), accel_bias=accel_bias._parts(),
+                                        gyro_bias=gyro_bias._parts(), ellipsoid=ellipsoid)
 
 
 class KalmanFilter:
