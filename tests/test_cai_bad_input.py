@@ -145,3 +145,25 @@ def test_a_bad_sensor_field_is_named_through_the_argument():
 def test_no_zero_division_or_nan_from_tiny_or_missing_values(call, error):
     with pytest.raises(error):
         call()
+
+
+@pytest.mark.parametrize("call, parameter", [
+    (lambda: cai.predictor.scale_factors(T=1e308, k=100, v0=100.0), "T"),  # was OverflowError
+    (lambda: cai.predictor.phase_noise(sigma_p=1e308), "sigma_p"),  # was inf, silently
+    (lambda: cai.predictor.in_shot_noise_phase(1.0, 1.0, 1e300), "T"),  # was OverflowError
+    (lambda: cai.predictor.sagnac_phase([[1.0, 0, 0]], [0, 1.0, 0], [0, 0, 1.0], 1e200), "T"),
+    (lambda: cai.predictor.phase_seed000(np.eye(3)[:2], np.zeros((3, 3)), [0, 0, 1e-3], [0, 0, -9.8], 0.1), "vbar"),
+])
+def test_overflow_and_parameter_names_found_by_the_fuzz(call, parameter):
+    """A finite input whose result overflows names that input; a core error about a
+    wrapper's renamed argument names the wrapper's parameter."""
+    with pytest.raises(InputError) as e:
+        call()
+    assert e.value.parameter == parameter
+
+
+def test_negative_zero_noise_is_zero_noise():
+    """σ = −0.0 passes the ≥ 0 check and must reach numpy's sampler as 0.0 (it rejects −0.0)."""
+    p, _ = cai.noise_id.simulate_fringe(16, p0=0.5, sigma_p0=-0.0, sigma_phi=-0.0, sigma_A=-0.0, seed=1)
+    p_ref, _ = cai.noise_id.simulate_fringe(16, p0=0.5, sigma_p0=0.0, sigma_phi=0.0, sigma_A=0.0, seed=1)
+    assert np.array_equal(p, p_ref)

@@ -117,6 +117,9 @@ def probability(x, name: str) -> float:
 
 
 def choice(value: str, options, name: str) -> str:
+    """``value`` if it is one of the string ``options``; a ``TypeError`` for a non-string."""
+    if not isinstance(value, str):
+        raise TypeError(f"{name}: expected one of {sorted(options)} (str), got {type(value).__name__}")
     if value not in options:
         raise input_error(name, f"unknown option {value!r}; choose one of {sorted(options)}")
     return value
@@ -145,11 +148,20 @@ def integer(x, name: str, low: int = 0, high: int = 2**63 - 1) -> int:
 
 
 def nonnegative(x, name: str) -> float:
-    """``x`` as a finite float >= 0."""
+    """``x`` as a finite float >= 0 (−0.0 becomes 0.0: numpy's samplers reject a negative-zero
+    scale)."""
     x = scalar(x, name)
     if not np.isfinite(x) or x < 0:
         raise input_error(name, f"must be finite and >= 0, got {x}")
-    return x
+    return abs(x)
+
+
+def finite_result(value, name: str, what: str):
+    """``value`` (a float or array computed from checked inputs) if it is finite; else an
+    :class:`InputError` naming ``name``, the input whose size made ``what`` overflow."""
+    if not np.all(np.isfinite(value)):
+        raise input_error(name, f"{what} is outside the range of floats for this value")
+    return value
 
 
 def finite_scalar(x, name: str) -> float:

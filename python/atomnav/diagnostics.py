@@ -53,7 +53,8 @@ def schuler_test(lat: float = np.deg2rad(55.75), *, v0: float = 200.0, hours: fl
     Returns the error table and the measured quantities: zero-crossing periods of v_N
     (min), the Schuler period 2π√((√(MN)+h)/γ) (min), and the first-period peaks of the
     horizontal position error (m) and tilt (rad)."""
-    err = stationary_errors(lat, hours, dv0=(scalar(v0, "v0"), 0.0, 0.0), h=h)
+    # 1 Hz is exact at rest and keeps multi-day tests to seconds
+    err = stationary_errors(lat, hours, rate_hz=1.0, dv0=(scalar(v0, "v0"), 0.0, 0.0), h=h)
     periods = zero_crossing_periods(err["time_s"].to_numpy(), err["dvel_n_mps"].to_numpy()) / 60.0
     ts = earth.schuler_period(lat, h)
     first = err["time_s"] < ts

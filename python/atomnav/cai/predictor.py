@@ -15,7 +15,8 @@ import numpy as np
 import pandas as pd
 
 from .. import _core
-from .._validate import as_floats, broadcast, finite, finite_scalar, input_error, instance, nonnegative, positive, rows, shaped, vector
+from .._validate import (as_floats, broadcast, finite, finite_result, finite_scalar, input_error, instance, nonnegative,
+                         positive, renamed, rows, shaped, vector)
 from ._config import ConfigMixin
 
 #: ⁸⁷Rb D2 wavelength (m) and the two-photon effective wave number 4π/λ (rad/m).
@@ -286,7 +287,8 @@ def phase_seed000(k, vbar, angular_rate, specific_force, T_total: float) -> np.n
     """Seed 000 (P-52) in the paper's convention: k·(¼ f − ½ ω×v̄) T0², T0 = total
     interrogation time. Equals the library's first-order phase with k → −k, v0 = −v̄,
     T = T0/2."""
-    return _closed("seed000", k, vbar, angular_rate, specific_force, T_total)
+    with renamed(v0="vbar", T="T_total"):
+        return _closed("seed000", k, vbar, angular_rate, specific_force, T_total)
 
 
 def sagnac_phase(k, v0, angular_rate, T: float) -> np.ndarray:
@@ -294,7 +296,9 @@ def sagnac_phase(k, v0, angular_rate, T: float) -> np.ndarray:
     k = rows(np.atleast_2d(as_floats(k, "k")), 3, "k")
     v0 = rows(broadcast(v0, k.shape, "v0"), 3, "v0")
     w = vector(angular_rate, 3, "angular_rate")
-    return -2.0 * finite_scalar(T, "T") ** 2 * np.einsum("ij,ij->i", k, np.cross(w, v0))
+    with np.errstate(over="ignore", invalid="ignore"):
+        phase = -2.0 * np.float64(finite_scalar(T, "T")) ** 2 * np.einsum("ij,ij->i", k, np.cross(w, v0))
+    return finite_result(phase, "T", "the Sagnac phase")
 
 
 def t_sep_from_total(T_total: float) -> float:
@@ -310,8 +314,10 @@ def total_from_t_sep(T: float) -> float:
 def scale_factors(T: float, k: float = K_RB87, v0: float = 2.8) -> dict:
     """Phase scale factors: ``acceleration`` kT² (rad per m/s²), ``sagnac`` 2kv0T² (rad per
     rad/s), ``euler`` kv0T³ (rad per rad/s²)."""
-    T, k, v0 = positive(T, "T"), finite_scalar(k, "k"), finite_scalar(v0, "v0")
-    return {"acceleration": k * T**2, "sagnac": 2 * k * v0 * T**2, "euler": k * v0 * T**3}
+    T, k, v0 = np.float64(positive(T, "T")), finite_scalar(k, "k"), finite_scalar(v0, "v0")
+    with np.errstate(over="ignore"):
+        out = {"acceleration": k * T**2, "sagnac": 2 * k * v0 * T**2, "euler": k * v0 * T**3}
+    return {key: float(finite_result(v, "T", f"the {key} scale factor")) for key, v in out.items()}
 
 
 def dynamic_range(T: float, k: float = K_RB87) -> float:
@@ -321,7 +327,8 @@ def dynamic_range(T: float, k: float = K_RB87) -> float:
 
 def _kt2(k: float, T: float) -> float:
     """The acceleration scale factor kT² (rad per m/s²), checked to be a positive float."""
-    scale = positive(k, "k") * positive(T, "T") ** 2
+    with np.errstate(over="ignore", under="ignore"):
+        scale = positive(k, "k") * np.float64(positive(T, "T")) ** 2
     if not 0 < scale < np.inf:
         raise input_error("T", f"kT² = {scale} rad/(m/s²) is outside the range of floats")
     return scale
@@ -338,15 +345,19 @@ def in_shot_noise_phase(q_accel: float, q_gyro: float, T: float, k: float = K_RB
     """Phase standard deviation (rad) caused by IMU white noise inside one shot (seed 003
     spec (E38)): ``accel`` k√(2q_a/3) T^{3/2} and ``gyro`` (Sagnac) 2kv0√(2q_g/3) T^{3/2},
     with q the white-noise PSDs (m²/s³, rad²/s), from Var = q k² ∫w² dt, ∫w² = 2T³/3."""
-    T = positive(T, "T")
+    T = np.float64(positive(T, "T"))
     q_accel, q_gyro = nonnegative(q_accel, "q_accel"), nonnegative(q_gyro, "q_gyro")
     k, v0 = finite_scalar(k, "k"), finite_scalar(v0, "v0")
-    return {"accel": k * np.sqrt(2 * q_accel / 3) * T**1.5, "gyro": 2 * k * v0 * np.sqrt(2 * q_gyro / 3) * T**1.5}
+    with np.errstate(over="ignore", invalid="ignore"):
+        out = {"accel": k * np.sqrt(2 * q_accel / 3) * T**1.5, "gyro": 2 * k * v0 * np.sqrt(2 * q_gyro / 3) * T**1.5}
+    return {key: float(finite_result(v, "T", f"the {key} phase noise")) for key, v in out.items()}
 
 
 def phase_noise(sigma_p: float, contrast: float = 1.0) -> float:
     """Phase noise (rad) of a mid-fringe readout with population noise σ_p: 2σ_p/C."""
-    return 2.0 * positive(sigma_p, "sigma_p") / positive(contrast, "contrast")
+    with np.errstate(over="ignore"):
+        noise = 2.0 * np.float64(positive(sigma_p, "sigma_p")) / positive(contrast, "contrast")
+    return float(finite_result(noise, "sigma_p", "2σ_p/C"))
 
 
 def acceleration_noise(sigma_phi: float, T: float, k: float = K_RB87) -> float:

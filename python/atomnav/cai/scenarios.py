@@ -11,7 +11,7 @@ import numpy as np
 import pandas as pd
 
 from .. import _core
-from .._validate import input_error, instance, positive, vector
+from .._validate import finite_result, input_error, instance, positive, vector
 from ..imu import ImuErrors
 from ._config import ConfigMixin
 from .campaign import run_campaign
@@ -231,7 +231,9 @@ def slalom_covariance(gravity: str = "earth", *, duration: float = 60.0, attitud
         ha = np.zeros((3, 15))
         ha[:, 6:9] = np.eye(3)
         h = np.vstack([h, ha])
-        ra = positive(attitude_sigma, "attitude_sigma")**2 * np.eye(3)
+        with np.errstate(over="ignore"):
+            var = np.float64(positive(attitude_sigma, "attitude_sigma"))**2
+        ra = finite_result(var, "attitude_sigma", "the attitude variance") * np.eye(3)
         r, r_true = (np.block([[x, np.zeros((m, 3))], [np.zeros((3, m)), ra]]) for x in (r, r_true))
         cross = np.concatenate([cross, np.zeros((len(cross), 15, 3))], axis=2)
     dt = np.diff(traj.time)
