@@ -117,3 +117,17 @@ def test_wrappers_name_their_own_parameters():
                                     n_refr=1.0, seed=1)
     with pytest.raises(TypeError, match="^dcm: "):
         atomnav.rotation.quat_from_dcm("soft")
+
+
+def test_refractive_index_domain():
+    # fuzz seed 20261202: H = -1e308 m returned inf; above the model's 44.3 km ceiling the
+    # base of the power turned negative (NaN)
+    with pytest.raises(atomnav.InputError) as e:
+        atomnav._core.astro_refractive_index(height=-1e308)
+    assert e.value.parameter == "height"
+    with pytest.raises(atomnav.InputError) as e:
+        astro.refractive_index(-2e4)
+    assert e.value.parameter == "height_m"
+    assert astro.refractive_index(5e4) == 1.0
+    # n − 1 = 2.7783e-4 (1 − 2.25577e-5 H)^4.25588 at H = 1 km, by hand
+    assert abs(astro.refractive_index(1000.0) - 1.0 - 2.7783e-4 * (1 - 2.25577e-2) ** 4.25588) < 1e-15

@@ -42,3 +42,10 @@ def test_scalar_wrappers_name_their_own_parameters():
     with pytest.raises(atomnav.InputError) as e:
         earth.ellipsoid("WGS-84")
     assert e.value.parameter == "name"
+
+
+def test_navigation_rates_rows_must_match():
+    # fuzz seed 20261202: 5 positions and 3 velocities reached numpy's concatenate
+    with pytest.raises(atomnav.InputError) as e:
+        earth.navigation_rates(np.zeros((5, 3)), np.ones((3, 3)))
+    assert e.value.parameter == "vel_ned" and "5 rows" in str(e.value)

@@ -11,7 +11,7 @@ import pytest
 
 import atomnav
 from atomnav import _core
-from atomnav.noise import allan, filters
+from atomnav.noise import allan, arma, filters
 from atomnav.noise.filters import ArimaStateSpace, ArmaFilterConfig
 
 Y = np.random.default_rng(5).normal(size=200)
@@ -145,3 +145,14 @@ def test_wrong_instances_are_type_errors(call):
     # these raised AttributeError from inside the call
     with pytest.raises(TypeError, match="^(model|config|fit): expected "):
         call()
+
+
+def test_acf_lag_count_is_an_integer():
+    # fuzz seed 20261202: an empty array as nlags reached numpy's truth-value error
+    z = np.random.default_rng(0).standard_normal(200)
+    with pytest.raises(TypeError, match="^nlags: "):
+        arma.acf_pacf(z, nlags=np.array([]))
+    with pytest.raises(atomnav.InputError) as e:
+        arma.acf_pacf(z, nlags=0)
+    assert e.value.parameter == "nlags"
+    assert len(arma.acf_pacf(z, nlags=5)) == 6

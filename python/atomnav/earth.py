@@ -107,7 +107,10 @@ def schuler_period(lat: float, h: float = 0.0, ellipsoid: str = "WGS84") -> floa
 def navigation_rates(lla, vel_ned, ellipsoid: str = "WGS84") -> pd.DataFrame:
     """Earth rate ω_ie^n and transport rate ω_en^n (rad/s) in NED for each position and
     NED velocity (m/s)."""
-    x = np.hstack([rows(lla, 3, "lla"), rows(vel_ned, 3, "vel_ned")])
+    p, v = rows(lla, 3, "lla"), rows(vel_ned, 3, "vel_ned")
+    if len(v) != len(p):
+        raise input_error("vel_ned", f"expected {len(p)} rows like lla, got {len(v)}")
+    x = np.hstack([p, v])
     with renamed(lla_vel="lla"):
         r = _core.nav_rates_rows(np.ascontiguousarray(x), ellipsoid)
     cols = [f"{w}_{a}_rad_s" for w in ("earth_rate", "transport_rate") for a in ("N", "E", "D")]

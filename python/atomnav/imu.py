@@ -46,7 +46,7 @@ import numpy as np
 import pandas as pd
 
 from . import _core, units
-from ._validate import as_floats, choice, input_error, instance, rows, scalar, vector
+from ._validate import as_floats, choice, input_error, instance, renamed, rows, scalar, vector
 
 KINDS = tuple(_core.OPTIONS["ImuKind"])
 _AXES = ("x", "y", "z")
@@ -203,7 +203,8 @@ class ImuSimulator:
 
     def __init__(self, errors: ImuErrors | str, dt: float, kind: str = "rates", seed: int = 0):
         if isinstance(errors, str):
-            errors = ImuErrors.preset(errors)
+            with renamed(preset="errors"):
+                errors = ImuErrors.preset(errors)
         instance(errors, ImuErrors, "errors")
         self.kind = kind
         self.dt = scalar(dt, "dt")

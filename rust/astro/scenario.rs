@@ -88,7 +88,7 @@ pub fn vasilyuk2024_like(catalog_seed: u64, mode: GyroErrorMode) -> Result<Scena
         fov_half: 12.0 * DEG,
         m_lim: 5.6,
         sigma_s: 16.0 * ARCSEC,
-        n_refr: refractive_index(h),
+        n_refr: refractive_index(h)?,
         gyro: GyroErrorModel::vasilyuk2024(mode),
     })
 }

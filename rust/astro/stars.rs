@@ -143,9 +143,18 @@ pub fn refraction_rows(s: &[Vec3], u: &[Vec3], n: f64, apply: bool) -> Result<Ve
     Ok(s.iter().zip(u).map(|(s, u)| f(s, u, n)).collect())
 }
 
-/// n(H) = 1 + 2.7783e-4 (1 − 2.25577e-5 H)^4.25588.
-pub fn refractive_index(height: f64) -> f64 {
-    1.0 + 2.7783e-4 * (1.0 - 2.25577e-5 * height).powf(4.25588)
+/// Lowest height (m) at which [`refractive_index`] is evaluated: below the deepest land
+/// depressions the standard-atmosphere model has no meaning.
+pub const REFRACTION_MIN_HEIGHT: f64 = -1.0e4;
+
+/// n(H) = 1 + 2.7783e-4 (1 − 2.25577e-5 H)^4.25588 for a height H (m) of at least
+/// [`REFRACTION_MIN_HEIGHT`]. Above H = 1/2.25577e-5 ≈ 44.3 km the model's air density
+/// reaches zero and n = 1 (vacuum).
+pub fn refractive_index(height: f64) -> Result<f64> {
+    if !(height.is_finite() && height >= REFRACTION_MIN_HEIGHT) {
+        return Err(invalid("height", format!("must be finite and ≥ {REFRACTION_MIN_HEIGHT} m, got {height}")));
+    }
+    Ok(1.0 + 2.7783e-4 * (1.0 - 2.25577e-5 * height).max(0.0).powf(4.25588))
 }
 
 /// Remove refraction: s^rfc = n(I − uuᵀ)s + u√(1 − n²(1 − (uᵀs)²)).
@@ -394,7 +403,7 @@ mod tests {
         // Oracle: Snell's law z_obs = asin(sin z / n) for the plane-parallel atmosphere.
         // (spec §5.2 row 15 prints 32.61″, 56.49″, 97.88″; the exact Snell values for
         // n − 1 = 2.7385e-4 are 32.602″, 56.463″, 97.769″ — the printed ones are not.)
-        let n = refractive_index(150.0);
+        let n = refractive_index(150.0).unwrap();
         assert!(((n - 1.0) / 2.7385e-4 - 1.0).abs() < 1e-4);
         let u = Vec3::z();
         for zdeg in [30.0f64, 45.0, 60.0, 85.0] {

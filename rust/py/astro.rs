@@ -305,8 +305,8 @@ fn astro_refraction<'py>(py: Python<'py>, s: PyReadonlyArray2<'py, f64>, u: PyRe
 }
 
 #[pyfunction]
-fn astro_refractive_index(height_m: f64) -> f64 {
-    stars::refractive_index(height_m)
+fn astro_refractive_index(height: f64) -> PyResult<f64> {
+    Ok(stars::refractive_index(height)?)
 }
 
 #[pyfunction]

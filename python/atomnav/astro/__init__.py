@@ -215,9 +215,9 @@ def load_catalog(path) -> Catalog:
 
 
 def refractive_index(height_m: float) -> float:
-    """n(H) = 1 + 2.7783e-4 (1 − 2.25577e-5 H)^4.25588 (Vasilyuk et al. 2024; H in m).
-    Above H = 1/2.25577e-5 ≈ 44.3 km the standard-atmosphere base turns negative and the
-    result may be non-finite."""
+    """Refractive index of air at height ``height_m`` (m, ≥ −10 km):
+    n(H) = 1 + 2.7783e-4 (1 − 2.25577e-5 H)^4.25588 (Vasilyuk et al. 2024). Above
+    H = 1/2.25577e-5 ≈ 44.3 km the model's air density is zero and n = 1."""
     with renamed(height="height_m"):
         return _core.astro_refractive_index(scalar(height_m, "height_m"))
 

@@ -93,6 +93,7 @@ def acf_pacf(z, nlags: int = 40) -> pd.DataFrame:
     ±1.96/√N white-noise band. Columns: lag, acf, pacf, band."""
     from statsmodels.tsa.stattools import acf, pacf
 
+    nlags = integer(nlags, "nlags", 1)
     x = _series(z, "z", 2 * nlags + 2)
     band = 1.96 / np.sqrt(x.size)
     return pd.DataFrame({"lag": np.arange(nlags + 1), "acf": acf(x, nlags=nlags, fft=True), "pacf": pacf(x, nlags=nlags, method="ywadjusted"), "band": band})
