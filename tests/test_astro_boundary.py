@@ -131,3 +131,13 @@ def test_refractive_index_domain():
     assert astro.refractive_index(5e4) == 1.0
     # n − 1 = 2.7783e-4 (1 − 2.25577e-5 H)^4.25588 at H = 1 km, by hand
     assert abs(astro.refractive_index(1000.0) - 1.0 - 2.7783e-4 * (1 - 2.25577e-2) ** 4.25588) < 1e-15
+
+
+def test_file_names_with_nul_are_input_errors(tmp_path):
+    # fuzz seed 13: numpy's "embedded null byte" ValueError
+    for call in (lambda: astro.results.Calibration.load("\x00"), lambda: astro.load_catalog("a\x00b")):
+        with pytest.raises(atomnav.InputError) as e:
+            call()
+        assert e.value.parameter == "path"
+    with pytest.raises(TypeError, match="^path: "):
+        astro.load_catalog(3)

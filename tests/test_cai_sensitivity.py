@@ -4,6 +4,7 @@
 import numpy as np
 import pytest
 
+import atomnav
 from atomnav import cai
 
 TD, TAU = 0.010, 7.5e-6
@@ -79,3 +80,10 @@ def test_finite_pulse_offset_constant_acceleration():
     want = T**2 / cai.response_area(TD, TAU) - 1
     assert want == pytest.approx(-2.0459e-4, rel=1e-4)
     np.testing.assert_allclose(sd / conv - 1, want, rtol=1e-6)
+
+
+def test_pulse_timing_whose_area_overflows_is_named():
+    # fuzz seed 13: T_d = 1e308 s returned an infinite area
+    with pytest.raises(atomnav.InputError) as e:
+        cai.response_area(1e308, 100.0)
+    assert e.value.parameter == "t_dark"

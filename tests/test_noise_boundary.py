@@ -156,3 +156,27 @@ def test_acf_lag_count_is_an_integer():
         arma.acf_pacf(z, nlags=0)
     assert e.value.parameter == "nlags"
     assert len(arma.acf_pacf(z, nlags=5)) == 6
+
+
+def test_fit_arguments_are_typed():
+    # fuzz seeds 11 and 12: an array as the differenced flag reached numpy's truth-value
+    # error; a Layout given as the Allan table raised the Layout's own error
+    z = np.random.default_rng(0).standard_normal(200)
+    with pytest.raises(TypeError, match="^differenced: "):
+        arma.fit_arma(z, differenced=np.array([1.0, 2.0]))
+    with pytest.raises(TypeError, match="^table: "):
+        allan.fit_allan_table(atomnav.filter.engine.Layout(blocks=("position",)), 100)
+    with pytest.raises(atomnav.InputError) as e:
+        allan.fit_allan_table(allan.allan_variance(z, 1.0).drop(columns="var"), 200)
+    assert e.value.parameter == "table"
+    with pytest.raises(TypeError, match="^n_samples: "):
+        allan.fit_allan_table(allan.allan_variance(z, 1.0), False)
+
+
+def test_core_fit_flags_are_checked():
+    # fuzz seed 13: a str of 6 characters as the five term flags gave pyo3's ValueError
+    with pytest.raises(TypeError, match="^terms: "):
+        _core.allan_fit([1], np.ones(1), np.ones(1), 8, "hybrid", 0.0, 1.0)
+    with pytest.raises(atomnav.InputError) as e:
+        _core.allan_fit([1], np.ones(1), np.ones(1), 8, [True] * 6, 0.0, 1.0)
+    assert e.value.parameter == "terms"

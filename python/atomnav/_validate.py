@@ -147,6 +147,13 @@ def integer(x, name: str, low: int = 0, high: int = 2**63 - 1) -> int:
     return int(x)
 
 
+def flag(x, name: str) -> bool:
+    """``x`` as a bool (Python or numpy); anything else is a ``TypeError`` naming ``name``."""
+    if not isinstance(x, (bool, np.bool_)):
+        raise TypeError(f"{name}: expected True or False, got {type(x).__name__}")
+    return bool(x)
+
+
 def nonnegative(x, name: str) -> float:
     """``x`` as a finite float >= 0 (−0.0 becomes 0.0: numpy's samplers reject a negative-zero
     scale)."""
@@ -197,6 +204,21 @@ def generator(seed, name: str) -> np.random.Generator:
         return np.random.default_rng(seed)
     integer(seed, name, 0, 2**64 - 1)
     return np.random.default_rng(int(seed))
+
+
+def path(x, name: str = "path"):
+    """``x`` (a str or path-like) as a :class:`pathlib.Path`; another type is a ``TypeError``
+    and a name the operating system cannot take (an embedded NUL) an :class:`InputError`,
+    both naming ``name``."""
+    import os
+    from pathlib import Path
+
+    if not isinstance(x, (str, os.PathLike)):
+        raise TypeError(f"{name}: expected a str or path-like, got {type(x).__name__}")
+    p = Path(x)
+    if "\x00" in str(p):
+        raise input_error(name, "contains a NUL character, which no file name can hold")
+    return p
 
 
 def json_object(text, name: str) -> dict:

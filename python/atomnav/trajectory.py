@@ -14,7 +14,7 @@ import numpy as np
 import pandas as pd
 
 from . import _core
-from ._validate import as_floats, finite_scalar, increasing, input_error, instance, positive, rows, vector
+from ._validate import as_floats, finite_scalar, increasing, input_error, instance, path as checked_path, positive, rows, vector
 from .rotation import euler_from_quat, quat_from_euler
 
 #: Column names of a trajectory table (units in the names).
@@ -99,17 +99,17 @@ class Trajectory:
     @classmethod
     def from_csv(cls, path, ellipsoid: str = "WGS84", **read_csv_kwargs) -> "Trajectory":
         """Read a CSV with the columns of :meth:`from_dataframe`."""
-        instance(path, (str, Path), "path")
         try:
-            df = pd.read_csv(path, **read_csv_kwargs)
+            df = pd.read_csv(checked_path(path), **read_csv_kwargs)
         except (pd.errors.ParserError, pd.errors.EmptyDataError, UnicodeDecodeError) as e:
             raise input_error("path", f"not a readable CSV table: {e}") from None
         return cls.from_dataframe(df, ellipsoid)
 
     def to_csv(self, path) -> Path:
         """Write the table as CSV (the columns :meth:`from_csv` reads)."""
-        self.df.to_csv(instance(path, (str, Path), "path"), index=False)
-        return Path(path)
+        path = checked_path(path)
+        self.df.to_csv(path, index=False)
+        return path
 
     # ---- access -------------------------------------------------------------------
     def __len__(self) -> int:

@@ -28,7 +28,11 @@ impl Pulses {
         if !(tau.is_finite() && tau >= 0.0) {
             return Err(invalid("tau", format!("must be finite and >= 0, got {tau}")));
         }
-        Ok(Pulses { t_dark, tau })
+        let pulses = Pulses { t_dark, tau };
+        if !pulses.area().is_finite() {
+            return Err(invalid("t_dark", format!("pulse timing T_d = {t_dark} s, τ = {tau} s is too long: the response area overflows")));
+        }
+        Ok(pulses)
     }
 
     /// Half width of the support, T_d + 2τ (s).

@@ -3,7 +3,7 @@
 //! sensor, the aided INS and the Monte-Carlo scenarios. Conversion only: every check and
 //! loop is in `crate::cai`.
 
-use super::convert::{count, counts, register_choices, seed as seed_arg, rows, to_py_rows, vec3, vec3_rows, vec3_to_py, vec_to_py, vector, Wrap};
+use super::convert::{count, counts, flags, register_choices, seed as seed_arg, rows, to_py_rows, vec3, vec3_rows, vec3_to_py, vec_to_py, vector, Wrap};
 use super::filter::{mats, AidedSetup, PyAidedIns};
 use super::imu::triad_from_dict;
 use super::trajectory::Motion;
@@ -321,7 +321,7 @@ fn cai_ml_identify<'py>(
     phi: PyReadonlyArray1<'py, f64>,
     amp: PyReadonlyArray1<'py, f64>,
     method: Wrap<Method>,
-    free: [bool; 3],
+    free: &Bound<'py, PyAny>,
     theta0: PyReadonlyArray1<'py, f64>,
     max_iter: &Bound<'py, PyAny>,
     tol: f64,
@@ -329,7 +329,7 @@ fn cai_ml_identify<'py>(
     sliding: bool,
 ) -> PyResult<Bound<'py, PyDict>> {
     let th = vec3(&theta0, "theta0")?;
-    let cfg = MlConfig { method: method.0, free, theta0: [th.x, th.y, th.z], max_iter: count(max_iter, "max_iter", 0, MAX_ML_ITER)?, tol };
+    let cfg = MlConfig { method: method.0, free: flags(free, "free")?, theta0: [th.x, th.y, th.z], max_iter: count(max_iter, "max_iter", 0, MAX_ML_ITER)?, tol };
     let batch = count(batch, "batch", 0, usize::MAX)?;
     let (x, phi, amp) = (x.as_array().to_vec(), phi.as_array().to_vec(), amp.as_array().to_vec());
     let res = py.detach(|| ml_windows(&x, &phi, &amp, &cfg, batch, sliding))?;

@@ -216,6 +216,16 @@ pub fn index_count(obj: &Bound<'_, PyAny>, field: &str, min: usize, max: usize) 
     }
 }
 
+/// `N` flags (a sequence of bools): another type is a `TypeError` naming `field`, another
+/// length an `InputError` naming it (not pyo3's own `ValueError`).
+pub fn flags<const N: usize>(obj: &Bound<'_, PyAny>, field: &str) -> PyResult<[bool; N]> {
+    let items: Vec<bool> = obj
+        .extract()
+        .map_err(|_| PyTypeError::new_err(format!("{field}: expected a sequence of {N} bools, got {}", type_name(obj))))?;
+    let n = items.len();
+    items.try_into().map_err(|_| invalid(field, format!("expected {N} flags, got {n}")).into())
+}
+
 /// A random seed: any integer in [0, 2⁶⁴ − 1]; others are an `InputError` naming `field`
 /// (not an `OverflowError`), a non-integer a `TypeError`.
 pub fn seed(obj: &Bound<'_, PyAny>, field: &str) -> PyResult<u64> {

@@ -1,7 +1,7 @@
 //! Bindings of noise/: Allan family (batch, streaming, EDF, five-term fit), NNLS, ARIMA
 //! state space and the Kalman filters (batch, streaming, steady state).
 
-use super::convert::{counts, index_count, flat_to_py, mat, mat_to_py, register_choices, set_floats, vec_to_py, vector, Wrap};
+use super::convert::{counts, flags, index_count, flat_to_py, mat, mat_to_py, register_choices, set_floats, vec_to_py, vector, Wrap};
 use crate::error::invalid;
 use crate::noise::allan::{self, AllanResult, AllanStream, DataType, Kind, NoiseType, TauGrid, TauSet};
 use crate::noise::arma_filter::{self, Adaptive, ArimaStateSpace, ArmaFilterConfig, FilterOutput, Kalman, NoiseForm, X0, MAX_DIM};
@@ -57,14 +57,14 @@ fn allan_fit<'py>(
     tau: PyReadonlyArray1<'py, f64>,
     var: PyReadonlyArray1<'py, f64>,
     n_samples: &Bound<'py, PyAny>,
-    terms: [bool; 5],
+    terms: &Bound<'py, PyAny>,
     tau_min: f64,
     tau_max: f64,
 ) -> PyResult<Bound<'py, PyDict>> {
     let m = counts(m, "m", 1, usize::MAX)?;
     let n = vec![0; m.len()];
     let res = AllanResult { m, tau: vector(&tau, "tau")?, var: vector(&var, "var")?, n };
-    let f = allan::fit(&res, index_count(n_samples, "n_samples", 1, usize::MAX)?, terms, tau_min, tau_max)?;
+    let f = allan::fit(&res, index_count(n_samples, "n_samples", 1, usize::MAX)?, flags(terms, "terms")?, tau_min, tau_max)?;
     let d = PyDict::new(py);
     d.set_item("coeffs", f.coeffs.to_vec())?;
     set_floats(&d, &f.parameters())?;

@@ -18,12 +18,11 @@ from __future__ import annotations
 
 import warnings
 from dataclasses import dataclass
-from pathlib import Path
 
 import numpy as np
 
 from .. import _core
-from .._validate import as_floats, input_error, instance, positive, renamed, rows, scalar, vector
+from .._validate import as_floats, input_error, instance, path as checked_path, positive, renamed, rows, scalar, vector
 from .results import D17_CAVEAT, Calibration, Observations
 from .scenario import Vasilyuk2024
 
@@ -195,7 +194,7 @@ def load_catalog(path) -> Catalog:
     """A user catalog from a CSV file with header ``id,ra_deg,dec_deg,mag`` (GCRS right
     ascension and declination in degrees) or ``id,x,y,z,mag`` (unit vectors)."""
     try:
-        data = np.genfromtxt(Path(path), delimiter=",", names=True, dtype=float)
+        data = np.genfromtxt(checked_path(path), delimiter=",", names=True, dtype=float)
     except ValueError as e:  # a path with a NUL byte, or a file that is not such a CSV
         raise input_error("path", str(e)) from None
     names = set(data.dtype.names or ())

@@ -7,6 +7,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .._validate import path as checked_path
+
 D17_CAVEAT = ("P_beta is precision conditional on the IMU calibration: a constant rotation of the gyro "
               "triad is indistinguishable from a mount error (accuracy vs the nominal MF >= ~sigma_phiG/sqrt(2)).")
 
@@ -50,13 +52,13 @@ class Calibration:
     def save(self, path) -> None:
         """Save as .npz (arrays, scalars, observability, provenance, caveat)."""
         obs = {f"obs_{k}": np.asarray(v) for k, v in self.observability.items()}
-        np.savez(path, **{k: getattr(self, k) for k in _RESULT_ARRAYS}, iterations=self.iterations,
+        np.savez(checked_path(path), **{k: getattr(self, k) for k in _RESULT_ARRAYS}, iterations=self.iterations,
                  relative_misfit=self.relative_misfit, condition_number=self.condition_number, sigma_weak=self.sigma_weak,
                  gyro_error_model=self.gyro_error_model, caveat=self.caveat, **obs)
 
     @classmethod
     def load(cls, path) -> "Calibration":
-        with np.load(path, allow_pickle=False) as z:
+        with np.load(checked_path(path), allow_pickle=False) as z:
             kw = {k: z[k] for k in _RESULT_ARRAYS}
             obs = {k[4:]: (z[k].item() if z[k].ndim == 0 else z[k]) for k in z.files if k.startswith("obs_")}
             return cls(**kw, iterations=int(z["iterations"]), relative_misfit=float(z["relative_misfit"]),

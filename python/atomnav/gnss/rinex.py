@@ -14,17 +14,11 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from .._validate import input_error, instance
+from .._validate import input_error, instance, path as checked_path
 from .ephemeris import GLONASS_COLUMNS, GPS_COLUMNS, Ephemerides
 from .observations import C_LIGHT, doppler_to_rate, obs_arrays
 
 WEEK_START = datetime(2017, 1, 1)   # a Sunday: GPS week 1930
-
-
-def _path(path) -> Path:
-    """``path`` (a str or path-like) as a Path."""
-    instance(path, (str, Path), "path")
-    return Path(path)
 
 
 def _week_start(week_start) -> datetime:
@@ -41,7 +35,7 @@ def _stamp(t: datetime) -> str:
 
 def write_nav(path, eph: Ephemerides, n_leap: float = 18.0, week_start: datetime = WEEK_START) -> Path:
     """Write the broadcast sets of ``eph`` as a RINEX 3.04 mixed navigation file."""
-    path, week_start = _path(path), _week_start(week_start)
+    path, week_start = checked_path(path), _week_start(week_start)
     instance(eph, Ephemerides, "eph")
     gps, glo = eph.tables()
     lines = [f"{3.04:9.2f}{'':11}{'N: GNSS NAV DATA':20}{'M: Mixed':20}RINEX VERSION / TYPE",
@@ -65,7 +59,7 @@ def write_nav(path, eph: Ephemerides, n_leap: float = 18.0, week_start: datetime
 def write_obs(path, obs: pd.DataFrame, week_start: datetime = WEEK_START) -> Path:
     """Write an observation table (``time_s, sat, channel, code_m, rate_mps``) as a RINEX
     3.04 file with C1C (m) and D1C (Hz, D = −rate/λ_k)."""
-    path, week_start = _path(path), _week_start(week_start)
+    path, week_start = checked_path(path), _week_start(week_start)
     obs_arrays(obs)
     if not len(obs):
         raise input_error("obs", "no observations to write")
@@ -87,7 +81,7 @@ def write_obs(path, obs: pd.DataFrame, week_start: datetime = WEEK_START) -> Pat
 
 
 def _load(path, what: str):
-    path = _path(path)
+    path = checked_path(path)
     if not path.is_file():
         raise FileNotFoundError(f"{what}: no RINEX file {path}")
     try:

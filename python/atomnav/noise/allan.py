@@ -160,6 +160,11 @@ def fit_allan_table(table: pd.DataFrame, n_samples: int, terms=TERMS, tau_min: f
     weighted NNLS with weights 1/σ_j², σ_j = AVAR_j/√max(1, ⌊N/m_j⌋ − 1); only the
     named ``terms`` are free, only points with tau_min ≤ τ ≤ tau_max (s) and positive
     variance are used."""
+    instance(table, pd.DataFrame, "table")
+    missing = [c for c in ("m", "tau_s", "var") if c not in table.columns]
+    if missing:
+        raise input_error("table", f"missing column(s) {missing}; expected an allan_variance table")
+    n_samples = integer(n_samples, "n_samples", 1)
     bad = [t for t in terms if t not in TERMS]
     if bad:
         raise input_error("terms", f"unknown term {bad[0]!r}; choose from {TERMS}")

@@ -10,7 +10,7 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
-from .._validate import choice, input_error, integer, scalar, vector
+from .._validate import choice, flag, input_error, integer, scalar, vector
 
 
 def _series(x, name: str, min_len: int) -> np.ndarray:
@@ -153,6 +153,7 @@ def fit_arma(omega, order=(2, 1), differenced: bool = False, lags: int = 10) -> 
     except (TypeError, ValueError):
         raise TypeError(f"order: expected a pair of ints (p, q), got {order!r}") from None
     p, q = integer(p, "order"), integer(q, "order")
+    differenced = flag(differenced, "differenced")
     need = _min_len(p, q) + (0 if differenced else 1)
     w = _series(omega, "omega", need)
     d = w if differenced else np.diff(w)
