@@ -87,3 +87,13 @@ def test_pulse_timing_whose_area_overflows_is_named():
     with pytest.raises(atomnav.InputError) as e:
         cai.response_area(1e308, 100.0)
     assert e.value.parameter == "t_dark"
+
+
+def test_transfer_whose_phase_overflows_is_named():
+    # fuzz seed 14: T = 1e308 s made ωT/2 infinite and the transfer NaN
+    with pytest.raises(atomnav.InputError) as e:
+        cai.ideal_transfer(1e308, 51.0)
+    assert e.value.parameter == "T"
+    with pytest.raises(atomnav.InputError) as e:
+        cai.ideal_transfer(1e300, [1.0, 1e10])
+    assert (e.value.parameter, e.value.index) == ("omega", 1)

@@ -154,6 +154,12 @@ pub fn sensitivity_samples(p: &Pulses, t: &[f64]) -> Result<(Vec<f64>, Vec<f64>)
 pub fn ideal_transfers(t_sep: f64, omega: &[f64]) -> Result<Vec<f64>> {
     crate::error::check_positive("T", t_sep)?;
     crate::error::check_finite("omega", omega, 1)?;
+    if !(t_sep * t_sep).is_finite() {
+        return Err(invalid("T", format!("T = {t_sep} s is too long: T² overflows")));
+    }
+    if let Some(i) = omega.iter().position(|&w| !(0.5 * w * t_sep).is_finite()) {
+        return Err(crate::error::invalid_at("omega", i, format!("ωT/2 overflows at index {i} for T = {t_sep} s")));
+    }
     Ok(omega.iter().map(|&w| ideal_transfer(t_sep, w)).collect())
 }
 
