@@ -95,5 +95,5 @@ def test_transfer_whose_phase_overflows_is_named():
         cai.ideal_transfer(1e308, 51.0)
     assert e.value.parameter == "T"
     with pytest.raises(atomnav.InputError) as e:
-        cai.ideal_transfer(1e300, [1.0, 1e10])
+        cai.ideal_transfer(1e150, [1.0, 1e160])
     assert (e.value.parameter, e.value.index) == ("omega", 1)
