@@ -139,31 +139,43 @@ def numpy_run(t, gyro, accel, shots, phase, noise, sensor, setup, p0, vel0, q0):
     return out_v
 
 
-def main() -> None:
-    ap = argparse.ArgumentParser()
-    ap.add_argument("--runs", type=int, default=100)
-    args = ap.parse_args()
+def car_run(seconds: float = 35.0) -> dict:
+    """The inputs of one car run of ``seconds``: truth, corrupted navigation IMU, shots,
+    predicted phases and their noise, sensor and filter setup, initial state."""
     traj = an.trajectory.car(rate_hz=200.0, origin=cai.HANNOVER, ellipsoid="kinematic")
-    n = 35 * 200 + 1
+    n = int(round(seconds * 200)) + 1
     df = traj.df.iloc[:n]
     ideal = traj.ideal_imu("rates").iloc[:n]
     gcols, acols = ["gyro_x_rad_s", "gyro_y_rad_s", "gyro_z_rad_s"], ["accel_x_mps2", "accel_y_mps2", "accel_z_mps2"]
     meas = an.imu.corrupt(ideal, errors="navigation", dt=DT, kind="rates", seed=1)
     t = ideal["time_s"].to_numpy()
-    gyro, accel = meas[gcols].to_numpy(), meas[acols].to_numpy()
     sensor = cai.seed003_sensor((0.0, 0.0, 0.0), interpolation="linear", omega_dot="pwl")
-    setup = cai.seed003_filter()
     shots = sensor.shots(0.0, t[-1])
     phase = predict_phase(t, ideal[acols].to_numpy(), ideal[gcols].to_numpy(), shots, T, sensor.channels, omega_dot="pwl").total
-    noise = np.random.default_rng(2).normal(0.0, sensor.sigma_p, phase.shape)
     s0 = df.iloc[0]
-    lla0, vel0, q0 = s0[["lat_rad", "lon_rad", "h_m"]].to_numpy(float), s0[["vn_mps", "ve_mps", "vd_mps"]].to_numpy(float), s0[["qw", "qx", "qy", "qz"]].to_numpy(float)
+    return dict(df=df, t=t, gyro=meas[gcols].to_numpy(), accel=meas[acols].to_numpy(), sensor=sensor,
+                setup=cai.seed003_filter(), shots=shots, phase=phase,
+                noise=np.random.default_rng(2).normal(0.0, sensor.sigma_p, phase.shape),
+                lla0=s0[["lat_rad", "lon_rad", "h_m"]].to_numpy(float), vel0=s0[["vn_mps", "ve_mps", "vd_mps"]].to_numpy(float),
+                q0=s0[["qw", "qx", "qy", "qz"]].to_numpy(float))
 
-    def rust():
-        ins = cai.cai_aided_ins(0.0, lla0, vel0, q0, sensor, shots, phase=phase, noise=noise, setup=setup, ellipsoid="kinematic")
-        return ins.run(t, gyro, accel, progress=False)
 
-    t_rust, res = best_of(rust, 3)
+def run_atomnav(d: dict):
+    """One CAI-aided INS run of atomnav on the inputs of :func:`car_run`."""
+    ins = cai.cai_aided_ins(0.0, d["lla0"], d["vel0"], d["q0"], d["sensor"], d["shots"], phase=d["phase"],
+                            noise=d["noise"], setup=d["setup"], ellipsoid="kinematic")
+    return ins.run(d["t"], d["gyro"], d["accel"], progress=False)
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--runs", type=int, default=100)
+    args = ap.parse_args()
+    d = car_run()
+    df, t, gyro, accel, shots, phase, noise, sensor, setup, vel0, q0 = (
+        d[k] for k in ("df", "t", "gyro", "accel", "shots", "phase", "noise", "sensor", "setup", "vel0", "q0"))
+    n = len(t)
+    t_rust, res = best_of(lambda: run_atomnav(d), 3)
     t0 = time.perf_counter()
     v_np = numpy_run(t, gyro, accel, shots, phase, noise, sensor, setup, setup.p0(0), vel0, q0)
     t_np = time.perf_counter() - t0

@@ -179,28 +179,34 @@ def numpy_loop(setup):
     return np.array([lat, lon, h])
 
 
-def main():
-    ap = argparse.ArgumentParser()
-    ap.add_argument("--minutes", type=float, default=10.0)
-    ap.add_argument("--repeat", type=int, default=1)
-    args = ap.parse_args()
-    dur = 60.0 * args.minutes
-    # free vertical channel like the numpy loop (no barometric reference)
+def workload(minutes: float) -> tuple[dict, tuple, float]:
+    """The 'precise' scenario over ``minutes`` with a free vertical channel and observations
+    without atmosphere above 0° (as the numpy loop models them): (setup, IMU columns,
+    mean satellites per epoch)."""
+    dur = 60.0 * minutes
     sc = S.Scenario("precise", duration_s=dur, rate_hz=100.0, vertical="free")
     setup = S.build(sc)
-    # the numpy loop models no atmosphere and sees every satellite above 0°
     t_gnss = np.arange(1.0, dur + 1e-9, 1.0)
     idx = np.rint(t_gnss * 100.0).astype(int)
     tr = setup["trajectory"]
     setup["obs"] = simulate(setup["eph"], t_gnss, tr.lla[idx], tr.vel_ned[idx], iono=False, tropo=False, mask_deg=0.0, seed=1)
     m = setup["imu"]
     imu = (m["time_s"].to_numpy(), m[["dtheta_x_rad", "dtheta_y_rad", "dtheta_z_rad"]].to_numpy(), m[["dv_x_mps", "dv_y_mps", "dv_z_mps"]].to_numpy())
-    nsat = setup["obs"].groupby("time_s").size().mean()
+    return setup, imu, setup["obs"].groupby("time_s").size().mean()
 
-    def run_atomnav():
-        return tight_ins(setup["eph"], setup["obs"], iono=False, tropo=False, **setup["args"]).run(*imu, progress=False)
 
-    t_an, res = best_of(run_atomnav, args.repeat)
+def run_atomnav(setup: dict, imu: tuple):
+    """One tightly coupled run of atomnav on the inputs of :func:`workload`."""
+    return tight_ins(setup["eph"], setup["obs"], iono=False, tropo=False, **setup["args"]).run(*imu, progress=False)
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--minutes", type=float, default=10.0)
+    ap.add_argument("--repeat", type=int, default=1)
+    args = ap.parse_args()
+    setup, imu, nsat = workload(args.minutes)
+    t_an, res = best_of(lambda: run_atomnav(setup, imu), args.repeat)
     t_np, end = best_of(lambda: numpy_loop(setup), args.repeat)
     truth_end = setup["trajectory"].lla[-1]
     print(f"tightly coupled GNSS/INS, {args.minutes:g} min of 100 Hz IMU, 1 Hz GNSS, {nsat:.1f} satellites")
