@@ -116,17 +116,19 @@ CORE = re.compile(r"_core[.\w-]*\.so$")
 def core_instructions(callgrind_out: str) -> int:
     """Instructions executed in the ``_core`` extension: the self cost of every function
     whose object file is ``_core*.so``, from a callgrind output file (name compression
-    resolved; the inclusive cost line after each ``calls=`` is skipped)."""
+    resolved, a name being defined by whichever of ``ob=`` and ``cob=`` meets it first;
+    the inclusive cost line after each ``calls=`` is skipped)."""
     objects: dict[str, str] = {}
     in_core, skip_next, total = False, False, 0
     with open(callgrind_out) as f:
         for line in f:
-            if line.startswith("ob="):
-                m = re.match(r"ob=(\(\d+\))?\s*(.*)", line.rstrip("\n"))
+            if line.startswith(("ob=", "cob=")):  # both define compressed object names
+                m = re.match(r"c?ob=(\(\d+\))?\s*(.*)", line.rstrip("\n"))
                 ref, name = m.group(1), m.group(2)
                 if ref and name:
                     objects[ref] = name
-                in_core = bool(CORE.search(name or objects.get(ref, "")))
+                if line.startswith("ob="):
+                    in_core = bool(CORE.search(name or objects.get(ref, "")))
             elif line.startswith("calls="):
                 skip_next = True
             elif line[:1].isdigit() or line[:1] in "+-*":
