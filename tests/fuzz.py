@@ -140,9 +140,13 @@ class Target:
     owner: str | None
     params: tuple[Param, ...]
     nonfinite_documented: bool
+    owner_params: tuple[str, ...] = ()  # a method's or property's instance was built from these
 
     def param_names(self) -> set[str]:
-        return {p.name for p in self.params}
+        """Names an ``InputError`` of this call may give: its parameters and, for a method or
+        property, the constructor parameters of its instance (a field of the receiver, such
+        as a sensor's ``T``, is an input of the call too)."""
+        return {p.name for p in self.params} | set(self.owner_params)
 
 
 def _params(obj, drop_self: bool) -> tuple[Param, ...] | None:
@@ -210,6 +214,7 @@ def _class_targets(module: str, name: str, cls) -> list[Target]:
     path = f"{module}.{name}"
     out = []
     params = _params(cls, drop_self=True)
+    fields = tuple(p.name for p in params or ())
     if params is not None and not (cls.__init__ is object.__init__ and cls.__new__ is object.__new__ and not params):
         out.append(Target(path, module, name, "constructor", None, params, _doc_nonfinite(cls)))
     for attr in sorted(vars(cls)):
@@ -223,11 +228,11 @@ def _class_targets(module: str, name: str, cls) -> list[Target]:
             if p is not None:
                 out.append(Target(f"{path}.{attr}", module, q, "static", None, p, _doc_nonfinite(member, cls)))
         elif isinstance(raw, property) or inspect.isgetsetdescriptor(raw) or inspect.ismemberdescriptor(raw):
-            out.append(Target(f"{path}.{attr}", module, q, "property", path, (), _doc_nonfinite(raw, cls)))
+            out.append(Target(f"{path}.{attr}", module, q, "property", path, (), _doc_nonfinite(raw, cls), fields))
         elif inspect.isfunction(raw) or inspect.ismethoddescriptor(raw):
             p = _params(member, drop_self=True)
             if p is not None:
-                out.append(Target(f"{path}.{attr}", module, q, "method", path, p, _doc_nonfinite(member, cls)))
+                out.append(Target(f"{path}.{attr}", module, q, "method", path, p, _doc_nonfinite(member, cls), fields))
     return out
 
 

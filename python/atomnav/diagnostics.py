@@ -11,15 +11,23 @@ from . import earth, strapdown, trajectory
 from ._validate import floats, input_error, positive, renamed, scalar, vector
 
 
+#: Samples a stationary test may take: 3 days at 1 Hz, a few seconds of work.
+STATIONARY_MAX_SAMPLES = 300_000
+
+
 def stationary_errors(lat: float, hours: float, *, rate_hz: float = 10.0, h: float = 100.0, dv0=(0.0, 0.0, 0.0),
                       gyro_bias=(0.0, 0.0, 0.0), accel_bias=(0.0, 0.0, 0.0), vertical: str = "damped") -> pd.DataFrame:
     """Errors (:meth:`atomnav.trajectory.Trajectory.errors`) of a level, north-pointing INS at
     rest at latitude ``lat`` (rad) and height ``h`` (m) over ``hours``, started with NED
     velocity error ``dv0`` (m/s), with constant body-frame gyro (rad/s) and accelerometer
     (m/s²) biases. The vertical channel is held to the true height by default (baro loop).
-    The vehicle is at rest, so a low ``rate_hz`` is exact."""
+    The vehicle is at rest, so a low ``rate_hz`` is exact; ``hours × 3600 × rate_hz`` may be
+    at most :data:`STATIONARY_MAX_SAMPLES` (a 3-day test at 1 Hz)."""
     lat, h = float(floats(scalar(lat, "lat"), "lat")), float(floats(scalar(h, "h"), "h"))
     hours, rate_hz = positive(hours, "hours"), positive(rate_hz, "rate_hz")
+    if not hours * 3600.0 * rate_hz <= STATIONARY_MAX_SAMPLES:
+        raise input_error("hours", f"{hours} h at {rate_hz} Hz is more than {STATIONARY_MAX_SAMPLES} samples; "
+                                   "at rest a lower rate_hz is exact")
     gyro_bias, accel_bias = vector(gyro_bias, 3, "gyro_bias"), vector(accel_bias, 3, "accel_bias")
     dv0 = vector(dv0, 3, "dv0")
     with renamed(origin="lat", duration="hours"):

@@ -163,11 +163,14 @@ pub fn ideal_transfers(t_sep: f64, omega: &[f64]) -> Result<Vec<f64>> {
     Ok(omega.iter().map(|&w| ideal_transfer(t_sep, w)).collect())
 }
 
+/// 4 sin²(ωT/2)/ω², evaluated as T² (sin x / x)² with x = ωT/2 so that an ω whose square
+/// underflows (|ω| < 1e-154 rad/s) still gives T² instead of 0/0.
 pub fn ideal_transfer(t_sep: f64, omega: f64) -> f64 {
-    if omega == 0.0 {
+    let x = 0.5 * omega * t_sep;
+    if x == 0.0 {
         t_sep * t_sep
     } else {
-        4.0 * (0.5 * omega * t_sep).sin().powi(2) / (omega * omega)
+        t_sep * t_sep * (x.sin() / x).powi(2)
     }
 }
 

@@ -47,7 +47,11 @@ pub fn discretize_checked(f: &DMatrix<f64>, qc: &DMatrix<f64>, dt: f64, method: 
     super::matrix::check_square("f", f, None)?;
     super::matrix::check_covariance("qc", qc, Some(f.nrows()), false)?;
     crate::error::check_positive("dt", dt)?;
-    Ok(discretize(f, qc, dt, method))
+    let (phi, qd) = discretize(f, qc, dt, method);
+    if !(phi.iter().chain(qd.iter()).all(|x| x.is_finite())) {
+        return Err(crate::error::invalid("dt", format!("exp(F·dt) over dt = {dt} s exceeds the range of floats (|F|·dt too large)")));
+    }
+    Ok((phi, qd))
 }
 
 /// (Φ, Q_d) over `dt` for continuous F (n × n) and white-noise intensity Q_c = G Q Gᵀ (n × n).
@@ -72,6 +76,21 @@ pub fn discretize(f: &DMatrix<f64>, qc: &DMatrix<f64>, dt: f64, method: Discreti
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn an_overflowing_transition_names_dt() {
+        // e^(67.4 · 17.2) ≈ e^1161 is beyond f64 (e^709.8)
+        let (f, qc) = (DMatrix::from_element(1, 1, 67.42249402142612), DMatrix::from_element(1, 1, 100.0));
+        for method in [Discretization::VanLoan, Discretization::FirstOrder] {
+            let dt = if method == Discretization::VanLoan { 17.224185682635586 } else { 1e307 };
+            match discretize_checked(&f, &qc, dt, method) {
+                Err(crate::error::NavError::InvalidInput { field, .. }) => assert_eq!(field, "dt"),
+                other => panic!("{other:?}"),
+            }
+        }
+        let (phi, _) = discretize_checked(&f, &qc, 0.01, Discretization::VanLoan).unwrap();
+        assert!((phi[(0, 0)] - (67.42249402142612_f64 * 0.01).exp()).abs() < 1e-12 * phi[(0, 0)]);
+    }
 
     /// Double integrator ẋ₁ = x₂, ẋ₂ = w: Q_d = q [[Δt³/3, Δt²/2], [Δt²/2, Δt]].
     #[test]

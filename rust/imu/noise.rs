@@ -60,7 +60,7 @@ pub fn white_density(sigma: f64, dt: f64, kind: ImuKind) -> Result<f64> {
 pub fn random_walk_step_sigma(density: f64, dt: f64) -> Result<f64> {
     check_density("density", density)?;
     check_positive("dt", dt)?;
-    Ok(density * dt.sqrt())
+    finite("density", density * dt.sqrt(), &format!("density = {density}, dt = {dt} s"))
 }
 
 /// Density K of a random walk whose per-sample step has σ `step_sigma` at Δt.
@@ -93,7 +93,7 @@ pub fn gauss_markov_sigma(driving_sigma: f64, tau: f64, dt: f64) -> Result<f64> 
 pub fn gauss_markov_low_freq_asd(sigma: f64, tau: f64) -> Result<f64> {
     check_density("sigma", sigma)?;
     check_positive("tau", tau)?;
-    Ok(sigma * (2.0 * tau).sqrt())
+    finite("sigma", sigma * (2.0 * tau).sqrt(), &format!("sigma = {sigma}, tau = {tau} s"))
 }
 
 /// One-sided PSD B²/(π f) of flicker noise of bias instability B at frequency f (Hz).
@@ -282,6 +282,10 @@ mod tests {
         };
         assert_eq!(field(super::flicker_psd(1.0, 5e-324)), "f");
         assert_eq!(field(super::gauss_markov_sigma(1.0, 1e300, 5e-324)), "dt");
+        assert_eq!(field(super::gauss_markov_low_freq_asd(1e308, 3.81)), "sigma");
+        assert_eq!(field(super::random_walk_step_sigma(1e308, 100.0)), "density");
+        assert_eq!(super::random_walk_step_sigma(3.0, 4.0).unwrap_or(f64::NAN), 6.0); // K√Δt
+        assert_eq!(super::gauss_markov_low_freq_asd(3.0, 2.0).unwrap_or(f64::NAN), 6.0); // σ√(2τ)
         // a small but representable step still gives the closed form N/√Δt
         let s = super::white_sigma(2.0, 1e-6, ImuKind::Rates).unwrap_or(f64::NAN);
         assert!((s / 2000.0 - 1.0).abs() < 1e-12, "{s}");

@@ -49,6 +49,19 @@ pub fn unit_quats(field: &str, q: &[Quat]) -> Result<Vec<Quat>> {
         .collect()
 }
 
+/// Quaternions of rotation vectors `phi` (rows named `field`). A row whose angle |φ|² is
+/// not a finite float (|φ| above about 1.3e154 rad) has no defined rotation: `InvalidInput`
+/// naming `field` and that row (never a NaN row).
+pub fn quats_from_rotvecs(field: &str, phi: &[Vec3]) -> Result<Vec<Quat>> {
+    phi.iter()
+        .enumerate()
+        .map(|(i, p)| match p.norm_squared().is_finite() {
+            true => Ok(quat_from_rotvec(p)),
+            false => Err(invalid_at(field, i, format!("rotation vector {:?} at index {i} has an angle beyond the range of floats", [p.x, p.y, p.z]))),
+        })
+        .collect()
+}
+
 /// Hamilton product a ⊗ b.
 pub fn quat_mul(a: &Quat, b: &Quat) -> Quat {
     a * b
@@ -246,6 +259,18 @@ mod tests {
                 Err(crate::error::NavError::InvalidInput { field, index, .. }) => assert_eq!((field.as_str(), index), ("q", Some(1))),
                 other => panic!("{other:?}"),
             }
+        }
+    }
+
+    #[test]
+    fn quats_from_rotvecs_rejects_an_angle_beyond_floats() {
+        let half_pi = Vec3::new(0.0, 0.0, std::f64::consts::FRAC_PI_2);
+        let q = quats_from_rotvecs("rotvec", &[half_pi]).unwrap();
+        let h = std::f64::consts::FRAC_1_SQRT_2; // a quarter turn about z: [cos π/4, 0, 0, sin π/4]
+        assert!((q[0].w - h).abs() < 1e-15 && (q[0].k - h).abs() < 1e-15);
+        match quats_from_rotvecs("rotvec", &[half_pi, Vec3::new(1e-3, 1e308, -1e308)]) {
+            Err(crate::error::NavError::InvalidInput { field, index, .. }) => assert_eq!((field.as_str(), index), ("rotvec", Some(1))),
+            other => panic!("{other:?}"),
         }
     }
 }

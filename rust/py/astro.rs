@@ -234,8 +234,8 @@ fn astro_star_attitudes<'py>(
 }
 
 #[pyfunction]
-fn astro_astro_increments<'py>(py: Python<'py>, s: PyReadonlyArray3<'py, f64>, p: PyReadonlyArray3<'py, f64>) -> PyResult<(Arr3<'py>, Arr3<'py>)> {
-    let (s, p) = (mats::<3, 3>(&s, "s_vf")?, mats::<3, 3>(&p, "p_avu")?);
+fn astro_astro_increments<'py>(py: Python<'py>, s_vf: PyReadonlyArray3<'py, f64>, p_avu: PyReadonlyArray3<'py, f64>) -> PyResult<(Arr3<'py>, Arr3<'py>)> {
+    let (s, p) = (mats::<3, 3>(&s_vf, "s_vf")?, mats::<3, 3>(&p_avu, "p_avu")?);
     if s.len() != p.len() {
         return Err(invalid("p_avu", format!("expected {} covariances, got {}", s.len(), p.len())).into());
     }

@@ -163,7 +163,7 @@ struct CaiGravity(Gravity);
 impl CaiGravity {
     #[new]
     fn new(g0: PyReadonlyArray1<'_, f64>, gradient: Option<PyReadonlyArray2<'_, f64>>, t_ref: f64) -> PyResult<Self> {
-        Ok(CaiGravity(Gravity { g0: vec3(&g0, "gravity")?, gradient: gradient_tensor(gradient)?, t_ref }))
+        Ok(CaiGravity(Gravity { g0: vec3(&g0, "g0")?, gradient: gradient_tensor(gradient)?, t_ref }))
     }
 }
 

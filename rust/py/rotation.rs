@@ -34,8 +34,7 @@ fn quat_from_dcm_rows<'py>(py: Python<'py>, dcm: PyReadonlyArray3<'py, f64>) -> 
 
 #[pyfunction]
 fn quat_from_rotvec_rows<'py>(py: Python<'py>, rotvec: PyReadonlyArray2<'py, f64>) -> PyResult<Bound<'py, PyArray2<f64>>> {
-    let v = vec3_rows(&rotvec, "rotvec")?;
-    Ok(quat_to_py(py, &v.iter().map(quat_from_rotvec).collect::<Vec<_>>()))
+    Ok(quat_to_py(py, &quats_from_rotvecs("rotvec", &vec3_rows(&rotvec, "rotvec")?)?))
 }
 
 #[pyfunction]

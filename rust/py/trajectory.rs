@@ -17,8 +17,8 @@ pub struct Motion {
 }
 
 fn origin(o: &PyReadonlyArray1<'_, f64>) -> PyResult<Vec3> {
-    let v = vec3(o, "origin")?;
-    check_latitude("origin", v.x, 0)?;
+    let v = vec3(o, "origin_lla")?;
+    check_latitude("origin_lla", v.x, 0)?;
     Ok(v)
 }
 

@@ -115,9 +115,9 @@ impl Motion {
 
     /// Check that `times` are increasing and inside [0, duration].
     pub fn check_times(&self, times: &[f64]) -> Result<()> {
-        check_increasing("time", times)?;
+        check_increasing("times", times)?;
         if let Some((i, t)) = times.iter().enumerate().find(|(_, &t)| t < 0.0 || t > self.duration + 1e-9) {
-            return Err(invalid("time", format!("time {t} at index {i} is outside the motion '{}' span [0, {}] s", self.name, self.duration)));
+            return Err(invalid("times", format!("time {t} at index {i} is outside the motion '{}' span [0, {}] s", self.name, self.duration)));
         }
         Ok(())
     }

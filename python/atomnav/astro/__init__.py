@@ -204,13 +204,21 @@ def load_catalog(path) -> Catalog:
     elif {"x", "y", "z"} <= names:
         dirs = np.column_stack([data["x"], data["y"], data["z"]])
     else:
-        raise input_error("catalog", f"expected columns id,ra_deg,dec_deg,mag or id,x,y,z,mag in {path}, got {sorted(names)}")
-    dirs = rows(dirs, 3, "catalog_directions")
+        raise input_error("path", f"expected columns id,ra_deg,dec_deg,mag or id,x,y,z,mag in {path}, got {sorted(names)}")
+    if "mag" not in names or "id" not in names:
+        raise input_error("path", f"expected the columns id and mag in {path}, got {sorted(names)}")
+    with renamed(catalog_directions="path", mag="path"):  # the file's rows are at fault
+        dirs = rows(dirs, 3, "catalog_directions")
+        mags = vector(np.atleast_1d(data["mag"]), None, "mag")
     norm = np.linalg.norm(dirs, axis=1)
     bad = np.nonzero(np.abs(norm - 1.0) > 1e-9)[0]
     if bad.size:
-        raise input_error("catalog_directions", f"not a unit vector at index {bad[0]} (norm {norm[bad[0]]})", bad[0])
-    return Catalog(dirs=dirs, mags=vector(data["mag"], None, "mag"), ids=np.asarray(data["id"], dtype=np.int64))
+        raise input_error("path", f"catalog direction not a unit vector in row {bad[0]} (norm {norm[bad[0]]})", bad[0])
+    ids = np.atleast_1d(data["id"])
+    if not np.all(np.isfinite(ids) & (ids == np.round(ids))):
+        k = int(np.argmin(np.isfinite(ids) & (ids == np.round(ids))))
+        raise input_error("path", f"catalog id {ids[k]} in row {k} is not an integer", k)
+    return Catalog(dirs=dirs, mags=mags, ids=ids.astype(np.int64))
 
 
 def refractive_index(height_m: float) -> float:

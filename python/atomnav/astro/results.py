@@ -7,7 +7,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .._validate import path as checked_path
+from .._validate import input_error, path as checked_path
 
 D17_CAVEAT = ("P_beta is precision conditional on the IMU calibration: a constant rotation of the gyro "
               "triad is indistinguishable from a mount error (accuracy vs the nominal MF >= ~sigma_phiG/sqrt(2)).")
@@ -58,13 +58,18 @@ class Calibration:
 
     @classmethod
     def load(cls, path) -> "Calibration":
-        with np.load(checked_path(path), allow_pickle=False) as z:
-            kw = {k: z[k] for k in _RESULT_ARRAYS}
-            obs = {k[4:]: (z[k].item() if z[k].ndim == 0 else z[k]) for k in z.files if k.startswith("obs_")}
-            return cls(**kw, iterations=int(z["iterations"]), relative_misfit=float(z["relative_misfit"]),
-                       condition_number=float(z["condition_number"]), sigma_weak=float(z["sigma_weak"]),
-                       observability=obs,
-                       gyro_error_model=str(z["gyro_error_model"]), caveat=str(z["caveat"]))
+        import zipfile
+
+        try:
+            with np.load(checked_path(path), allow_pickle=False) as z:
+                kw = {k: z[k] for k in _RESULT_ARRAYS}
+                obs = {k[4:]: (z[k].item() if z[k].ndim == 0 else z[k]) for k in z.files if k.startswith("obs_")}
+                return cls(**kw, iterations=int(z["iterations"]), relative_misfit=float(z["relative_misfit"]),
+                           condition_number=float(z["condition_number"]), sigma_weak=float(z["sigma_weak"]),
+                           observability=obs,
+                           gyro_error_model=str(z["gyro_error_model"]), caveat=str(z["caveat"]))
+        except (ValueError, KeyError, AttributeError, TypeError, EOFError, zipfile.BadZipFile) as e:
+            raise input_error("path", f"{path} is not a calibration saved by Calibration.save ({type(e).__name__}: {e})") from None
 
 
 @dataclass(frozen=True)

@@ -32,7 +32,8 @@ JACOBIAN_PARAMS = tuple(_core.CAI_JACOBIAN_PARAMS)
 
 def k_eff(wavelength: float = LAMBDA_RB87) -> float:
     """Effective two-photon wave number 4π/λ (rad/m) of a wavelength λ (m)."""
-    return 4.0 * np.pi / positive(wavelength, "wavelength")
+    with np.errstate(over="ignore"):
+        return float(finite_result(4.0 * np.pi / np.float64(positive(wavelength, "wavelength")), "wavelength", "the wave number 4π/λ"))
 
 
 @dataclass
@@ -308,7 +309,8 @@ def t_sep_from_total(T_total: float) -> float:
 
 def total_from_t_sep(T: float) -> float:
     """Seed 000's total interrogation time T0 = 2T (s)."""
-    return 2.0 * positive(T, "T")
+    with np.errstate(over="ignore"):
+        return float(finite_result(2.0 * np.float64(positive(T, "T")), "T", "2T"))
 
 
 def scale_factors(T: float, k: float = K_RB87, v0: float = 2.8) -> dict:
@@ -338,7 +340,9 @@ def capture_limits(T: float, k: float = K_RB87, v0: float = 2.8) -> dict:
     """Largest bias errors keeping the phase error below π/2: accelerometer π/(2kT²) (m/s²),
     gyro π/(2·2kv0T²) (rad/s) (seed 000 spec §2.8)."""
     s = scale_factors(T, positive(k, "k"), positive(v0, "v0"))
-    return {"accelerometer": 0.5 * np.pi / s["acceleration"], "gyro": 0.5 * np.pi / s["sagnac"]}
+    with np.errstate(over="ignore", divide="ignore"):
+        limits = {"accelerometer": 0.5 * np.pi / np.float64(s["acceleration"]), "gyro": 0.5 * np.pi / np.float64(s["sagnac"])}
+    return {key: float(finite_result(v, "T", f"the {key} capture limit (a scale factor that underflows to 0)")) for key, v in limits.items()}
 
 
 def in_shot_noise_phase(q_accel: float, q_gyro: float, T: float, k: float = K_RB87, v0: float = 2.8) -> dict:

@@ -11,7 +11,7 @@ import numpy as np
 import pandas as pd
 
 from .. import _core
-from .._validate import finite_result, input_error, instance, positive, vector
+from .._validate import finite_result, input_error, instance, positive, renamed, vector
 from ..imu import ImuErrors
 from ._config import ConfigMixin
 from .campaign import run_campaign
@@ -205,7 +205,8 @@ def slalom_covariance(gravity: str = "earth", *, duration: float = 60.0, attitud
 
     ell = _core.cai_gravity_ellipsoid(gravity)
     sensor, setup = seed003_sensor(lever), seed003_filter()
-    traj = slalom_trajectory(rate_hz=1.0 / (2 * sensor.T), origin=HANNOVER, duration=positive(duration, "duration"), ellipsoid=ell)
+    with renamed(rate_hz="duration"):  # the shot rate is fixed: only the duration can make too many epochs
+        traj = slalom_trajectory(rate_hz=1.0 / (2 * sensor.T), origin=HANNOVER, duration=positive(duration, "duration"), ellipsoid=ell)
     imu = traj.ideal_imu("rates")
     f_b = imu[["accel_x_mps2", "accel_y_mps2", "accel_z_mps2"]].to_numpy()
     df = traj.df

@@ -17,7 +17,7 @@ import numpy as np
 
 from .. import _core
 from .._core import InputError
-from .._validate import as_floats, finite_scalar, input_error, instance, integer, nonnegative, positive, vector
+from .._validate import as_floats, finite_scalar, input_error, instance, integer, nonnegative, positive, scalar, vector
 from ._config import ConfigMixin
 from .predictor import Channels
 
@@ -72,9 +72,12 @@ class CaiSensor(ConfigMixin):
     first_shot: float = 0.0
 
     def shots(self, t0: float, t_end: float) -> np.ndarray:
-        """Shot start times (s) from t0, one per ``shot_period``, the last ending by t_end."""
-        period = 2 * self.T if self.shot_period is None else self.shot_period
-        return _core.cai_shot_times(finite_scalar(t0, "t0"), finite_scalar(t_end, "t_end"), float(self.T), float(period))
+        """Shot start times (s) from t0, one per ``shot_period``, the last ending by t_end
+        (an :class:`atomnav.InputError` naming ``T`` or ``shot_period`` when the sensor's own
+        timing is invalid)."""
+        T = scalar(self.T, "T")
+        period = 2 * T if self.shot_period is None else scalar(self.shot_period, "shot_period")
+        return _core.cai_shot_times(finite_scalar(t0, "t0"), finite_scalar(t_end, "t_end"), T, period)
 
     def n_extra(self) -> int:
         """Number of extra filter states (misalignment, lever arm, force error)."""

@@ -19,7 +19,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .. import _core
-from .._validate import as_floats, finite, finite_scalar, input_error
+from .._validate import as_floats, finite, finite_result, finite_scalar, input_error
 
 
 def _mat(x, name: str) -> np.ndarray:
@@ -100,7 +100,9 @@ def closed_loop_matrix(phi, h, gain) -> np.ndarray:
         raise input_error("h", f"expected shape ({m}, {n}) to match phi {phi.shape}, got {h.shape}")
     if gain.shape != (n, m):
         raise input_error("gain", f"expected shape ({n}, {m}) to match phi and h, got {gain.shape}")
-    return (np.eye(n) - gain @ h) @ phi
+    with np.errstate(all="ignore"):
+        out = (np.eye(n) - gain @ h) @ phi
+    return finite_result(out, "phi", "(I − KH)Φ (phi, h or gain too large)")
 
 
 def riccati_scalar(q: float, r: float, h: float) -> tuple[float, float]:

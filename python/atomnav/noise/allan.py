@@ -14,7 +14,7 @@ import numpy as np
 import pandas as pd
 
 from .. import _core, units
-from .._validate import as_floats, input_error, instance, integer, positive, probability, renamed, scalar, vector
+from .._validate import as_floats, finite_result, flag, input_error, instance, integer, positive, probability, renamed, scalar, vector
 
 #: Option names, listed (and checked) by the Rust core.
 KINDS = tuple(_core.OPTIONS["AllanKind"])
@@ -31,7 +31,7 @@ def _series(x, name: str, min_len: int = 1, check_finite: bool = True) -> np.nda
     if check_finite:
         a = vector(x, None, name)
     else:
-        a = np.ascontiguousarray(np.asarray(x, dtype=float))
+        a = np.ascontiguousarray(as_floats(x, name))
         if a.ndim != 1:
             raise input_error(name, f"expected shape (N,), got {a.shape}")
     if a.size < min_len:
@@ -223,9 +223,13 @@ def improvement_ratio(before, after, absolute: bool = False):
     ``absolute=True`` gives the paper's |M_raw − M_filt|/M_raw·100."""
     b = as_floats(before, "before")
     a = as_floats(after, "after")
+    absolute = flag(absolute, "absolute")
     if a.shape != b.shape and a.size != 1 and b.size != 1:
         raise input_error("after", f"expected the shape of before {b.shape}, got {a.shape}")
     if np.any(b == 0):
         raise input_error("before", "metric is zero, the ratio is undefined")
-    r = (b - a) / b * 100.0
+    with np.errstate(over="ignore", invalid="ignore"):
+        r = (b - a) / b * 100.0
+    if np.isfinite(a).all() and np.isfinite(b).all():  # NaN in, NaN out; finite in, finite out
+        finite_result(r, "after", "the ratio (M_raw − M_filt)/M_raw")
     return np.abs(r) if absolute else r

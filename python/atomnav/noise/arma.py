@@ -10,7 +10,7 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
-from .._validate import choice, flag, input_error, integer, scalar, vector
+from .._validate import choice, finite_result, flag, input_error, integer, scalar, vector
 
 
 def _series(x, name: str, min_len: int) -> np.ndarray:
@@ -116,6 +116,7 @@ def select_arma(d, max_p: int = 3, max_q: int = 3) -> pd.DataFrame:
     """AIC and BIC of ARMA(p, q) fits to the (already differenced) series d for every
     p ≤ max_p, q ≤ max_q (spec D3). AIC = 2n_p − 2 ln L, BIC = n_p ln n − 2 ln L, n_p
     including σ². Columns: p, q, llf, aic, bic, sorted by BIC."""
+    max_p, max_q = integer(max_p, "max_p"), integer(max_q, "max_q")
     x = _series(d, "d", _min_len(max_p, max_q))
     rows = []
     for p in range(max_p + 1):
@@ -186,7 +187,10 @@ def durbin_watson(e) -> float:
     x = vector(e, None, "e")
     if x.size < 2:
         raise input_error("e", f"series of {x.size} samples is too short; at least 2 are needed")
-    return float(dw(x))
+    if not np.any(x):
+        raise input_error("e", "every residual is zero: Σe² = 0 and DW is undefined")
+    with np.errstate(over="ignore", invalid="ignore"):
+        return float(finite_result(dw(x), "e", "Σ(e_k − e_{k−1})² / Σe_k²"))
 
 
 def ljung_box(e, lags: int = 10) -> pd.DataFrame:
@@ -194,6 +198,7 @@ def ljung_box(e, lags: int = 10) -> pd.DataFrame:
     from statsmodels.stats.diagnostic import acorr_ljungbox
 
     x = vector(e, None, "e")
+    lags = integer(lags, "lags", 1)
     if x.size <= lags + 1:
         raise input_error("e", f"series of {x.size} samples is too short for {lags} lags")
     return acorr_ljungbox(x, lags=lags)

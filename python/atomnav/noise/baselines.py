@@ -4,7 +4,11 @@ from __future__ import annotations
 
 import numpy as np
 
-from .._validate import choice, input_error, positive, vector
+from .._validate import choice, finite_result, flag, input_error, integer, positive, vector
+
+#: Highest Butterworth order taken: beyond it the second-order sections' poles crowd the unit
+#: circle and the filter is numerically meaningless for a record of this kind.
+MAX_BUTTERWORTH_ORDER = 24
 
 
 def butterworth_lowpass(omega, tau0: float, fc: float = 0.002, order: int = 2, zero_phase: bool = True) -> np.ndarray:
@@ -14,11 +18,15 @@ def butterworth_lowpass(omega, tau0: float, fc: float = 0.002, order: int = 2, z
     from scipy.signal import butter, sosfilt, sosfilt_zi, sosfiltfilt
 
     x = vector(omega, None, "omega")
-    fs = 1.0 / positive(tau0, "tau0")
+    with np.errstate(over="ignore"):
+        fs = float(finite_result(1.0 / np.float64(positive(tau0, "tau0")), "tau0", "the sample rate 1/τ₀"))
     fc = positive(fc, "fc")
+    order, zero_phase = integer(order, "order", 1, MAX_BUTTERWORTH_ORDER), flag(zero_phase, "zero_phase")
     if fc >= fs / 2:
         raise input_error("fc", f"cutoff {fc} Hz must be below the Nyquist frequency {fs / 2} Hz")
-    sos = butter(int(order), fc, fs=fs, output="sos")
+    if not 2.0 * fc / fs > 0.0:
+        raise input_error("fc", f"cutoff {fc} Hz is too small against the sample rate {fs} Hz (fc/fs underflows)")
+    sos = butter(order, fc, fs=fs, output="sos")
     if zero_phase:
         need = 3 * (2 * sos.shape[0] + 1)
         if x.size <= need:
@@ -40,6 +48,9 @@ def wavelet_denoise(omega, wavelet: str = "db4", level: int = 5, threshold: str 
         raise TypeError(f"wavelet: expected a str (a PyWavelets name), got {type(wavelet).__name__}")
     choice(threshold, ("universal",), "threshold")
     choice(mode, ("soft", "hard"), "mode")
+    if wavelet not in pywt.wavelist(kind="discrete"):
+        raise input_error("wavelet", f"unknown discrete wavelet {wavelet!r}; see pywt.wavelist(kind='discrete')")
+    level = integer(level, "level", 1)
     max_level = pywt.dwt_max_level(x.size, pywt.Wavelet(wavelet).dec_len)
     if level > max_level:
         raise input_error("omega", f"series of {x.size} samples is too short for a {level}-level {wavelet} decomposition (max {max_level})")

@@ -53,7 +53,9 @@ class ArimaStateSpace:
 
     @classmethod
     def from_arma(cls, ar, ma, sigma2: float, d: int = 1, noise_form: str = "paper") -> "ArimaStateSpace":
-        return cls(tuple(ar), tuple(ma), float(sigma2), d, noise_form)
+        """The state-space form of an ARIMA(len(ar), d, len(ma)) model (checked as the
+        constructor checks it)."""
+        return cls(ar, ma, sigma2, d, noise_form)
 
     @classmethod
     def paper(cls, noise_form: str = "paper") -> "ArimaStateSpace":

@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import numpy as np
 from .. import units
-from .._validate import instance, integer, scalar
+from .._validate import finite_result, finite_scalar, input_error, floats, generator, instance, integer, nonnegative, positive
 from .filters import PAPER_AR, PAPER_MA, PAPER_SIGMA2
 
 #: Niu et al. 2025: sample interval (s), record length, Table 2 raw mean (°/h).
@@ -27,6 +27,7 @@ def flicker(rng: np.random.Generator, n: int, sigma: float) -> np.ndarray:
     from scipy.signal import fftconvolve
 
     instance(rng, np.random.Generator, "rng")
+    n, sigma = _n(n), nonnegative(sigma, "sigma")
     j = np.arange(1, n)
     h = np.concatenate([[1.0], np.cumprod((j - 0.5) / j)])
     e = rng.normal(0.0, sigma, n)
@@ -39,11 +40,19 @@ def model_a(seed: int = 20250226, n: int = N_SAMPLES, ar=PAPER_AR, ma=PAPER_MA, 
     from scipy.signal import lfilter
 
     n = _n(n)
-    rng = np.random.default_rng(seed)
+    burn_in = integer(burn_in, "burn_in", 0, 10**8)
+    ar, ma = (np.atleast_1d(floats(v, k)) for k, v in (("ar", ar), ("ma", ma)))
+    for k, v in (("ar", ar), ("ma", ma)):
+        if v.ndim != 1:
+            raise input_error(k, f"expected a sequence of coefficients, got shape {v.shape}")
+    sigma2, mean = nonnegative(sigma2, "sigma2"), finite_scalar(mean, "mean")
+    rng = generator(seed, "seed")
     a = rng.normal(0.0, np.sqrt(sigma2), n + burn_in)
-    d = lfilter(np.r_[1.0, ma], np.r_[1.0, -np.asarray(ar, dtype=float)], a)[burn_in:]
-    w = np.cumsum(d)
-    return w - w.mean() + scalar(mean, "mean")
+    with np.errstate(all="ignore"):
+        d = lfilter(np.r_[1.0, ma], np.r_[1.0, -ar], a)[burn_in:]
+        w = np.cumsum(d)
+        w = w - w.mean() + mean
+    return finite_result(w, "ar", "the simulated rate (an explosive AR polynomial, or ma or sigma2 too large)")
 
 
 def model_b(seed: int = 105, n: int = N_SAMPLES, tau0: float = TAU0, arw: float = 0.015, flicker_b: float = 0.01, rrw: float = 0.01, ramp: float = 0.0042, mean: float = MEAN) -> np.ndarray:
@@ -51,13 +60,16 @@ def model_b(seed: int = 105, n: int = N_SAMPLES, tau0: float = TAU0, arw: float 
     random walk (``rrw`` °/h/√h) + trend (``ramp`` °/h per h), drawn in that order, then
     shifted to ``mean``. Per-sample σ of the white part: arw/√(τ₀/h)."""
     n = _n(n)
-    tau0, arw, flicker_b, rrw, ramp, mean = (scalar(v, k) for k, v in (
-        ("tau0", tau0), ("arw", arw), ("flicker_b", flicker_b), ("rrw", rrw), ("ramp", ramp), ("mean", mean)))
-    rng = np.random.default_rng(seed)
+    tau0 = positive(tau0, "tau0")
+    arw, flicker_b, rrw = (nonnegative(v, k) for k, v in (("arw", arw), ("flicker_b", flicker_b), ("rrw", rrw)))
+    ramp, mean = finite_scalar(ramp, "ramp"), finite_scalar(mean, "mean")
+    rng = generator(seed, "seed")
     hours = tau0 / units.HOUR
-    white = rng.normal(0.0, arw / np.sqrt(hours), n)
-    fl = flicker(rng, n, flicker_b)
-    rw = np.cumsum(rng.normal(0.0, rrw * np.sqrt(hours), n))
-    trend = ramp * hours * np.arange(n)
-    w = white + fl + rw + trend
-    return w - w.mean() + scalar(mean, "mean")
+    with np.errstate(all="ignore"):
+        white = rng.normal(0.0, finite_result(arw / np.sqrt(hours), "arw", "the white-noise σ per sample"), n)
+        fl = flicker(rng, n, flicker_b)
+        rw = np.cumsum(rng.normal(0.0, finite_result(rrw * np.sqrt(hours), "rrw", "the random-walk σ per sample"), n))
+        trend = ramp * hours * np.arange(n)
+        w = white + fl + rw + trend
+        w = w - w.mean() + mean
+    return finite_result(w, "tau0", "the simulated rate (τ₀, a noise level or the ramp too large)")
