@@ -30,9 +30,12 @@ def _input_error(parameter, call, index=None):
 @pytest.mark.parametrize("call, parameter", [
     # the core named its own field instead of the caller's argument
     (lambda: _core.CaiGravity(g0=np.array([5.0, 7.0]), gradient=None, t_ref=0.0), "g0"),
-    (lambda: _core.Motion.vasilyuk2024_stand(origin_lla=np.zeros(13)), "origin_lla"),
-    (lambda: _core.Motion.stationary(origin_lla=np.array([0.0]), duration=1.5, euler=np.array([0.27])), "origin_lla"),
-    (lambda: _core.Motion.vasilyuk2024_stand(origin_lla=np.array([0.99, 1.23, 1.40])).truth(times=np.array([-3.8e-4, 3.4e-5])), "times"),
+    (lambda: _core.Motion.vasilyuk2024_stand(origin=np.zeros(13)), "origin"),
+    (lambda: _core.Motion.stationary(origin=np.array([0.0]), duration=1.5, euler=np.array([0.27])), "origin"),
+    (lambda: _core.Motion.vasilyuk2024_stand(origin=np.array([0.99, 1.23, 1.40])).truth(times=np.array([-3.8e-4, 3.4e-5])), "times"),
+    # the Python wrappers name their own argument
+    (lambda: atomnav.diagnostics.schuler_test(lat=100.0), "lat"),
+    (lambda: atomnav.trajectory.stationary(10.0, origin=(3.0, 0.0, 0.0)), "origin"),
     (lambda: _core.astro_astro_increments(s_vf=np.ones((1, 1, 1)), p_avu=np.ones((1, 3, 3))), "s_vf"),
     (lambda: cai.slalom_covariance(duration=1e308), "duration"),
     # finite input, an output beyond the range of floats
@@ -46,6 +49,7 @@ def _input_error(parameter, call, index=None):
     (lambda: allan.improvement_ratio(before=0.99999, after=HUGE), "after"),
     (lambda: synth.model_a(n=900, ar=-HUGE, ma=(-0.99,), burn_in=14), "ar"),
     (lambda: synth.model_b(n=900, tau0=0.0), "tau0"),  # was NaN
+    (lambda: ArimaStateSpace.from_arma(ar=np.zeros(8), ma=HUGE, sigma2=0.001), "ma"),  # was an inf B Q Bᵀ
     (lambda: synth.model_b(n=13, flicker_b=-HUGE), "flicker_b"),  # was numpy's "scale < 0"
     (lambda: synth.model_a(seed=-1, n=900), "seed"),  # was numpy's "expected non-negative integer"
     (lambda: arma.ljung_box(e=[1.4459627328942797], lags=-HUGE), "lags"),  # was "Maximum allowed size exceeded"

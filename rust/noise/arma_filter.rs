@@ -109,6 +109,12 @@ impl ArimaStateSpace {
             }
         }
         let qd = &b * &qm * b.transpose();
+        if !phi.iter().all(|x| x.is_finite()) {
+            return Err(crate::error::invalid("ar", format!("the integrated AR polynomial (d = {d}) has coefficients beyond the range of floats")));
+        }
+        if !qd.iter().all(|x| x.is_finite()) {
+            return Err(crate::error::invalid("ma", format!("the process noise B Q Bᵀ (σ² = {sigma2}) has entries beyond the range of floats")));
+        }
         Ok(ArimaStateSpace { phi, b, q: qm, qd, sigma2 })
     }
 
@@ -544,6 +550,16 @@ mod tests {
         }
         assert!((m.qd[(0, 0)] - 0.0693035).abs() < 1e-12);
         assert_eq!(m.qd.iter().filter(|v| **v != 0.0).count(), 1);
+    }
+
+    #[test]
+    fn a_model_beyond_floats_names_its_coefficients() {
+        let field = |r: Result<ArimaStateSpace>| match r {
+            Err(crate::error::NavError::InvalidInput { field, .. }) => field,
+            other => panic!("expected InvalidInput, got {other:?}"),
+        };
+        assert_eq!(field(ArimaStateSpace::from_arma(&[0.0; 8], &[1e308], 0.001, 1, NoiseForm::Paper)), "ma");
+        assert_eq!(field(ArimaStateSpace::from_arma(&[1e308, 1e308], &[], 1.0, 3, NoiseForm::Exact)), "ar");
     }
 
     #[test]

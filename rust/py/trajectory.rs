@@ -16,9 +16,10 @@ pub struct Motion {
     pub inner: CoreMotion,
 }
 
-fn origin(o: &PyReadonlyArray1<'_, f64>) -> PyResult<Vec3> {
-    let v = vec3(o, "origin_lla")?;
-    check_latitude("origin_lla", v.x, 0)?;
+/// The `origin` argument (lat rad, lon rad, h m) of every motion constructor, checked.
+fn checked_origin(o: &PyReadonlyArray1<'_, f64>) -> PyResult<Vec3> {
+    let v = vec3(o, "origin")?;
+    check_latitude("origin", v.x, 0)?;
     Ok(v)
 }
 
@@ -42,15 +43,15 @@ impl Motion {
     }
 
     #[staticmethod]
-    fn stationary(origin_lla: PyReadonlyArray1<'_, f64>, duration: f64, euler: PyReadonlyArray1<'_, f64>) -> PyResult<Motion> {
+    fn stationary(origin: PyReadonlyArray1<'_, f64>, duration: f64, euler: PyReadonlyArray1<'_, f64>) -> PyResult<Motion> {
         crate::error::check_positive("duration", duration)?;
-        Ok(wrap(CoreMotion::stationary("stationary", origin(&origin_lla)?, duration, vec3(&euler, "euler")?)))
+        Ok(wrap(CoreMotion::stationary("stationary", checked_origin(&origin)?, duration, vec3(&euler, "euler")?)))
     }
 
     #[staticmethod]
     #[allow(clippy::too_many_arguments)]
     fn sinusoidal(
-        origin_lla: PyReadonlyArray1<'_, f64>,
+        origin: PyReadonlyArray1<'_, f64>,
         duration: f64,
         amp_ned: PyReadonlyArray1<'_, f64>,
         period_ned: PyReadonlyArray1<'_, f64>,
@@ -60,7 +61,7 @@ impl Motion {
     ) -> PyResult<Motion> {
         crate::error::check_positive("duration", duration)?;
         Ok(wrap(generators::sinusoidal(
-            origin(&origin_lla)?,
+            checked_origin(&origin)?,
             duration,
             vec3(&amp_ned, "amp_ned")?,
             vec3(&period_ned, "period_ned")?,
@@ -71,30 +72,30 @@ impl Motion {
     }
 
     #[staticmethod]
-    fn hexapod(origin_lla: PyReadonlyArray1<'_, f64>, max_tilt: f64, pitch_delay: f64, heading: f64) -> PyResult<Motion> {
-        Ok(wrap(generators::hexapod(origin(&origin_lla)?, max_tilt, pitch_delay, heading)?))
+    fn hexapod(origin: PyReadonlyArray1<'_, f64>, max_tilt: f64, pitch_delay: f64, heading: f64) -> PyResult<Motion> {
+        Ok(wrap(generators::hexapod(checked_origin(&origin)?, max_tilt, pitch_delay, heading)?))
     }
 
     #[staticmethod]
-    fn drive_with_yaw(origin_lla: PyReadonlyArray1<'_, f64>, speed: f64, yaw_rate_amp: f64, period: f64, duration: f64, heading: f64) -> PyResult<Motion> {
+    fn drive_with_yaw(origin: PyReadonlyArray1<'_, f64>, speed: f64, yaw_rate_amp: f64, period: f64, duration: f64, heading: f64) -> PyResult<Motion> {
         crate::error::check_positive("duration", duration)?;
-        Ok(wrap(generators::drive_with_yaw(origin(&origin_lla)?, speed, yaw_rate_amp, period, duration, heading)?))
+        Ok(wrap(generators::drive_with_yaw(checked_origin(&origin)?, speed, yaw_rate_amp, period, duration, heading)?))
     }
 
     #[staticmethod]
-    fn slalom(origin_lla: PyReadonlyArray1<'_, f64>, speed: f64, amp: f64, period: f64, duration: f64) -> PyResult<Motion> {
+    fn slalom(origin: PyReadonlyArray1<'_, f64>, speed: f64, amp: f64, period: f64, duration: f64) -> PyResult<Motion> {
         crate::error::check_positive("duration", duration)?;
-        Ok(wrap(generators::slalom(origin(&origin_lla)?, speed, amp, period, duration)?))
+        Ok(wrap(generators::slalom(checked_origin(&origin)?, speed, amp, period, duration)?))
     }
 
     #[staticmethod]
-    fn car(origin_lla: PyReadonlyArray1<'_, f64>, heading: f64, vibration: bool) -> PyResult<Motion> {
-        Ok(wrap(generators::car(origin(&origin_lla)?, heading, vibration)))
+    fn car(origin: PyReadonlyArray1<'_, f64>, heading: f64, vibration: bool) -> PyResult<Motion> {
+        Ok(wrap(generators::car(checked_origin(&origin)?, heading, vibration)))
     }
 
     #[staticmethod]
     fn rotary_stand(
-        origin_lla: PyReadonlyArray1<'_, f64>,
+        origin: PyReadonlyArray1<'_, f64>,
         states: PyReadonlyArray2<'_, f64>,
         move_starts: PyReadonlyArray1<'_, f64>,
         move_duration: f64,
@@ -102,12 +103,12 @@ impl Motion {
     ) -> PyResult<Motion> {
         let st: Vec<(f64, f64)> = super::convert::rows::<2>(&states, "states")?.into_iter().map(|r| (r[0], r[1])).collect();
         let ms = vector(&move_starts, "move_starts")?;
-        Ok(wrap(generators::rotary_stand(origin(&origin_lla)?, &st, &ms, move_duration, duration)?))
+        Ok(wrap(generators::rotary_stand(checked_origin(&origin)?, &st, &ms, move_duration, duration)?))
     }
 
     #[staticmethod]
-    fn vasilyuk2024_stand(origin_lla: PyReadonlyArray1<'_, f64>) -> PyResult<Motion> {
-        Ok(wrap(generators::vasilyuk2024_stand(origin(&origin_lla)?)?))
+    fn vasilyuk2024_stand(origin: PyReadonlyArray1<'_, f64>) -> PyResult<Motion> {
+        Ok(wrap(generators::vasilyuk2024_stand(checked_origin(&origin)?)?))
     }
 
     /// Truth at `times` (s, increasing, within [0, duration]): dict of arrays
