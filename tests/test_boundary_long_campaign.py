@@ -38,6 +38,7 @@ def _input_error(parameter, call, index=None):
     (lambda: atomnav.trajectory.stationary(10.0, origin=(3.0, 0.0, 0.0)), "origin"),
     (lambda: _core.astro_astro_increments(s_vf=np.ones((1, 1, 1)), p_avu=np.ones((1, 3, 3))), "s_vf"),
     (lambda: cai.slalom_covariance(duration=1e308), "duration"),
+    (lambda: cai.slalom_covariance(duration=60.0, attitude_sigma=TINY), "attitude_sigma"),  # σ² = 0 named r
     # finite input, an output beyond the range of floats
     (lambda: _core.imu_gauss_markov_low_freq_asd(sigma=HUGE, tau=3.81), "sigma"),
     (lambda: _core.imu_random_walk_step_sigma(density=HUGE, dt=100.0), "density"),

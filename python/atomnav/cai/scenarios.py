@@ -232,8 +232,10 @@ def slalom_covariance(gravity: str = "earth", *, duration: float = 60.0, attitud
         ha = np.zeros((3, 15))
         ha[:, 6:9] = np.eye(3)
         h = np.vstack([h, ha])
-        with np.errstate(over="ignore"):
+        with np.errstate(over="ignore", under="ignore"):
             var = np.float64(positive(attitude_sigma, "attitude_sigma"))**2
+        if not var > 0.0:
+            raise input_error("attitude_sigma", f"σ = {attitude_sigma} rad is so small that σ² underflows to 0 (a singular R)")
         ra = finite_result(var, "attitude_sigma", "the attitude variance") * np.eye(3)
         r, r_true = (np.block([[x, np.zeros((m, 3))], [np.zeros((3, m)), ra]]) for x in (r, r_true))
         cross = np.concatenate([cross, np.zeros((len(cross), 15, 3))], axis=2)
