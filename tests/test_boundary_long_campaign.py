@@ -13,7 +13,7 @@ from atomnav import _core, astro, cai, diagnostics, rotation
 from atomnav.cai import predictor
 from atomnav.filter import engine, riccati
 from atomnav.noise import allan, arma, baselines, synth
-from atomnav.noise.filters import ArimaStateSpace
+from atomnav.noise.filters import ArimaStateSpace, ArmaFilterConfig
 
 TINY, HUGE = 5e-324, 1e308
 
@@ -51,6 +51,7 @@ def _input_error(parameter, call, index=None):
     (lambda: synth.model_a(n=900, ar=-HUGE, ma=(-0.99,), burn_in=14), "ar"),
     (lambda: synth.model_b(n=900, tau0=0.0), "tau0"),  # was NaN
     (lambda: ArimaStateSpace.from_arma(ar=np.zeros(8), ma=HUGE, sigma2=0.001), "ma"),  # was an inf B Q Bᵀ
+    (lambda: ArmaFilterConfig(ar=np.zeros(48), ma=100.0, sigma2=20.6, r0=77.0), "ar"),  # was "model"
     (lambda: synth.model_b(n=13, flicker_b=-HUGE), "flicker_b"),  # was numpy's "scale < 0"
     (lambda: synth.model_a(seed=-1, n=900), "seed"),  # was numpy's "expected non-negative integer"
     (lambda: arma.ljung_box(e=[1.4459627328942797], lags=-HUGE), "lags"),  # was "Maximum allowed size exceeded"

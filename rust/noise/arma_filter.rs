@@ -237,6 +237,10 @@ impl ArmaFilterConfig {
     /// The filter this configuration describes (checks every field).
     pub fn build(&self, record: bool) -> Result<Kalman> {
         let model = ArimaStateSpace::from_arma(&self.ar, &self.ma, self.sigma2, self.d, self.noise_form)?;
+        if model.dim() > MAX_DIM {
+            let (p, q, d) = (self.ar.len(), self.ma.len(), self.d);
+            return Err(invalid("ar", format!("ARIMA({p},{d},{q}) needs {} filter states, more than the supported {MAX_DIM}", model.dim())));
+        }
         let mode = RMode::new(self.adaptive, self.b, self.adapt_q, self.fading)?;
         Kalman::new(&model, self.r0.unwrap_or(self.sigma2), mode, self.x0, self.p0, record)
     }
@@ -550,6 +554,17 @@ mod tests {
         }
         assert!((m.qd[(0, 0)] - 0.0693035).abs() < 1e-12);
         assert_eq!(m.qd.iter().filter(|v| **v != 0.0).count(), 1);
+    }
+
+    #[test]
+    fn a_filter_too_large_names_ar() {
+        let config = ArmaFilterConfig { ar: vec![0.0; 48], ma: vec![100.0], sigma2: 20.6, d: 1, noise_form: NoiseForm::Paper, r0: Some(77.0),
+                                        adaptive: Adaptive::Fixed, b: 0.98, adapt_q: false, fading: false, x0: X0::Zeros, p0: 1.0 };
+        match config.build(false).err() {
+            Some(crate::error::NavError::InvalidInput { field, .. }) => assert_eq!(field, "ar"),
+            other => panic!("expected InvalidInput, got {other:?}"),
+        }
+        assert!(ArmaFilterConfig { ar: vec![-0.018, 0.029], ma: vec![-0.99], ..config }.build(false).is_ok());
     }
 
     #[test]
