@@ -215,8 +215,9 @@ def load_catalog(path) -> Catalog:
     if bad.size:
         raise input_error("path", f"catalog direction not a unit vector in row {bad[0]} (norm {norm[bad[0]]})", bad[0])
     ids = np.atleast_1d(data["id"])
-    if not np.all(np.isfinite(ids) & (ids == np.round(ids))):
-        k = int(np.argmin(np.isfinite(ids) & (ids == np.round(ids))))
+    whole = np.isfinite(ids) & (ids == np.round(ids))
+    if not whole.all():
+        k = int(np.argmin(whole))
         raise input_error("path", f"catalog id {ids[k]} in row {k} is not an integer", k)
     return Catalog(dirs=dirs, mags=mags, ids=ids.astype(np.int64))
 

@@ -68,7 +68,7 @@ class Calibration:
                            condition_number=float(z["condition_number"]), sigma_weak=float(z["sigma_weak"]),
                            observability=obs,
                            gyro_error_model=str(z["gyro_error_model"]), caveat=str(z["caveat"]))
-        except (ValueError, KeyError, AttributeError, TypeError, EOFError, zipfile.BadZipFile) as e:
+        except (ValueError, KeyError, EOFError, zipfile.BadZipFile) as e:  # not an .npz, or one without our arrays
             raise input_error("path", f"{path} is not a calibration saved by Calibration.save ({type(e).__name__}: {e})") from None
 
 

@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import numpy as np
 from .. import units
-from .._validate import finite_result, finite_scalar, input_error, floats, generator, instance, integer, nonnegative, positive
+from .._validate import as_floats, finite_result, finite_scalar, generator, instance, integer, nonnegative, positive, vector
 from .filters import PAPER_AR, PAPER_MA, PAPER_SIGMA2
 
 #: Niu et al. 2025: sample interval (s), record length, Table 2 raw mean (°/h).
@@ -41,10 +41,7 @@ def model_a(seed: int = 20250226, n: int = N_SAMPLES, ar=PAPER_AR, ma=PAPER_MA, 
 
     n = _n(n)
     burn_in = integer(burn_in, "burn_in", 0, 10**8)
-    ar, ma = (np.atleast_1d(floats(v, k)) for k, v in (("ar", ar), ("ma", ma)))
-    for k, v in (("ar", ar), ("ma", ma)):
-        if v.ndim != 1:
-            raise input_error(k, f"expected a sequence of coefficients, got shape {v.shape}")
+    ar, ma = (vector(np.atleast_1d(as_floats(v, k)), None, k) for k, v in (("ar", ar), ("ma", ma)))
     sigma2, mean = nonnegative(sigma2, "sigma2"), finite_scalar(mean, "mean")
     rng = generator(seed, "seed")
     a = rng.normal(0.0, np.sqrt(sigma2), n + burn_in)
