@@ -58,6 +58,9 @@ def _input_error(parameter, call, index=None):
     (lambda: arma.durbin_watson(e=np.zeros(2)), "e"),  # was 0/0
     (lambda: baselines.butterworth_lowpass(omega=np.zeros(100), tau0=TINY, order=9), "tau0"),  # was scipy's ValueError
     (lambda: baselines.wavelet_denoise(omega=np.zeros(8), wavelet="paper_literal", level=17), "wavelet"),  # was pywt's
+    (lambda: arma.ljung_box(e=[0.0] * 13, lags=10), "e"),  # was 0/0 NaN
+    (lambda: allan.bias_stability(omega=np.array([1.7e308, -1.7e308])), "omega"),  # σ = 1.7e308·√2 = 2.4e308
+    (lambda: atomnav.trajectory.nav_table([0.0], [[0.5, 0.5, 0.0]], [[0.0, 0.0, 0.0]], [[0.0, 0.0, 0.0, 0.0]]), "q_nb"),  # was "q"
     # a 1.2-million-sample stationary run took over 10 s
     (lambda: diagnostics.stationary_errors(lat=0.99999, hours=50.55306038528544, rate_hz=6.632903781541362), "hours"),
 ])
@@ -111,3 +114,25 @@ def test_the_checked_paths_still_give_the_closed_forms():
     # model A and B keep their seeded draws (the paper's reference numbers rest on them)
     y = synth.model_a()
     assert y.shape == (synth.N_SAMPLES,) and y.mean() == pytest.approx(synth.MEAN, abs=1e-12)
+
+
+def test_bias_stability_of_rates_whose_squares_overflow():
+    # was inf: the deviations ±5e307 square beyond the range of floats; σ = 5e307·√2
+    assert allan.bias_stability(np.array([HUGE, 0.0], dtype=object)) == pytest.approx(HUGE / np.sqrt(2), rel=1e-15)
+    assert allan.bias_stability(np.array([1.0, 2.0, 4.0, 7.0]), window=2) == pytest.approx(np.std([1.5, 5.5], ddof=1), rel=1e-15)
+    assert allan.bias_stability(np.zeros(4)) == 0.0
+
+
+def test_a_heading_beyond_the_range_of_squares_still_gives_a_rotation():
+    # was a NaN quaternion named q_nb: the rotation vector's θ² overflowed
+    tr = atomnav.trajectory.drive_with_yaw(rate_hz=2.0, duration=1.0, heading=HUGE)
+    yaw = tr.df["yaw_rad"].to_numpy()
+    np.testing.assert_allclose(yaw, np.arctan2(np.sin(HUGE), np.cos(HUGE)), atol=1e-9)  # ψ = ψ₀ + k(1 − cos) stays 1e308
+
+
+def test_in_shot_noise_covers_a_shot_that_the_imu_spacing_does_not_divide():
+    # was "shots: ... outside the IMU record": the grid ended at ⌊2T/dt⌋·dt < 2T
+    sensor = cai.accelerometer_sensor(T=8.751752501183626)
+    sigma, _ = cai.in_shot_noise(sensor, dt=12.209590018062322, q_accel=88.69, q_gyro=3.0)
+    assert sigma.shape == (3, 3) and np.isfinite(sigma).all()
+    assert (np.diag(sigma) > 0).all() and np.allclose(sigma, sigma.T, rtol=1e-12)

@@ -14,7 +14,7 @@ import numpy as np
 import pandas as pd
 
 from . import _core
-from ._validate import as_floats, finite_scalar, increasing, input_error, instance, path as checked_path, positive, rows, vector
+from ._validate import as_floats, finite_scalar, increasing, input_error, instance, path as checked_path, positive, renamed, rows, vector
 from .rotation import euler_from_quat, quat_from_euler
 
 #: Column names of a trajectory table (units in the names).
@@ -33,7 +33,8 @@ MAX_SAMPLES = 100_000_000
 def nav_table(time, lla, vel_ned, q_nb) -> pd.DataFrame:
     """A trajectory / navigation-solution table from arrays (Euler angles added)."""
     q = rows(q_nb, 4, "q_nb")
-    e = euler_from_quat(q) if len(q) else np.zeros((0, 3))
+    with renamed(q="q_nb"):
+        e = euler_from_quat(q) if len(q) else np.zeros((0, 3))
     data = np.column_stack([vector(time, None, "time"), rows(lla, 3, "lla"), rows(vel_ned, 3, "vel_ned"), q, e])
     return pd.DataFrame(data, columns=COLUMNS)
 

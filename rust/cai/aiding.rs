@@ -288,7 +288,8 @@ impl CaiConfig {
     }
 
     /// In-shot IMU noise of one shot on a regular record of spacing `dt` (s), samples from
-    /// the interpolation / ω̇ window before the shot to its end (as the aiding holds them),
+    /// the interpolation / ω̇ window before the shot to the first sample at or after its end
+    /// (as the aiding holds them),
     /// white PSDs `q_a` (m²/s³), `q_g` (rad²/s): the phase covariance Σ (channels ×
     /// channels, rad²) and, for each 15-state model `f` held over a filter step of one shot,
     /// E[w δφ̂ᵀ] (15 × channels) (see `in_shot.rs`).
@@ -300,7 +301,9 @@ impl CaiConfig {
             }
         }
         let pad = self.omega_dot.pad();
-        let n = crate::error::check_count("dt", ((2.0 * self.t_sep / dt + 1e-9).floor() as usize).saturating_add(pad + 1), 2, MAX_SHOT_SAMPLES)?;
+        // enough intervals to cover the last pulse at 2T, also when dt does not divide 2T
+        let intervals = (2.0 * self.t_sep / dt - 1e-9).ceil().max(1.0);
+        let n = crate::error::check_count("dt", (intervals as usize).saturating_add(pad + 1), 2, MAX_SHOT_SAMPLES)?;
         let t: Vec<f64> = (0..n).map(|i| (i as f64 - pad as f64) * dt).collect();
         let sens = in_shot::sensitivity(&t, 0.0, &self.channels, &self.predictor())?;
         let sigma = in_shot::covariance(&t, &sens, q_a, q_g, self.channels.len());
@@ -741,6 +744,11 @@ mod tests {
         let (sigma, cross) = cfg.in_shot_noise(0.005, 1.25e-11, 1.0576e-12, &[]).unwrap();
         assert!(cross.is_empty());
         assert!((sigma[(0, 0)] / (sampled * (sa * sa + sg * sg)) - 1.0).abs() < 1e-3, "{}", sigma[(0, 0)]);
+        // a spacing that does not divide 2T, or exceeds it, still covers the whole shot
+        for dt in [0.007, 1.0] {
+            let (sigma, _) = cfg.in_shot_noise(dt, 1.25e-11, 1.0576e-12, &[]).unwrap();
+            assert!(sigma[(0, 0)].is_finite() && sigma[(0, 0)] > 0.0, "dt = {dt}: {}", sigma[(0, 0)]);
+        }
         for (dt, qa, qg, field) in [(0.0, 1.0, 1.0, "dt"), (0.005, -1.0, 1.0, "q_a"), (0.005, 1.0, f64::NAN, "q_g"), (1e-12, 1.0, 1.0, "dt")] {
             let e = cfg.in_shot_noise(dt, qa, qg, &[]).unwrap_err().to_string();
             assert!(e.starts_with(&format!("{field}:")), "{e}");

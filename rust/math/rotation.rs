@@ -86,6 +86,15 @@ pub fn quat_from_rotvec(phi: &Vec3) -> Quat {
     Quaternion::new(c, s_over_th * phi.x, s_over_th * phi.y, s_over_th * phi.z)
 }
 
+/// Quaternion of a rotation by `angle` (rad) about the unit vector `axis`. Unlike
+/// [`quat_from_rotvec`] of `axis·angle`, whose θ² overflows beyond 1.3e154 rad, it holds
+/// for every finite angle.
+#[inline]
+pub fn quat_from_axis_angle(axis: &Vec3, angle: f64) -> Quat {
+    let (s, c) = (0.5 * angle).sin_cos();
+    Quaternion::new(c, s * axis.x, s * axis.y, s * axis.z)
+}
+
 /// Rotation vector of a unit quaternion (logarithmic map), angle in [0, π].
 pub fn rotvec_from_quat(q: &Quat) -> Vec3 {
     // q and −q are the same rotation: take the representative with w ≥ 0.
@@ -260,6 +269,19 @@ mod tests {
                 other => panic!("{other:?}"),
             }
         }
+    }
+
+    #[test]
+    fn axis_angle_matches_the_rotation_vector_and_holds_for_every_finite_angle() {
+        for (axis, angle) in [(Vec3::z(), 1e-7), (Vec3::x(), -0.3), (Vec3::new(0.6, 0.0, 0.8), 2.9)] {
+            let (a, b) = (quat_from_axis_angle(&axis, angle), quat_from_rotvec(&(axis * angle)));
+            assert!((a.coords - b.coords).amax() < 1e-16, "{a:?} {b:?}");
+        }
+        // θ² overflows for a rotation vector; half the angle's cos/sin do not
+        let q = quat_from_axis_angle(&Vec3::z(), 1e308);
+        let (s, c) = (5e307f64).sin_cos();
+        assert_eq!((q.w, q.i, q.j, q.k), (c, 0.0, 0.0, s));
+        assert!(quat_from_rotvec(&(Vec3::z() * 1e308)).w.is_nan());
     }
 
     #[test]

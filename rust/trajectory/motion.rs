@@ -9,7 +9,7 @@
 use super::profile::{Eval, Profile};
 use crate::earth::Ellipsoid;
 use crate::error::{check_increasing, invalid, Result};
-use crate::math::{dcm_from_rotvec, quat_from_dcm, Mat3, Quat, Vec3};
+use crate::math::{dcm_from_quat, quat_from_axis_angle, quat_from_dcm, Mat3, Quat, Vec3};
 
 /// One elementary rotation of the attitude chain: angle θ(t) about a fixed unit axis.
 #[derive(Debug, Clone, PartialEq)]
@@ -77,7 +77,7 @@ impl Motion {
         for rot in self.attitude.iter().rev() {
             let e = rot.angle.eval(t);
             w += e.d1 * (c_nb.transpose() * rot.axis);
-            c_nb = dcm_from_rotvec(&(rot.axis * e.v)) * c_nb;
+            c_nb = dcm_from_quat(&quat_from_axis_angle(&rot.axis, e.v)) * c_nb;
         }
         Kinematics { vel, acc, c_nb, w_nb_b: w }
     }

@@ -201,4 +201,6 @@ def ljung_box(e, lags: int = 10) -> pd.DataFrame:
     lags = integer(lags, "lags", 1)
     if x.size <= lags + 1:
         raise input_error("e", f"series of {x.size} samples is too short for {lags} lags")
+    if np.all(x == x[0]):
+        raise input_error("e", "constant residuals have no autocorrelation (0/0)")
     return acorr_ljungbox(x, lags=lags)
