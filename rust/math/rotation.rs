@@ -275,7 +275,7 @@ mod tests {
     fn axis_angle_matches_the_rotation_vector_and_holds_for_every_finite_angle() {
         for (axis, angle) in [(Vec3::z(), 1e-7), (Vec3::x(), -0.3), (Vec3::new(0.6, 0.0, 0.8), 2.9)] {
             let (a, b) = (quat_from_axis_angle(&axis, angle), quat_from_rotvec(&(axis * angle)));
-            assert!((a.coords - b.coords).amax() < 1e-16, "{a:?} {b:?}");
+            assert!((a.coords - b.coords).amax() < 4.0 * f64::EPSILON, "{a:?} {b:?}"); // a few ulp: two roundings differ
         }
         // θ² overflows for a rotation vector; half the angle's cos/sin do not
         let q = quat_from_axis_angle(&Vec3::z(), 1e308);
