@@ -289,10 +289,9 @@ impl CaiConfig {
 
     /// In-shot IMU noise of one shot on a regular record of spacing `dt` (s), samples from
     /// the interpolation / ω̇ window before the shot to the first sample at or after its end
-    /// (as the aiding holds them),
-    /// white PSDs `q_a` (m²/s³), `q_g` (rad²/s): the phase covariance Σ (channels ×
-    /// channels, rad²) and, for each 15-state model `f` held over a filter step of one shot,
-    /// E[w δφ̂ᵀ] (15 × channels) (see `in_shot.rs`).
+    /// (as the aiding holds them), white PSDs `q_a` (m²/s³), `q_g` (rad²/s): the phase
+    /// covariance Σ (channels × channels, rad²) and, for each 15-state model `f` held over
+    /// a filter step of one shot, E[w δφ̂ᵀ] (15 × channels) (see `in_shot.rs`).
     pub fn in_shot_noise(&self, dt: f64, q_a: f64, q_g: f64, f: &[DMatrix<f64>]) -> Result<(DMatrix<f64>, Vec<DMatrix<f64>>)> {
         check_positive("dt", dt)?;
         for (name, q) in [("q_a", q_a), ("q_g", q_g)] {
