@@ -7,8 +7,9 @@ column names. Conventions (units, frames, signs) are in the README and in
 """
 
 from ._core import InputError, NumericalError
+from .plausibility import UnitWarning
 from . import units, rotation, earth, trajectory, strapdown, imu, diagnostics, cai, noise, filter, astro, gnss
 
 __version__ = "0.1.0"
 
-__all__ = ["InputError", "NumericalError", "units", "rotation", "earth", "trajectory", "strapdown", "imu", "diagnostics", "cai", "noise", "filter", "astro", "gnss", "__version__"]
+__all__ = ["InputError", "NumericalError", "UnitWarning", "units", "rotation", "earth", "trajectory", "strapdown", "imu", "diagnostics", "cai", "noise", "filter", "astro", "gnss", "__version__"]

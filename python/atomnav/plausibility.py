@@ -1,0 +1,306 @@
+"""Unit plausibility warnings: values that are valid numbers but implausible in their
+declared SI unit, because they were given in another unit (g for m/s², °/s for rad/s, ms
+for s, degrees for rad, nm for m, % for a fraction).
+
+Such a value passes every range check and gives a wrong answer without a word (an IMU
+table in g instead of m/s² integrates to a height error of −245 m after 10 s), so each
+check below raises a :class:`UnitWarning` naming the argument, the likely unit and the
+factor that converts it to SI. The warning goes through the standard :mod:`warnings`
+machinery and points at the user's line (the first frame outside atomnav)::
+
+    import warnings, atomnav
+    warnings.simplefilter("ignore", atomnav.UnitWarning)   # silence it
+    warnings.simplefilter("error", atomnav.UnitWarning)    # make it an exception
+
+Every threshold is a constant of this module, with the reason for its value. The checks
+read cheap statistics computed once per call (a median time step, a mean or a spread over
+at most :data:`SAMPLE_ROWS` evenly spaced rows, a maximum over the array); non-finite
+values are left to the input checks, which reject them.
+"""
+
+from __future__ import annotations
+
+import os
+import sys
+import warnings
+
+import numpy as np
+
+from . import _core, units
+
+#: Earth's rotation rate ω_ie (rad/s, WGS-84), from the core's ellipsoid constants.
+EARTH_RATE: float = _core.ellipsoid_constants("WGS84")["omega"]
+
+#: The mean specific-force magnitude of an Earth-bound record in m/s² is gravity, 9.78 to
+#: 9.83 m/s², give or take the vehicle's mean acceleration over the record. A mean in this
+#: band (m/s²) is the same record in g: 1 g at rest, up to 0.25 g more or 0.2 g less on
+#: average while moving. No SI record is there short of near free fall.
+ACCEL_G_BAND: tuple[float, float] = (0.8, 1.25)
+
+#: Largest plausible angular rate (rad/s): ≈ 2000 °/s, the full range of a consumer MEMS
+#: gyro; the fastest real platforms (spinning projectiles aside) rotate below it. A rate
+#: beyond it is in °/s.
+MAX_ANGULAR_RATE: float = 35.0
+
+#: A static gyro reads Earth rate, 7.292115e-5 rad/s; in °/s the same reading is 57.3 times
+#: larger, 4.18e-3. A static record whose mean rate is within this relative tolerance of
+#: the latter is in °/s. 15 % covers the mean of a tactical-grade gyro (ARW 0.1 °/√h, bias
+#: 1 °/h) over 100 s at 100 Hz; a navigation-grade one is within 1 %.
+EARTH_RATE_TOLERANCE: float = 0.15
+
+#: A record is static for the Earth-rate test when the RMS spread of its angular rate about
+#: the mean is below this (rad/s, ≈ 6 °/s): a tactical gyro's per-sample noise read as °/s
+#: is ≈ 0.02 at 100 Hz, while a vehicle in motion turns by more than that.
+STATIC_RATE_SPREAD: float = 0.1
+
+#: Longest plausible IMU sample interval (s): strapdown IMUs sample at 1 Hz (satellite
+#: accelerometers) or faster, so a step above 1 s is a millisecond time stamp (a 100 Hz log
+#: stamped in ms steps by 10).
+MAX_IMU_STEP: float = 1.0
+
+#: Relative tolerance of a stated IMU interval ``dt`` against the median step of the
+#: record's own time stamps: a 10 % difference is no clock jitter but a wrong ``dt`` (or a
+#: factor 1000 within it: one of the two in ms).
+STEP_TOLERANCE: float = 0.1
+
+#: Largest plausible angle (rad) for a longitude or an Euler angle: one turn, 2π. Beyond
+#: it the value is in degrees (37.6 for Moscow's longitude). A latitude in degrees beyond
+#: π/2 is already an error of the input checks.
+MAX_ANGLE: float = 2.0 * np.pi
+
+#: Longest plausible atom-interferometer pulse separation T (s): fountains and drop towers
+#: reach about 1 s, the long-baseline space proposals a few s; 10 s is beyond all of them,
+#: so a larger T is in ms (T = 100 for 100 ms).
+MAX_PULSE_SEPARATION: float = 10.0
+
+#: Longest plausible laser wavelength (m): 100 µm, beyond the far infrared of any atom
+#: interferometer (⁸⁷Rb: 780 nm). A larger "wavelength" is in nm (780.241).
+MAX_WAVELENGTH: float = 1e-4
+
+#: A fringe contrast, an offset or a probability is a fraction in [0, 1]; beyond 1 it is a
+#: percentage (contrast 50 for 50 %).
+MAX_FRACTION: float = 1.0
+
+#: A measured population is a fraction in [0, 1] plus readout noise of a few per cent
+#: (σ_p ≈ 0.03 in Tennstedt et al. 2021 and 2023); beyond 1.5 it is no noise but a
+#: percentage.
+MAX_POPULATION: float = 1.5
+
+#: Statistics of long records (means, spreads, median steps) are read from at most this
+#: many evenly spaced rows, so a check costs the same on any record length.
+SAMPLE_ROWS: int = 100_000
+
+_DEG = units.DEG
+_MS = 1e-3
+_PACKAGE = os.path.join(os.path.dirname(os.path.abspath(__file__)), "")
+
+
+class UnitWarning(UserWarning):
+    """A value is implausible in its declared unit.
+
+    Attributes
+    ----------
+    parameter : str
+        The argument of the function the user called.
+    unit : str or None
+        The unit the value most likely is in (``"g"``, ``"deg/s"``, ``"ms"``, ``"deg"``,
+        ``"nm"``, ``"%"``), None when only a contradiction is known.
+    factor : float
+        Multiply the value by this to get the declared SI unit.
+    """
+
+    def __init__(self, message: str, parameter: str, unit: str | None, factor: float):
+        super().__init__(message)
+        self.parameter, self.unit, self.factor = parameter, unit, factor
+
+    def __reduce__(self):
+        return type(self), (str(self), self.parameter, self.unit, self.factor)
+
+
+def _warn(parameter: str, quantity: str, unit: str | None, si: str, evidence: str, factor: float) -> None:
+    """Warn that ``quantity`` of argument ``parameter`` looks like ``unit`` rather than
+    ``si``, shown at the first frame outside atomnav (the user's line)."""
+    frame, level = sys._getframe(0), 1
+    while frame is not None and frame.f_code.co_filename.startswith(_PACKAGE):
+        frame, level = frame.f_back, level + 1
+    looks = f"looks like {unit}, not {si}" if unit else f"contradicts {si}"
+    message = f"{parameter}: {quantity} {looks} ({evidence}); multiply by {factor:.6g}"
+    warnings.warn(UnitWarning(message, parameter, unit, factor), stacklevel=level)
+
+
+def _sample(a: np.ndarray) -> np.ndarray:
+    """At most :data:`SAMPLE_ROWS` evenly spaced rows of ``a`` (a view)."""
+    return a[:: max(1, len(a) // SAMPLE_ROWS)]
+
+
+def _max_abs(a) -> float:
+    """Largest magnitude in ``a`` (NaN if ``a`` is empty or holds a non-finite value)."""
+    a = np.asarray(a, dtype=float)
+    if a.size == 0:
+        return np.nan
+    m = max(float(a.max()), -float(a.min()))
+    return m if np.isfinite(m) else np.nan
+
+
+def _median_step(t: np.ndarray) -> float:
+    """Median time step (s) of the first :data:`SAMPLE_ROWS` steps of ``t`` (NaN for fewer
+    than two samples or non-finite stamps)."""
+    t = np.asarray(t, dtype=float)[: SAMPLE_ROWS + 1]
+    if len(t) < 2:
+        return np.nan
+    with np.errstate(all="ignore"):
+        step = float(np.median(np.diff(t)))
+    return step if np.isfinite(step) else np.nan
+
+
+def _near(value: float, target: float, tolerance: float) -> bool:
+    return abs(value - target) <= tolerance * target
+
+
+def specific_force(f: np.ndarray, name: str, scale: float = 1.0) -> None:
+    """Warn if the specific force ``f`` (N, 3) times ``scale`` (1 for m/s², 1/Δt for Δv
+    in m/s) has a mean magnitude in :data:`ACCEL_G_BAND`: the record is in g."""
+    s = _sample(np.asarray(f, dtype=float))
+    if s.size == 0:
+        return
+    with np.errstate(all="ignore"):
+        mean = float(np.sqrt((s * s).sum(axis=1)).mean()) * scale
+    if ACCEL_G_BAND[0] <= mean <= ACCEL_G_BAND[1]:
+        _warn(name, "specific force", "g", "m/s²", f"mean |f| = {mean:.3g}, Earth's gravity is 9.8 m/s²", units.G0)
+
+
+def angular_rate(w, name: str, scale: float = 1.0, *, static: bool = False):
+    """Warn if an angular rate ``w`` (rad/s; times ``scale``, 1/Δt for Δθ in rad) exceeds
+    :data:`MAX_ANGULAR_RATE` anywhere or, with ``static`` (a full IMU record that may be
+    at rest), if it is static with a mean of 57.3 × Earth rate: it is in °/s. Returns ``w``."""
+    peak = _max_abs(w) * scale
+    if peak > MAX_ANGULAR_RATE:
+        _warn(name, "angular rate", "deg/s", "rad/s", f"max |ω| = {peak:.4g}, beyond {MAX_ANGULAR_RATE} rad/s", _DEG)
+    elif static and np.ndim(w) == 2 and len(w):
+        s = _sample(np.asarray(w, dtype=float))
+        with np.errstate(all="ignore"):
+            mean = s.mean(axis=0) * scale
+            spread = float(np.sqrt(s.var(axis=0).sum())) * scale
+        norm = float(np.sqrt(mean @ mean))
+        if spread < STATIC_RATE_SPREAD and _near(norm, EARTH_RATE / _DEG, EARTH_RATE_TOLERANCE):
+            _warn(name, "angular rate", "deg/s", "rad/s",
+                  f"static mean |ω| = {norm:.4g}, Earth rate is {EARTH_RATE:.4g} rad/s = {EARTH_RATE / _DEG:.4g} °/s", _DEG)
+    return w
+
+
+def time_steps(t, name: str):
+    """Warn if the median step of the IMU time stamps ``t`` (s) exceeds
+    :data:`MAX_IMU_STEP`: they are in ms. Returns ``t``."""
+    step = _median_step(t)
+    if step > MAX_IMU_STEP:
+        _warn(name, "time stamps", "ms", "s", f"median step {step:.4g}, an IMU samples at least every {MAX_IMU_STEP} s", _MS)
+    return t
+
+
+def sample_interval(dt, name: str):
+    """Warn if an IMU sample interval ``dt`` (s) exceeds :data:`MAX_IMU_STEP`: it is in
+    ms. Returns ``dt``."""
+    if np.isfinite(dt) and dt > MAX_IMU_STEP:
+        _warn(name, "sample interval", "ms", "s", f"{dt:.4g}, an IMU samples at least every {MAX_IMU_STEP} s", _MS)
+    return dt
+
+
+def _stated_interval(t, dt: float, name: str, dt_name: str) -> None:
+    """Warn if the stated interval ``dt`` (argument ``dt_name``) and the median step of the
+    time stamps ``t`` (argument ``name``) differ by more than :data:`STEP_TOLERANCE`,
+    naming the one in ms when they differ by a factor 1000."""
+    step = _median_step(t)
+    if not (np.isfinite(step) and step > 0 and np.isfinite(dt) and dt > 0):
+        return
+    ratio = step / dt
+    evidence = f"median time_s step {step:.4g} vs dt = {dt:.4g} s"
+    if _near(ratio, 1 / _MS, STEP_TOLERANCE):
+        _warn(name, "time stamps", "ms", "s", evidence, _MS)
+    elif _near(ratio, _MS, STEP_TOLERANCE):
+        _warn(dt_name, "sample interval", "ms", "s", evidence, _MS)
+    elif not _near(ratio, 1.0, STEP_TOLERANCE):
+        _warn(dt_name, "sample interval", None, "the time stamps", evidence, ratio)
+
+
+def imu(time, gyro, accel, kind: str, name: str = "imu", *, gyro_name: str | None = None, dt: float | None = None) -> None:
+    """All checks of one IMU record: ``time`` (N,) s or None, ``gyro`` and ``accel``
+    (N, 3) of ``kind`` ``"rates"`` (rad/s, m/s²) or ``"increments"`` (rad, m/s over the
+    sample interval). ``name`` is the argument holding the record (and its accelerations),
+    ``gyro_name`` the one holding the gyro if it differs; ``dt`` the stated sample interval
+    (s), compared with the time stamps when both are given."""
+    gyro_name = gyro_name or name
+    if time is not None and dt is not None:
+        _stated_interval(time, dt, name, "dt")
+    elif time is not None:
+        time_steps(time, name)
+    if kind == "rates":
+        scale = 1.0
+    else:
+        step = dt if dt is not None else _median_step(time) if time is not None else np.nan
+        if not (np.isfinite(step) and step > 0):
+            return  # no interval to turn increments into rates
+        scale = 1.0 / step
+    specific_force(accel, name, scale)
+    angular_rate(gyro, gyro_name, scale, static=True)
+
+
+def longitude(lon, name: str):
+    """Warn if a longitude (rad; any shape) exceeds :data:`MAX_ANGLE` in magnitude: it is
+    in degrees. Returns ``lon``."""
+    peak = _max_abs(lon)
+    if peak > MAX_ANGLE:
+        _warn(name, "longitude", "deg", "rad", f"|lon| = {peak:.4g}, beyond 2π", _DEG)
+    return lon
+
+
+def lla(p, name: str):
+    """:func:`longitude` of positions ``p`` (..., 3) of (lat rad, lon rad, h m), unless a
+    latitude is beyond ±π/2 (an input error of its own). Returns ``p``."""
+    p = np.asarray(p)
+    if p.size and p.shape[-1] == 3 and not _max_abs(p[..., 0]) > np.pi / 2:
+        longitude(p[..., 1], name)
+    return p
+
+
+def angles(a, name: str, quantity: str = "Euler angles"):
+    """Warn if any angle in ``a`` (rad) exceeds :data:`MAX_ANGLE` in magnitude: it is in
+    degrees. Returns ``a``."""
+    peak = _max_abs(a)
+    if peak > MAX_ANGLE:
+        _warn(name, quantity, "deg", "rad", f"max |angle| = {peak:.4g}, beyond 2π", _DEG)
+    return a
+
+
+def pulse_separation(T, name: str, pulses: float = 1.0):
+    """Warn if an interferometer time ``T`` (s), spanning ``pulses`` pulse separations (2
+    for a total interrogation time 2T), exceeds ``pulses`` × :data:`MAX_PULSE_SEPARATION`:
+    it is in ms. Returns ``T``."""
+    if np.isfinite(T) and T > pulses * MAX_PULSE_SEPARATION:
+        _warn(name, "pulse timing", "ms", "s", f"{T:.4g} s, beyond {pulses * MAX_PULSE_SEPARATION:g} s", _MS)
+    return T
+
+
+def wavelength(x, name: str):
+    """Warn if a laser wavelength (m) exceeds :data:`MAX_WAVELENGTH`: it is in nm. Returns
+    ``x``."""
+    if np.isfinite(x) and x > MAX_WAVELENGTH:
+        _warn(name, "wavelength", "nm", "m", f"{x:.6g} m, beyond {MAX_WAVELENGTH:g} m", 1e-9)
+    return x
+
+
+def fraction(x, name: str, quantity: str = "fraction"):
+    """Warn if a contrast, offset or probability (any shape) exceeds :data:`MAX_FRACTION`:
+    it is in %. Returns ``x``."""
+    peak = _max_abs(x)
+    if peak > MAX_FRACTION:
+        _warn(name, quantity, "%", "a fraction in [0, 1]", f"{peak:.4g}", 0.01)
+    return x
+
+
+def population(p, name: str):
+    """Warn if a measured population (any shape) exceeds :data:`MAX_POPULATION`: it is in
+    %. Returns ``p``."""
+    peak = _max_abs(p)
+    if peak > MAX_POPULATION:
+        _warn(name, "population", "%", "a fraction in [0, 1]", f"max {peak:.4g}", 0.01)
+    return p
