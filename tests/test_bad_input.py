@@ -24,13 +24,13 @@ def _integrate(traj, imu, **kw):
 
 def test_nan_sample_names_field_and_index(traj, imu):
     imu.loc[17, "dtheta_y_rad"] = np.nan
-    with pytest.raises(ValueError, match=r"gyro.*index 17"):
+    with pytest.raises(ValueError, match=r"imu: column .dtheta_y_rad.*index 17"):
         _integrate(traj, imu)
 
 
 def test_inf_sample_names_field_and_index(traj, imu):
     imu.loc[42, "dv_z_mps"] = np.inf
-    with pytest.raises(ValueError, match=r"accel.*index 42"):
+    with pytest.raises(ValueError, match=r"imu: column .dv_z_mps.*index 42"):
         _integrate(traj, imu)
 
 
@@ -128,7 +128,7 @@ def test_bad_row_in_a_later_block_leaves_the_stream_unchanged():
     bad = good.copy()
     bad.loc[10_000, "dv_y_mps"] = np.nan
     sd = an.strapdown.Strapdown(**long.initial_state())
-    with pytest.raises(ValueError, match=r"accel.*index 10000"):
+    with pytest.raises(ValueError, match=r"imu: column .dv_y_mps.*index 10000"):
         sd.run(bad)
     fresh = an.strapdown.Strapdown(**long.initial_state())
     pd.testing.assert_frame_equal(sd.run(good), fresh.run(good))

@@ -41,9 +41,9 @@ def test_bad_row_in_a_later_chunk_names_its_record_row(traj):
     imu.loc[5321, "dtheta_z_rad"] = np.inf
     sd = Strapdown(**traj.initial_state())
     sd.run(imu.iloc[:3000])
-    with pytest.raises(an.InputError, match=r"gyro.*index 5321") as info:
+    with pytest.raises(an.InputError, match=r"dtheta_z_rad.*index 5321") as info:
         sd.run(imu.iloc[3000:])
-    assert (info.value.parameter, info.value.index) == ("gyro", 5321)
+    assert (info.value.parameter, info.value.index) == ("imu", 5321)
 
 
 def test_streaming_divergence_raises_with_the_rows_before_it():

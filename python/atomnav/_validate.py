@@ -1,12 +1,32 @@
 """Input checks shared by the Python wrappers. Every failure is an
 :class:`atomnav.InputError` (a ``ValueError``) whose ``parameter`` names the argument and,
-for series, whose ``index`` is the first offending row."""
+for series, whose ``index`` is the first offending row; a wrong type is a ``TypeError``
+naming the argument (numeric strings are not numbers).
+
+Tables. Every function that takes a pandas DataFrame reads it by column name through
+:func:`table`: the order of the columns does not matter and extra columns are ignored. A
+wanted column that is missing, or that appears more than once (a duplicated name, e.g.
+from ``pd.concat``, or a MultiIndex level matching several columns), is an
+:class:`InputError` naming the argument and the column. Columns must hold numbers:
+nullable dtypes (``Float64``, ``Int64``) are read with ``pd.NA`` as NaN, which is then
+rejected like any NaN with its row in ``.index``; object, string, boolean and datetime
+columns are a ``TypeError`` naming the argument and the column.
+
+Time. A time column (``time_s``) may also be datetime64 (naive or tz-aware) or
+timedelta64. A timedelta64 is an elapsed time and converts to its seconds. A datetime64
+converts to seconds since an epoch: the function's own epoch where it has one (a
+``datetime`` ``t0`` of :func:`atomnav.strapdown.integrate`, the ``epoch`` of
+:meth:`atomnav.trajectory.Trajectory.from_dataframe`, the start of the GPS week for GNSS
+observations), else the first sample; both sides must be tz-aware or both naive, and
+tz-aware times are compared in UTC. Integer nanoseconds are never read as seconds.
+"""
 
 from __future__ import annotations
 
 from contextlib import contextmanager
 
 import numpy as np
+import pandas as pd
 
 from ._core import InputError
 
@@ -43,14 +63,153 @@ def floats(x, name: str) -> np.ndarray:
 
 
 def as_floats(x, name: str) -> np.ndarray:
-    """``x`` as a float64 array; anything that is not numbers is a ``TypeError`` naming
-    ``name``."""
-    if x is None:
-        raise TypeError(f"{name}: expected numbers, got None")
+    """``x`` as a float64 array; anything that is not numbers (None, strings even when
+    they spell numbers, datetimes, complex numbers, ragged nesting) is a ``TypeError``
+    naming ``name``. A pandas object's ``pd.NA`` becomes NaN."""
+    if x is None or isinstance(x, (str, bytes)):
+        raise TypeError(f"{name}: expected numbers, got {type(x).__name__} {x!r}")
+    if isinstance(x, (pd.Series, pd.DataFrame)):
+        frame = x.to_frame() if isinstance(x, pd.Series) else x
+        for column, values in frame.items():
+            _check_numbers(values, name, column)
+        return x.to_numpy(dtype=float, na_value=np.nan)
     try:
-        return np.asarray(x, dtype=float)
+        a = np.asarray(x)
+    except ValueError as e:  # ragged nesting
+        raise TypeError(f"{name}: expected numbers in a regular (N, ...) shape, got {type(x).__name__} ({e})") from None
+    if a.dtype.kind in "USMmcV" or (a.dtype.kind == "O" and any(isinstance(v, (str, bytes)) for v in a.flat)):
+        raise TypeError(f"{name}: expected numbers, got an array of {a.dtype}")
+    try:
+        return np.asarray(a, dtype=float)
     except (TypeError, ValueError) as e:
         raise TypeError(f"{name}: expected numbers, got {type(x).__name__} ({e})") from None
+
+
+def _check_numbers(values: pd.Series, parameter: str, column) -> None:
+    """A ``TypeError`` naming ``parameter`` and ``column`` unless the column holds numbers
+    (a numeric dtype, nullable or not, or objects that are all numbers or missing)."""
+    dtype = values.dtype
+    if pd.api.types.is_bool_dtype(dtype) or pd.api.types.is_complex_dtype(dtype):
+        ok = False
+    elif pd.api.types.is_numeric_dtype(dtype):
+        ok = True
+    else:
+        ok = dtype == object and pd.api.types.infer_dtype(values, skipna=True) in ("floating", "integer", "mixed-integer-float", "empty")
+    if not ok:
+        raise TypeError(f"{parameter}: column {column!r} holds {dtype} values, expected numbers (strings are not read as numbers)")
+
+
+#: ``epoch`` of :func:`table` for a datetime column read relative to its first sample.
+FIRST_SAMPLE = "first sample"
+
+
+def timestamp(x):
+    """``x`` as a :class:`pandas.Timestamp` if it is a point in time (``datetime``,
+    ``numpy.datetime64``, ``pandas.Timestamp``), else None (a number of seconds)."""
+    import datetime
+
+    if isinstance(x, (datetime.datetime, np.datetime64)):
+        return pd.Timestamp(x)
+    return None
+
+
+def _utc_naive(t, tz_aware: bool, parameter: str, what: str):
+    """Datetimes ``t`` (a Series or a Timestamp) as naive UTC; a naive value where a
+    tz-aware one is compared (or the reverse) is an :class:`InputError` naming ``parameter``."""
+    aware = (t.dt.tz if isinstance(t, pd.Series) else t.tz) is not None
+    if aware != tz_aware:
+        raise input_error(parameter, f"{what} is {'tz-aware' if aware else 'naive'} but the time it is compared with is not: "
+                                     "give both with a time zone or both without")
+    if not aware:
+        return t
+    return t.dt.tz_convert("UTC").dt.tz_localize(None) if isinstance(t, pd.Series) else t.tz_convert("UTC").tz_localize(None)
+
+
+def seconds(values: pd.Series, parameter: str, column, epoch=FIRST_SAMPLE, epoch_name: str = "epoch") -> np.ndarray:
+    """A time column as float seconds (NaN where missing): numbers as they are,
+    timedelta64 as its seconds, datetime64 as seconds since ``epoch`` (a datetime, or
+    :data:`FIRST_SAMPLE`; None: datetimes are refused with a ``TypeError``, this caller has
+    no epoch). Other dtypes are a ``TypeError`` naming ``parameter`` and ``column``;
+    ``epoch_name`` names the epoch's argument in errors."""
+    dtype = values.dtype
+    if pd.api.types.is_timedelta64_dtype(dtype):
+        return _timedelta_seconds(values.to_numpy())
+    if not pd.api.types.is_datetime64_any_dtype(dtype):
+        _check_numbers(values, parameter, column)
+        return values.to_numpy(dtype=float, na_value=np.nan)
+    if epoch is None:
+        raise TypeError(f"{parameter}: column {column!r} holds datetimes, which this call cannot place in time; "
+                        "give seconds (or a timedelta64) instead")
+    tz_aware = isinstance(dtype, pd.DatetimeTZDtype)
+    if epoch is FIRST_SAMPLE:
+        present = values.dropna()
+        if present.empty:  # nothing to place in time: every row is missing
+            return np.full(len(values), np.nan)
+        epoch, epoch_name = present.iloc[0], parameter
+    t = _utc_naive(values, tz_aware, parameter, f"column {column!r}")
+    ref = _utc_naive(pd.Timestamp(epoch), tz_aware, epoch_name, epoch_name)
+    return _timedelta_seconds(t.to_numpy() - ref.to_datetime64())
+
+
+def _timedelta_seconds(d: np.ndarray) -> np.ndarray:
+    """timedelta64 values as float seconds, NaN for NaT (one correctly rounded division of
+    the integer count by the unit's count per second)."""
+    unit, count = np.datetime_data(d.dtype)
+    per_second = np.timedelta64(1, "s") / np.timedelta64(count, unit)
+    out = d.view(np.int64) / per_second
+    out[np.isnat(d)] = np.nan
+    return out
+
+
+def table(df, names, parameter: str, *, order: str = "C", epoch=FIRST_SAMPLE, epoch_name: str = "epoch",
+          time=("time_s",), finite: bool = True) -> np.ndarray:
+    """The columns ``names`` of DataFrame ``df`` (argument ``parameter``) as one float64
+    array (N, len(names)) in memory ``order`` ("C" or "F"), read by name (module
+    docstring: extra columns ignored; missing, duplicated or ambiguous columns an
+    :class:`InputError`; non-numbers a ``TypeError``). Columns named in ``time`` convert
+    through :func:`seconds` with ``epoch``. With ``finite``, a NaN (also ``pd.NA``) or inf
+    is an :class:`InputError` naming the column, its row in ``.index``."""
+    instance(df, pd.DataFrame, parameter)
+    where = locate(df, names, parameter)
+    if all(df.dtypes.iloc[k] == np.float64 for k in where):  # plain floats: one block read, often without a copy
+        out = np.asarray(df.iloc[:, where].to_numpy(dtype=np.float64), order=order)
+    else:
+        out = np.empty((len(df), len(names)), order=order)
+        for j, (name, k) in enumerate(zip(names, where)):
+            values = df.iloc[:, k]
+            out[:, j] = seconds(values, parameter, name, epoch, epoch_name) if name in time else _numbers(values, parameter, name)
+    if finite:
+        for j, name in enumerate(names):
+            bad = np.flatnonzero(~np.isfinite(out[:, j]))
+            if bad.size:
+                raise input_error(parameter, f"column {name!r}: non-finite value {out[bad[0], j]} at index {bad[0]}", bad[0])
+    return out
+
+
+def _numbers(values: pd.Series, parameter: str, column) -> np.ndarray:
+    _check_numbers(values, parameter, column)
+    return values.to_numpy(dtype=float, na_value=np.nan)
+
+
+def locate(df: pd.DataFrame, names, parameter: str) -> list[int]:
+    """The positions of columns ``names`` in ``df``: a missing column, or one whose name
+    matches several columns, is an :class:`InputError` naming ``parameter`` (and listing
+    the columns expected, or the ambiguous one)."""
+    where, missing = [], []
+    for name in names:
+        try:
+            k = df.columns.get_loc(name)
+        except KeyError:
+            missing.append(name)
+            continue
+        if not isinstance(k, (int, np.integer)):  # a slice or a mask of the matching columns
+            count = len(range(len(df.columns))[k]) if isinstance(k, slice) else int(np.count_nonzero(k))
+            raise input_error(parameter, f"column {name!r} is ambiguous: {count} columns match it (a duplicated name, e.g. "
+                                         "from pd.concat, or a MultiIndex level); keep exactly one")
+        where.append(int(k))
+    if missing:
+        raise input_error(parameter, f"missing column(s) {missing}; expected {list(names)} (extra columns are ignored)")
+    return where
 
 
 def rows(x, width: int, name: str) -> np.ndarray:

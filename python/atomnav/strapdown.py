@@ -14,12 +14,13 @@ Options by name are checked by the core; their accepted names are
 from __future__ import annotations
 
 from collections.abc import Mapping
+from contextlib import contextmanager
 
 import numpy as np
 import pandas as pd
 
 from . import _core
-from ._validate import as_floats, input_error, rows, scalar, vector
+from ._validate import as_floats, flag, input_error, rows, scalar, table, timestamp, vector
 from .trajectory import COLUMNS, IMU_COLUMNS
 
 #: Rows per call into Rust: the progress bar's granularity for long runs.
@@ -33,22 +34,42 @@ def _table(columns: np.ndarray, first_row: int = 0) -> pd.DataFrame:
     return pd.DataFrame(columns.T, columns=COLUMNS, index=index, copy=False)
 
 
-def _imu_arrays(imu, kind: str):
+def _imu_arrays(imu, kind: str, epoch=None):
     """(time, gyro, accel) views of an IMU table of the given kind, in one Fortran-ordered
-    array so the core reads each in place. Only shapes are checked here: the core checks
-    values (NaN/inf, time order) once, with indices in the record."""
-    cols = IMU_COLUMNS[kind]
+    array so the core reads each in place. A DataFrame is read by column name once per
+    call (a datetime ``time_s`` as seconds since ``epoch``, None: refused); an array must
+    have the columns of ``IMU_COLUMNS[kind]`` in that order. Only shapes and types are
+    checked here: the core checks values (NaN/inf, time order) once, with indices in the
+    record, and :func:`_imu_errors` names the column."""
     if isinstance(imu, pd.DataFrame):
-        missing = [c for c in cols if c not in imu.columns]
-        if missing:
-            raise input_error("imu", f"missing column(s) {missing} for kind={kind!r} (expected {cols})")
-        a = imu[cols].to_numpy(float)
+        a = table(imu, IMU_COLUMNS[kind], "imu", order="F", epoch=epoch, epoch_name="t0", finite=False)
     else:
         a = as_floats(imu, "imu")
         if a.ndim != 2 or a.shape[1] != 7:
-            raise input_error("imu", f"expected shape (N, 7), got {a.shape}")
-    a = np.asfortranarray(a)
+            raise input_error("imu", f"expected shape (N, 7) with the columns {IMU_COLUMNS[kind]} in this order, got {a.shape}")
+        a = np.asfortranarray(a)
     return a[:, 0], a[:, 1:4], a[:, 4:7]
+
+
+@contextmanager
+def _imu_errors(kind: str, gyro: np.ndarray, accel: np.ndarray, first_row: int):
+    """The core's errors about the IMU arrays (``time``, ``gyro``, ``accel``, rows of the
+    record from ``first_row``) name the caller's argument ``imu`` and, in the message, the
+    offending column."""
+    try:
+        yield
+    except _core.InputError as e:
+        field = getattr(e, "parameter", None)
+        if field not in ("time", "gyro", "accel"):
+            raise
+        cols = IMU_COLUMNS[kind]
+        names, block = {"time": (cols[:1], None), "gyro": (cols[1:4], gyro), "accel": (cols[4:7], accel)}[field]
+        row = None if e.index is None else e.index - first_row
+        if block is not None and row is not None and 0 <= row < len(block) and not np.isfinite(block[row]).all():
+            names = [names[int(np.flatnonzero(~np.isfinite(block[row]))[0])]]
+        msg = str(e)
+        reason = msg[len(field) + 2:] if msg.startswith(f"{field}: ") else msg
+        raise input_error("imu", f"column {names[0]!r}: {reason}" if len(names) == 1 else f"columns {names}: {reason}", e.index) from None
 
 
 def _h_ref(h_ref, n: int):
@@ -75,6 +96,12 @@ class Strapdown:
     """Streaming strapdown INS from an initial state: time ``t0`` (s), ``lla`` (lat rad,
     lon rad, h m), NED velocity ``vel_ned`` (m/s) and attitude ``q_nb`` (scalar first).
 
+    ``t0`` may instead be a datetime (``pandas.Timestamp``, ``datetime``,
+    ``numpy.datetime64``): it is then the epoch, IMU tables may carry a datetime64
+    ``time_s`` column (both tz-aware or both naive), and every time in and out is in
+    seconds since ``t0`` (the solution starts at ``time_s`` 0). With a ``t0`` in seconds a
+    datetime64 ``time_s`` is a ``TypeError``; a timedelta64 one is read as seconds either way.
+
     Parameters
     ----------
     kind : str
@@ -96,7 +123,9 @@ class Strapdown:
 
     def __init__(self, t0, lla, vel_ned, q_nb, *, kind: str = "increments", ellipsoid: str = "WGS84",
                  vertical: str = "free", zeta: float | None = None, omega: float | None = None):
-        self._core = _core.Strapdown(scalar(t0, "t0"), vector(lla, 3, "lla"), vector(vel_ned, 3, "vel_ned"),
+        #: The datetime of time 0 when ``t0`` was given as a datetime, else None.
+        self.epoch = timestamp(t0)
+        self._core = _core.Strapdown(0.0 if self.epoch is not None else scalar(t0, "t0"), vector(lla, 3, "lla"), vector(vel_ned, 3, "vel_ned"),
                                      vector(q_nb, 4, "q_nb"), kind=kind, ellipsoid=ellipsoid, vertical=vertical,
                                      zeta=None if zeta is None else scalar(zeta, "zeta"),
                                      omega=None if omega is None else scalar(omega, "omega"))
@@ -114,7 +143,10 @@ class Strapdown:
         ----------
         imu : DataFrame or array (N, 7)
             IMU table with the columns of :data:`atomnav.trajectory.IMU_COLUMNS` for this
-            object's kind (time s, gyro, accel).
+            object's kind (time s, gyro, accel). A DataFrame is read by column name (any
+            order, extra columns ignored; ``time_s`` may be datetime64 when ``t0`` is a
+            datetime, or timedelta64). A plain array is accepted only with exactly these
+            seven columns in exactly this order: time, gyro x/y/z, accel x/y/z.
         h_ref : array (N,), optional
             Reference altitude (m) per row, required with ``vertical="damped"``.
 
@@ -126,16 +158,20 @@ class Strapdown:
         Raises
         ------
         InputError
-            For a bad row (its record row in ``.index``); the state is left unchanged.
+            ``parameter == "imu"`` for a bad row (its record row in ``.index``, the column
+            in the message); the state is left unchanged.
+        TypeError
+            For a column that does not hold numbers (strings included).
         NumericalError
             If the solution diverges: ``.partial`` holds the rows computed before it (as
             this method would return them), ``.row`` and ``.time_s`` (s) name the sample
             at which it diverged. Restart with :meth:`reset`.
         """
-        t, g, a = _imu_arrays(imu, self.kind)
+        t, g, a = _imu_arrays(imu, self.kind, self.epoch)
         first = self._rows
         try:
-            table = self._core.run(t, g, a, _h_ref(h_ref, len(t)), first)
+            with _imu_errors(self.kind, g, a, first):
+                table = self._core.run(t, g, a, _h_ref(h_ref, len(t)), first)
         except _core.NumericalError as err:
             self._rows = first + err.rows + 1
             raise _diverged(err, err.table, err.rows, first, t) from None
@@ -189,9 +225,12 @@ def integrate(imu, t0, lla, vel_ned, q_nb, *, kind: str = "increments", ellipsoi
     Parameters
     ----------
     imu : DataFrame or array (N, 7)
-        IMU table (see :meth:`Strapdown.run`).
+        IMU table, read by column name (see :meth:`Strapdown.run`); a plain array only in
+        the column order of ``atomnav.trajectory.IMU_COLUMNS[kind]``: time, gyro x/y/z,
+        accel x/y/z.
     t0, lla, vel_ned, q_nb
-        Initial state: time (s); lat (rad), lon (rad), h (m); NED velocity (m/s); q_nb.
+        Initial state: time (s, or a datetime: the epoch of a datetime64 ``time_s``, see
+        :class:`Strapdown`); lat (rad), lon (rad), h (m); NED velocity (m/s); q_nb.
     kind, ellipsoid, vertical, zeta, omega
         As for :class:`Strapdown`.
     h_ref : array (N,), optional
@@ -212,9 +251,9 @@ def integrate(imu, t0, lla, vel_ned, q_nb, *, kind: str = "increments", ellipsoi
         ``.row`` and ``.time_s`` (s) name the sample at which it diverged.
     """
     sd = Strapdown(t0, lla, vel_ned, q_nb, kind=kind, ellipsoid=ellipsoid, vertical=vertical, zeta=zeta, omega=omega)
-    t, g, a = _imu_arrays(imu, sd.kind)
+    t, g, a = _imu_arrays(imu, sd.kind, sd.epoch)
     h = _h_ref(h_ref, len(t))
-    show = len(t) > 1_000_000 if progress is None else progress
+    show = len(t) > 1_000_000 if progress is None else flag(progress, "progress")
     # one table for the whole record, filled chunk by chunk in place (no concatenation)
     table = np.empty((len(COLUMNS), len(t)))
     from tqdm.auto import tqdm
@@ -223,7 +262,8 @@ def integrate(imu, t0, lla, vel_ned, q_nb, *, kind: str = "increments", ellipsoi
         for s in range(0, len(t), CHUNK):
             sl = slice(s, s + CHUNK)
             try:
-                sd._core.run_into(t[sl], g[sl], a[sl], table, None if h is None else h[sl], s)
+                with _imu_errors(sd.kind, g, a, 0):
+                    sd._core.run_into(t[sl], g[sl], a[sl], table, None if h is None else h[sl], s)
             except _core.NumericalError as err:
                 raise _diverged(err, table, s + err.rows, 0, t) from None
             bar.update(len(t[sl]))
