@@ -95,7 +95,13 @@ proptest! {
             }
             if let Ok(rep) = kf.update(&z, &h, &r, sequential, gate) {
                 prop_assert!(finite(kf.x.iter()) && finite(kf.p.iter()), "update: {} {}", kf.x, kf.p);
-                prop_assert!(finite(&rep.innovation) && finite(&rep.nis));
+                // NaN (a missing component of z) exactly at the skipped rows; the stacked
+                // NIS is NaN only when every row is skipped
+                let nan_rows = |v: &[f64]| v.iter().enumerate().filter(|(_, x)| !x.is_finite()).map(|(i, _)| i).collect::<Vec<usize>>();
+                prop_assert_eq!(nan_rows(&rep.innovation), rep.skipped.clone());
+                let all_skipped = !z.is_empty() && rep.skipped.len() == z.len();
+                let nis_nan = if sequential { rep.skipped.clone() } else if all_skipped { vec![0] } else { vec![] };
+                prop_assert_eq!(nan_rows(&rep.nis), nis_nan);
             }
         }
     }

@@ -190,10 +190,11 @@ def test_bad_r_not_positive_definite():
         kf.update([0.0], np.ones((1, 2)), [[0.0]])
 
 
-def test_bad_nan_measurement():
+def test_bad_infinite_measurement():
+    # NaN is a missing component (tests/test_nan_missing.py); inf is invalid
     kf = KalmanFilter(np.eye(2))
-    with pytest.raises(ValueError, match="z: non-finite value NaN at index 1"):
-        kf.update([0.0, np.nan], np.eye(2), np.eye(2))
+    with pytest.raises(ValueError, match="z: infinite value inf at index 1"):
+        kf.update([0.0, np.inf], np.eye(2), np.eye(2))
 
 
 def test_bad_phi_dimensions():

@@ -7,7 +7,7 @@
 
 use super::dense::{self, Algebra};
 use super::matrix::{check_covariance, check_square, has_register_kernel, propagate_covariance, symmetrize};
-use crate::error::{invalid, NavError, Result};
+use crate::error::{invalid, invalid_at, NavError, Result};
 use nalgebra::{DMatrix, DVector};
 
 /// How the filter's estimate reaches the navigation solution.
@@ -29,15 +29,27 @@ fn positive(x: f64) -> bool {
     x.is_finite() && x > 0.0
 }
 
-/// Result of one update.
+/// Result of one update. Row indices are those of the z given; the rows of its NaN
+/// (missing) components are `skipped` and hold NaN in `innovation` (and in `nis` when
+/// sequential).
 #[derive(Debug, Clone, PartialEq)]
 pub struct UpdateReport {
-    /// Innovation y = z − Hδx̂⁻ per row (sequential: of the decorrelated rows z̄ = L⁻¹z).
+    /// Innovation y = z − Hδx̂⁻ per row (sequential: of the decorrelated rows z̄ = L⁻¹z of
+    /// the used components).
     pub innovation: Vec<f64>,
-    /// Normalised innovation squared: one value yᵀS⁻¹y (stacked) or y²/s per row (sequential).
+    /// Normalised innovation squared over the used components: one value yᵀS⁻¹y (stacked;
+    /// NaN when every component is missing) or y²/s per row (sequential).
     pub nis: Vec<f64>,
-    /// Rows (sequential) or all rows (stacked) rejected by the χ² gate.
+    /// Rows (sequential) or all used rows (stacked) rejected by the χ² gate.
     pub rejected: Vec<usize>,
+    /// Rows whose z component is NaN: missing, left out of the update.
+    pub skipped: Vec<usize>,
+}
+
+/// The first non-finite entry of `m` in the given rows and columns: (row, column, value).
+fn first_non_finite(m: &DMatrix<f64>, rows: &[usize], cols: &[usize]) -> Option<(usize, usize, f64)> {
+    let cells = rows.iter().flat_map(|&i| cols.iter().map(move |&j| (i, j)));
+    cells.into_iter().find_map(|(i, j)| m.get((i, j)).filter(|v| !v.is_finite()).map(|&v| (i, j, v)))
 }
 
 /// Filter state (δx̂, P) and epoch counter.
@@ -155,20 +167,71 @@ impl Kf {
     /// otherwise one stacked vector update. `gate`: χ² threshold — on yᵀS⁻¹y (stacked)
     /// or on each scalar row's y²/s (sequential); rejected rows are reported, not applied.
     /// Covariance in Joseph form P = (I − KH)P(I − KH)ᵀ + KRKᵀ.
+    ///
+    /// A NaN component of z is a missing measurement: the update uses the components that
+    /// are not NaN, with their rows of z and H and their rows and columns of R (the rows of
+    /// H and R of a missing component are not read), so the NIS and the gate are over the
+    /// used components. With every component missing nothing is updated. ±inf in z, and a
+    /// non-finite H or R entry of a used component, are invalid input.
     pub fn update(&mut self, z: &[f64], h: &DMatrix<f64>, r: &DMatrix<f64>, sequential: bool, gate: Option<f64>) -> Result<UpdateReport> {
         let n = self.size();
         let m = z.len();
-        crate::error::check_finite("z", z, 1)?;
+        if let Some((i, v)) = z.iter().enumerate().find(|(_, v)| v.is_infinite()) {
+            return Err(invalid_at("z", i, format!("infinite value {v} at index {i} (NaN marks a missing component)")));
+        }
         if h.nrows() != m || h.ncols() != n {
             return Err(invalid("h", format!("expected {m}x{n} (measurements x states), got {}x{}", h.nrows(), h.ncols())));
         }
-        crate::error::check_finite("h", h.as_slice(), 1)?;
-        check_covariance("r", r, Some(m), true)?;
+        if r.shape() != (m, m) {
+            return Err(invalid("r", format!("expected {m}x{m} (measurements x measurements), got {}x{}", r.nrows(), r.ncols())));
+        }
         if let Some(g) = gate {
             if !positive(g) {
                 return Err(invalid("gate", format!("chi-square threshold must be > 0, got {g}")));
             }
         }
+        let (used, skipped): (Vec<usize>, Vec<usize>) = (0..m).partition(|&i| z.get(i).is_some_and(|v| !v.is_nan()));
+        if let Some((i, j, v)) = first_non_finite(h, &used, &(0..n).collect::<Vec<_>>()) {
+            return Err(invalid_at("h", i, format!("non-finite value {v} at ({i}, {j}), the row of a measured (non-NaN) component of z")));
+        }
+        if let Some((i, j, v)) = first_non_finite(r, &used, &used) {
+            return Err(invalid_at("r", i, format!("non-finite value {v} at ({i}, {j}), between measured (non-NaN) components of z")));
+        }
+        let report = if skipped.is_empty() {
+            check_covariance("r", r, Some(m), true)?;
+            self.update_used(z, h, r, sequential, gate)?
+        } else {
+            let zu: Vec<f64> = z.iter().copied().filter(|v| !v.is_nan()).collect();
+            let ru = r.select_rows(&used).select_columns(&used);
+            check_covariance("r", &ru, None, true).map_err(|e| match e {
+                NavError::InvalidInput { field, reason, index } => {
+                    NavError::InvalidInput { field, reason: format!("{reason} (its rows and columns of the measured components {used:?}, numbered from 0 there)"), index }
+                }
+                other => other,
+            })?;
+            let used_report = if used.is_empty() {
+                UpdateReport { innovation: vec![], nis: if sequential { vec![] } else { vec![f64::NAN] }, rejected: vec![], skipped: vec![] }
+            } else {
+                self.update_used(&zu, &h.select_rows(&used), &ru, sequential, gate)?
+            };
+            // back to the rows of z: NaN at the skipped ones
+            let spread = |values: &[f64]| {
+                let mut out = vec![f64::NAN; m];
+                used.iter().zip(values).for_each(|(&i, &v)| out.get_mut(i).into_iter().for_each(|o| *o = v));
+                out
+            };
+            UpdateReport {
+                innovation: spread(&used_report.innovation),
+                nis: if sequential { spread(&used_report.nis) } else { used_report.nis },
+                rejected: used_report.rejected.iter().filter_map(|&k| used.get(k).copied()).collect(),
+                skipped,
+            }
+        };
+        Ok(report)
+    }
+
+    /// The update of a z without missing components (checked by [`Kf::update`]).
+    fn update_used(&mut self, z: &[f64], h: &DMatrix<f64>, r: &DMatrix<f64>, sequential: bool, gate: Option<f64>) -> Result<UpdateReport> {
         let report = if sequential { self.update_sequential(z, h, r, gate) } else { self.update_stacked(z, h, r, gate) }?;
         self.check_pd("update")?;
         // finite z, H, R and P can still give an innovation beyond the f64 range
@@ -185,12 +248,12 @@ impl Kf {
         let chol = s.clone().cholesky().ok_or_else(|| NavError::Numerical(format!("innovation covariance not positive definite at epoch {}", self.epoch)))?;
         let nis = y.dot(&chol.solve(&y));
         if gate.is_some_and(|g| nis > g) {
-            return Ok(UpdateReport { innovation: y.as_slice().to_vec(), nis: vec![nis], rejected: (0..z.len()).collect() });
+            return Ok(UpdateReport { innovation: y.as_slice().to_vec(), nis: vec![nis], rejected: (0..z.len()).collect(), skipped: vec![] });
         }
         let k = chol.solve(&ph.transpose()).transpose();
         self.x += &k * &y;
         self.joseph(&k, h, r);
-        Ok(UpdateReport { innovation: y.as_slice().to_vec(), nis: vec![nis], rejected: vec![] })
+        Ok(UpdateReport { innovation: y.as_slice().to_vec(), nis: vec![nis], rejected: vec![], skipped: vec![] })
     }
 
     // invariant: i < m = z.len() = rows of hb (update checks h m × n), j < n; the
@@ -220,7 +283,7 @@ impl Kf {
             self.x += k.column(0) * y;
             self.joseph(&k, &hi, &one);
         }
-        Ok(UpdateReport { innovation, nis, rejected })
+        Ok(UpdateReport { innovation, nis, rejected, skipped: vec![] })
     }
 
     fn joseph(&mut self, k: &DMatrix<f64>, h: &DMatrix<f64>, r: &DMatrix<f64>) {
@@ -376,6 +439,33 @@ mod tests {
             c.update(&[1.0], &DMatrix::from_element(1, 1, 1.0), &DMatrix::from_element(1, 1, 0.5), false, None).unwrap();
         }
         assert!((c.p[(0, 0)] - 1.0 / (0.5 + 10.0)).abs() < 1e-14);
+    }
+
+    /// A NaN component of z is the update without its row of z and H and its row and
+    /// column of R; every component NaN leaves the state unchanged.
+    #[test]
+    fn missing_component_is_the_reduced_update() {
+        let p0 = DMatrix::from_row_slice(3, 3, &[4.0, 1.0, 0.5, 1.0, 3.0, 0.2, 0.5, 0.2, 2.0]);
+        let h = DMatrix::from_row_slice(3, 3, &[1.0, 0.3, 0.0, -0.2, 1.0, 0.4, 0.5, 0.0, 1.0]);
+        let r = DMatrix::from_row_slice(3, 3, &[2.0, 0.5, 0.1, 0.5, 1.0, 0.2, 0.1, 0.2, 1.5]);
+        for sequential in [false, true] {
+            let mut a = Kf::new(p0.clone(), LoopMode::Open).unwrap();
+            let mut b = Kf::new(p0.clone(), LoopMode::Open).unwrap();
+            let mut h_nan = h.clone();
+            h_nan[(1, 2)] = f64::NAN; // the row of a missing component is not read
+            let rep = a.update(&[0.7, f64::NAN, -0.4], &h_nan, &r, sequential, None).unwrap();
+            let keep = [0, 2];
+            b.update(&[0.7, -0.4], &h.select_rows(&keep), &r.select_rows(&keep).select_columns(&keep), sequential, None).unwrap();
+            assert!((&a.x - &b.x).norm() < 1e-12 && (&a.p - &b.p).norm() < 1e-12, "sequential = {sequential}");
+            assert_eq!(rep.skipped, vec![1]);
+            assert!(rep.innovation[1].is_nan() && rep.innovation[0].is_finite() && rep.innovation[2].is_finite());
+            let mut c = Kf::new(p0.clone(), LoopMode::Open).unwrap();
+            let rep = c.update(&[f64::NAN; 3], &h, &r, sequential, None).unwrap();
+            assert_eq!((rep.skipped, &c.x, &c.p), (vec![0, 1, 2], &DVector::zeros(3), &p0));
+            // a non-finite H entry of a measured component is still invalid
+            let e = c.update(&[0.7, 1.0, f64::NAN], &h_nan, &r, sequential, None).unwrap_err();
+            assert!(matches!(&e, NavError::InvalidInput { field, index: Some(1), .. } if field == "h"), "{e}");
+        }
     }
 
     fn sample(n: usize, m: usize, seed: usize) -> DMatrix<f64> {

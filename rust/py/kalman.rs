@@ -86,6 +86,13 @@ fn discretize_model<'py>(
     Ok((mat_to_py(py, &phi), mat_to_py(py, &qd)))
 }
 
+/// A 2-D float array as a DMatrix without the finiteness check of `mat`: the rows of a
+/// missing measurement component may hold NaN, and `Kf::update` checks the others.
+fn with_missing(a: &PyReadonlyArray2<'_, f64>) -> DMatrix<f64> {
+    let (rows, cols) = a.as_array().dim();
+    DMatrix::from_row_iterator(rows, cols, a.as_array().iter().copied())
+}
+
 /// Error-state Kalman filter (closed or open loop), streaming one call per step.
 #[pyclass(module = "atomnav._core")]
 pub struct KalmanFilter {
@@ -112,7 +119,8 @@ impl KalmanFilter {
         Ok(py.detach(|| kf.predict_many(&phi, &qd, steps))?)
     }
 
-    /// Returns (innovation, nis, rejected rows).
+    /// Returns (innovation, nis, rejected rows, skipped rows). NaN in z marks a missing
+    /// component; the core checks z, H and R (the rows of a missing one are not read).
     #[pyo3(signature = (z, h, r, sequential=false, gate=None))]
     #[allow(clippy::type_complexity)]
     fn update<'py>(
@@ -123,10 +131,10 @@ impl KalmanFilter {
         r: PyReadonlyArray2<'py, f64>,
         sequential: bool,
         gate: Option<f64>,
-    ) -> PyResult<(Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<f64>>, Vec<usize>)> {
-        let z = vector(&z, "z")?;
-        let rep = self.inner.update(&z, &mat(&h, "h")?, &mat(&r, "r")?, sequential, gate)?;
-        Ok((rep.innovation.into_pyarray(py), rep.nis.into_pyarray(py), rep.rejected))
+    ) -> PyResult<(Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<f64>>, Vec<usize>, Vec<usize>)> {
+        let z: Vec<f64> = z.as_array().iter().copied().collect();
+        let rep = self.inner.update(&z, &with_missing(&h), &with_missing(&r), sequential, gate)?;
+        Ok((rep.innovation.into_pyarray(py), rep.nis.into_pyarray(py), rep.rejected, rep.skipped))
     }
 
     /// Closed loop: returns δx̂ and resets it to 0; open loop: returns δx̂.

@@ -169,6 +169,21 @@ def ins_error_model(lla, vel_ned, q_nb, f_b, accel_psd: float, gyro_psd: float,
                                         gyro_bias=gyro_bias._parts(), ellipsoid=ellipsoid)
 
 
+class UpdateResult(tuple):
+    """What :meth:`KalmanFilter.update` returns: the tuple ``(innovation, nis, rejected)``,
+    whose parts are also the attributes of those names, and ``skipped``, the list of the
+    rows of z that were NaN (missing) and left out of the update."""
+
+    def __new__(cls, values, skipped=()):
+        self = super().__new__(cls, values)
+        self.skipped = list(skipped)
+        return self
+
+    innovation = property(lambda self: self[0], doc="Innovation per row of z (NaN at the skipped rows).")
+    nis = property(lambda self: self[1], doc="Normalised innovation squared over the used rows.")
+    rejected = property(lambda self: self[2], doc="Rows rejected by the χ² gate.")
+
+
 class KalmanFilter:
     """Error-state Kalman filter.
 
@@ -188,17 +203,46 @@ class KalmanFilter:
         else:
             self._core.predict_many(_mat(phi, "phi"), _mat(qd, "qd"), integer(steps, "steps", 0, 2**64 - 1))
 
-    def update(self, z, h, r, sequential: bool = False, gate: float | None = None):
+    def update(self, z, h, r, sequential: bool = False, gate: float | None = None) -> UpdateResult:
         """Update with z = Hδx + v (z = predicted − measured), R = cov(v).
 
-        sequential: decorrelate with chol(R) and process scalar rows (spec gnss-ins-tight
-        Eq. 40); gate: χ² threshold (per row when sequential, else on the whole NIS).
-        Returns (innovation, nis, rejected_rows).
+        A NaN component of z is a missing measurement (a satellite not tracked, a channel
+        dropped): the update uses only the other components, with their rows of z and H and
+        their rows and columns of R, exactly as if the missing rows had not been given. The
+        rows of H and R of a missing component are not read; a non-finite entry in the row
+        of a used one, or ±inf in z, raises :class:`atomnav.InputError`. With every
+        component missing, the state and covariance are left unchanged.
+
+        Parameters
+        ----------
+        z : array_like, shape (m,)
+            Measurement, in the units of the rows of H; NaN marks a missing component.
+        h : array_like, shape (m, n)
+            Measurement matrix.
+        r : array_like, shape (m, m)
+            Measurement noise covariance (positive definite over the used components).
+        sequential : bool
+            Decorrelate with L = chol(R) (z̄ = L⁻¹z, H̄ = L⁻¹H) and process scalar rows
+            (Groves 2013, ch. 3) instead of one stacked vector update.
+        gate : float, optional
+            χ² threshold on the NIS: per row when ``sequential``, else on the whole NIS of
+            the used components, whose number of degrees of freedom is ``m − len(skipped)``.
+
+        Returns
+        -------
+        UpdateResult
+            Unpacks as ``(innovation, nis, rejected)``: the innovation y = z − Hδx̂⁻ per row
+            of z (of the decorrelated rows when ``sequential``), NaN at the skipped rows; the
+            NIS, one value yᵀS⁻¹y over the used components (NaN when every component is
+            missing) or y²/s per row (NaN at the skipped rows) when ``sequential``; the rows
+            rejected by the gate. ``.skipped`` lists the rows of z that were NaN.
         """
         z = np.ascontiguousarray(np.atleast_1d(as_floats(z, "z")))
         if z.ndim != 1:
             raise input_error("z", f"expected a vector, got shape {z.shape}")
-        return self._core.update(z, _mat(h, "h"), _mat(r, "r"), bool(sequential), None if gate is None else finite_scalar(gate, "gate"))
+        *values, skipped = self._core.update(z, _mat(h, "h"), _mat(r, "r"), bool(sequential),
+                                             None if gate is None else finite_scalar(gate, "gate"))
+        return UpdateResult(values, skipped)
 
     def take_correction(self) -> np.ndarray:
         return self._core.take_correction()
