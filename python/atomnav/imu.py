@@ -46,7 +46,7 @@ import numpy as np
 import pandas as pd
 
 from . import _core, units
-from ._validate import as_floats, choice, input_error, instance, renamed, rows, scalar, vector
+from ._validate import as_floats, choice, input_error, instance, locate, renamed, rows, scalar, seconds, table, vector
 
 KINDS = tuple(_core.OPTIONS["ImuKind"])
 _AXES = ("x", "y", "z")
@@ -60,7 +60,7 @@ BIAS_COLUMNS = ([f"accel_bias_{a}_mps2" for a in _AXES], [f"gyro_bias_{a}_rad_s"
 @dataclass(frozen=True)
 class GaussMarkov:
     """First-order Gauss–Markov term: stationary ``sigma`` (m/s² or rad/s) and correlation
-    time ``tau`` (s)."""
+    time ``tau`` (s). Where a triad takes one, a ``(sigma, tau)`` tuple is read as this."""
 
     sigma: float
     tau: float
@@ -69,7 +69,8 @@ class GaussMarkov:
 @dataclass(frozen=True)
 class Flicker:
     """Flicker (1/f) term of bias instability ``b`` (m/s² or rad/s), valid between ``f_lo``
-    and ``f_hi`` (Hz; ``f_hi`` must not exceed the Nyquist frequency 1/(2Δt))."""
+    and ``f_hi`` (Hz; ``f_hi`` must not exceed the Nyquist frequency 1/(2Δt)). Where a
+    triad takes one, a tuple ``(b,)``, ``(b, f_lo)`` or ``(b, f_lo, f_hi)`` is read as this."""
 
     b: float
     f_lo: float = 1e-4
@@ -83,8 +84,11 @@ class TriadErrors:
     ``bias`` (3,) fixed bias; ``bias_sigma`` σ of a random turn-on bias per axis;
     ``scale`` (3,) scale-factor errors (1e-6 = 1 ppm); ``misalignment`` (3, 3) with zero
     diagonal, measured = (I + diag(scale) + misalignment) · true; ``white`` density N
-    (m/s/√s or rad/√s); ``bias_rw`` density K (m/s²/√s or rad/s/√s); ``gauss_markov``;
-    ``flicker``."""
+    (m/s/√s or rad/√s); ``bias_rw`` density K (m/s²/√s or rad/s/√s); ``gauss_markov``
+    (a :class:`GaussMarkov` or a ``(sigma, tau)`` tuple); ``flicker`` (a :class:`Flicker`
+    or a tuple of its fields in order). Fields may be set after construction; they are
+    checked when used: a string where a number is expected (``white = '1e-4'``) or a term
+    of another type is a ``TypeError`` naming the field (``gyro.white``)."""
 
     bias: tuple = (0.0, 0.0, 0.0)
     bias_sigma: float = 0.0
@@ -95,20 +99,24 @@ class TriadErrors:
     gauss_markov: GaussMarkov | None = None
     flicker: Flicker | None = None
 
+    def _terms(self, name: str) -> tuple[GaussMarkov | None, Flicker | None]:
+        """``gauss_markov`` and ``flicker`` as their classes (a tuple of fields accepted)."""
+        return (_term(self.gauss_markov, GaussMarkov, f"{name}.gauss_markov"), _term(self.flicker, Flicker, f"{name}.flicker"))
+
     def _to_core(self, name: str) -> dict:
         m = as_floats(self.misalignment, f"{name}.misalignment")
         if m.shape != (3, 3):
             raise input_error(f"{name}.misalignment", f"expected shape (3, 3), got {m.shape}")
-        gm, fl = self.gauss_markov, self.flicker
+        gm, fl = self._terms(name)
         return {
             "bias": vector(self.bias, 3, f"{name}.bias").tolist(),
-            "bias_sigma": float(self.bias_sigma),
+            "bias_sigma": scalar(self.bias_sigma, f"{name}.bias_sigma"),
             "scale": vector(self.scale, 3, f"{name}.scale").tolist(),
             "misalignment": m.ravel().tolist(),  # finiteness and zero diagonal checked in Rust
-            "white": float(self.white),
-            "bias_rw": float(self.bias_rw),
-            "gauss_markov": None if gm is None else (float(gm.sigma), float(gm.tau)),
-            "flicker": None if fl is None else (float(fl.b), float(fl.f_lo), float(fl.f_hi)),
+            "white": scalar(self.white, f"{name}.white"),
+            "bias_rw": scalar(self.bias_rw, f"{name}.bias_rw"),
+            "gauss_markov": None if gm is None else (scalar(gm.sigma, f"{name}.gauss_markov.sigma"), scalar(gm.tau, f"{name}.gauss_markov.tau")),
+            "flicker": None if fl is None else tuple(scalar(getattr(fl, f), f"{name}.flicker.{f}") for f in ("b", "f_lo", "f_hi")),
         }
 
     @classmethod
@@ -124,6 +132,20 @@ class TriadErrors:
             gauss_markov=None if gm is None else GaussMarkov(*gm),
             flicker=None if fl is None else Flicker(*fl),
         )
+
+
+def _term(value, cls, name: str):
+    """``value`` (None, a ``cls`` or a tuple/list of its fields in order) as a ``cls`` or
+    None; anything else is a ``TypeError`` naming ``name``."""
+    if value is None or isinstance(value, cls):
+        return value
+    fields = cls.__dataclass_fields__
+    if isinstance(value, (tuple, list)):
+        try:
+            return cls(*value)
+        except TypeError:
+            pass
+    raise TypeError(f"{name}: expected a {cls.__name__} or a tuple of its fields {tuple(fields)}, got {type(value).__name__} {value!r}")
 
 
 _USER_PRESETS: dict[str, "ImuErrors"] = {}
@@ -169,7 +191,7 @@ class ImuErrors:
             ("accel", self.accel, "m/s^2", units.MICRO_G, "ug", units.MICRO_G_PER_SQRT_HZ, "ug/sqrt(Hz)"),
             ("gyro", self.gyro, "rad/s", units.DEG_PER_HOUR, "deg/h", units.DEG_PER_SQRT_HOUR, "deg/sqrt(h)"),
         ):
-            gm, fl = t.gauss_markov, t.flicker
+            gm, fl = t._terms(sensor)
             items = [(f"bias_{a}", b, si, b / u, u_name) for a, b in zip(_AXES, t.bias)]
             items += [
                 ("bias_sigma", t.bias_sigma, si, t.bias_sigma / u, u_name),
@@ -215,19 +237,22 @@ class ImuSimulator:
     def corrupt(self, accel, gyro=None) -> pd.DataFrame:
         """Corrupt the next chunk. ``accel``, ``gyro``: (N, 3) true specific force (m/s²)
         and angular rate (rad/s), or Δv (m/s) and Δθ (rad) for increments; or one DataFrame
-        with the stream columns of this kind (module docstring). Returns a DataFrame
-        indexed by the running sample number with the measured columns (same names) and the
-        bias truth columns."""
+        in ``accel`` with the stream columns of this kind (module docstring), read by name
+        (extra columns ignored); its errors name ``accel`` and the column. Returns a
+        DataFrame indexed by the running sample number with the measured columns (same
+        names) and the bias truth columns; a ``time_s`` column is carried through as given
+        (datetime64 included)."""
         fcols, wcols = COLUMNS[self.kind]
         t = None
         if isinstance(accel, pd.DataFrame):
             if gyro is not None:
                 raise input_error("gyro", "must be None when accel is a DataFrame")
-            missing = [c for c in fcols + wcols if c not in accel.columns]
-            if missing:
-                raise input_error("accel", f"DataFrame lacks columns {missing} for kind {self.kind!r}")
-            t = accel["time_s"].to_numpy() if "time_s" in accel.columns else None
-            accel, gyro = accel[fcols].to_numpy(), accel[wcols].to_numpy()
+            df = accel
+            measured = table(df, fcols + wcols, "accel")  # by name: order and extra columns do not matter
+            accel, gyro = measured[:, :3], measured[:, 3:]
+            if "time_s" in df.columns:  # carried through as given; read in seconds (type-checked) for the checks
+                time_column = df.iloc[:, locate(df, ["time_s"], "accel")[0]]
+                t = seconds(time_column, "accel", "time_s")
         elif gyro is None:
             raise input_error("gyro", "required when accel is an array")
         f, w = rows(accel, 3, "accel"), rows(gyro, 3, "gyro")
@@ -238,7 +263,7 @@ class ImuSimulator:
         self._k += len(f)
         df = pd.DataFrame(np.hstack([fm, wm, fb, wb]), columns=fcols + wcols + BIAS_COLUMNS[0] + BIAS_COLUMNS[1], index=index)
         if t is not None:
-            df.insert(0, "time_s", t)
+            df.insert(0, "time_s", time_column.to_numpy())
         return df
 
 
