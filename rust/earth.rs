@@ -321,6 +321,21 @@ pub fn dcm_ned_to_ecef(lat: f64, lon: f64) -> Mat3 {
     Mat3::new(-sl * co, -so, -cl * co, -sl * so, co, -cl * so, cl, 0.0, -sl)
 }
 
+/// Heights (m) of a navigation state the Earth model is used for: from the deepest ocean
+/// trench (−11 km, rounded to −10 km) to low Earth orbit. Below, normal gravity and the
+/// radii lose their meaning (at −7e6 m the Schuler period is NaN); above, a navigation
+/// frame on the ellipsoid is no longer what an orbit needs.
+pub const HEIGHT_RANGE: (f64, f64) = (-1e4, 1e6);
+
+/// `h` (m) inside [`HEIGHT_RANGE`]; else `InvalidInput` naming `field`.
+pub fn check_height(field: &str, h: f64) -> Result<()> {
+    let (lo, hi) = HEIGHT_RANGE;
+    match (lo..=hi).contains(&h) {
+        true => Ok(()),
+        false => Err(invalid(field, format!("height {h} m is outside [{lo}, {hi}] m"))),
+    }
+}
+
 /// Check a latitude (rad) is within [−π/2, π/2] and finite.
 pub fn check_latitude(field: &str, lat: f64, index: usize) -> Result<()> {
     if lat.is_finite() && lat.abs() <= std::f64::consts::FRAC_PI_2 {

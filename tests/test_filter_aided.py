@@ -267,7 +267,7 @@ def test_bad_vertical_option():
 
 
 def test_bad_vertical_damping():
-    with pytest.raises(ValueError, match="vertical: damping ratio and frequency must be > 0, got zeta=0"):
+    with pytest.raises(ValueError, match="zeta: the baro loop's damping ratio must be finite and > 0, got 0"):
         position_aided_ins(**_no_fix_kwargs(vertical="damped", zeta=0.0))
 
 

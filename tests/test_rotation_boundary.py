@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 import atomnav
-from atomnav import _core, rotation
+from atomnav import InputError, _core, rotation
 
 GOOD = [1.0, 0.0, 0.0, 0.0]
 
@@ -33,6 +33,9 @@ def test_python_wrappers_and_angle():
     assert e.value.parameter == "dcm"
 
 
-def test_non_unit_rows_are_still_normalised():
-    # a quaternion of any finite non-zero norm is the rotation of its direction
-    np.testing.assert_allclose(rotation.dcm_from_quat([2.0, 0.0, 0.0, 0.0]), np.eye(3), atol=0)
+def test_a_quaternion_off_unit_norm_is_no_rotation_but_normalize_rescales_it():
+    # [2, 0, 0, 0] is no rotation: only quat_normalize turns it into the rotation of its direction
+    with pytest.raises(InputError, match="not a rotation") as e:
+        rotation.dcm_from_quat([2.0, 0.0, 0.0, 0.0])
+    assert e.value.parameter == "q"
+    np.testing.assert_allclose(rotation.dcm_from_quat(rotation.quat_normalize([2.0, 0.0, 0.0, 0.0])), np.eye(3), atol=0)

@@ -10,8 +10,13 @@ from __future__ import annotations
 
 import numpy as np
 
-from . import _core
+from . import _core, plausibility
 from ._validate import as_floats, input_error, rows
+
+#: How far a rotation given as input may be from an exact one: |‖q‖ − 1| for a quaternion,
+#: max |RᵀR − I| for a matrix (which must also have det +1). Every function taking a
+#: rotation checks it (:func:`quat_normalize` is the one that rescales any quaternion).
+ROTATION_TOLERANCE = _core.ROTATION_TOLERANCE
 
 
 def _single(x, width):
@@ -25,12 +30,15 @@ def _wrap(fn, x, width, name, out_single):
 
 
 def quat_from_euler(euler):
-    """Quaternion(s) q_nb (N, 4) from (roll, pitch, yaw) rows in rad (N, 3)."""
-    return _wrap(_core.quat_from_euler_rows, euler, 3, "euler", True)
+    """Quaternion(s) q_nb (N, 4) from (roll, pitch, yaw) rows in rad (N, 3). An angle
+    beyond 2π is likely in degrees: a :class:`atomnav.UnitWarning`."""
+    return _wrap(lambda e: _core.quat_from_euler_rows(plausibility.angles(e, "euler")), euler, 3, "euler", True)
 
 
 def euler_from_quat(q):
-    """(roll, pitch, yaw) in rad of quaternion rows; yaw in (−π, π]."""
+    """(roll, pitch, yaw) in rad of quaternion rows; yaw in (−π, π]. Every function of
+    this module taking quaternions, except :func:`quat_normalize` and
+    :func:`quat_multiply`, needs unit norm within :data:`ROTATION_TOLERANCE`."""
     return _wrap(_core.euler_from_quat_rows, q, 4, "q", True)
 
 
@@ -40,7 +48,11 @@ def dcm_from_quat(q):
 
 
 def quat_from_dcm(dcm):
-    """Quaternion(s) of rotation matrices (N, 3, 3) or (3, 3); scalar part ≥ 0."""
+    """Quaternion(s) of rotation matrices (N, 3, 3) or (3, 3); scalar part ≥ 0.
+
+    Each matrix must be a rotation: orthonormal within :data:`ROTATION_TOLERANCE` and
+    with determinant +1. A reflection such as ``diag(1, 1, -1)`` or any other matrix is
+    an :class:`InputError` naming ``dcm`` and the first such matrix."""
     m = as_floats(dcm, "dcm")
     single = m.shape == (3, 3)
     m = np.ascontiguousarray(m[None] if single else m)

@@ -261,8 +261,8 @@ pub fn check_increments(ds_imu: &[Mat3], ds_avu: &[Mat3]) -> Result<()> {
         return Err(invalid("ds_imu", "need at least one increment"));
     }
     for (i, (a, b)) in ds_imu.iter().zip(ds_avu).enumerate() {
-        super::check_rotation("ds_imu", i, a)?;
-        super::check_rotation("ds_avu", i, b)?;
+        crate::math::check_rotation("ds_imu", i, a)?;
+        crate::math::check_rotation("ds_avu", i, b)?;
     }
     Ok(())
 }
@@ -305,7 +305,7 @@ fn normal_equations_euler_fd(beta: &Vec3, ds_imu: &[Mat3], ds_avu: &[Mat3]) -> (
 pub fn calibrate(ds_imu: &[Mat3], ds_avu: &[Mat3], opt: &Options) -> Result<Calibration> {
     check_increments(ds_imu, ds_avu)?;
     if let Init::Given(c) = opt.init {
-        super::check_rotation("c0", 0, &c)?;
+        crate::math::check_rotation("c0", 0, &c)?;
     }
     let obs = observability(ds_avu);
     if obs.verdict == Verdict::Reject {

@@ -53,11 +53,6 @@ pub fn d2(b: &Vec3) -> Mat3 {
     Mat3::new(0.0, cp, ct * sp, 0.0, -sp, ct * cp, -1.0, 0.0, st)
 }
 
-/// [`check_rotation`] of every matrix of a series (names the first that is not a rotation).
-pub fn check_rotations(field: &str, r: &[Mat3]) -> crate::Result<()> {
-    r.iter().enumerate().try_for_each(|(i, m)| check_rotation(field, i, m))
-}
-
 /// Rotation angle of a rotation matrix by atan2: accurate for small angles.
 pub fn rotation_angle(s: &Mat3) -> f64 {
     (2.0 * vee(s).norm()).atan2(s.trace() - 1.0)
@@ -71,19 +66,6 @@ pub fn nearest_rotation(b: &Mat3) -> Mat3 {
     let (u, vt) = (svd.u.expect("u requested"), svd.v_t.expect("v_t requested"));
     let d = (u.determinant() * vt.determinant()).signum();
     u * Mat3::from_diagonal(&Vec3::new(1.0, 1.0, d)) * vt
-}
-
-/// `‖RᵀR − I‖∞ ≤ 1e-9` and det R > 0; the name of the offending field and index otherwise.
-pub fn check_rotation(field: &str, index: usize, r: &Mat3) -> crate::Result<()> {
-    let orth = (r.transpose() * r - Mat3::identity()).abs().max();
-    if !orth.is_finite() || orth > 1e-9 || r.determinant() <= 0.0 {
-        return Err(crate::error::invalid_at(
-            field,
-            index,
-            format!("not a rotation matrix at index {index} (‖RᵀR − I‖ = {orth:.3e}, det = {:.6})", r.determinant()),
-        ));
-    }
-    Ok(())
 }
 
 #[cfg(test)]

@@ -2,7 +2,8 @@
 //! catalog, a camera simulator, refraction, bundle merging into the virtual camera VF,
 //! Wahba/SVD attitudes with their covariance, and the astro increments.
 
-use super::{check_rotation, check_rotations, d1, euler_from_dcm, nearest_rotation};
+use super::{d1, euler_from_dcm, nearest_rotation};
+use crate::math::{check_rotation, check_rotations};
 use crate::error::{invalid, invalid_at, Result};
 use crate::math::{Mat3, Vec3};
 use rand::Rng;
@@ -93,8 +94,12 @@ impl Catalog {
 }
 
 pub fn check_unit(field: &str, v: &[Vec3]) -> Result<()> {
-    // NaN norms fail too: `is_nan() ||` keeps them out of the accepted set
-    match v.iter().enumerate().find(|(_, s)| (s.norm() - 1.0).is_nan() || (s.norm() - 1.0).abs() > UNIT_TOLERANCE) {
+    // one norm per vector; a NaN norm fails too: `is_nan() ||` keeps it out of the accepted set
+    let off_unit = |s: &Vec3| {
+        let e = (s.norm() - 1.0).abs();
+        e.is_nan() || e > UNIT_TOLERANCE
+    };
+    match v.iter().enumerate().find(|(_, s)| off_unit(s)) {
         None => Ok(()),
         Some((i, vi)) => Err(invalid_at(field, i, format!("not a unit vector at index {i} (norm {})", vi.norm()))),
     }
@@ -267,14 +272,16 @@ pub fn star_attitudes(
         }
         check_unit("up_gcrs", up)?;
     }
-    // Every epoch needs three stars, checked on the m observations before anything is
-    // sized by n_epochs: the search stops within m/3 + 1 epochs, however large n_epochs is.
-    let mut stars_at = std::collections::BTreeMap::<usize, usize>::new();
+    // Every epoch needs three stars, checked before anything is sized by n_epochs: m
+    // observations cannot give m/3 + 1 epochs three stars each, so the first short epoch is
+    // among the first m/3 + 1 and the count vector is bounded by m, however large n_epochs is.
+    let mut stars_at = vec![0usize; n_epochs.min(m / 3 + 1)];
     for &e in &obs.epoch {
-        *stars_at.entry(e).or_default() += 1;
+        if let Some(k) = stars_at.get_mut(e) {
+            *k += 1;
+        }
     }
-    if let Some(e) = (0..n_epochs).find(|e| stars_at.get(e).is_none_or(|&k| k < 3)) {
-        let k = stars_at.get(&e).copied().unwrap_or(0);
+    if let Some((e, &k)) = stars_at.iter().enumerate().find(|(_, &k)| k < 3) {
         return Err(invalid("star_directions", format!("epoch at index {e} has {k} stars, need at least 3")));
     }
     let mut rows: Vec<Vec<usize>> = vec![Vec::new(); n_epochs];

@@ -359,10 +359,7 @@ fn check_channels(channels: &[Channel]) -> Result<()> {
         if ch.c_sb.iter().any(|x| !x.is_finite()) {
             return Err(invalid(&format!("channels[{j}].c_sb"), "non-finite value"));
         }
-        let orth = (ch.c_sb.transpose() * ch.c_sb - Mat3::identity()).abs().max();
-        if orth > 1e-9 || ch.c_sb.determinant() < 0.0 {
-            return Err(invalid(&format!("channels[{j}].c_sb"), format!("not a rotation matrix (|CᵀC − I| = {orth:.3e})")));
-        }
+        crate::math::check_rotation(&format!("channels[{j}].c_sb"), 0, &ch.c_sb)?;
     }
     Ok(())
 }

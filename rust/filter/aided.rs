@@ -205,13 +205,14 @@ pub struct InsSetup {
 }
 
 impl InsSetup {
-    /// Check everything that does not depend on the aiding sensor: a finite initial state
-    /// with a non-zero quaternion and latitude inside ±90°, finite bias estimates, P₀
+    /// Check everything that does not depend on the aiding sensor: the initial state as a
+    /// strapdown INS checks it ([`NavState::check`]; kept with q_nb scaled to exactly unit
+    /// norm), finite bias estimates, P₀
     /// symmetric positive definite, `predict_every` ≥ 1, the noise model, the baro loop.
     #[allow(clippy::too_many_arguments)]
     pub fn new(initial: NavState, kind: ImuKind, ell: Ellipsoid, accel_bias0: Vec3, gyro_bias0: Vec3, p0: DMatrix<f64>, cfg: AidedConfig, damped: Option<DampedVertical>) -> Result<InsSetup> {
         let vertical = damped.map_or(Vertical::Free, |d| Vertical::Damped { zeta: d.zeta, omega: d.omega });
-        Strapdown::new(initial, kind, ell, vertical)?;
+        let initial = Strapdown::new(initial, kind, ell, vertical)?.state;
         for (field, v) in [("ba0", &accel_bias0), ("bg0", &gyro_bias0)] {
             crate::error::check_finite(field, v.as_slice(), 1)?;
         }

@@ -49,6 +49,54 @@ pub fn unit_quats(field: &str, q: &[Quat]) -> Result<Vec<Quat>> {
         .collect()
 }
 
+/// How far a rotation given by the user may be from an exact one: |‖q‖ − 1| for a
+/// quaternion, max |RᵀR − I| for a matrix. A quaternion or matrix stored in single
+/// precision or printed with seven significant digits is within it; one typed by hand
+/// with a wrong sign or a swapped element is not.
+pub const ROTATION_TOLERANCE: f64 = 1e-6;
+
+/// Quaternion rows `q` given as rotations: each must have unit norm within
+/// [`ROTATION_TOLERANCE`] (`[1, .1, .1, .1]`, norm 1.015, is no rotation, not one to be
+/// silently rescaled); returned scaled to exactly unit norm. `InvalidInput` naming `field`
+/// and the first row that is not.
+pub fn rotation_quats(field: &str, q: &[Quat]) -> Result<Vec<Quat>> {
+    q.iter().enumerate().map(|(i, q)| rotation_quat(field, i, q)).collect()
+}
+
+/// [`rotation_quats`] of one quaternion, row `index` of `field`.
+pub fn rotation_quat(field: &str, index: usize, q: &Quat) -> Result<Quat> {
+    let n = q.norm();
+    match (n - 1.0).abs() <= ROTATION_TOLERANCE {
+        true => Ok(q / n),
+        false => Err(invalid_at(
+            field,
+            index,
+            format!("quaternion {:?} at index {index} has norm {n}, not a rotation (unit norm within {ROTATION_TOLERANCE})", quat_to_array(q)),
+        )),
+    }
+}
+
+/// Matrix `r`, row `index` of `field`, given as a rotation: orthonormal (max |RᵀR − I| ≤
+/// [`ROTATION_TOLERANCE`]) with det R = +1 (a reflection such as diag(1, 1, −1) is not a
+/// rotation). `InvalidInput` naming `field` and `index` otherwise.
+pub fn check_rotation(field: &str, index: usize, r: &Mat3) -> Result<()> {
+    let orth = (r.transpose() * r - Mat3::identity()).abs().max();
+    let det = r.determinant();
+    if !orth.is_finite() || orth > ROTATION_TOLERANCE || det <= 0.0 {
+        return Err(invalid_at(
+            field,
+            index,
+            format!("not a rotation matrix at index {index} (max |RᵀR − I| = {orth:.3e}, tolerance {ROTATION_TOLERANCE}; det = {det:.6})"),
+        ));
+    }
+    Ok(())
+}
+
+/// [`check_rotation`] of every matrix of a series (names the first that is not a rotation).
+pub fn check_rotations(field: &str, r: &[Mat3]) -> Result<()> {
+    r.iter().enumerate().try_for_each(|(i, m)| check_rotation(field, i, m))
+}
+
 /// Quaternions of rotation vectors `phi` (rows named `field`). A row whose angle |φ|² is
 /// not a finite float (|φ| above about 1.3e154 rad) has no defined rotation: `InvalidInput`
 /// naming `field` and that row (never a NaN row).
@@ -282,6 +330,32 @@ mod tests {
         let (s, c) = (5e307f64).sin_cos();
         assert_eq!((q.w, q.i, q.j, q.k), (c, 0.0, 0.0, s));
         assert!(quat_from_rotvec(&(Vec3::z() * 1e308)).w.is_nan());
+    }
+
+    #[test]
+    fn a_reflection_or_a_non_orthonormal_matrix_is_no_rotation() {
+        let r = dcm_from_euler(0.3, -0.2, 1.1);
+        assert!(check_rotations("dcm", &[Mat3::identity(), r]).is_ok());
+        // within the tolerance: a rotation perturbed by 1e-7 (single precision storage)
+        assert!(check_rotation("dcm", 0, &(r + Mat3::from_element(1e-7))).is_ok());
+        for bad in [Mat3::from_diagonal(&Vec3::new(1.0, 1.0, -1.0)), Mat3::from_element(1.0), r * 1.01, Mat3::from_element(f64::NAN)] {
+            match check_rotations("dcm", &[r, bad]) {
+                Err(crate::error::NavError::InvalidInput { field, index, .. }) => assert_eq!((field.as_str(), index), ("dcm", Some(1))),
+                other => panic!("{other:?}"),
+            }
+        }
+    }
+
+    #[test]
+    fn a_quaternion_off_unit_norm_is_no_rotation() {
+        let ok = quat(1.0 + 0.5e-6, 0.0, 0.0, 0.0);
+        assert_eq!(quat_to_array(&rotation_quats("q_nb", &[ok]).unwrap()[0]), [1.0, 0.0, 0.0, 0.0]);
+        for bad in [quat(1.0, 0.1, 0.1, 0.1), quat(0.0, 0.0, 0.0, 0.0), quat(f64::NAN, 0.0, 0.0, 0.0), quat(2.0, 0.0, 0.0, 0.0)] {
+            match rotation_quats("q_nb", &[ok, bad]) {
+                Err(crate::error::NavError::InvalidInput { field, index, .. }) => assert_eq!((field.as_str(), index), ("q_nb", Some(1))),
+                other => panic!("{other:?}"),
+            }
+        }
     }
 
     #[test]

@@ -5,7 +5,8 @@ use crate::astro::calibration::{self, Calibration, DiffForm, Init, Observability
 use crate::astro::increments::{self, GyroErrorMode, GyroErrorModel, ImuRecord, TaylorVariant};
 use crate::astro::scenario::{self, Run, Scenario};
 use crate::astro::stars::{self, Camera, Catalog, Observations};
-use crate::astro::{check_rotations, d1, d2, euler_dcm, euler_from_dcm};
+use crate::astro::{d1, d2, euler_dcm, euler_from_dcm};
+use crate::math::check_rotations;
 use crate::error::{invalid, NavError};
 use crate::math::{Mat3, Vec3};
 use crate::options::Choice;
@@ -262,7 +263,7 @@ fn astro_model_covariance<'py>(
     sigmas: Option<(f64, f64, f64, f64)>,
 ) -> PyResult<(Bound<'py, PyArray2<f64>>, Bound<'py, PyArray2<f64>>)> {
     let c = mat3_arg(&c, "c")?;
-    crate::astro::check_rotation("c", 0, &c)?;
+    crate::math::check_rotation("c", 0, &c)?;
     let (a, b) = (mats::<3, 3>(&ds_imu, "ds_imu")?, mats::<3, 3>(&ds_avu, "ds_avu")?);
     calibration::check_increments(&a, &b)?;
     let (e, p) = (mats::<3, 3>(&e_imu, "e_imu")?, mats::<3, 3>(&p_avu, "p_avu")?);

@@ -98,5 +98,6 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(nav_rates_rows, m)?)?;
     m.add_function(wrap_pyfunction!(dcm_ned_to_ecef_py, m)?)?;
     m.add_function(wrap_pyfunction!(ellipsoid_constants, m)?)?;
+    m.add("HEIGHT_RANGE", crate::earth::HEIGHT_RANGE)?;
     Ok(())
 }

@@ -5,9 +5,10 @@ use crate::math::*;
 use numpy::{PyArray2, PyArray3, PyReadonlyArray2, PyReadonlyArray3};
 use pyo3::prelude::*;
 
-/// Quaternion rows scaled to unit norm; a zero or non-finite row is an `InputError`.
-fn unit_rows(q: &PyReadonlyArray2<'_, f64>, field: &str) -> PyResult<Vec<Quat>> {
-    Ok(unit_quats(field, &quat_rows(q, field)?)?)
+/// Quaternion rows given as rotations (unit norm within the core's tolerance), scaled to
+/// exactly unit norm; any other row is an `InputError`.
+fn rotation_rows(q: &PyReadonlyArray2<'_, f64>, field: &str) -> PyResult<Vec<Quat>> {
+    Ok(rotation_quats(field, &quat_rows(q, field)?)?)
 }
 
 #[pyfunction]
@@ -18,17 +19,18 @@ fn quat_from_euler_rows<'py>(py: Python<'py>, euler: PyReadonlyArray2<'py, f64>)
 
 #[pyfunction]
 fn euler_from_quat_rows<'py>(py: Python<'py>, q: PyReadonlyArray2<'py, f64>) -> PyResult<Bound<'py, PyArray2<f64>>> {
-    Ok(vec3_to_py(py, &unit_rows(&q, "q")?.iter().map(euler_from_quat).collect::<Vec<_>>()))
+    Ok(vec3_to_py(py, &rotation_rows(&q, "q")?.iter().map(euler_from_quat).collect::<Vec<_>>()))
 }
 
 #[pyfunction]
 fn dcm_from_quat_rows<'py>(py: Python<'py>, q: PyReadonlyArray2<'py, f64>) -> PyResult<Bound<'py, PyArray3<f64>>> {
-    Ok(mats_to_py(py, &unit_rows(&q, "q")?.iter().map(dcm_from_quat).collect::<Vec<_>>()))
+    Ok(mats_to_py(py, &rotation_rows(&q, "q")?.iter().map(dcm_from_quat).collect::<Vec<_>>()))
 }
 
 #[pyfunction]
 fn quat_from_dcm_rows<'py>(py: Python<'py>, dcm: PyReadonlyArray3<'py, f64>) -> PyResult<Bound<'py, PyArray2<f64>>> {
     let m = mats::<3, 3>(&dcm, "dcm")?;
+    check_rotations("dcm", &m)?;
     Ok(quat_to_py(py, &m.iter().map(quat_from_dcm).collect::<Vec<_>>()))
 }
 
@@ -39,7 +41,7 @@ fn quat_from_rotvec_rows<'py>(py: Python<'py>, rotvec: PyReadonlyArray2<'py, f64
 
 #[pyfunction]
 fn rotvec_from_quat_rows<'py>(py: Python<'py>, q: PyReadonlyArray2<'py, f64>) -> PyResult<Bound<'py, PyArray2<f64>>> {
-    Ok(vec3_to_py(py, &unit_rows(&q, "q")?.iter().map(rotvec_from_quat).collect::<Vec<_>>()))
+    Ok(vec3_to_py(py, &rotation_rows(&q, "q")?.iter().map(rotvec_from_quat).collect::<Vec<_>>()))
 }
 
 /// Two quaternion series of equal length named `na`, `nb` (`nb` is named when they differ).
@@ -59,7 +61,7 @@ fn quat_mul_rows<'py>(py: Python<'py>, a: PyReadonlyArray2<'py, f64>, b: PyReado
 
 #[pyfunction]
 fn quat_normalize_rows<'py>(py: Python<'py>, q: PyReadonlyArray2<'py, f64>) -> PyResult<Bound<'py, PyArray2<f64>>> {
-    Ok(quat_to_py(py, &unit_rows(&q, "q")?))
+    Ok(quat_to_py(py, &unit_quats("q", &quat_rows(&q, "q")?)?))
 }
 
 #[pyfunction]
@@ -72,7 +74,7 @@ fn skew_rows<'py>(py: Python<'py>, v: PyReadonlyArray2<'py, f64>) -> PyResult<Bo
 #[pyfunction]
 fn quat_angle_rows<'py>(py: Python<'py>, q_a: PyReadonlyArray2<'py, f64>, q_b: PyReadonlyArray2<'py, f64>) -> PyResult<Bound<'py, PyArray2<f64>>> {
     let (a, b) = pair(&q_a, &q_b, "q_a", "q_b")?;
-    let (a, b) = (unit_quats("q_a", &a)?, unit_quats("q_b", &b)?);
+    let (a, b) = (rotation_quats("q_a", &a)?, rotation_quats("q_b", &b)?);
     let r: Vec<[f64; 1]> = a.iter().zip(&b).map(|(x, y)| [quat_angle_between(x, y)]).collect();
     Ok(to_py_rows(py, &r))
 }
@@ -88,5 +90,6 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(quat_normalize_rows, m)?)?;
     m.add_function(wrap_pyfunction!(skew_rows, m)?)?;
     m.add_function(wrap_pyfunction!(quat_angle_rows, m)?)?;
+    m.add("ROTATION_TOLERANCE", ROTATION_TOLERANCE)?;
     Ok(())
 }

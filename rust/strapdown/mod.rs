@@ -13,10 +13,10 @@
 
 mod pipeline;
 
-use crate::earth::{check_latitude, AnchoredSinCos, Ellipsoid, LocalModel};
+use crate::earth::{check_height, check_latitude, AnchoredSinCos, Ellipsoid, LocalModel};
 use crate::error::{invalid, invalid_at, Result};
 pub use crate::imu::ImuKind;
-use crate::math::{quat_from_rotvec, quat_normalize, quat_rotate, Quat, Vec3};
+use crate::math::{quat_from_rotvec, quat_normalize, quat_rotate, rotation_quat, Quat, Vec3};
 use crate::options::Choice;
 pub use pipeline::{nav_columns, ImuSlices, NavTable, Samples3, NAV_COLUMNS, NAV_WIDTH, PIPELINE_BLOCK};
 
@@ -59,6 +59,27 @@ impl Vertical {
     }
 }
 
+impl NavState {
+    /// The checks every state a user starts from passes, the same for a new object and a
+    /// restart: finite time `t0`, velocity `vel_ned` and position `lla` with the latitude
+    /// within ±90° and the height in [`crate::earth::HEIGHT_RANGE`], and a rotation `q_nb` (unit norm
+    /// within [`crate::math::ROTATION_TOLERANCE`]). Returns `q_nb` scaled to exactly unit norm. Errors
+    /// name the argument (`t0`, `lla`, `vel_ned`, `q_nb`).
+    pub fn check(&self) -> Result<Quat> {
+        if !self.t.is_finite() {
+            return Err(invalid("t0", format!("must be finite, got {}", self.t)));
+        }
+        for (field, v) in [("lla", &self.lla), ("vel_ned", &self.vel)] {
+            if let Some(x) = v.iter().find(|x| !x.is_finite()) {
+                return Err(invalid(field, format!("non-finite value {x}")));
+            }
+        }
+        check_latitude("lla", self.lla.x, 0)?;
+        check_height("lla", self.lla.z)?;
+        rotation_quat("q_nb", 0, &self.q_nb)
+    }
+}
+
 impl Choice for Vertical {
     const PARAMETER: &'static str = "vertical";
     const CHOICES: &'static [(&'static str, Self)] =
@@ -73,10 +94,6 @@ impl Choice for Vertical {
     }
 }
 
-/// Heights (m) a restarted state may have: from the deepest ocean trench to low orbit.
-const HEIGHT_RANGE: (f64, f64) = (-1e4, 1e6);
-/// How far a restarted state's q_nb may be from unit norm.
-const UNIT_NORM_TOLERANCE: f64 = 1e-6;
 
 #[derive(Debug, Clone)]
 pub struct Strapdown {
@@ -95,42 +112,27 @@ pub struct Strapdown {
 }
 
 impl Strapdown {
+    /// A strapdown INS from `initial`, checked by [`NavState::check`] (errors name the
+    /// constructor's arguments `t0`, `lla`, `vel_ned`, `q_nb`) and with the baro loop's
+    /// gains checked (`zeta`, `omega`).
     pub fn new(initial: NavState, kind: ImuKind, ell: Ellipsoid, vertical: Vertical) -> Result<Strapdown> {
-        check_latitude("initial lla", initial.lla.x, 0)?;
-        let finite = initial.lla.iter().chain(initial.vel.iter()).chain(initial.q_nb.coords.iter()).all(|x| x.is_finite());
-        if !finite || !initial.t.is_finite() {
-            return Err(invalid("initial state", "non-finite value"));
-        }
-        if initial.q_nb.norm() == 0.0 {
-            return Err(invalid("initial q_nb", "zero quaternion"));
-        }
+        let q_nb = initial.check()?;
         if let Vertical::Damped { zeta, omega } = vertical {
-            if !(zeta.is_finite() && zeta > 0.0 && omega.is_finite() && omega > 0.0) {
-                return Err(invalid("vertical", format!("damping ratio and frequency must be > 0, got zeta={zeta}, omega={omega}")));
+            if !(zeta.is_finite() && zeta > 0.0) {
+                return Err(invalid("zeta", format!("the baro loop's damping ratio must be finite and > 0, got {zeta}")));
+            }
+            if !(omega.is_finite() && omega > 0.0) {
+                return Err(invalid("omega", format!("the baro loop's natural frequency must be finite and > 0 rad/s, got {omega}")));
             }
         }
-        let state = NavState { q_nb: quat_normalize(&initial.q_nb), ..initial };
+        let state = NavState { q_nb, ..initial };
         Ok(Strapdown { ell, vertical, state, earth: ell.local_model(), lat_sin_cos: AnchoredSinCos::new(state.lla.x), front: BodyFront::new(kind), last_step: None })
     }
 
     /// Restart from `state` as a new object with this one's IMU kind, ellipsoid and
-    /// vertical channel would (no coning/sculling history, rate priming anew). The state is
-    /// checked (field "state"): finite, q_nb of unit norm within 1e-6, latitude within
-    /// ±90°, height in [−10 km, 1000 km]. On error nothing changes.
+    /// vertical channel would (no coning/sculling history, rate priming anew), with the
+    /// constructor's checks. On error nothing changes.
     pub fn reset(&mut self, state: NavState) -> Result<()> {
-        let finite = state.lla.iter().chain(state.vel.iter()).chain(state.q_nb.coords.iter()).all(|x| x.is_finite()) && state.t.is_finite();
-        if !finite {
-            return Err(invalid("state", "non-finite value"));
-        }
-        let norm = state.q_nb.norm();
-        if (norm - 1.0).abs() > UNIT_NORM_TOLERANCE {
-            return Err(invalid("state", format!("q_nb has norm {norm}, not 1 within {UNIT_NORM_TOLERANCE}")));
-        }
-        check_latitude("state", state.lla.x, 0)?;
-        let (lo, hi) = HEIGHT_RANGE;
-        if !(lo..=hi).contains(&state.lla.z) {
-            return Err(invalid("state", format!("height {} m is outside [{lo}, {hi}] m", state.lla.z)));
-        }
         *self = Strapdown::new(state, self.kind(), self.ell, self.vertical)?;
         Ok(())
     }
@@ -531,6 +533,35 @@ mod tests {
     }
 
     #[test]
+    fn new_and_reset_reject_the_same_states_naming_the_argument() {
+        let good = NavState { t: 0.0, lla: Vec3::new(0.4, 0.1, 10.0), vel: Vec3::zeros(), q_nb: crate::math::quat(1.0, 0.0, 0.0, 0.0) };
+        let mut sd = Strapdown::new(good, ImuKind::Increments, WGS84, Vertical::Free).unwrap();
+        let nudged = |f: &dyn Fn(&mut NavState)| {
+            let mut s = good;
+            f(&mut s);
+            s
+        };
+        for (bad, field, why) in [
+            (nudged(&|s| s.q_nb = crate::math::quat(1.0, 0.1, 0.1, 0.1)), "q_nb", "norm"),
+            (nudged(&|s| s.q_nb = crate::math::quat(1.0 + 2e-6, 0.0, 0.0, 0.0)), "q_nb", "norm"),
+            (nudged(&|s| s.lla.x = 1.5708), "lla", "latitude"),
+            (nudged(&|s| s.lla.z = -1.1e4), "lla", "height"),
+            (nudged(&|s| s.lla.z = 2e7), "lla", "height"),
+            (nudged(&|s| s.vel.y = f64::NAN), "vel_ned", "non-finite"),
+            (nudged(&|s| s.t = f64::INFINITY), "t0", "finite"),
+        ] {
+            for e in [Strapdown::new(bad, ImuKind::Increments, WGS84, Vertical::Free).unwrap_err(), sd.reset(bad).unwrap_err()] {
+                assert!(matches!(&e, crate::error::NavError::InvalidInput { field: f, .. } if f == field), "{e}");
+                assert!(e.to_string().contains(why), "{e}");
+            }
+            assert_eq!(sd.state, good);
+        }
+        let damped = |zeta, omega| Strapdown::new(good, ImuKind::Increments, WGS84, Vertical::Damped { zeta, omega }).unwrap_err();
+        assert!(matches!(damped(-1.0, 0.01), crate::error::NavError::InvalidInput { field, .. } if field == "zeta"));
+        assert!(matches!(damped(0.7, 0.0), crate::error::NavError::InvalidInput { field, .. } if field == "omega"));
+    }
+
+    #[test]
     fn reset_rejects_an_invalid_state_and_keeps_the_old_one() {
         let good = NavState { t: 0.0, lla: Vec3::new(0.4, 0.1, 10.0), vel: Vec3::zeros(), q_nb: crate::math::quat(1.0, 0.0, 0.0, 0.0) };
         let mut sd = Strapdown::new(good, ImuKind::Increments, WGS84, Vertical::Free).unwrap();
@@ -547,7 +578,7 @@ mod tests {
             (nudged(&|s| s.vel.y = f64::NAN), "non-finite"),
         ] {
             let e = sd.reset(bad).unwrap_err();
-            assert!(matches!(&e, crate::error::NavError::InvalidInput { field, .. } if field == "state"), "{e}");
+            assert!(matches!(&e, crate::error::NavError::InvalidInput { .. }), "{e}");
             assert!(e.to_string().contains(why), "{e}");
             assert_eq!(sd.state, good);
         }

@@ -335,7 +335,7 @@ mod tests {
     }
 
     fn start(kind: ImuKind) -> Strapdown {
-        let init = NavState { t: 0.0, lla: Vec3::new(0.9, 0.3, 120.0), vel: Vec3::new(10.0, -3.0, 0.5), q_nb: quat(0.9, 0.1, -0.2, 0.3) };
+        let init = NavState { t: 0.0, lla: Vec3::new(0.9, 0.3, 120.0), vel: Vec3::new(10.0, -3.0, 0.5), q_nb: crate::math::quat_normalize(&quat(0.9, 0.1, -0.2, 0.3)) };
         Strapdown::new(init, kind, WGS84, Vertical::Free).unwrap()
     }
 
