@@ -8,6 +8,7 @@ hang, no NaN/inf output from finite input."""
 import pytest
 
 import fuzz
+import fuzz_mistakes
 
 CALLS = 20_000
 SEED = 20261202
@@ -38,3 +39,32 @@ def test_fuzz_public_api():
 def test_fuzz_public_api_long(seed):
     """Five more campaigns of 100,000 calls each (run with -m fuzz_long)."""
     _run(100_000, seed)
+
+
+def _mistake_failures(c: fuzz_mistakes.Campaign) -> str:
+    lines = [f"{c.n_bad} bad outcomes in {c.calls} mutated calls; first reproducer per (callable, class):",
+             fuzz_mistakes.REPRO_HEADER]
+    for (target, cls), (rec, n) in sorted(c.first_failures().items()):
+        lines += [f"# {target}: {cls} ({n}x): {rec.message[:300]}", rec.call]
+    return "\n".join(lines)
+
+
+def _run_mistakes(thread_rounds: int) -> None:
+    c = fuzz_mistakes.campaign(thread_rounds)
+    assert c.calls > 0
+    assert not c.n_bad, _mistake_failures(c)
+
+
+def test_fuzz_realistic_mistakes():
+    """The realistic mistakes (tests/fuzz_mistakes.py) on every catalogued clean call
+    and stateful object: no result differs from the clean call's without an error or a
+    warning, every unit mistake a documented rule can see warns or raises, 4 threads on one
+    object never reach pyo3's borrow flag, and pickled or deep-copied objects continue bit
+    for bit (a few seconds)."""
+    _run_mistakes(fuzz_mistakes.THREAD_ROUNDS)
+
+
+@pytest.mark.fuzz_long
+def test_fuzz_realistic_mistakes_long():
+    """The same with 20 thread rounds per stateful object (run with -m fuzz_long)."""
+    _run_mistakes(20)

@@ -1,0 +1,846 @@
+#!/usr/bin/env python
+"""The "realistic mistakes" strategy of the fuzz suite: the mistakes people actually make
+with pandas, units, threads and pickling, each applied to a clean call that works.
+
+A catalogue of clean calls is built from the library's own generators (``FIXTURES``: a
+10 s sinusoidal trajectory at 100 Hz, its ideal and corrupted IMU tables, a stationary
+record, a gyro noise series, GNSS observations, ...). Each clean call is made once; then
+one argument is mutated and the call is made again and compared with the clean one:
+
+* tables (every DataFrame argument): a duplicated column (the
+  ``pd.concat([df, df[[col]]], axis=1)`` merge mistake), a renamed column, a missing
+  column, extra columns, reordered columns; the time column as naive datetime64,
+  tz-aware datetime64 and timedelta64; nullable ``Float64`` with and without ``pd.NA``;
+  numbers as strings;
+* units: the physically meaningful columns and arguments (accelerations, angular rates,
+  time, latitude, longitude, Euler angles, the CAI pulse separation T, wavelengths,
+  contrasts) scaled by the factor of a real unit mistake (``UNIT_MISTAKES``: a value in
+  g, °, °/s, ms, nm or %, from the factors π/180, 180/π, 1000, 1/1000, 9.80665,
+  1/9.80665, 100 and 1e9);
+* stateful objects (``STATEFUL``): the same call from 4 threads on one shared object,
+  compared with the same calls made one after the other; and ``pickle`` / ``deepcopy``
+  after some calls, the copy continuing next to the original.
+
+Verdict (``GOOD`` and ``BAD``): a mutation that keeps the meaning (extra or reordered
+columns, a time column that converts exactly, ``Float64`` without missing values) must give
+the identical result; one that changes it must raise ``InputError`` (its ``.parameter`` a
+parameter of the called function) or ``TypeError`` naming one, warn (``UnitWarning``), or
+give the identical result (a column the call does not read); ``pd.NA`` must behave as
+``NaN`` in a float64 column (the pandas convention for a missing value); numbers as
+strings must raise; a unit mistake must warn or raise. A unit mistake is judged only where
+the documented plausibility rules can see it (``detectable``): the others are
+counted as ``not judged``.
+
+Usage::
+
+    python tests/fuzz_mistakes.py --out mistakes.md            # the CI share
+    python tests/fuzz_mistakes.py --thread-rounds 20           # the long run
+
+Reproducers assume ``REPRO_HEADER`` (run from tests/).
+"""
+
+from __future__ import annotations
+
+import argparse
+import copy
+import dataclasses
+import inspect
+import math
+import pickle
+import re
+import sys
+import threading
+import time
+import warnings
+from collections import Counter
+
+import numpy as np
+import pandas as pd
+
+import fuzz
+
+GOOD = ("identical", "raised", "warned")
+"""Outcome classes that are a correct answer to a mistake."""
+
+BAD = ("silent-different", "unit-not-warned", "foreign-exception", "thread-borrow-error", "pickle-failed",
+       "pickle-diverged", "raised-bad-parameter", "harmless-rejected", "strings-accepted", "na-not-nan",
+       "clean-failed")
+"""Outcome classes that are a defect: a result that differs from the clean call's without
+a word; a unit mistake that neither warns nor raises; an exception that is not atomnav's
+answer to bad input (``NumericalError`` for a mistaken input included); pyo3's borrow
+flag reached from threads; an object that does not survive ``pickle``/``deepcopy`` or whose
+copy does not continue bit for bit; an ``InputError``/``TypeError`` that names no
+parameter of the called function; a harmless mutation rejected; numeric strings taken
+as numbers; ``pd.NA`` handled unlike ``NaN``; a clean call of the catalogue that raises
+or warns (a false unit warning on good data)."""
+
+NOT_JUDGED = "not judged"
+"""A unit mistake no documented plausibility rule can see (e.g. a gyro in °/s on a vehicle
+turning slower than 35 rad/s/57.3): counted, listed, not a verdict."""
+
+G0 = 9.80665  # standard gravity (m/s²), the g of an accelerometer in g
+DEG = math.pi / 180.0
+EARTH_RATE = 7.292115e-5  # rad/s (WGS-84)
+EPOCH = pd.Timestamp("2024-01-01")  # the date of the datetime64 time columns
+EXTRA_COLUMNS = {"extra_m": 1.0, "note": "x"}  # columns added to a table (a result echoing them is still identical)
+THREADS = 4
+THREAD_ROUNDS = 3  # thread cases per stateful entry in the CI share (each round a fresh object)
+REPRO_KEEP = fuzz.REPRO_KEEP
+
+REPRO_HEADER = ("import copy, pickle, threading, numpy as np, pandas as pd, atomnav as an; "
+                "from fuzz_mistakes import fixtures; globals().update(fixtures())")
+
+FIXTURES = """\
+import dataclasses
+import numpy as np, pandas as pd, atomnav as an
+traj = an.trajectory.sinusoidal(10.0, rate_hz=100.0)
+init = traj.initial_state()
+truth = traj.df
+ideal = traj.ideal_imu("increments")
+ideal_rates = traj.ideal_imu("rates")
+meas = an.imu.corrupt(ideal, errors="tactical", dt=0.01, kind="increments", seed=7)
+meas_rates = an.imu.corrupt(ideal_rates, errors="tactical", dt=0.01, kind="rates", seed=7)
+nav = an.strapdown.integrate(meas, **init)
+still = an.trajectory.stationary(10.0, rate_hz=100.0)
+still_init = still.initial_state()
+still_meas = an.imu.corrupt(still.ideal_imu("increments"), errors="tactical", dt=0.01, kind="increments", seed=7)
+omega = an.noise.synth.model_b(seed=3, n=2048, tau0=1.0)
+allan = an.noise.allan.allan_variance(omega, tau0=1.0)
+arima = an.noise.filters.ArimaStateSpace.paper()
+eph = an.gnss.ephemeris.Ephemerides.nominal(0.0, 600.0)
+gnss_t = np.arange(0.0, 10.0, 1.0)
+gnss_lla = np.tile(traj.lla[0], (len(gnss_t), 1))
+obs = an.gnss.observations.simulate(eph, gnss_t, gnss_lla, np.zeros((len(gnss_t), 3)), seed=1)
+k_c = np.array([[0.0, 0.0, 1.61e7], [1.61e7, 0.0, 0.0]])
+"""
+
+
+def fixtures() -> dict:
+    """The fixture namespace (built once per process; every case works on copies)."""
+    if not _FIXTURES:
+        exec(FIXTURES, _FIXTURES)  # noqa: S102 - the catalogue's own source text
+    return {k: v for k, v in _FIXTURES.items() if not k.startswith("__")}
+
+
+_FIXTURES: dict = {}
+
+
+# ----------------------------------------------------------------------------------------
+# the catalogue
+
+
+@dataclasses.dataclass(frozen=True)
+class Unit:
+    """A physically meaningful argument: variable ``var`` of the clean call, the element
+    ``index`` of it (a Python subscript such as ``"[:, 1]"``; the whole value when empty),
+    of quantity ``role`` (a key of ``UNIT_MISTAKES``)."""
+
+    var: str
+    role: str
+    index: str = ""
+
+
+@dataclasses.dataclass(frozen=True)
+class Clean:
+    """A clean call that works: ``setup`` (Python lines on the fixtures) then the
+    expression ``call``; ``target`` is the dotted name of the callable it calls (its
+    parameters are the names an error may give). ``tables``: variables holding a DataFrame
+    (or Series) whose mutations are drawn, their unit-bearing columns found by name
+    (``COLUMN_ROLES``); ``units``: the other unit-bearing arguments."""
+
+    target: str
+    call: str
+    setup: str = ""
+    tables: tuple[str, ...] = ()
+    units: tuple[Unit, ...] = ()
+    time_origin: str = ""  # the argument fixing the origin of a table's time in seconds (e.g. t0)
+
+
+def _c(target, call, setup="", tables=(), units=(), time_origin=""):
+    return Clean(target, call, setup, tuple(tables), tuple(units), time_origin)
+
+
+LLA = (Unit("lla", "lat", "[0]"), Unit("lla", "lon", "[1]"))
+LLA_ROWS = (Unit("lla", "lat", "[:, 0]"), Unit("lla", "lon", "[:, 1]"))
+INIT = 't0, lla, vel_ned, q_nb = init["t0"], init["lla"], init["vel_ned"], init["q_nb"]'
+EULER = "euler = np.array([[0.1, -0.2, 1.5], [0.05, 0.1, -2.5]])"
+
+CATALOGUE: tuple[Clean, ...] = (
+    # strapdown
+    _c("atomnav.strapdown.integrate", "an.strapdown.integrate(imu, **init)", "imu = meas", ["imu"], time_origin="t0"),
+    _c("atomnav.strapdown.integrate", 'an.strapdown.integrate(imu, kind="rates", **init)', "imu = meas_rates",
+       ["imu"], time_origin="t0"),
+    _c("atomnav.strapdown.integrate", "an.strapdown.integrate(imu, **still_init)", "imu = still_meas", ["imu"],
+       time_origin="t0"),
+    _c("atomnav.strapdown.integrate", "an.strapdown.integrate(meas, t0, lla, vel_ned, q_nb)", INIT, (), LLA),
+    _c("atomnav.strapdown.Strapdown.run", "an.strapdown.Strapdown(**init).run(imu)", "imu = meas", ["imu"],
+       time_origin="t0"),
+    _c("atomnav.strapdown.Strapdown", "an.strapdown.Strapdown(t0, lla, vel_ned, q_nb).run(meas)", INIT, (), LLA),
+    # IMU errors
+    _c("atomnav.imu.corrupt", 'an.imu.corrupt(imu, errors="tactical", dt=0.01, kind="increments", seed=7)',
+       "imu = ideal", ["imu"]),
+    _c("atomnav.imu.corrupt", 'an.imu.corrupt(imu, errors="tactical", dt=0.01, kind="rates", seed=7)',
+       "imu = ideal_rates", ["imu"]),
+    _c("atomnav.imu.ImuSimulator.corrupt",
+       'an.imu.ImuSimulator("tactical", dt=0.01, kind="rates", seed=7).corrupt(accel, gyro)',
+       'accel = ideal_rates[["accel_x_mps2", "accel_y_mps2", "accel_z_mps2"]].to_numpy()\n'
+       'gyro = ideal_rates[["gyro_x_rad_s", "gyro_y_rad_s", "gyro_z_rad_s"]].to_numpy()', (),
+       (Unit("accel", "accel"), Unit("gyro", "gyro"))),
+    # trajectories
+    _c("atomnav.trajectory.Trajectory.from_dataframe", "an.trajectory.Trajectory.from_dataframe(df)", "df = truth",
+       ["df"]),
+    _c("atomnav.trajectory.Trajectory.from_dataframe", "an.trajectory.Trajectory.from_dataframe(df)",
+       'df = truth.drop(columns=["qw", "qx", "qy", "qz"])', ["df"]),
+    _c("atomnav.trajectory.Trajectory", "an.trajectory.Trajectory(df)", "df = truth", ["df"]),
+    _c("atomnav.trajectory.Trajectory.errors", "traj.errors(nav)", "", ["nav"]),
+    _c("atomnav.trajectory.nav_table", "an.trajectory.nav_table(time, lla, vel_ned, q_nb)",
+       "time, lla, vel_ned, q_nb = traj.time, traj.lla, traj.vel_ned, traj.q_nb", (),
+       (Unit("time", "time"),) + LLA_ROWS),
+    _c("atomnav.trajectory.stationary", "an.trajectory.stationary(10.0, euler=euler)", "euler = (0.1, -0.2, 1.5)",
+       (), (Unit("euler", "euler"),)),
+    _c("atomnav.trajectory.stationary", "an.trajectory.stationary(10.0, origin=lla)", "lla = init['lla']", (), LLA),
+    # rotations
+    _c("atomnav.rotation.quat_from_euler", "an.rotation.quat_from_euler(euler)", EULER, (), (Unit("euler", "euler"),)),
+    _c("atomnav.rotation.dcm_from_euler", "an.rotation.dcm_from_euler(euler)", EULER, (), (Unit("euler", "euler"),)),
+    _c("atomnav.astro.euler_dcm", "an.astro.euler_dcm(euler)", EULER, (), (Unit("euler", "euler"),)),
+    # Earth
+    _c("atomnav.earth.lla_to_ecef", "an.earth.lla_to_ecef(lla)", "lla = traj.lla", (), LLA_ROWS),
+    _c("atomnav.earth.gravity", "an.earth.gravity(lat, 200.0)", "lat = traj.lla[:, 0]", (), (Unit("lat", "lat"),)),
+    _c("atomnav.earth.schuler_period", "an.earth.schuler_period(lat, 200.0)", "lat = 0.9", (), (Unit("lat", "lat"),)),
+    # atom interferometer closed forms
+    _c("atomnav.cai.predictor.k_eff", "an.cai.predictor.k_eff(wavelength)", "wavelength = 780.241e-9", (),
+       (Unit("wavelength", "wavelength"),)),
+    _c("atomnav.cai.predictor.phase_constant", "an.cai.predictor.phase_constant(k_c, 2.8, w, f, T)",
+       "w, f, T = np.array([0.0, 0.0, 7.29e-5]), np.array([0.0, 0.0, -9.81]), 0.05", (), (Unit("T", "T"),)),
+    _c("atomnav.cai.predictor.scale_factors", "an.cai.predictor.scale_factors(T)", "T = 0.05", (), (Unit("T", "T"),)),
+    _c("atomnav.cai.predictor.phase_noise", "an.cai.predictor.phase_noise(0.01, contrast)", "contrast = 0.5", (),
+       (Unit("contrast", "contrast"),)),
+    _c("atomnav.cai.readout.readout", "an.cai.readout(phi, contrast=contrast)",
+       "phi, contrast = np.linspace(0.0, 3.0, 7), 0.5", (), (Unit("contrast", "contrast"),)),
+    # sensor noise
+    _c("atomnav.noise.allan.allan_variance", "an.noise.allan.allan_variance(data, tau0=1.0)",
+       "data = pd.Series(omega, name='omega_deg_h')", ["data"]),
+    # (the fit carries its input table; the fit itself is compared)
+    _c("atomnav.noise.allan.fit_allan_table",
+       "dataclasses.replace(an.noise.allan.fit_allan_table(table, n_samples=2048), table=None)",
+       "table = allan", ["table"]),
+    _c("atomnav.noise.filters.kalman", "an.noise.filters.kalman(series, arima)", "series = pd.Series(omega[:500])",
+       ["series"]),
+    # GNSS
+    _c("atomnav.gnss.spp.solve", "an.gnss.spp.solve(eph, obs)", "", ["obs"], time_origin="eph"),
+    _c("atomnav.gnss.observations.simulate", "an.gnss.observations.simulate(eph, t, lla, np.zeros((10, 3)), seed=1)",
+       "t, lla = gnss_t, gnss_lla", (), (Unit("t", "time"),) + LLA_ROWS),
+)
+
+
+@dataclasses.dataclass(frozen=True)
+class Stateful:
+    """A stateful (or configuration) object ``obj`` built by ``setup``: ``first`` is the
+    call the 4 threads make at once and the use before pickling (empty: a configuration
+    object, pickled as built), ``then`` the continuation compared after pickling, and
+    ``state`` an expression reading its state."""
+
+    target: str
+    setup: str
+    first: str
+    then: str
+    state: str
+
+
+STATEFUL: tuple[Stateful, ...] = (
+    Stateful("atomnav.strapdown.Strapdown.run", "obj = an.strapdown.Strapdown(**init)", "obj.run(meas.iloc[:500])",
+             "obj.run(meas.iloc[500:])", "obj.state()"),
+    Stateful("atomnav.imu.ImuSimulator.corrupt", 'obj = an.imu.ImuSimulator("tactical", dt=0.01, kind="increments", seed=7)',
+             "obj.corrupt(ideal.iloc[:500])", "obj.corrupt(ideal.iloc[500:])", "obj.corrupt(ideal.iloc[:3])"),
+    Stateful("atomnav.noise.allan.AllanStream.update", "obj = an.noise.allan.AllanStream([1, 2, 4, 8], tau0=1.0)",
+             "obj.update(omega[:1000])", "obj.update(omega[1000:])", 'obj.result("allan")'),
+    Stateful("atomnav.noise.filters.KalmanStream.update", "obj = an.noise.filters.KalmanStream(arima)",
+             "obj.update(omega[:1000])", "obj.update(omega[1000:])", "obj.update(omega[:3])"),
+    Stateful("atomnav.filter.engine.KalmanFilter.predict",
+             "obj = an.filter.engine.KalmanFilter(np.eye(3))\nphi, qd = np.eye(3) + 0.01 * np.ones((3, 3)), 1e-4 * np.eye(3)",
+             "obj.predict(phi, qd, steps=2000)", "obj.predict(phi, qd, steps=10)", "(obj.x, obj.p, obj.epoch)"),
+    Stateful("atomnav.filter.engine.KalmanFilter.update",
+             "obj = an.filter.engine.KalmanFilter(np.eye(3))\nz, h, r = np.array([0.1, 0.2]), np.eye(3)[:2], 0.01 * np.eye(2)",
+             "obj.update(z, h, r)", "obj.update(z, h, r)", "(obj.x, obj.p, obj.epoch)"),
+    Stateful("atomnav.trajectory.Trajectory", "obj = an.trajectory.sinusoidal(10.0, rate_hz=100.0)", "",
+             "obj.ideal_imu('increments')", "obj.initial_state()"),
+    Stateful("atomnav.imu.ImuErrors", 'obj = an.imu.ImuErrors.preset("tactical")', "", "obj.summary()", "obj.summary()"),
+    Stateful("atomnav.gnss.ephemeris.Ephemerides", "obj = an.gnss.ephemeris.Ephemerides.nominal(0.0, 600.0)", "",
+             "obj.state('G01', 100.0)", "obj.satellites"),
+)
+
+
+# ----------------------------------------------------------------------------------------
+# mutations
+
+
+UNIT_MISTAKES = {
+    "accel": ((1 / G0, "g"),),
+    "gyro": ((1 / DEG, "°/s (° per increment)"),),
+    "time": ((1000.0, "ms"),),
+    "lat": ((1 / DEG, "°"),),
+    "lon": ((1 / DEG, "°"),),
+    "euler": ((1 / DEG, "°"),),
+    "T": ((1000.0, "ms"),),
+    "wavelength": ((1e9, "nm"),),
+    "contrast": ((100.0, "%"),),
+}
+"""The unit mistakes of each quantity: (factor that turns the SI value into the mistaken
+number, the unit the user meant)."""
+
+COLUMN_ROLES = (
+    (r"^(accel_[xyz]_mps2|dv_[xyz]_mps)$", "accel"),
+    (r"^(gyro_[xyz]_rad_s|dtheta_[xyz]_rad)$", "gyro"),
+    (r"^time_s$", "time"),
+    (r"^lat_rad$", "lat"),
+    (r"^lon_rad$", "lon"),
+    (r"^(roll|pitch|yaw)_rad$", "euler"),
+)
+"""Unit-bearing table columns, by name (the units are in the column names)."""
+
+GYRO_LIMIT = 35.0  # rad/s: beyond it an angular rate is in °/s (the documented rule)
+STATIC_RATE = 1e-3  # rad/s: a record whose angular rates scatter less than this (σ per axis) is at rest
+T_LIMIT = 10.0  # s: a CAI pulse separation beyond it is in ms (the documented rule)
+
+
+def detectable(role: str, clean, scaled, dt: float | None, imu: bool = False) -> bool:
+    """Can the documented plausibility rules see this unit mistake? ``clean`` and
+    ``scaled`` are the values before and after (arrays); ``dt`` the sampling interval (s)
+    of increments (None for rates and other quantities); ``imu``: the value is a column of
+    an IMU table (whose time step has a plausible range; a trajectory's or an observation
+    table's has none)."""
+    c, s = np.abs(np.asarray(clean, float)), np.abs(np.asarray(scaled, float))
+    if role == "gyro":  # beyond 35 rad/s, or at rest (a mean near 57.3 x Earth rate)
+        rate = np.atleast_2d(np.asarray(clean, float) / (dt or 1.0))
+        return bool(np.max(np.abs(rate), initial=0.0) / DEG > GYRO_LIMIT or rate.std(axis=0).max() < STATIC_RATE)
+    if role == "lat":
+        return bool((s > math.pi / 2).any())
+    if role in ("lon", "euler"):
+        return bool((s > 2 * math.pi).any())
+    if role == "T":
+        return bool((s > T_LIMIT).any())
+    if role == "contrast":
+        return bool((s > 1.0).any())
+    if role == "time":
+        return imu
+    return True  # accel in g (|f| near 1), wavelength in nm: always visible
+
+
+@dataclasses.dataclass(frozen=True)
+class Mutation:
+    """One mistake: ``kind`` (``harmless``: must be identical; ``changes``: must raise,
+    warn or be identical; ``strings``: must raise; ``na``: must behave as ``nan_code``
+    does; ``unit``: must warn or raise), a short ``name`` and the Python lines ``code``
+    that make it (rebinding the variable, never changing a fixture in place)."""
+
+    kind: str
+    name: str
+    code: str
+    nan_code: str = ""
+    judged: bool = True
+
+
+def _renamed(col: str) -> str:
+    """A realistic misspelling: the name without its unit suffix, or upper case."""
+    head, _, tail = col.rpartition("_")
+    return head if head and tail in ("s", "rad", "mps", "mps2", "m", "hz") else col.upper()
+
+
+def table_mutations(var: str, df, time_origin: str = "") -> list[Mutation]:
+    """The DataFrame (or Series) mistakes on variable ``var``; ``time_origin``: the
+    argument of the call that fixes the origin of its time in seconds, if any."""
+    out = []
+    if isinstance(df, pd.Series):
+        df_cols = []
+    else:
+        df_cols = [str(c) for c in df.columns]
+    for c in df_cols:
+        out += [Mutation("changes", f"duplicated column {c!r}", f"{var} = pd.concat([{var}, {var}[[{c!r}]]], axis=1)"),
+                Mutation("changes", f"renamed column {c!r} -> {_renamed(c)!r}",
+                         f"{var} = {var}.rename(columns={{{c!r}: {_renamed(c)!r}}})"),
+                Mutation("changes", f"missing column {c!r}", f"{var} = {var}.drop(columns=[{c!r}])")]
+    if df_cols:
+        extra = ", ".join(f"{k}={v!r}" for k, v in EXTRA_COLUMNS.items())
+        out += [Mutation("harmless", "extra columns", f"{var} = {var}.assign({extra})"),
+                Mutation("harmless", "reordered columns", f"{var} = {var}[{var}.columns[::-1]]")]
+        if "time_s" in df_cols:
+            # a time column that starts at 0 converts exactly whether it is read relative to the
+            # first sample or to an epoch; one that does not is a mistake the call must see, and so
+            # is a date where another argument (time_origin) places the record in time in seconds
+            kind = "harmless" if float(df["time_s"].iloc[0]) == 0.0 else "changes"
+            dated = "changes" if time_origin else kind
+            td = f"pd.to_timedelta({var}['time_s'], unit='s')"
+            out += [Mutation(dated, "time as naive datetime64", f"{var} = {var}.assign(time_s=pd.Timestamp({str(EPOCH)!r}) + {td})"),
+                    Mutation(dated, "time as tz-aware datetime64",
+                             f"{var} = {var}.assign(time_s=pd.Timestamp({str(EPOCH)!r}, tz='UTC') + {td})"),
+                    Mutation(kind, "time as timedelta64", f"{var} = {var}.assign(time_s={td})"),
+                    Mutation("strings", "time as strings", f"{var} = {var}.assign(time_s={var}['time_s'].astype(str))")]
+    numeric = [c for c in df_cols if pd.api.types.is_float_dtype(df[c])]
+    if isinstance(df, pd.Series):
+        out += [Mutation("harmless", "nullable Float64", f"{var} = {var}.astype('Float64')"),
+                Mutation("na", "nullable Float64 with pd.NA at row 5",
+                         f"{var} = {var}.astype('Float64')\n{var}.iloc[5] = pd.NA",
+                         f"{var} = {var}.copy()\n{var}.iloc[5] = np.nan"),
+                Mutation("strings", "numbers as strings", f"{var} = {var}.astype(str)")]
+    elif numeric:
+        col = next((c for c in numeric if c != "time_s"), numeric[0])
+        out += [Mutation("harmless", "nullable Float64", f"{var} = {var}.astype({{c: 'Float64' for c in {numeric!r}}})"),
+                Mutation("na", f"nullable Float64 with pd.NA in {col!r} row 5",
+                         f"{var} = {var}.astype({{c: 'Float64' for c in {numeric!r}}})\n"
+                         f"{var}.loc[{var}.index[5], {col!r}] = pd.NA",
+                         f"{var} = {var}.copy()\n{var}.loc[{var}.index[5], {col!r}] = np.nan"),
+                Mutation("strings", f"numbers as strings in {col!r}", f"{var} = {var}.assign({col}={var}[{col!r}].astype(str))"),
+                Mutation("strings", "all numbers as strings", f"{var} = {var}.astype(str)")]
+    return out
+
+
+def array_mutations(var: str) -> list[Mutation]:
+    """The mistakes on a float array argument ``var``: the same numbers as nested lists
+    (harmless) and as strings."""
+    return [Mutation("harmless", f"{var} as nested lists", f"{var} = {var}.tolist()"),
+            Mutation("strings", f"{var} as strings", f"{var} = {var}.astype(str)")]
+
+
+def _increment_dt(df) -> float | None:
+    """The sampling interval (s) of an increments table (None for rates)."""
+    if any(str(c).startswith("dtheta_") for c in df.columns) and "time_s" in df.columns and len(df) > 1:
+        return float(np.median(np.diff(df["time_s"].to_numpy(float))))
+    return None
+
+
+def unit_mutations(clean: Clean, ns: dict) -> list[Mutation]:
+    """The unit mistakes of a clean call: its tables' unit-bearing columns (the three axes
+    of a triad together) and its ``units`` arguments."""
+    out = []
+    for var in clean.tables:
+        df = ns[var]
+        if isinstance(df, pd.Series):
+            continue
+        groups: dict[str, list[str]] = {}
+        for c in map(str, df.columns):
+            role = next((r for pattern, r in COLUMN_ROLES if re.match(pattern, c)), None)
+            if role is not None:
+                groups.setdefault(role, []).append(c)
+        for role, cols in groups.items():
+            for factor, unit in UNIT_MISTAKES[role]:
+                clean_v = df[cols].to_numpy(float)
+                scaled = ", ".join(f"{c}={var}[{c!r}] * {factor!r}" for c in cols)
+                out.append(Mutation("unit", f"{role} columns {cols} in {unit} (x{factor:.6g})",
+                                    f"{var} = {var}.assign({scaled})",
+                                    judged=detectable(role, clean_v, clean_v * factor, _increment_dt(df),
+                                                      imu="accel" in groups or "gyro" in groups)))
+    for u in clean.units:
+        v = np.asarray(eval(f"{u.var}{u.index}", {}, ns), float)  # noqa: S307 - the catalogue's own source
+        for factor, unit in UNIT_MISTAKES[u.role]:
+            if u.index:
+                code = f"{u.var} = np.array({u.var}, dtype=float)\n{u.var}{u.index} = {u.var}{u.index} * {factor!r}"
+            else:
+                code = f"{u.var} = np.asarray({u.var}, dtype=float) * {factor!r}" if np.ndim(v) else \
+                    f"{u.var} = {u.var} * {factor!r}"
+            out.append(Mutation("unit", f"{u.var}{u.index} ({u.role}) in {unit} (x{factor:.6g})", code,
+                                judged=detectable(u.role, v, v * factor, None)))
+    return out
+
+
+# ----------------------------------------------------------------------------------------
+# calls and comparison
+
+
+@dataclasses.dataclass
+class Attempt:
+    value: object = None
+    error: BaseException | None = None
+    unit_warnings: tuple[str, ...] = ()
+    seconds: float = 0.0
+
+
+def unit_warning_class():
+    import atomnav
+
+    return getattr(atomnav, "UnitWarning", None)
+
+
+def attempt(thunk) -> Attempt:
+    """Run ``thunk()``: its value or exception and the ``UnitWarning`` messages it gave."""
+    unit = unit_warning_class()
+    start = time.perf_counter()
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        try:
+            value, error = thunk(), None
+        except Exception as e:  # noqa: BLE001 - every exception is classified
+            value, error = None, e
+    msgs = tuple(str(w.message) for w in caught if unit is not None and issubclass(w.category, unit))
+    return Attempt(value, error, msgs, time.perf_counter() - start)
+
+
+def canon(x, depth: int = 0):
+    """A comparable form of a result: frames, series and arrays as (labels, arrays), time
+    columns as seconds (datetime64 from ``EPOCH``, timedelta64 from 0), objects by their
+    public attributes."""
+    if depth > 5:
+        return ("deep",)
+    if isinstance(x, pd.DataFrame):  # columns by name, in name order, without the extra columns drawn
+        keep = sorted((str(c), i) for i, c in enumerate(x.columns) if str(c) not in EXTRA_COLUMNS)
+        return ("frame", tuple(c for c, _ in keep), canon(np.asarray(x.index), depth + 1),
+                tuple(canon(x.iloc[:, i], depth + 1) for _, i in keep))
+    if isinstance(x, pd.Series):
+        if isinstance(x.dtype, pd.DatetimeTZDtype):
+            x = x.dt.tz_convert(None)
+        return canon(x.to_numpy(), depth + 1)
+    if isinstance(x, np.ndarray):
+        if x.dtype.kind == "M":
+            return (x - np.datetime64(EPOCH)) / np.timedelta64(1, "s")
+        if x.dtype.kind == "m":
+            return x / np.timedelta64(1, "s")
+        return x
+    if isinstance(x, (float, int, np.number, bool, np.bool_)):
+        return np.asarray(x)
+    if isinstance(x, dict):
+        return ("dict", tuple((str(k), canon(v, depth + 1)) for k, v in x.items()))
+    if isinstance(x, (list, tuple)):
+        return ("seq", tuple(canon(v, depth + 1) for v in x))
+    if x is None or isinstance(x, (str, bytes)):
+        return x
+    if dataclasses.is_dataclass(x):
+        return ("dc", type(x).__name__, tuple((f.name, canon(getattr(x, f.name), depth + 1)) for f in dataclasses.fields(x)))
+    props = [k for k, v in inspect.getmembers(type(x)) if not k.startswith("_")
+             and (isinstance(v, property) or inspect.isgetsetdescriptor(v))]
+    if props:  # an object is what its public properties read
+        return ("obj", type(x).__name__, tuple((k, canon(_read(x, k), depth + 1)) for k in props))
+    if hasattr(x, "__dict__"):
+        return ("obj", type(x).__name__, tuple((k, canon(v, depth + 1)) for k, v in sorted(vars(x).items())
+                                               if not k.startswith("_")))
+    return ("opaque", type(x).__name__)
+
+
+def _read(x, name: str):
+    try:
+        return getattr(x, name)
+    except Exception as e:  # noqa: BLE001 - a property that fails reads as its exception
+        return ("error", type(e).__name__)
+
+
+def same(a, b) -> bool:
+    """Bit-identical canonical forms (NaN equal to NaN)."""
+    return _eq(canon(a), canon(b))
+
+
+def _eq(a, b) -> bool:
+    if isinstance(a, np.ndarray) or isinstance(b, np.ndarray):
+        if not (isinstance(a, np.ndarray) and isinstance(b, np.ndarray)) or a.shape != b.shape:
+            return False
+        if a.dtype.kind in "fc" and b.dtype.kind in "fc":
+            return bool(np.array_equal(a, b, equal_nan=True))
+        try:
+            return bool(np.array_equal(a, b))
+        except (TypeError, ValueError):
+            return False
+    if isinstance(a, tuple) and isinstance(b, tuple):
+        return len(a) == len(b) and all(_eq(x, y) for x, y in zip(a, b))
+    return type(a) is type(b) and a == b
+
+
+def error_names(target: str) -> set[str]:
+    """The names an error of a call of ``target`` may give (fuzz's rule: its parameters and,
+    for a method, its instance's constructor parameters)."""
+    fuzz._init_targets()
+    return fuzz.TARGETS_BY_NAME[target].param_names()
+
+
+def classify_error(e: BaseException, names: set[str]) -> str:
+    """``raised`` for atomnav's answer to bad input naming an argument of the call; the bad
+    classes otherwise."""
+    import atomnav
+
+    if isinstance(e, atomnav.InputError):
+        p = getattr(e, "parameter", None)
+        return "raised" if str(p).split(".")[0].split("[")[0] in names else "raised-bad-parameter"
+    if isinstance(e, TypeError):
+        msg = str(e)
+        return "raised" if any(re.search(rf"\b{re.escape(n)}\b", msg) for n in names) else "raised-bad-parameter"
+    if isinstance(e, RuntimeError) and "borrowed" in str(e):
+        return "thread-borrow-error"
+    return "foreign-exception"
+
+
+def _describe(a: Attempt) -> str:
+    if a.error is not None:
+        e = a.error
+        return f"{type(e).__name__}(parameter={getattr(e, 'parameter', None)!r}, index={getattr(e, 'index', None)!r}): {e}"
+    return "returned a result"
+
+
+def judge(m: Mutation, got: Attempt, clean: Attempt, nan_ref: Attempt | None, names: set[str]) -> tuple[str, str]:
+    """(outcome class, message) of a mutated call against the clean call."""
+    if m.kind == "na" and nan_ref is not None:
+        if (got.error is None) != (nan_ref.error is None):
+            return "na-not-nan", f"pd.NA: {_describe(got)}; NaN: {_describe(nan_ref)}"
+        if got.error is not None:
+            cls = classify_error(got.error, names)
+            e, r = got.error, nan_ref.error
+            if cls == "raised" and (type(e) is not type(r) or getattr(e, "parameter", None) != getattr(r, "parameter", None)
+                                    or getattr(e, "index", None) != getattr(r, "index", None)):
+                return "na-not-nan", f"pd.NA: {_describe(got)}; NaN: {_describe(nan_ref)}"
+            return cls, _describe(got)
+        return ("identical", "") if same(got.value, nan_ref.value) else (
+            "na-not-nan", "pd.NA gives a different result than NaN")
+    if got.unit_warnings and m.kind != "harmless":
+        return "warned", got.unit_warnings[0]
+    if got.error is not None:
+        cls = classify_error(got.error, names)
+        if cls == "raised" and m.kind == "harmless":
+            return "harmless-rejected", _describe(got)
+        return cls, _describe(got)
+    if same(got.value, clean.value):
+        return ("strings-accepted", "numbers given as strings were read as numbers") if m.kind == "strings" else (
+            "identical", "")
+    if m.kind == "unit":
+        return "unit-not-warned", "the result changed with no UnitWarning and no error"
+    if m.kind == "strings":
+        return "strings-accepted", "numbers given as strings were taken (the result differs)"
+    return "silent-different", "the result differs from the clean call's, with no warning and no error"
+
+
+def fresh_namespace() -> dict:
+    """Copies of the fixtures (tables and arrays deep-copied; a case never sees another's)."""
+    out = {}
+    for k, v in fixtures().items():
+        out[k] = v.copy(deep=True) if isinstance(v, (pd.DataFrame, pd.Series)) else (
+            v.copy() if isinstance(v, np.ndarray) else v)
+    out.update(copy=copy, pickle=pickle, threading=threading)
+    return out
+
+
+# ----------------------------------------------------------------------------------------
+# a campaign
+
+
+@dataclasses.dataclass
+class Campaign:
+    """Outcome counts per class and per (callable, class), the first reproducers of each
+    bad pair, and the unit mistakes not judged."""
+
+    calls: int = 0
+    seconds: float = 0.0
+    counts: Counter = dataclasses.field(default_factory=Counter)
+    pairs: Counter = dataclasses.field(default_factory=Counter)
+    kept: list = dataclasses.field(default_factory=list)  # fuzz.Record, REPRO_KEEP per bad pair
+    not_judged: list = dataclasses.field(default_factory=list)  # (target, mutation name)
+    covered: set = dataclasses.field(default_factory=set)
+    cases: list = dataclasses.field(default_factory=list)  # (target, outcome, message) of every call
+
+    def add(self, target: str, outcome: str, message: str, seconds: float, repro: str) -> None:
+        self.cases.append((target, outcome, message))
+        self.calls += 1
+        self.counts[outcome] += 1
+        self.pairs[(target, outcome)] += 1
+        if outcome in BAD and self.pairs[(target, outcome)] <= REPRO_KEEP:
+            self.kept.append(fuzz.Record(target, outcome, message, seconds, repro))
+
+    @property
+    def n_bad(self) -> int:
+        return sum(n for (_, cls), n in self.pairs.items() if cls in BAD)
+
+    def first_failures(self) -> dict:
+        out: dict = {}
+        for r in self.kept:
+            out.setdefault((r.target, r.outcome), (r, self.pairs[(r.target, r.outcome)]))
+        return out
+
+    def report(self) -> str:
+        lines = ["# atomnav realistic-mistakes campaign", "",
+                 f"{self.calls} mutated calls over {len(self.covered)} public callables in {self.seconds:.0f} s; "
+                 f"{len(self.not_judged)} unit mistakes not judged (no documented rule can see them).", "",
+                 "## Outcomes", "", "| class | calls | bad |", "|---|---:|---|"]
+        for cls, n in sorted(self.counts.items(), key=lambda kv: -kv[1]):
+            lines.append(f"| {cls} | {n} | {'yes' if cls in BAD else ''} |")
+        fails = self.first_failures()
+        lines += ["", f"## Failing callables ({len({k[0] for k in fails})}; {len(fails)} (callable, class) pairs)", ""]
+        for (target, cls), (rec, n) in sorted(fails.items()):
+            lines += [f"### `{target}` — {cls} ({n}×)", "", fuzz._md(rec.message), "", "```python", rec.call, "```", ""]
+        lines += ["## Unit mistakes not judged", ""]
+        lines += [f"- `{t}`: {name}" for t, name in self.not_judged] or ["none"]
+        missing = sorted(table_or_array_callables() - self.covered)
+        lines += ["", f"## Table- or array-taking callables without a clean call ({len(missing)})", "",
+                  ", ".join(f"`{n}`" for n in missing), ""]
+        return "\n".join(lines)
+
+
+def _repro(*blocks: str) -> str:
+    return "\n".join(b for b in blocks if b)
+
+
+def run_clean(c: Clean, camp: Campaign) -> None:
+    """The clean call, then each of its mutations."""
+    names = error_names(c.target)
+    camp.covered.add(c.target)
+
+    def call(code: str) -> Attempt:
+        ns = fresh_namespace()
+        exec(_repro(c.setup, code), ns)  # noqa: S102 - the catalogue's own source text
+        return attempt(lambda: eval(c.call, ns))  # noqa: S307
+
+    clean = call("")
+    if clean.error is not None or clean.unit_warnings:
+        camp.add(c.target, "clean-failed", _describe(clean) if clean.error else clean.unit_warnings[0], clean.seconds,
+                 _repro(c.setup, c.call))
+        return
+    base = fixtures()
+    ns = dict(base)
+    exec(c.setup, ns)  # noqa: S102
+    arrays = [k for k, v in ns.items() if isinstance(v, np.ndarray) and v.size and v.dtype.kind == "f"
+              and not (k in base and v is base[k]) and re.search(rf"\b{k}\b", c.call)]
+    mutations = ([m for v in c.tables for m in table_mutations(v, ns[v], c.time_origin)]
+                 + [m for v in arrays for m in array_mutations(v)] + unit_mutations(c, ns))
+    for m in mutations:
+        if not m.judged:
+            camp.not_judged.append((c.target, m.name))
+            continue
+        got = call(m.code)
+        nan_ref = call(m.nan_code) if m.kind == "na" else None
+        cls, msg = judge(m, got, clean, nan_ref, names)
+        camp.add(c.target, cls, f"{m.name}: {msg}", got.seconds, _repro(c.setup, f"# mistake: {m.name}", m.code, c.call))
+
+
+def _outcome_key(a: Attempt) -> str:
+    return "ok" if a.error is None else type(a.error).__name__
+
+
+def run_threads(s: Stateful, camp: Campaign, rounds: int) -> None:
+    """``first`` from 4 threads on one object, against the same calls one after the other on
+    a fresh object: the same outcomes and the same final state, never pyo3's borrow error."""
+    import atomnav
+
+    names = error_names(s.target)
+    concurrent = getattr(atomnav, "ConcurrentUseError", None)
+    repro = _repro(s.setup, f"barrier = threading.Barrier({THREADS})",
+                   f"def go():\n    barrier.wait()\n    {s.first}",
+                   f"threads = [threading.Thread(target=go) for _ in range({THREADS})]",
+                   "[t.start() for t in threads]; [t.join() for t in threads]", s.state)
+    for _ in range(rounds):
+        ns = fresh_namespace()
+        exec(s.setup, ns)  # noqa: S102
+        barrier = threading.Barrier(THREADS)
+        got: list = [None] * THREADS
+
+        def go(i, ns=ns, barrier=barrier, got=got):
+            barrier.wait()
+            got[i] = attempt(lambda: eval(s.first, ns))  # noqa: S307
+
+        threads = [threading.Thread(target=go, args=(i,)) for i in range(THREADS)]
+        start = time.perf_counter()
+        for t in threads:
+            t.start()
+        for t in threads:
+            t.join()
+        seconds = time.perf_counter() - start
+        made = [a for a in got if not (concurrent is not None and isinstance(a.error, concurrent))]
+        bad = [classify_error(a.error, names) for a in made if a.error is not None]
+        bad = [b for b in bad if b != "raised"]
+        if bad:
+            first = next(a for a in made if a.error is not None and classify_error(a.error, names) == bad[0])
+            camp.add(s.target, bad[0], f"{THREADS} threads: {_describe(first)}", seconds, repro)
+            continue
+        ref = fresh_namespace()
+        exec(s.setup, ref)  # noqa: S102
+        seq = [attempt(lambda: eval(s.first, ref)) for _ in made]  # noqa: S307
+        if sorted(map(_outcome_key, made)) != sorted(map(_outcome_key, seq)):
+            camp.add(s.target, "silent-different", f"{THREADS} threads gave {sorted(map(_outcome_key, made))}, "
+                     f"the same calls in sequence {sorted(map(_outcome_key, seq))}", seconds, repro)
+            continue
+        end, end_ref = attempt(lambda: eval(s.state, ns)), attempt(lambda: eval(s.state, ref))  # noqa: S307
+        if end.error is not None or end_ref.error is not None or not same(end.value, end_ref.value):
+            camp.add(s.target, "silent-different", f"the state after {THREADS} threads differs from the state after "
+                     f"the same calls in sequence ({_describe(end)})", seconds, repro)
+        else:
+            camp.add(s.target, "identical" if not any(a.error for a in made) else "raised", "", seconds, repro)
+
+
+def run_pickle(s: Stateful, camp: Campaign) -> None:
+    """After ``first``, a ``pickle`` and a ``deepcopy`` copy continue (``then``, ``state``)
+    bit for bit like the original."""
+    copiers = (("pickle.loads(pickle.dumps(obj))", lambda o: pickle.loads(pickle.dumps(o))),
+               ("copy.deepcopy(obj)", copy.deepcopy))
+    ns = fresh_namespace()
+    exec(_repro(s.setup, s.first), ns)  # noqa: S102
+    copies = []
+    for how, copier in copiers:
+        repro = _repro(s.setup, s.first, f"dup = {how}", s.then, s.state, f"obj = dup  # continue the copy",
+                       s.then, s.state)
+        start = time.perf_counter()
+        try:
+            copies.append((how, copier(ns["obj"]), repro))
+        except Exception as e:  # noqa: BLE001 - a copy that fails is the finding
+            camp.add(s.target, "pickle-failed", f"{how}: {type(e).__name__}: {e}", time.perf_counter() - start, repro)
+    if not copies:
+        return
+    original = [attempt(lambda: eval(s.then, ns)), attempt(lambda: eval(s.state, ns))]  # noqa: S307
+    for how, dup, repro in copies:
+        other = dict(ns, obj=dup)
+        got = [attempt(lambda: eval(s.then, other)), attempt(lambda: eval(s.state, other))]  # noqa: S307
+        ok = all(_outcome_key(a) == _outcome_key(b) and same(a.value, b.value) for a, b in zip(got, original))
+        camp.add(s.target, "identical" if ok else "pickle-diverged",
+                 "" if ok else f"{how} continues unlike the original ({_describe(got[0])})", sum(a.seconds for a in got), repro)
+
+
+def campaign(thread_rounds: int = THREAD_ROUNDS, only: list[str] | None = None) -> Campaign:
+    """Every clean call with its mistakes, every stateful object from threads and through
+    pickling. ``only``: dotted-name prefixes of the callables to run."""
+    start = time.monotonic()
+    camp = Campaign()
+
+    def chosen(target: str) -> bool:
+        return not only or any(target.startswith(o) for o in only)
+
+    for c in CATALOGUE:
+        if chosen(c.target):
+            run_clean(c, camp)
+    for s in STATEFUL:
+        if chosen(s.target):
+            camp.covered.add(s.target)
+            if s.first:
+                run_threads(s, camp, thread_rounds)
+            run_pickle(s, camp)
+    camp.seconds = time.monotonic() - start
+    return camp
+
+
+def table_or_array_callables() -> set[str]:
+    """The public callables of ``atomnav`` (not the ``_core`` binding) whose signature or
+    docstring says they take a DataFrame or an array, by introspection."""
+    fuzz._init_targets()
+    out = set()
+    for t in fuzz.TARGETS:
+        if t.module.startswith("atomnav._core") or t.kind == "property" or not t.params:
+            continue
+        obj = fuzz.resolve(t.module, t.qualname)
+        doc = " ".join((inspect.getdoc(obj) or "").split())
+        if re.search(r"DataFrame|\barray|\(N\b|\(N,|\(M,|\(\d+,\s*\d*\)", doc):
+            out.add(t.name)
+    return out
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--thread-rounds", type=int, default=THREAD_ROUNDS)
+    ap.add_argument("--only", action="append", default=None, metavar="PREFIX")
+    ap.add_argument("--out", default=None, help="markdown report (default: stdout)")
+    ap.add_argument("--cases", default=None, help="also write every call's callable, class and mistake (TSV)")
+    a = ap.parse_args(argv)
+    c = campaign(a.thread_rounds, a.only)
+    if a.cases:
+        with open(a.cases, "w") as f:
+            f.writelines(f"{t}\t{cls}\t{fuzz._md(msg)}\n" for t, cls, msg in c.cases)
+    text = c.report() + f"\nReproducers assume `{REPRO_HEADER}` (run from tests/).\n"
+    if a.out:
+        with open(a.out, "w") as f:
+            f.write(text)
+    else:
+        print(text)
+    print(f"{c.calls} calls, {c.n_bad} bad, {c.seconds:.0f} s", file=sys.stderr)
+    return 1 if c.n_bad else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
