@@ -176,6 +176,10 @@ CATALOGUE: tuple[Clean, ...] = (
     _c("atomnav.strapdown.Strapdown.run", "an.strapdown.Strapdown(**init).run(imu)", "imu = meas", ["imu"],
        time_origin="t0"),
     _c("atomnav.strapdown.Strapdown", "an.strapdown.Strapdown(t0, lla, vel_ned, q_nb).run(meas)", INIT, (), LLA),
+    _c("atomnav.strapdown.Strapdown.reset", "(sd.reset(state), sd.state())",
+       "sd = an.strapdown.Strapdown(**init)\nstate = nav.iloc[[-1]]", ["state"]),
+    _c("atomnav.strapdown.integrate_attitude", "an.strapdown.integrate_attitude(init['q_nb'], dtheta)",
+       'dtheta = meas[["dtheta_x_rad", "dtheta_y_rad", "dtheta_z_rad"]].to_numpy()'),
     # IMU errors
     _c("atomnav.imu.corrupt", 'an.imu.corrupt(imu, errors="tactical", dt=0.01, kind="increments", seed=7)',
        "imu = ideal", ["imu"]),
@@ -203,8 +207,14 @@ CATALOGUE: tuple[Clean, ...] = (
     _c("atomnav.rotation.quat_from_euler", "an.rotation.quat_from_euler(euler)", EULER, (), (Unit("euler", "euler"),)),
     _c("atomnav.rotation.dcm_from_euler", "an.rotation.dcm_from_euler(euler)", EULER, (), (Unit("euler", "euler"),)),
     _c("atomnav.astro.euler_dcm", "an.astro.euler_dcm(euler)", EULER, (), (Unit("euler", "euler"),)),
+    _c("atomnav.rotation.quat_from_dcm", "an.rotation.quat_from_dcm(dcm)", "dcm = an.rotation.dcm_from_quat(traj.q_nb)"),
+    _c("atomnav.rotation.dcm_from_quat", "an.rotation.dcm_from_quat(q)", "q = traj.q_nb"),
+    _c("atomnav.rotation.attitude_error_angle", "an.rotation.attitude_error_angle(q_a, q_b)",
+       'q_a, q_b = traj.q_nb[1:], nav[["qw", "qx", "qy", "qz"]].to_numpy()'),
     # Earth
     _c("atomnav.earth.lla_to_ecef", "an.earth.lla_to_ecef(lla)", "lla = traj.lla", (), LLA_ROWS),
+    _c("atomnav.earth.dcm_ned_to_ecef", "an.earth.dcm_ned_to_ecef(lat, lon)", "lat, lon = init['lla'][0], init['lla'][1]",
+       (), (Unit("lat", "lat"), Unit("lon", "lon"))),
     _c("atomnav.earth.gravity", "an.earth.gravity(lat, 200.0)", "lat = traj.lla[:, 0]", (), (Unit("lat", "lat"),)),
     _c("atomnav.earth.schuler_period", "an.earth.schuler_period(lat, 200.0)", "lat = 0.9", (), (Unit("lat", "lat"),)),
     # atom interferometer closed forms
@@ -376,19 +386,20 @@ def table_mutations(var: str, df, time_origin: str = "") -> list[Mutation]:
                     Mutation(kind, "time as timedelta64", f"{var} = {var}.assign(time_s={td})"),
                     Mutation("strings", "time as strings", f"{var} = {var}.assign(time_s={var}['time_s'].astype(str))")]
     numeric = [c for c in df_cols if pd.api.types.is_float_dtype(df[c])]
+    row = min(5, len(df) - 1)  # the row given pd.NA
     if isinstance(df, pd.Series):
         out += [Mutation("harmless", "nullable Float64", f"{var} = {var}.astype('Float64')"),
-                Mutation("na", "nullable Float64 with pd.NA at row 5",
-                         f"{var} = {var}.astype('Float64')\n{var}.iloc[5] = pd.NA",
-                         f"{var} = {var}.copy()\n{var}.iloc[5] = np.nan"),
+                Mutation("na", f"nullable Float64 with pd.NA at row {row}",
+                         f"{var} = {var}.astype('Float64')\n{var}.iloc[{row}] = pd.NA",
+                         f"{var} = {var}.copy()\n{var}.iloc[{row}] = np.nan"),
                 Mutation("strings", "numbers as strings", f"{var} = {var}.astype(str)")]
     elif numeric:
         col = next((c for c in numeric if c != "time_s"), numeric[0])
         out += [Mutation("harmless", "nullable Float64", f"{var} = {var}.astype({{c: 'Float64' for c in {numeric!r}}})"),
-                Mutation("na", f"nullable Float64 with pd.NA in {col!r} row 5",
+                Mutation("na", f"nullable Float64 with pd.NA in {col!r} row {row}",
                          f"{var} = {var}.astype({{c: 'Float64' for c in {numeric!r}}})\n"
-                         f"{var}.loc[{var}.index[5], {col!r}] = pd.NA",
-                         f"{var} = {var}.copy()\n{var}.loc[{var}.index[5], {col!r}] = np.nan"),
+                         f"{var}.loc[{var}.index[{row}], {col!r}] = pd.NA",
+                         f"{var} = {var}.copy()\n{var}.loc[{var}.index[{row}], {col!r}] = np.nan"),
                 Mutation("strings", f"numbers as strings in {col!r}", f"{var} = {var}.assign({col}={var}[{col!r}].astype(str))"),
                 Mutation("strings", "all numbers as strings", f"{var} = {var}.astype(str)")]
     return out
