@@ -71,7 +71,7 @@ def as_floats(x, name: str) -> np.ndarray:
     if isinstance(x, (pd.Series, pd.DataFrame)):
         frame = x.to_frame() if isinstance(x, pd.Series) else x
         for column, values in frame.items():
-            _check_numbers(values, name, column)
+            check_numbers(values, name, column)
         return x.to_numpy(dtype=float, na_value=np.nan)
     try:
         a = np.asarray(x)
@@ -85,7 +85,7 @@ def as_floats(x, name: str) -> np.ndarray:
         raise TypeError(f"{name}: expected numbers, got {type(x).__name__} ({e})") from None
 
 
-def _check_numbers(values: pd.Series, parameter: str, column) -> None:
+def check_numbers(values: pd.Series, parameter: str, column) -> None:
     """A ``TypeError`` naming ``parameter`` and ``column`` unless the column holds numbers
     (a numeric dtype, nullable or not, or objects that are all numbers or missing)."""
     dtype = values.dtype
@@ -113,42 +113,40 @@ def timestamp(x):
     return None
 
 
-def _utc_naive(t, tz_aware: bool, parameter: str, what: str):
-    """Datetimes ``t`` (a Series or a Timestamp) as naive UTC; a naive value where a
-    tz-aware one is compared (or the reverse) is an :class:`InputError` naming ``parameter``."""
-    aware = (t.dt.tz if isinstance(t, pd.Series) else t.tz) is not None
-    if aware != tz_aware:
-        raise input_error(parameter, f"{what} is {'tz-aware' if aware else 'naive'} but the time it is compared with is not: "
-                                     "give both with a time zone or both without")
-    if not aware:
-        return t
-    return t.dt.tz_convert("UTC").dt.tz_localize(None) if isinstance(t, pd.Series) else t.tz_convert("UTC").tz_localize(None)
+def _utc_naive(t):
+    """Datetimes ``t`` (a Series or a Timestamp) as naive UTC (naive ones as they are)."""
+    if isinstance(t, pd.Series):
+        return t if t.dt.tz is None else t.dt.tz_convert("UTC").dt.tz_localize(None)
+    return t if t.tz is None else t.tz_convert("UTC").tz_localize(None)
 
 
 def seconds(values: pd.Series, parameter: str, column, epoch=FIRST_SAMPLE, epoch_name: str = "epoch") -> np.ndarray:
     """A time column as float seconds (NaN where missing): numbers as they are,
     timedelta64 as its seconds, datetime64 as seconds since ``epoch`` (a datetime, or
-    :data:`FIRST_SAMPLE`; None: datetimes are refused with a ``TypeError``, this caller has
-    no epoch). Other dtypes are a ``TypeError`` naming ``parameter`` and ``column``;
-    ``epoch_name`` names the epoch's argument in errors."""
+    :data:`FIRST_SAMPLE`; None: this call has no epoch and datetimes are a
+    ``TypeError``). Other dtypes are a ``TypeError`` naming ``parameter`` and
+    ``column``; ``epoch_name`` says in that message how to give an epoch. A tz-aware
+    column with a naive epoch, or the reverse, is an :class:`InputError` naming
+    ``parameter``."""
     dtype = values.dtype
     if pd.api.types.is_timedelta64_dtype(dtype):
         return _timedelta_seconds(values.to_numpy())
     if not pd.api.types.is_datetime64_any_dtype(dtype):
-        _check_numbers(values, parameter, column)
+        check_numbers(values, parameter, column)
         return values.to_numpy(dtype=float, na_value=np.nan)
     if epoch is None:
-        raise TypeError(f"{parameter}: column {column!r} holds datetimes, which this call cannot place in time; "
-                        "give seconds (or a timedelta64) instead")
-    tz_aware = isinstance(dtype, pd.DatetimeTZDtype)
+        raise TypeError(f"{parameter}: column {column!r} holds datetimes but no {epoch_name} was given to count seconds from; "
+                        "give one, or the column in seconds (or as timedelta64)")
     if epoch is FIRST_SAMPLE:
         present = values.dropna()
         if present.empty:  # nothing to place in time: every row is missing
             return np.full(len(values), np.nan)
-        epoch, epoch_name = present.iloc[0], parameter
-    t = _utc_naive(values, tz_aware, parameter, f"column {column!r}")
-    ref = _utc_naive(pd.Timestamp(epoch), tz_aware, epoch_name, epoch_name)
-    return _timedelta_seconds(t.to_numpy() - ref.to_datetime64())
+        epoch = present.iloc[0]
+    epoch = pd.Timestamp(epoch)
+    if (values.dt.tz is None) != (epoch.tz is None):
+        raise input_error(parameter, f"column {column!r} is {'naive' if values.dt.tz is None else 'tz-aware'} but the epoch "
+                                     f"{epoch} is not: give both with a time zone or both without")
+    return _timedelta_seconds(_utc_naive(values).to_numpy() - _utc_naive(epoch).to_datetime64())
 
 
 def _timedelta_seconds(d: np.ndarray) -> np.ndarray:
@@ -187,7 +185,7 @@ def table(df, names, parameter: str, *, order: str = "C", epoch=FIRST_SAMPLE, ep
 
 
 def _numbers(values: pd.Series, parameter: str, column) -> np.ndarray:
-    _check_numbers(values, parameter, column)
+    check_numbers(values, parameter, column)
     return values.to_numpy(dtype=float, na_value=np.nan)
 
 

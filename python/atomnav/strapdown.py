@@ -20,7 +20,7 @@ import numpy as np
 import pandas as pd
 
 from . import _core
-from ._validate import as_floats, flag, input_error, rows, scalar, table, timestamp, vector
+from ._validate import as_floats, flag, input_error, rows, scalar, seconds, table, timestamp, vector
 from .trajectory import COLUMNS, IMU_COLUMNS
 
 #: Rows per call into Rust: the progress bar's granularity for long runs.
@@ -42,7 +42,7 @@ def _imu_arrays(imu, kind: str, epoch=None):
     checked here: the core checks values (NaN/inf, time order) once, with indices in the
     record, and :func:`_imu_errors` names the column."""
     if isinstance(imu, pd.DataFrame):
-        a = table(imu, IMU_COLUMNS[kind], "imu", order="F", epoch=epoch, epoch_name="t0", finite=False)
+        a = table(imu, IMU_COLUMNS[kind], "imu", order="F", epoch=epoch, epoch_name="epoch (or t0 as a datetime)", finite=False)
     else:
         a = as_floats(imu, "imu")
         if a.ndim != 2 or a.shape[1] != 7:
@@ -72,6 +72,15 @@ def _imu_errors(kind: str, gyro: np.ndarray, accel: np.ndarray, first_row: int):
         raise input_error("imu", f"column {names[0]!r}: {reason}" if len(names) == 1 else f"columns {names}: {reason}", e.index) from None
 
 
+def _epoch(t0, epoch):
+    """The datetime of time 0: ``epoch``, else ``t0`` if it is a datetime, else None."""
+    if epoch is None:
+        return timestamp(t0)
+    if timestamp(epoch) is None:
+        raise TypeError(f"epoch: expected a datetime (pandas.Timestamp, datetime or numpy.datetime64), got {type(epoch).__name__}")
+    return timestamp(epoch)
+
+
 def _h_ref(h_ref, n: int):
     """The reference altitudes as a float array of ``n`` values (the core checks them)."""
     if h_ref is None:
@@ -96,11 +105,11 @@ class Strapdown:
     """Streaming strapdown INS from an initial state: time ``t0`` (s), ``lla`` (lat rad,
     lon rad, h m), NED velocity ``vel_ned`` (m/s) and attitude ``q_nb`` (scalar first).
 
-    ``t0`` may instead be a datetime (``pandas.Timestamp``, ``datetime``,
-    ``numpy.datetime64``): it is then the epoch, IMU tables may carry a datetime64
-    ``time_s`` column (both tz-aware or both naive), and every time in and out is in
-    seconds since ``t0`` (the solution starts at ``time_s`` 0). With a ``t0`` in seconds a
-    datetime64 ``time_s`` is a ``TypeError``; a timedelta64 one is read as seconds either way.
+    Times are in seconds. A timedelta64 ``time_s`` column of the IMU tables is read as
+    seconds. A datetime64 one needs an epoch, the datetime of time 0: ``epoch``, or else
+    ``t0`` given as a datetime (then time 0 is ``t0``); every time in and out (``t0``, the
+    solution's ``time_s``) is then in seconds since it, and without one a datetime64
+    column is a ``TypeError``. Datetimes and the epoch must be both tz-aware or both naive.
 
     Parameters
     ----------
@@ -116,16 +125,21 @@ class Strapdown:
     zeta, omega : float, optional
         Damping ratio and natural frequency (rad/s) of the baro loop; the core's defaults
         (0.707, 0.01 rad/s) when not given.
+    epoch : datetime, optional
+        ``pandas.Timestamp``, ``datetime`` or ``numpy.datetime64``: time 0 of the seconds
+        (see above); :meth:`atomnav.trajectory.Trajectory.initial_state` gives it for a
+        trajectory read from datetimes.
 
     Rows are numbered in the whole record: the DataFrames of successive :meth:`run` calls
     continue each other's index, as do error indices.
     """
 
     def __init__(self, t0, lla, vel_ned, q_nb, *, kind: str = "increments", ellipsoid: str = "WGS84",
-                 vertical: str = "free", zeta: float | None = None, omega: float | None = None):
-        #: The datetime of time 0 when ``t0`` was given as a datetime, else None.
-        self.epoch = timestamp(t0)
-        self._core = _core.Strapdown(0.0 if self.epoch is not None else scalar(t0, "t0"), vector(lla, 3, "lla"), vector(vel_ned, 3, "vel_ned"),
+                 vertical: str = "free", zeta: float | None = None, omega: float | None = None, epoch=None):
+        #: The datetime of time 0 (``epoch``, or ``t0`` given as a datetime), else None.
+        self.epoch = _epoch(t0, epoch)
+        t0 = scalar(t0, "t0") if timestamp(t0) is None else seconds(pd.Series([t0]), "t0", "t0", self.epoch, "epoch")[0]
+        self._core = _core.Strapdown(t0, vector(lla, 3, "lla"), vector(vel_ned, 3, "vel_ned"),
                                      vector(q_nb, 4, "q_nb"), kind=kind, ellipsoid=ellipsoid, vertical=vertical,
                                      zeta=None if zeta is None else scalar(zeta, "zeta"),
                                      omega=None if omega is None else scalar(omega, "omega"))
@@ -219,7 +233,7 @@ class Strapdown:
 
 def integrate(imu, t0, lla, vel_ned, q_nb, *, kind: str = "increments", ellipsoid: str = "WGS84",
               vertical: str = "free", h_ref=None, zeta: float | None = None, omega: float | None = None,
-              progress: bool | None = None) -> pd.DataFrame:
+              progress: bool | None = None, epoch=None) -> pd.DataFrame:
     """Integrate a whole IMU record from the initial state.
 
     Parameters
@@ -229,10 +243,10 @@ def integrate(imu, t0, lla, vel_ned, q_nb, *, kind: str = "increments", ellipsoi
         the column order of ``atomnav.trajectory.IMU_COLUMNS[kind]``: time, gyro x/y/z,
         accel x/y/z.
     t0, lla, vel_ned, q_nb
-        Initial state: time (s, or a datetime: the epoch of a datetime64 ``time_s``, see
-        :class:`Strapdown`); lat (rad), lon (rad), h (m); NED velocity (m/s); q_nb.
-    kind, ellipsoid, vertical, zeta, omega
-        As for :class:`Strapdown`.
+        Initial state: time (s, or a datetime, see :class:`Strapdown`); lat (rad), lon
+        (rad), h (m); NED velocity (m/s); q_nb.
+    kind, ellipsoid, vertical, zeta, omega, epoch
+        As for :class:`Strapdown` (``epoch``: time 0 of a datetime64 ``time_s``).
     h_ref : array (N,), optional
         Reference altitude (m) per IMU row for a damped vertical channel.
     progress : bool, optional
@@ -250,7 +264,7 @@ def integrate(imu, t0, lla, vel_ned, q_nb, *, kind: str = "increments", ellipsoi
         If the solution diverges: ``.partial`` holds every row computed before it,
         ``.row`` and ``.time_s`` (s) name the sample at which it diverged.
     """
-    sd = Strapdown(t0, lla, vel_ned, q_nb, kind=kind, ellipsoid=ellipsoid, vertical=vertical, zeta=zeta, omega=omega)
+    sd = Strapdown(t0, lla, vel_ned, q_nb, kind=kind, ellipsoid=ellipsoid, vertical=vertical, zeta=zeta, omega=omega, epoch=epoch)
     t, g, a = _imu_arrays(imu, sd.kind, sd.epoch)
     h = _h_ref(h_ref, len(t))
     show = len(t) > 1_000_000 if progress is None else flag(progress, "progress")

@@ -14,7 +14,8 @@ import numpy as np
 import pandas as pd
 
 from . import _core
-from ._validate import as_floats, finite_scalar, increasing, input_error, instance, path as checked_path, positive, renamed, rows, vector
+from ._validate import (FIRST_SAMPLE, check_numbers, finite_scalar, increasing, input_error, instance, locate, path as checked_path,
+                        positive, renamed, rows, table, timestamp, vector)
 from .rotation import euler_from_quat, quat_from_euler
 
 #: Column names of a trajectory table (units in the names).
@@ -46,15 +47,19 @@ class Trajectory:
     Build from data with :meth:`from_dataframe` / :meth:`from_csv`, or with the
     generators of this module (:func:`sinusoidal`, :func:`hexapod`, ...)."""
 
-    def __init__(self, df: pd.DataFrame, motion: _core.Motion | None = None, ellipsoid: str = "WGS84"):
-        missing = [c for c in COLUMNS if c not in instance(df, pd.DataFrame, "df").columns]
-        if missing:
-            raise input_error("df", f"missing column(s) {missing} (a table of nav_table, columns {COLUMNS})")
+    def __init__(self, df: pd.DataFrame, motion: _core.Motion | None = None, ellipsoid: str = "WGS84", epoch=None):
+        # the table is kept as given (no copy): its columns are checked by name and type here
+        for name, k in zip(COLUMNS, locate(instance(df, pd.DataFrame, "df"), COLUMNS, "df")):
+            check_numbers(df.iloc[:, k], "df", name)
         if motion is not None:
             instance(motion, _core.Motion, "motion")
+        if epoch is not None and timestamp(epoch) is None:
+            raise TypeError(f"epoch: expected a datetime (pandas.Timestamp, datetime or numpy.datetime64), got {type(epoch).__name__}")
         self.df = df
         self.motion = motion
         self.ellipsoid = instance(ellipsoid, str, "ellipsoid")
+        #: The datetime of ``time_s`` 0 for a trajectory read from datetimes (or given one), else None.
+        self.epoch = None if epoch is None else timestamp(epoch)
 
     # ---- construction -------------------------------------------------------------
     @classmethod
@@ -71,35 +76,39 @@ class Trajectory:
         return cls(nav_table(tr["time"], tr["lla"], tr["vel_ned"], tr["q_nb"]), motion, ellipsoid)
 
     @classmethod
-    def from_dataframe(cls, df: pd.DataFrame, ellipsoid: str = "WGS84") -> "Trajectory":
+    def from_dataframe(cls, df: pd.DataFrame, ellipsoid: str = "WGS84", *, epoch=None) -> "Trajectory":
         """From a table with ``time_s, lat_rad, lon_rad, h_m, vn_mps, ve_mps, vd_mps`` and
-        either ``qw, qx, qy, qz`` or ``roll_rad, pitch_rad, yaw_rad``. Validated: finite
-        values, strictly increasing time, latitude within ±π/2."""
+        either ``qw, qx, qy, qz`` or ``roll_rad, pitch_rad, yaw_rad`` (the quaternion when
+        both are there), read by column name (extra columns ignored). Validated: finite
+        values, strictly increasing time, latitude within ±π/2.
+
+        ``time_s`` holds seconds, a timedelta64 (read as seconds) or a datetime64: then
+        seconds since ``epoch`` (a datetime), by default since the first sample. The
+        trajectory keeps that datetime as :attr:`epoch`, which :meth:`initial_state` passes
+        on and :meth:`errors` reads datetime solutions against."""
         need = ["time_s", "lat_rad", "lon_rad", "h_m", "vn_mps", "ve_mps", "vd_mps"]
-        missing = [c for c in need if c not in instance(df, pd.DataFrame, "df").columns]
-        if missing:
-            raise input_error("df", f"missing column(s) {missing}; expected {need} plus quaternion or Euler columns")
-
-        def cols(names):
-            return as_floats(df[names].to_numpy(), "df")
-
-        if all(c in df.columns for c in ("qw", "qx", "qy", "qz")):
-            q = cols(["qw", "qx", "qy", "qz"])
-        elif all(c in df.columns for c in ("roll_rad", "pitch_rad", "yaw_rad")):
-            q = quat_from_euler(rows(cols(["roll_rad", "pitch_rad", "yaw_rad"]), 3, "df"))
-        else:
-            raise input_error("df", "needs attitude columns qw, qx, qy, qz or roll_rad, pitch_rad, yaw_rad")
-        t = vector(cols("time_s"), None, "df")
+        attitudes = (["qw", "qx", "qy", "qz"], ["roll_rad", "pitch_rad", "yaw_rad"])
+        attitude = next((a for a in attitudes if all(c in instance(df, pd.DataFrame, "df").columns for c in a)), None)
+        if attitude is None:
+            raise input_error("df", f"needs attitude columns qw, qx, qy, qz or roll_rad, pitch_rad, yaw_rad (and {need})")
+        if epoch is not None and timestamp(epoch) is None:
+            raise TypeError(f"epoch: expected a datetime (pandas.Timestamp, datetime or numpy.datetime64), got {type(epoch).__name__}")
+        a = table(df, need + attitude, "df", epoch=FIRST_SAMPLE if epoch is None else epoch)
+        if epoch is None and pd.api.types.is_datetime64_any_dtype(df["time_s"].dtype):
+            epoch = df["time_s"].iloc[0]  # the conversion's reference (table() has checked the column)
+        t, lla, vel = a[:, 0], a[:, 1:4], a[:, 4:7]
+        q = a[:, 7:] if len(attitude) == 4 else quat_from_euler(np.ascontiguousarray(a[:, 7:]))
         increasing(t, "df", "time_s")
-        lla = rows(cols(["lat_rad", "lon_rad", "h_m"]), 3, "df")
         bad = np.nonzero(np.abs(lla[:, 0]) > np.pi / 2)[0]
         if bad.size:
             raise input_error("df", f"lat_rad: latitude {lla[bad[0], 0]} rad at index {bad[0]} is outside [-pi/2, pi/2]", bad[0])
-        return cls(nav_table(t, lla, cols(["vn_mps", "ve_mps", "vd_mps"]), q), None, ellipsoid)
+        return cls(nav_table(t, lla, vel, q), None, ellipsoid, epoch)
 
     @classmethod
     def from_csv(cls, path, ellipsoid: str = "WGS84", **read_csv_kwargs) -> "Trajectory":
-        """Read a CSV with the columns of :meth:`from_dataframe`."""
+        """Read a CSV with the columns of :meth:`from_dataframe` (time in seconds; for
+        datetimes read the file with ``pandas.read_csv(..., parse_dates=["time_s"])`` and
+        use :meth:`from_dataframe`)."""
         try:
             df = pd.read_csv(checked_path(path), **read_csv_kwargs)
         except (pd.errors.ParserError, pd.errors.EmptyDataError, UnicodeDecodeError) as e:
@@ -119,7 +128,8 @@ class Trajectory:
     def __repr__(self) -> str:
         name = self.motion.name if self.motion is not None else "user data"
         t = self.df["time_s"]
-        return f"Trajectory({name}, {len(self)} samples, {t.iloc[0]:.3f}..{t.iloc[-1]:.3f} s)"
+        span = f", {t.iloc[0]:.3f}..{t.iloc[-1]:.3f} s" if len(t) else ""
+        return f"Trajectory({name}, {len(self)} samples{span})"
 
     @property
     def time(self) -> np.ndarray:
@@ -138,8 +148,13 @@ class Trajectory:
         return self.df[["qw", "qx", "qy", "qz"]].to_numpy()
 
     def initial_state(self) -> dict:
-        """The first sample as keyword arguments for :func:`atomnav.strapdown.integrate`."""
-        return {"t0": float(self.time[0]), "lla": self.lla[0], "vel_ned": self.vel_ned[0], "q_nb": self.q_nb[0]}
+        """The first sample as keyword arguments for :func:`atomnav.strapdown.integrate`
+        (with ``epoch`` when the trajectory has one, so that datetime64 IMU times count
+        from the same datetime as this trajectory's seconds)."""
+        if not len(self):
+            raise input_error("df", "the trajectory has no samples, so no initial state")
+        state = {"t0": float(self.time[0]), "lla": self.lla[0], "vel_ned": self.vel_ned[0], "q_nb": self.q_nb[0]}
+        return state if self.epoch is None else {**state, "epoch": self.epoch}
 
     # ---- IMU ------------------------------------------------------------------------
     def ideal_imu(self, kind: str = "increments") -> pd.DataFrame:
@@ -165,18 +180,18 @@ class Trajectory:
         velocity error (m/s), attitude error ψ (rad, nav frame, C_nb(est) = (I − [ψ×])
         C_nb(true)), one row per solution row. Every solution time stamp must be one of
         the trajectory's (an increments-driven solution, which starts one step after the
-        initial state, is fine)."""
-        lla, vel, q = (["lat_rad", "lon_rad", "h_m"], ["vn_mps", "ve_mps", "vd_mps"], ["qw", "qx", "qy", "qz"])
-        missing = [c for c in ["time_s", *lla, *vel, *q] if c not in instance(nav, pd.DataFrame, "nav").columns]
-        if missing:
-            raise input_error("nav", f"missing column(s) {missing}")
-        tn = vector(as_floats(nav["time_s"].to_numpy(), "nav"), None, "nav")
+        initial state, is fine). ``nav`` is read by column name; a datetime64 ``time_s``
+        counts from this trajectory's :attr:`epoch` (a ``TypeError`` when it has none)."""
+        a = table(nav, ["time_s", "lat_rad", "lon_rad", "h_m", "vn_mps", "ve_mps", "vd_mps", "qw", "qx", "qy", "qz"], "nav",
+                  epoch=self.epoch, epoch_name="epoch (Trajectory.from_dataframe's)")
+        tn = a[:, 0]
         idx = np.clip(np.searchsorted(self.time, tn), 0, len(self.time) - 1)
         off = np.nonzero(np.abs(self.time[idx] - tn) > 1e-9)[0]
         if off.size:
             raise input_error("nav", f"time stamp {tn[off[0]]} at index {off[0]} is not a time stamp of the trajectory", off[0])
-        truth, est = self.df.iloc[idx], nav
-        arrays = [np.ascontiguousarray(as_floats(df[c].to_numpy(), "nav")) for df in (est, truth) for c in (lla, vel, q)]
+        truth = self.df.iloc[idx]
+        arrays = [np.ascontiguousarray(x) for x in (a[:, 1:4], a[:, 4:7], a[:, 7:11], truth[["lat_rad", "lon_rad", "h_m"]].to_numpy(),
+                                                    truth[["vn_mps", "ve_mps", "vd_mps"]].to_numpy(), truth[["qw", "qx", "qy", "qz"]].to_numpy())]
         err = _core.nav_errors(*arrays, ellipsoid=self.ellipsoid)
         return pd.DataFrame(np.column_stack([tn, err]), columns=["time_s", *_core.NAV_ERROR_COLUMNS])
 
