@@ -19,14 +19,16 @@ from ._validate import as_floats, input_error, rows
 ROTATION_TOLERANCE = _core.ROTATION_TOLERANCE
 
 
-def _single(x, width):
-    return np.ndim(x) == 1 and np.shape(x)[0] == width
+def _single(a: np.ndarray, width: int) -> bool:
+    """Whether ``a`` (already read by ``as_floats``: ragged input is a TypeError naming
+    the argument there) is one row of ``width`` values."""
+    return a.ndim == 1 and a.shape[0] == width
 
 
 def _wrap(fn, x, width, name, out_single):
-    single = _single(x, width)
-    r = fn(rows(x, width, name))
-    return r[0] if single and out_single else r
+    a = as_floats(x, name)
+    r = fn(rows(a, width, name))
+    return r[0] if _single(a, width) and out_single else r
 
 
 def quat_from_euler(euler):
@@ -90,6 +92,7 @@ def rotvec_from_dcm(dcm):
 
 def quat_multiply(a, b):
     """Hamilton product a ⊗ b, row by row."""
+    a, b = as_floats(a, "a"), as_floats(b, "b")
     single = _single(a, 4) and _single(b, 4)
     r = _core.quat_mul_rows(rows(a, 4, "a"), rows(b, 4, "b"))
     return r[0] if single else r
