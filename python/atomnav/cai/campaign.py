@@ -10,7 +10,7 @@ import os
 import numpy as np
 
 from .. import _core
-from .._validate import instance, integer
+from .._validate import flag, instance, integer
 from ..imu import ImuErrors
 from .results import HybridResult
 
@@ -44,7 +44,7 @@ def run_campaign(name: str, motion, config, *, runs: int = 1, seed: int = 0, pro
                            truth_rate_hz=None if config.truth_rate_hz is None else float(config.truth_rate_hz),
                            phase_source=config.phase_source, accel_psd=float(setup.accel_psd), gyro_psd=float(setup.gyro_psd),
                            accel_bias_psd=float(setup.accel_bias_psd), gyro_bias_psd=float(setup.gyro_bias_psd),
-                           predict_every=setup.predict_every, aiding=bool(config.aiding), draw_initial=bool(config.draw_initial))
+                           predict_every=setup.predict_every, aiding=flag(config.aiding, "aiding"), draw_initial=flag(config.draw_initial, "draw_initial"))
     chunk = max(1, os.cpu_count() or 1)
     parts = []
     with tqdm(total=int(runs), desc=name, disable=not progress, unit="run") as bar:

@@ -13,7 +13,7 @@ import numpy as np
 import pandas as pd
 
 from .. import _core
-from .._validate import as_floats, choice, finite_scalar, generator, input_error, instance, integer, nonnegative, vector
+from .._validate import as_floats, choice, finite_scalar, flag, generator, input_error, integer, nonnegative, table, vector
 
 _NAMES = ("p0", "phi", "A")
 
@@ -44,14 +44,10 @@ def fringe_track(p, psi, *, zeta0=(0.5, 0.0, 0.1), sigma0=(0.1, 1.0, 0.1), q=(1e
 
 def residuals(p, psi, track: pd.DataFrame):
     """Residuals x_i = p_i − (p̂0 + Â cos φ_i), fringe phases φ_i = φ̂ + ψ_i and amplitudes Â."""
-    instance(track, pd.DataFrame, "track")
-    missing = [c for c in ("p0", "phi_rad", "A") if c not in track.columns]
-    if missing:
-        raise input_error("track", f"missing columns {missing} (a frame of fringe_track)")
-    n = len(track)
-    phase = track["phi_rad"].to_numpy(dtype=float) + vector(psi, n, "psi")
-    amp = track["A"].to_numpy(dtype=float)
-    return vector(p, n, "p") - (track["p0"].to_numpy(dtype=float) + amp * np.cos(phase)), phase, amp
+    p0, phi, amp = table(track, ["p0", "phi_rad", "A"], "track").T  # a frame of fringe_track, read by name
+    n = len(p0)
+    phase = phi + vector(psi, n, "psi")
+    return vector(p, n, "p") - (p0 + amp * np.cos(phase)), phase, amp
 
 
 def identify_noise(x, phi, amplitude, *, free=("p0", "phi"), theta0=(0.02, 0.2, 0.02), method: str = "newton",
@@ -77,7 +73,7 @@ def identify_noise(x, phi, amplitude, *, free=("p0", "phi"), theta0=(0.02, 0.2, 
     n = len(x)
     res = _core.cai_ml_identify(x, vector(phi, n, "phi"), vector(amplitude, n, "amplitude"), method=method, free=mask,
                                 theta0=vector(theta0, 3, "theta0"), max_iter=max_iter, tol=finite_scalar(tol, "tol"), batch=n if batch is None else batch,
-                                sliding=bool(sliding))
+                                sliding=flag(sliding, "sliding"))
     th = res["theta"]
     return pd.DataFrame({
         "sigma_p0": th[:, 0], "sigma_phi_rad": th[:, 1], "sigma_A": th[:, 2],

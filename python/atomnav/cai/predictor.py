@@ -15,7 +15,7 @@ import numpy as np
 import pandas as pd
 
 from .. import _core
-from .._validate import (as_floats, broadcast, finite, finite_result, finite_scalar, input_error, instance, nonnegative,
+from .._validate import (as_floats, broadcast, finite, finite_result, finite_scalar, flag, input_error, instance, nonnegative,
                          positive, renamed, rows, shaped, vector)
 from ._config import ConfigMixin
 
@@ -170,7 +170,7 @@ def phase_jacobian(t, specific_force, angular_rate, shots, T: float, channels: C
     shots, setup = _setup(t, specific_force, angular_rate, shots, T, channels, angular_acceleration, omega_dot,
                           savgol_half_width, interpolation, substeps, gradient, bias_a, bias_g)
     steps = None if fd_steps is None else tuple(vector(fd_steps, 4, "fd_steps"))
-    return setup.jacobian(bool(euler), steps).reshape(len(shots), len(channels), len(JACOBIAN_PARAMS))
+    return setup.jacobian(flag(euler, "euler"), steps).reshape(len(shots), len(channels), len(JACOBIAN_PARAMS))
 
 
 def check_jacobian(*args, fd_steps=(1e-3, 1e-4, 1e-3, 1e-4), **kwargs) -> dict:

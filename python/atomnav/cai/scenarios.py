@@ -11,7 +11,7 @@ import numpy as np
 import pandas as pd
 
 from .. import _core
-from .._validate import finite_result, input_error, instance, positive, renamed, vector
+from .._validate import finite_result, flag, input_error, instance, positive, renamed, vector
 from ..imu import ImuErrors
 from ._config import ConfigMixin
 from .campaign import run_campaign
@@ -128,7 +128,7 @@ def slalom(runs: int = 100, seed: int = 2024, *, gravity: str = "kinematic", dur
     instance(aiding, (bool, np.bool_), "aiding")
     motion = _core.Motion.slalom(vector(HANNOVER, 3, "origin"), 5.0, 2.0, 10.0, positive(duration, "duration"))
     config = ScenarioConfig(seed003_sensor(lever) if sensor is None else sensor, seed003_filter() if setup is None else setup,
-                            gravity=gravity, aiding=bool(aiding))
+                            gravity=gravity, aiding=flag(aiding, "aiding"))
     return run_campaign("slalom", motion, config, runs=runs, seed=seed, progress=progress,
                         params={"gravity": gravity, "lever_m": tuple(lever), "duration_s": duration})
 

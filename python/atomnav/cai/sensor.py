@@ -17,7 +17,7 @@ import numpy as np
 
 from .. import _core
 from .._core import InputError
-from .._validate import as_floats, finite_scalar, input_error, instance, integer, nonnegative, positive, scalar, vector
+from .._validate import as_floats, finite_scalar, flag, input_error, instance, integer, nonnegative, positive, scalar, vector
 from ._config import ConfigMixin
 from .predictor import Channels
 
@@ -97,7 +97,7 @@ class CaiSensor(ConfigMixin):
         return _core.CaiSensor(self.channels._native(), positive(self.T, "T"), offset=float(self.offset), contrast=float(self.contrast),
                                sigma_p=float(self.sigma_p), inflation=self.inflation, omega_dot=self.omega_dot,
                                savgol_half_width=self.savgol_half_width, interpolation=self.interpolation, substeps=self.substeps,
-                               jacobian_euler=bool(self.jacobian_euler), misalignment=self.misalignment_psd, lever_arm=self.lever_arm_psd,
+                               jacobian_euler=flag(self.jacobian_euler, "jacobian_euler"), misalignment=self.misalignment_psd, lever_arm=self.lever_arm_psd,
                                force=self.force, force_tau=self.force_tau, force_sigma=self.force_sigma)
 
 

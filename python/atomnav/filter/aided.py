@@ -18,7 +18,7 @@ import pandas as pd
 from tqdm.auto import tqdm
 
 from .. import _core
-from .._validate import as_floats, finite_scalar, input_error, instance, integer, positive, rows
+from .._validate import as_floats, finite_scalar, flag, input_error, instance, integer, positive, rows
 from ..strapdown import _table
 from .engine import BiasModel, Config, _floats
 from .riccati import _mat
@@ -102,7 +102,7 @@ class InsSetup(Config):
             accel_psd=finite_scalar(self.accel_psd, "accel_psd"), gyro_psd=finite_scalar(self.gyro_psd, "gyro_psd"),
             accel_bias=self.accel_bias._parts(), gyro_bias=self.gyro_bias._parts(), ba0=list(self.ba0), bg0=list(self.bg0),
             predict_every=integer(self.predict_every, "predict_every", 1, 2**63 - 1),
-            method=self.method, mode=self.mode, sequential=bool(self.sequential), ellipsoid=self.ellipsoid, vertical=self.vertical,
+            method=self.method, mode=self.mode, sequential=flag(self.sequential, "sequential"), ellipsoid=self.ellipsoid, vertical=self.vertical,
             baro_psd=finite_scalar(self.baro_psd, "baro_psd"),
             baro_bias=None if self.baro_bias is None else self.baro_bias._parts(), **opt)
         object.__setattr__(self, "_native", native)
@@ -197,6 +197,7 @@ class AidedIns:
         error the exception's ``partial`` attribute holds every epoch computed before it."""
         t, g, a, h = _imu(time, gyro, accel, h_ref)
         positive(chunk_s, "chunk_s")
+        progress = flag(progress, "progress")
         n = len(t)
         if n < 2:
             raise input_error("time", f"need >= 2 samples, got {n}")

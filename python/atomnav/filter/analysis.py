@@ -16,7 +16,7 @@ import pandas as pd
 from scipy.stats import chi2
 
 from .. import _core
-from .._validate import as_floats, input_error, instance, integer, scalar
+from .._validate import as_floats, flag, input_error, instance, integer, scalar
 from .riccati import _mat
 
 
@@ -42,7 +42,7 @@ class Scenario:
             dt=np.ascontiguousarray(as_floats(dt, "dt").ravel()),
             p0=_mat(p0, "p0"), h=_mat(h, "h"), r=_mat(r, "r"),
             measure=[bool(m) for m in flags],
-            method=instance(method, str, "method"), sequential=bool(sequential),
+            method=instance(method, str, "method"), sequential=flag(sequential, "sequential"),
         )
         for name in ("f", "qc"):
             if self._args[name].ndim != 3:

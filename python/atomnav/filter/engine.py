@@ -14,7 +14,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .. import _core
-from .._validate import as_floats, finite_scalar, input_error, instance, integer, json_object, renamed, rows
+from .._validate import as_floats, finite_scalar, flag, input_error, instance, integer, json_object, renamed, rows
 from .riccati import _mat
 
 #: Standard blocks and their sizes (read from the core, ``rust/filter/layout.rs``); extra
@@ -240,7 +240,7 @@ class KalmanFilter:
         z = np.ascontiguousarray(np.atleast_1d(as_floats(z, "z")))
         if z.ndim != 1:
             raise input_error("z", f"expected a vector, got shape {z.shape}")
-        *values, skipped = self._core.update(z, _mat(h, "h"), _mat(r, "r"), bool(sequential),
+        *values, skipped = self._core.update(z, _mat(h, "h"), _mat(r, "r"), flag(sequential, "sequential"),
                                              None if gate is None else finite_scalar(gate, "gate"))
         return UpdateResult(values, skipped)
 

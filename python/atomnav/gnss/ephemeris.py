@@ -11,7 +11,7 @@ import numpy as np
 import pandas as pd
 
 from .. import _core
-from .._validate import as_floats, finite_scalar, input_error, instance, integer, rows, vector
+from .._validate import as_floats, finite_scalar, instance, integer, rows, table, vector
 
 #: Columns of a GPS ephemeris table (angles rad, times GPS s, clock s, s/s, s/s²).
 GPS_COLUMNS = ["prn", "toe", "sqrt_a", "e", "m0", "delta_n", "omega0", "i0", "omega", "omega_dot", "idot",
@@ -24,10 +24,7 @@ def _table(df, columns, name) -> np.ndarray:
     if df is None:
         return np.zeros((0, len(columns)))
     if isinstance(df, pd.DataFrame):
-        missing = [c for c in columns if c not in df.columns]
-        if missing:
-            raise input_error(name, f"missing columns {missing}")
-        df = df[columns].to_numpy()
+        df = table(df, columns, name, finite=False)  # by name; values are the core's checks
     a = as_floats(df, name)
     return rows(a, len(columns), name) if a.size else np.zeros((0, len(columns)))
 

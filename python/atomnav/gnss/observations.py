@@ -8,7 +8,7 @@ import numpy as np
 import pandas as pd
 
 from .. import _core
-from .._validate import as_floats, finite, finite_scalar, input_error, instance, integer, rows, vector
+from .._validate import as_floats, finite, finite_scalar, input_error, instance, integer, locate, rows, table, vector
 from .ephemeris import Ephemerides
 from .options import GnssOptions, split_options
 
@@ -67,17 +67,28 @@ def doppler_to_rate(doppler_hz, sat, channel) -> np.ndarray:
     return -C_LIGHT / f * d
 
 
+def _gps_week_start(obs: pd.DataFrame):
+    """The epoch of a datetime64 ``time_s``: 00:00 of the Sunday starting the GPS week of
+    the first observation, the datetimes being GPS time (as in RINEX); None for seconds.
+    A tz-aware column is civil time, off GPS time by the leap seconds: an InputError."""
+    t = obs.iloc[:, locate(obs, ["time_s"], "obs")[0]]
+    if not pd.api.types.is_datetime64_any_dtype(t.dtype) or t.dropna().empty:
+        return None
+    if t.dt.tz is not None:
+        raise input_error("obs", "column 'time_s' is tz-aware (civil time, which differs from GPS time by the leap seconds): "
+                                 "give GPS time as naive datetimes or as GPS seconds of week")
+    first = t.dropna().iloc[0]
+    return first.normalize() - pd.Timedelta(days=(first.dayofweek + 1) % 7)
+
+
 def obs_arrays(obs: pd.DataFrame) -> tuple:
-    """The observation table as the arrays the core takes."""
-    instance(obs, pd.DataFrame, "obs")
-    missing = [c for c in OBS_COLUMNS if c not in obs.columns]
-    if missing:
-        raise input_error("obs", f"missing columns {missing}")
-    cols = {c: np.ascontiguousarray(as_floats(obs[c].to_numpy(), "obs")) for c in ("time_s", "channel", "code_m", "rate_mps")}
-    for c, a in cols.items():
-        bad = np.nonzero(~np.isfinite(a))[0]
-        if bad.size:
-            raise input_error("obs", f"column {c}: non-finite value {a[bad[0]]} at index {bad[0]}", bad[0])
-    if np.any(cols["channel"] != np.round(cols["channel"])) or np.any(np.abs(cols["channel"]) > 2**31):
-        raise input_error("obs", "column channel: expected integer FDMA channels")
-    return (cols["time_s"], [str(s) for s in obs["sat"]], cols["channel"].astype(np.int64), cols["code_m"], cols["rate_mps"])
+    """The observation table as the arrays the core takes, read by column name (extra
+    columns ignored). ``time_s`` is GPS seconds of week, or naive GPS-time datetime64
+    (converted to seconds since the start of its GPS week)."""
+    numeric = ["time_s", "channel", "code_m", "rate_mps"]
+    time, channel, code, rate = (np.ascontiguousarray(c) for c in table(obs, numeric, "obs", epoch=_gps_week_start(obs),
+                                                                      epoch_name="GPS week start").T)
+    if np.any(channel != np.round(channel)) or np.any(np.abs(channel) > 2**31):
+        raise input_error("obs", "column 'channel': expected integer FDMA channels")
+    sats = obs.iloc[:, locate(obs, ["sat"], "obs")[0]]
+    return (time, [str(s) for s in sats], channel.astype(np.int64), code, rate)

@@ -14,7 +14,7 @@ import numpy as np
 import pandas as pd
 
 from .. import _core, units
-from .._validate import as_floats, finite_result, flag, input_error, instance, integer, positive, probability, renamed, scalar, vector
+from .._validate import as_floats, finite_result, flag, input_error, instance, integer, positive, probability, renamed, scalar, table as read_table, vector
 
 #: Option names, listed (and checked) by the Rust core.
 KINDS = tuple(_core.OPTIONS["AllanKind"])
@@ -160,10 +160,10 @@ def fit_allan_table(table: pd.DataFrame, n_samples: int, terms=TERMS, tau_min: f
     weighted NNLS with weights 1/σ_j², σ_j = AVAR_j/√max(1, ⌊N/m_j⌋ − 1); only the
     named ``terms`` are free, only points with tau_min ≤ τ ≤ tau_max (s) and positive
     variance are used."""
-    instance(table, pd.DataFrame, "table")
-    missing = [c for c in ("m", "tau_s", "var") if c not in table.columns]
-    if missing:
-        raise input_error("table", f"missing column(s) {missing}; expected an allan_variance table")
+    m, tau, var = read_table(table, ["m", "tau_s", "var"], "table", finite=False).T  # an allan_variance table, by name
+    bad = np.flatnonzero(~(m >= 1) | (m != np.round(m)))
+    if bad.size:
+        raise input_error("table", f"column 'm': averaging factor {m[bad[0]]} at index {bad[0]} is not an integer >= 1", bad[0])
     n_samples = integer(n_samples, "n_samples", 1)
     bad = [t for t in terms if t not in TERMS]
     if bad:
@@ -171,7 +171,7 @@ def fit_allan_table(table: pd.DataFrame, n_samples: int, terms=TERMS, tau_min: f
     mask = [t in terms for t in TERMS]
     lo = 0.0 if tau_min is None else scalar(tau_min, "tau_min")
     hi = np.inf if tau_max is None else scalar(tau_max, "tau_max")
-    d = _core.allan_fit(table["m"].to_numpy().tolist(), np.ascontiguousarray(table["tau_s"], dtype=float), np.ascontiguousarray(table["var"], dtype=float), n_samples, mask, lo, hi)
+    d = _core.allan_fit(m.astype(np.uint64).tolist(), np.ascontiguousarray(tau), np.ascontiguousarray(var), n_samples, mask, lo, hi)
     return AllanFit(coeffs=np.asarray(d["coeffs"]), quantization=d["quantization"], arw=d["arw"], bias_instability=d["bias_instability"],
                     rrw=d["rrw"], ramp=d["ramp"], points=d["points"], tau_min=lo, tau_max=hi, table=table)
 
