@@ -78,7 +78,7 @@ def _gps_week_start(obs: pd.DataFrame):
         raise input_error("obs", "column 'time_s' is tz-aware (civil time, which differs from GPS time by the leap seconds): "
                                  "give GPS time as naive datetimes or as GPS seconds of week")
     first = t.dropna().iloc[0]
-    return first.normalize() - pd.Timedelta(days=(first.dayofweek + 1) % 7)
+    return first.normalize() - pd.Timedelta(days=(first.day_of_week + 1) % 7)
 
 
 def obs_arrays(obs: pd.DataFrame) -> tuple:
