@@ -233,7 +233,7 @@ impl Local {
 
 /// The position-independent constants of `Ellipsoid::local`, computed once (a
 /// mechanization evaluates the Earth model at every step).
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug, Clone, Copy, serde::Serialize, serde::Deserialize)]
 pub struct LocalModel {
     a: f64,
     e2: f64,
@@ -284,7 +284,7 @@ impl LocalModel {
 /// 1.4e-21, so the result is as exact as `f64::sin_cos` at about a sixth of its cost; a
 /// latitude beyond the reach becomes the new anchor. A mechanization step moves the
 /// latitude by ~1e-7 rad, so the anchor is renewed every few thousand steps.
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug, Clone, Copy, serde::Serialize, serde::Deserialize)]
 pub struct AnchoredSinCos {
     lat: f64,
     sin: f64,
@@ -430,7 +430,7 @@ impl Ellipsoid {
 /// A seven-parameter Helmert transformation r_WGS = T + (1 + s)·Rot·r_PZ with the
 /// coordinate-frame rotation Rot = [[1, r_z, −r_y], [−r_z, 1, r_x], [r_y, −r_x, 1]]
 /// (spec gnss-ins-tight §2.1 Eq. 6). Rotations in rad, scale dimensionless.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Helmert {
     pub translation: Vec3,
     pub rotation: Vec3,

@@ -30,6 +30,23 @@ pub trait Choice: Sized + Copy + PartialEq + 'static {
     }
 }
 
+/// Serde adapter for a field whose type is a [`Choice`]: saved as its name, restored by
+/// [`Choice::parse`] (`#[serde(with = "crate::options::by_name")]`). A saved state then
+/// reads the same whatever the option's representation in memory.
+pub mod by_name {
+    use super::Choice;
+    use serde::{de::Error, Deserialize, Deserializer, Serializer};
+
+    pub fn serialize<T: Choice, S: Serializer>(v: &T, s: S) -> std::result::Result<S::Ok, S::Error> {
+        s.serialize_str(v.name())
+    }
+
+    pub fn deserialize<'de, T: Choice, D: Deserializer<'de>>(d: D) -> std::result::Result<T, D::Error> {
+        let name = <&str>::deserialize(d)?;
+        T::parse(name).map_err(D::Error::custom)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

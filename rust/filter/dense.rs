@@ -13,7 +13,7 @@ use faer::{Accum, MatMut, MatRef, Par, Side};
 use nalgebra::DMatrix;
 
 /// Which implementation a dense step runs on.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub enum Algebra {
     /// The hand-tuned register kernels of matrix.rs and nalgebra's own products.
     Kernels,

@@ -53,10 +53,11 @@ fn first_non_finite(m: &DMatrix<f64>, rows: &[usize], cols: &[usize]) -> Option<
 }
 
 /// Filter state (δx̂, P) and epoch counter.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
 pub struct Kf {
     pub x: DVector<f64>,
     pub p: DMatrix<f64>,
+    #[serde(with = "crate::options::by_name")]
     pub mode: LoopMode,
     /// Number of predictions done (the "epoch" named by numerical errors).
     pub epoch: usize,

@@ -25,7 +25,7 @@ pub struct SatState {
     pub clock_rate: f64,
 }
 
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
 pub struct Ephemerides {
     gps: BTreeMap<u8, Vec<GpsEphemeris>>,
     glo: BTreeMap<u8, Vec<GloEphemeris>>,

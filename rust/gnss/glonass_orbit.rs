@@ -14,7 +14,7 @@ pub const OMEGA_GLO: f64 = 7.292115e-5;
 pub const DEFAULT_STEP: f64 = 30.0;
 
 /// One broadcast GLONASS ephemeris: state at t_b (GLONASS time, s) in PZ-90, clock terms.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct GloEphemeris {
     pub slot: u8,
     /// FDMA channel k ∈ [−7, 6].

@@ -13,7 +13,7 @@ pub const F_REL: f64 = -4.442807633e-10;
 const HALF_WEEK: f64 = 302_400.0;
 
 /// One broadcast ephemeris and clock set (angles in rad, times in GPS seconds).
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
+#[derive(Debug, Clone, Copy, PartialEq, Default, serde::Serialize, serde::Deserialize)]
 pub struct GpsEphemeris {
     pub prn: u8,
     pub toe: f64,

@@ -108,7 +108,7 @@ pub fn l1_wavelength(sat: SatId, channel: i8) -> f64 {
 
 /// Time-scale relation T_GPS − T_GLO = ΔT_leap + τ_GPS with ΔT_leap = n_leap − 10800 s
 /// (spec Eq. 7; n_leap = 15 s in 2009, 18 s since 2017).
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct TimeScales {
     pub n_leap: f64,
 }

@@ -143,7 +143,7 @@ impl ImuErrorModel {
 }
 
 /// One noise term on three axes with its own random stream.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
 struct Term<P> {
     rng: ChaCha12Rng,
     axes: [P; 3],
@@ -166,7 +166,7 @@ fn stream(seed: u64, triad: u64, term: u64) -> ChaCha12Rng {
 }
 
 /// Stateful simulator of one triad.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
 struct TriadSim {
     sensor: Mat3,
     /// Constant bias including the turn-on draw (rate units).
@@ -227,9 +227,10 @@ pub struct CorruptedImu {
 }
 
 /// Seeded, stateful IMU corruption: feed the ideal stream in one call or in chunks.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
 pub struct ImuSimulator {
     dt: f64,
+    #[serde(with = "crate::options::by_name")]
     kind: ImuKind,
     accel: TriadSim,
     gyro: TriadSim,

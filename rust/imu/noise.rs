@@ -120,7 +120,7 @@ fn normal<R: Rng>(rng: &mut R) -> f64 {
 }
 
 /// White noise of density N: increment N·√Δt·z.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
 pub struct White {
     sigma_increment: f64,
 }
@@ -140,7 +140,7 @@ impl Increment for White {
 /// Bias random walk b(t) = b_k + K·W(t − t_k), started at b = 0. Exact joint draw of the
 /// step and the integral: with W over one interval, Var W(Δt) = Δt, Var ∫W = Δt³/3,
 /// Cov = Δt²/2, so W(Δt) = √Δt z₁ and ∫W = Δt^{3/2}(z₁/2 + z₂/(2√3)).
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
 pub struct RandomWalk {
     dt: f64,
     /// K√Δt, σ of the step.
@@ -188,7 +188,7 @@ fn ou_integral_variance_factor(x: f64) -> f64 {
 ///   ∫m      = τ(1 − a) m_k + ε₂,     Var ε₂ = 2σ²τ² f(x),  Cov(ε₁, ε₂) = σ²τ(1 − a)²
 /// (integrals of the OU Green's function e^{−(t−u)/τ} against dW; stationary check:
 /// Var ∫m = 2σ²τ²(x − 1 + e^{−x})). ε₁, ε₂ are drawn by a 2 × 2 Cholesky factor.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
 pub struct GaussMarkov {
     a: f64,
     gain_int: f64,
@@ -238,7 +238,7 @@ pub const FLICKER_EDGE_POLES: i32 = 3;
 /// below f_lo it flattens
 /// (bounded variance N_p σ_p²), above f_hi it falls as 1/f². Streamable with bounded
 /// memory, unlike Kasdin's fractional-difference filter, whose memory grows with the record.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
 pub struct Flicker {
     poles: Vec<GaussMarkov>,
 }

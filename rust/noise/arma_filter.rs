@@ -124,7 +124,7 @@ impl ArimaStateSpace {
 }
 
 /// How R_k is chosen (spec E9–E11, D7, D12).
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub enum RMode {
     /// R_k ≡ R₀.
     Fixed,
@@ -174,7 +174,7 @@ impl RMode {
 
 /// Running Eq. 17: R̂(k) = (1 − 1/c) R̂(k−1) + (y_k − y_{k−1})²/(2c), c = number of
 /// differences so far; equals Σ(y_i − y_{i−1})²/(2c).
-#[derive(Debug, Clone, Default)]
+#[derive(Debug, Clone, Default, serde::Serialize, serde::Deserialize)]
 pub struct RunningAllanR {
     prev: Option<f64>,
     count: usize,
@@ -210,7 +210,7 @@ impl Choice for X0 {
 /// Everything that defines an ARMA Kalman filter run (model, measurement-noise mode,
 /// initial state), frozen: the binding builds it once, Python mirrors it as
 /// `atomnav.noise.filters.ArmaFilterConfig` (to/from dict and JSON).
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct ArmaFilterConfig {
     /// AR coefficients φ of the differenced series.
     pub ar: Vec<f64>,
@@ -220,14 +220,17 @@ pub struct ArmaFilterConfig {
     pub sigma2: f64,
     /// Differencing order.
     pub d: usize,
+    #[serde(with = "crate::options::by_name")]
     pub noise_form: NoiseForm,
     /// Initial (and fixed) measurement variance; σ_a² when None.
     pub r0: Option<f64>,
+    #[serde(with = "crate::options::by_name")]
     pub adaptive: Adaptive,
     /// Sage–Husa forgetting factor, Q adaptation and fading.
     pub b: f64,
     pub adapt_q: bool,
     pub fading: bool,
+    #[serde(with = "crate::options::by_name")]
     pub x0: X0,
     /// P₀ = p0·I.
     pub p0: f64,
@@ -274,7 +277,7 @@ pub const MAX_DIM: usize = 8;
 const FADING_RHO: f64 = 0.95;
 
 /// Measurement-variance bookkeeping shared by every state dimension.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
 struct RState {
     mode: RMode,
     r: f64,
@@ -307,11 +310,27 @@ impl RState {
     }
 }
 
+/// Serde for `[T; N]` of any const N (serde itself covers N ≤ 32 of concrete sizes only).
+mod const_array {
+    use serde::{de::Error, Deserialize, Deserializer, Serialize, Serializer};
+
+    pub fn serialize<S: Serializer, T: Serialize, const N: usize>(a: &[T; N], s: S) -> Result<S::Ok, S::Error> {
+        s.collect_seq(a)
+    }
+
+    pub fn deserialize<'de, D: Deserializer<'de>, T: Deserialize<'de>, const N: usize>(d: D) -> Result<[T; N], D::Error> {
+        let v = Vec::<T>::deserialize(d)?;
+        let n = v.len();
+        v.try_into().map_err(|_| D::Error::invalid_length(n, &"the filter's state dimension"))
+    }
+}
+
 /// The filter at a fixed state dimension N (fixed-size algebra, no allocation per step).
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
 struct Core<const N: usize> {
     /// Φ = e₀cᵀ + shifts: first row c, row i ≥ 1 copies row i−1 where `shift[i]`.
     c: SVector<f64, N>,
+    #[serde(with = "const_array")]
     shift: [bool; N],
     qd: SMatrix<f64, N, N>,
     x: SVector<f64, N>,
@@ -438,7 +457,7 @@ fn check_companion(phi: &DMatrix<f64>, qd: &DMatrix<f64>) -> Result<()> {
 
 macro_rules! cores {
     ($($v:ident = $n:literal),*) => {
-        #[derive(Debug, Clone)]
+        #[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
         #[allow(clippy::large_enum_variant)] // one per filter; boxing would add an indirection per step
         enum AnyCore { $($v(Core<$n>)),* }
 
@@ -466,7 +485,7 @@ cores!(D1 = 1, D2 = 2, D3 = 3, D4 = 4, D5 = 5, D6 = 6, D7 = 7, D8 = 8);
 
 /// Stateful Kalman filter on an ARIMA state-space model (Niu et al. 2025 Eq. 15); feed chunks
 /// with [`Kalman::update`] for streaming, or use [`kalman`] for a whole series.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
 pub struct Kalman {
     core: AnyCore,
     rs: RState,

@@ -29,6 +29,7 @@ use pyo3::types::PyDict;
 pub struct PyEphemerides {
     pub(crate) inner: Ephemerides,
 }
+super::pickle::picklable!(PyEphemerides, inner, "GnssEphemerides");
 
 fn sat_id(name: &str) -> PyResult<SatId> {
     Ok(SatId::from_name(name, "sat", 0)?)

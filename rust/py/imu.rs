@@ -91,6 +91,8 @@ fn imu_validate_errors(accel: &Bound<'_, PyDict>, gyro: &Bound<'_, PyDict>) -> P
 struct ImuErrorSimulator {
     sim: ImuSimulator,
 }
+// the state includes every random stream's position
+super::pickle::picklable!(ImuErrorSimulator, sim, "ImuErrorSimulator");
 
 #[pymethods]
 impl ImuErrorSimulator {

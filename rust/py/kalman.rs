@@ -98,6 +98,7 @@ fn with_missing(a: &PyReadonlyArray2<'_, f64>) -> DMatrix<f64> {
 pub struct KalmanFilter {
     inner: Kf,
 }
+super::pickle::picklable!(KalmanFilter, inner, "KalmanFilter");
 
 #[pymethods]
 impl KalmanFilter {

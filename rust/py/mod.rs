@@ -11,6 +11,7 @@ mod gnss;
 mod imu;
 mod kalman;
 mod noise;
+mod pickle;
 mod rotation;
 mod strapdown;
 mod trajectory;

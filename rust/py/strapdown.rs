@@ -16,6 +16,8 @@ use std::borrow::Cow;
 pub struct Strapdown {
     inner: Core,
 }
+// the state includes the coning/sculling history and the rate priming
+super::pickle::picklable!(Strapdown, inner, "Strapdown");
 
 /// Navigation states as a (14, N) array — one row per column of
 /// `atomnav.trajectory.COLUMNS` (time, lat, lon, h, v_N, v_E, v_D, q_nb (4), roll, pitch,

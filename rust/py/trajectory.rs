@@ -15,6 +15,7 @@ use pyo3::types::PyDict;
 pub struct Motion {
     pub inner: CoreMotion,
 }
+super::pickle::picklable!(Motion, inner, "Motion");
 
 /// The `origin` argument (lat rad, lon rad, h m) of every motion constructor, checked.
 fn checked_origin(o: &PyReadonlyArray1<'_, f64>) -> PyResult<Vec3> {

@@ -13,6 +13,7 @@
 
 mod pipeline;
 
+use serde::{Deserialize, Serialize};
 use crate::earth::{check_height, check_latitude, AnchoredSinCos, Ellipsoid, LocalModel};
 use crate::error::{invalid, invalid_at, Result};
 pub use crate::imu::ImuKind;
@@ -21,7 +22,7 @@ use crate::options::Choice;
 pub use pipeline::{nav_columns, ImuSlices, NavTable, Samples3, NAV_COLUMNS, NAV_WIDTH, PIPELINE_BLOCK};
 
 /// Navigation solution at one instant.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct NavState {
     pub t: f64,
     /// (lat rad, lon rad, h m).
@@ -37,7 +38,7 @@ pub struct NavState {
 /// K_v1 = 2ζω_v, K_v2 = ω_v² + 2γ/R₀, whose 2γ/R₀ cancels the free channel's instability.
 /// Chosen by name ("free", "damped"); "damped" has the loop's default damping ratio and
 /// natural frequency until [`Vertical::tuned`] sets them.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub enum Vertical {
     Free,
     Damped { zeta: f64, omega: f64 },
@@ -95,8 +96,9 @@ impl Choice for Vertical {
 }
 
 
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct Strapdown {
+    #[serde(with = "crate::options::by_name")]
     pub ell: Ellipsoid,
     pub vertical: Vertical,
     pub state: NavState,
@@ -261,8 +263,9 @@ pub type BodyStep = Option<(Quat, Vec3)>;
 /// and sculling over the last intervals. It depends on the IMU record alone, so a
 /// pipelined run computes it for the next block on another core while the navigation
 /// half integrates this one.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct BodyFront {
+    #[serde(with = "crate::options::by_name")]
     kind: ImuKind,
     /// Increments (Δθ, Δv) of up to the two previous intervals (most recent last), for
     /// the multi-interval coning and sculling terms.
@@ -390,7 +393,7 @@ fn rates_to_increment(history: &[(f64, Vec3, Vec3)], t: f64, w: &Vec3, f: &Vec3)
 }
 
 /// The last two entries of a stream (oldest first), kept without allocation.
-#[derive(Debug, Clone, Copy, Default)]
+#[derive(Debug, Clone, Copy, Default, Serialize, Deserialize)]
 struct History<T: Copy + Default> {
     items: [T; 2],
     len: usize,

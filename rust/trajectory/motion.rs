@@ -12,13 +12,13 @@ use crate::error::{check_increasing, invalid, Result};
 use crate::math::{dcm_from_quat, quat_from_axis_angle, quat_from_dcm, Mat3, Quat, Vec3};
 
 /// One elementary rotation of the attitude chain: angle θ(t) about a fixed unit axis.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct AxisRotation {
     pub axis: Vec3,
     pub angle: Profile,
 }
 
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Motion {
     pub name: String,
     /// Geodetic start position (lat rad, lon rad, h m).

@@ -19,7 +19,7 @@ impl std::ops::Add for Eval {
 }
 
 /// Shape of a smooth 0→1 transition over u ∈ [0, 1].
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub enum StepShape {
     /// Raised cosine (1 − cos πu)/2.
     RaisedCosine,
@@ -48,7 +48,7 @@ impl StepShape {
     }
 }
 
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub enum Term {
     /// c + r·t.
     Linear { c: f64, r: f64 },
@@ -115,7 +115,7 @@ impl Term {
 }
 
 /// A sum of terms; the empty profile is identically zero.
-#[derive(Debug, Clone, Default, PartialEq)]
+#[derive(Debug, Clone, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Profile(pub Vec<Term>);
 
 impl Profile {

@@ -17,6 +17,7 @@ from dataclasses import KW_ONLY, dataclass, field, fields
 import numpy as np
 
 from .. import _core
+from .._stateful import Stateful, serialized
 from .._validate import as_floats, finite, input_error, instance, positive, vector
 
 #: The default reading of Eq. 17 (spec D7, binding).
@@ -212,9 +213,10 @@ def steady_state_gain(model: ArimaStateSpace, r: float):
     return _core.steady_state_gain(*model._args()[:3], r=positive(r, "r"), d=model.d, noise_form=model.noise_form)
 
 
-class KalmanStream:
+class KalmanStream(Stateful):
     """Streaming form of :func:`kalman` / :func:`sage_husa`: ``update(chunk)`` returns the
-    :class:`KalmanResult` of that chunk; the state carries over between chunks.
+    :class:`KalmanResult` of that chunk; the state carries over between chunks. One object
+    may be shared by threads (calls run one after another) and pickled mid-stream.
     ``adaptive`` as in :class:`ArmaFilterConfig` (None or False: "fixed", True: the
     default reading of Eq. 17); :meth:`from_config` takes a saved configuration."""
 
@@ -230,5 +232,6 @@ class KalmanStream:
         s._f, s.config = _core.KalmanStream(config._core, record=record), config
         return s
 
+    @serialized
     def update(self, chunk) -> KalmanResult:
         return KalmanResult(*self._f.update(vector(chunk, None, "chunk")))
