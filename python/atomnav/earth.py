@@ -10,7 +10,7 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from . import _core
+from . import _core, plausibility
 from ._validate import floats, input_error, renamed, rows, scalar, vector
 
 
@@ -23,7 +23,7 @@ def ellipsoid(name: str = "WGS84") -> dict:
 
 def lla_to_ecef(lla, ellipsoid: str = "WGS84") -> np.ndarray:
     """ECEF (m) of (lat rad, lon rad, h m) rows."""
-    r = _core.lla_to_ecef_rows(rows(lla, 3, "lla"), ellipsoid)
+    r = _core.lla_to_ecef_rows(plausibility.lla(rows(lla, 3, "lla"), "lla"), ellipsoid)
     return r[0] if np.ndim(lla) == 1 else r
 
 
@@ -35,13 +35,13 @@ def ecef_to_lla(ecef, ellipsoid: str = "WGS84") -> np.ndarray:
 
 def ecef_to_ned(ecef, origin_lla, ellipsoid: str = "WGS84") -> np.ndarray:
     """NED coordinates (m) of ECEF points relative to a geodetic origin."""
-    r = _core.ecef_to_ned_rows(rows(ecef, 3, "ecef"), vector(origin_lla, 3, "origin_lla"), ellipsoid)
+    r = _core.ecef_to_ned_rows(rows(ecef, 3, "ecef"), plausibility.lla(vector(origin_lla, 3, "origin_lla"), "origin_lla"), ellipsoid)
     return r[0] if np.ndim(ecef) == 1 else r
 
 
 def ned_to_ecef(ned, origin_lla, ellipsoid: str = "WGS84") -> np.ndarray:
     """ECEF points (m) of NED coordinates relative to a geodetic origin."""
-    r = _core.ned_to_ecef_rows(rows(ned, 3, "ned"), vector(origin_lla, 3, "origin_lla"), ellipsoid)
+    r = _core.ned_to_ecef_rows(rows(ned, 3, "ned"), plausibility.lla(vector(origin_lla, 3, "origin_lla"), "origin_lla"), ellipsoid)
     return r[0] if np.ndim(ned) == 1 else r
 
 
@@ -52,7 +52,7 @@ def lla_to_ned(lla, origin_lla, ellipsoid: str = "WGS84") -> np.ndarray:
 
 def dcm_ned_to_ecef(lat: float, lon: float) -> np.ndarray:
     """C_n^e (3, 3): columns are the north, east, down axes in ECEF."""
-    return _core.dcm_ned_to_ecef_py(scalar(lat, "lat"), scalar(lon, "lon"))
+    return _core.dcm_ned_to_ecef_py(scalar(lat, "lat"), plausibility.longitude(scalar(lon, "lon"), "lon"))
 
 
 def parameters(lla, ellipsoid: str = "WGS84") -> pd.DataFrame:
@@ -61,7 +61,7 @@ def parameters(lla, ellipsoid: str = "WGS84") -> pd.DataFrame:
     Columns: ``M_m`` (meridian radius), ``N_m`` (prime-vertical radius), ``gravity_mps2``
     (Somigliana with height correction), ``dgravity_dlat_mps2_per_rad``,
     ``schuler_rad_s`` (√(γ/(√(MN)+h)))."""
-    p = _core.earth_params_rows(rows(lla, 3, "lla"), ellipsoid)
+    p = _core.earth_params_rows(plausibility.lla(rows(lla, 3, "lla"), "lla"), ellipsoid)
     return pd.DataFrame(p, columns=["M_m", "N_m", "gravity_mps2", "dgravity_dlat_mps2_per_rad", "schuler_rad_s"])
 
 
@@ -107,7 +107,7 @@ def schuler_period(lat: float, h: float = 0.0, ellipsoid: str = "WGS84") -> floa
 def navigation_rates(lla, vel_ned, ellipsoid: str = "WGS84") -> pd.DataFrame:
     """Earth rate ω_ie^n and transport rate ω_en^n (rad/s) in NED for each position and
     NED velocity (m/s)."""
-    p, v = rows(lla, 3, "lla"), rows(vel_ned, 3, "vel_ned")
+    p, v = plausibility.lla(rows(lla, 3, "lla"), "lla"), rows(vel_ned, 3, "vel_ned")
     if len(v) != len(p):
         raise input_error("vel_ned", f"expected {len(p)} rows like lla, got {len(v)}")
     x = np.hstack([p, v])

@@ -45,7 +45,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import pandas as pd
 
-from . import _core, units
+from . import _core, plausibility, units
 from ._validate import as_floats, choice, input_error, instance, locate, renamed, rows, scalar, seconds, table, vector
 
 KINDS = tuple(_core.OPTIONS["ImuKind"])
@@ -232,6 +232,7 @@ class ImuSimulator:
         self.dt = scalar(dt, "dt")
         self.errors = copy.deepcopy(errors)
         self._sim = _core.ImuErrorSimulator(*errors._to_core(), self.dt, self.kind, seed)
+        plausibility.sample_interval(self.dt, "dt")
         self._k = 0
 
     def corrupt(self, accel, gyro=None) -> pd.DataFrame:
@@ -243,6 +244,7 @@ class ImuSimulator:
         names) and the bias truth columns; a ``time_s`` column is carried through as given
         (datetime64 included)."""
         fcols, wcols = COLUMNS[self.kind]
+        gyro_name = "accel" if gyro is None else "gyro"  # a DataFrame in accel holds the gyro too
         t = None
         if isinstance(accel, pd.DataFrame):
             if gyro is not None:
@@ -258,6 +260,7 @@ class ImuSimulator:
         f, w = rows(accel, 3, "accel"), rows(gyro, 3, "gyro")
         if len(w) != len(f):
             raise input_error("gyro", f"expected {len(f)} rows like accel, got {len(w)}")
+        plausibility.imu(t, w, f, self.kind, "accel", gyro_name=gyro_name, dt=self.dt)
         fm, wm, fb, wb = self._sim.corrupt(f, w)
         index = pd.RangeIndex(self._k, self._k + len(f), name="sample")
         self._k += len(f)

@@ -15,7 +15,9 @@ machinery and points at the user's line (the first frame outside atomnav)::
 Every threshold is a constant of this module, with the reason for its value. The checks
 read cheap statistics computed once per call (a median time step, a mean or a spread over
 at most :data:`SAMPLE_ROWS` evenly spaced rows, a maximum over the array); non-finite
-values are left to the input checks, which reject them.
+values are left to the input checks, which reject them. A value is flagged only when it
+is beyond its SI limit and, multiplied by the factor, within it (a T of 100 is 100 ms; a T
+of 1e300 is no plausible time in any unit, and is left to the input checks).
 """
 
 from __future__ import annotations
@@ -48,10 +50,12 @@ MAX_ANGULAR_RATE: float = 35.0
 #: 1 °/h) over 100 s at 100 Hz; a navigation-grade one is within 1 %.
 EARTH_RATE_TOLERANCE: float = 0.15
 
-#: A record is static for the Earth-rate test when the RMS spread of its angular rate about
-#: the mean is below this (rad/s, ≈ 6 °/s): a tactical gyro's per-sample noise read as °/s
-#: is ≈ 0.02 at 100 Hz, while a vehicle in motion turns by more than that.
-STATIC_RATE_SPREAD: float = 0.1
+#: A record is static for the Earth-rate test when the variance of its angular rate about
+#: the mean is at most this many times its white-noise variance (half the mean square of
+#: successive differences, von Neumann 1941): at rest the rate varies by its sensor noise
+#: only (ratio ≈ 1), while a moving platform's rate varies smoothly, far more over the
+#: record than from one sample to the next.
+STATIC_VARIANCE_RATIO: float = 4.0
 
 #: Longest plausible IMU sample interval (s): strapdown IMUs sample at 1 Hz (satellite
 #: accelerometers) or faster, so a step above 1 s is a millisecond time stamp (a 100 Hz log
@@ -118,39 +122,60 @@ class UnitWarning(UserWarning):
 
 
 def _warn(parameter: str, quantity: str, unit: str | None, si: str, evidence: str, factor: float) -> None:
-    """Warn that ``quantity`` of argument ``parameter`` looks like ``unit`` rather than
-    ``si``, shown at the first frame outside atomnav (the user's line)."""
+    """Warn that ``quantity`` of argument ``parameter`` is likely in ``unit`` rather than
+    ``si`` (or, with no ``unit``, contradicts ``si``), shown at the first frame outside atomnav (the user's line)."""
     frame, level = sys._getframe(0), 1
     while frame is not None and frame.f_code.co_filename.startswith(_PACKAGE):
         frame, level = frame.f_back, level + 1
-    looks = f"looks like {unit}, not {si}" if unit else f"contradicts {si}"
+    looks = f"likely in {unit}, not {si}" if unit else f"contradicts {si}"
     message = f"{parameter}: {quantity} {looks} ({evidence}); multiply by {factor:.6g}"
     warnings.warn(UnitWarning(message, parameter, unit, factor), stacklevel=level)
 
 
-def _sample(a: np.ndarray) -> np.ndarray:
-    """At most :data:`SAMPLE_ROWS` evenly spaced rows of ``a`` (a view)."""
-    return a[:: max(1, len(a) // SAMPLE_ROWS)]
+def _floats(x) -> np.ndarray:
+    """``x`` as a float array, empty if it is not numbers (the input checks report that)."""
+    try:
+        return np.asarray(x, dtype=float)
+    except (TypeError, ValueError):
+        return np.empty(0)
+
+
+def _sample(a) -> np.ndarray:
+    """At most :data:`SAMPLE_ROWS` evenly spaced rows of ``a`` as floats."""
+    a = _floats(a)
+    return a[:: max(1, len(a) // SAMPLE_ROWS)] if a.ndim else a
 
 
 def _max_abs(a) -> float:
     """Largest magnitude in ``a`` (NaN if ``a`` is empty or holds a non-finite value)."""
-    a = np.asarray(a, dtype=float)
+    a = _floats(a)
     if a.size == 0:
         return np.nan
     m = max(float(a.max()), -float(a.min()))
     return m if np.isfinite(m) else np.nan
 
 
+def _value(x) -> float:
+    """A scalar ``x`` as a float (NaN if it is not one finite number)."""
+    a = _floats(x)
+    return float(a) if a.size == 1 and a.ndim == 0 and np.isfinite(a) else np.nan
+
+
 def _median_step(t: np.ndarray) -> float:
     """Median time step (s) of the first :data:`SAMPLE_ROWS` steps of ``t`` (NaN for fewer
     than two samples or non-finite stamps)."""
-    t = np.asarray(t, dtype=float)[: SAMPLE_ROWS + 1]
+    t = _floats(t).reshape(-1)[: SAMPLE_ROWS + 1]
     if len(t) < 2:
         return np.nan
     with np.errstate(all="ignore"):
         step = float(np.median(np.diff(t)))
     return step if np.isfinite(step) else np.nan
+
+
+def _converts(value: float, limit: float, factor: float) -> bool:
+    """``value`` is beyond ``limit`` in the declared unit, but within it once multiplied by
+    ``factor`` (False for NaN)."""
+    return limit < value and value * factor <= limit
 
 
 def _near(value: float, target: float, tolerance: float) -> bool:
@@ -160,8 +185,8 @@ def _near(value: float, target: float, tolerance: float) -> bool:
 def specific_force(f: np.ndarray, name: str, scale: float = 1.0) -> None:
     """Warn if the specific force ``f`` (N, 3) times ``scale`` (1 for m/s², 1/Δt for Δv
     in m/s) has a mean magnitude in :data:`ACCEL_G_BAND`: the record is in g."""
-    s = _sample(np.asarray(f, dtype=float))
-    if s.size == 0:
+    s = _sample(f)
+    if s.ndim != 2 or s.size == 0:
         return
     with np.errstate(all="ignore"):
         mean = float(np.sqrt((s * s).sum(axis=1)).mean()) * scale
@@ -174,15 +199,15 @@ def angular_rate(w, name: str, scale: float = 1.0, *, static: bool = False):
     :data:`MAX_ANGULAR_RATE` anywhere or, with ``static`` (a full IMU record that may be
     at rest), if it is static with a mean of 57.3 × Earth rate: it is in °/s. Returns ``w``."""
     peak = _max_abs(w) * scale
-    if peak > MAX_ANGULAR_RATE:
+    if _converts(peak, MAX_ANGULAR_RATE, _DEG):
         _warn(name, "angular rate", "deg/s", "rad/s", f"max |ω| = {peak:.4g}, beyond {MAX_ANGULAR_RATE} rad/s", _DEG)
-    elif static and np.ndim(w) == 2 and len(w):
-        s = _sample(np.asarray(w, dtype=float))
+    elif static and (s := _sample(w)).ndim == 2 and len(s):
         with np.errstate(all="ignore"):
             mean = s.mean(axis=0) * scale
-            spread = float(np.sqrt(s.var(axis=0).sum())) * scale
+            variance = float(s.var(axis=0).sum())
+            noise = float((np.diff(s, axis=0) ** 2).mean(axis=0).sum()) / 2 if len(s) > 1 else 0.0
         norm = float(np.sqrt(mean @ mean))
-        if spread < STATIC_RATE_SPREAD and _near(norm, EARTH_RATE / _DEG, EARTH_RATE_TOLERANCE):
+        if variance <= STATIC_VARIANCE_RATIO * noise and _near(norm, EARTH_RATE / _DEG, EARTH_RATE_TOLERANCE):
             _warn(name, "angular rate", "deg/s", "rad/s",
                   f"static mean |ω| = {norm:.4g}, Earth rate is {EARTH_RATE:.4g} rad/s = {EARTH_RATE / _DEG:.4g} °/s", _DEG)
     return w
@@ -192,7 +217,7 @@ def time_steps(t, name: str):
     """Warn if the median step of the IMU time stamps ``t`` (s) exceeds
     :data:`MAX_IMU_STEP`: they are in ms. Returns ``t``."""
     step = _median_step(t)
-    if step > MAX_IMU_STEP:
+    if _converts(step, MAX_IMU_STEP, _MS):
         _warn(name, "time stamps", "ms", "s", f"median step {step:.4g}, an IMU samples at least every {MAX_IMU_STEP} s", _MS)
     return t
 
@@ -200,8 +225,8 @@ def time_steps(t, name: str):
 def sample_interval(dt, name: str):
     """Warn if an IMU sample interval ``dt`` (s) exceeds :data:`MAX_IMU_STEP`: it is in
     ms. Returns ``dt``."""
-    if np.isfinite(dt) and dt > MAX_IMU_STEP:
-        _warn(name, "sample interval", "ms", "s", f"{dt:.4g}, an IMU samples at least every {MAX_IMU_STEP} s", _MS)
+    if _converts(_value(dt), MAX_IMU_STEP, _MS):
+        _warn(name, "sample interval", "ms", "s", f"{_value(dt):.4g} s, an IMU samples at least every {MAX_IMU_STEP} s", _MS)
     return dt
 
 
@@ -248,7 +273,7 @@ def longitude(lon, name: str):
     """Warn if a longitude (rad; any shape) exceeds :data:`MAX_ANGLE` in magnitude: it is
     in degrees. Returns ``lon``."""
     peak = _max_abs(lon)
-    if peak > MAX_ANGLE:
+    if _converts(peak, MAX_ANGLE, _DEG):
         _warn(name, "longitude", "deg", "rad", f"|lon| = {peak:.4g}, beyond 2π", _DEG)
     return lon
 
@@ -256,9 +281,9 @@ def longitude(lon, name: str):
 def lla(p, name: str):
     """:func:`longitude` of positions ``p`` (..., 3) of (lat rad, lon rad, h m), unless a
     latitude is beyond ±π/2 (an input error of its own). Returns ``p``."""
-    p = np.asarray(p)
-    if p.size and p.shape[-1] == 3 and not _max_abs(p[..., 0]) > np.pi / 2:
-        longitude(p[..., 1], name)
+    a = _floats(p)
+    if a.ndim and a.shape[-1] == 3 and a.size and not _max_abs(a[..., 0]) > np.pi / 2:
+        longitude(a[..., 1], name)
     return p
 
 
@@ -266,7 +291,7 @@ def angles(a, name: str, quantity: str = "Euler angles"):
     """Warn if any angle in ``a`` (rad) exceeds :data:`MAX_ANGLE` in magnitude: it is in
     degrees. Returns ``a``."""
     peak = _max_abs(a)
-    if peak > MAX_ANGLE:
+    if _converts(peak, MAX_ANGLE, _DEG):
         _warn(name, quantity, "deg", "rad", f"max |angle| = {peak:.4g}, beyond 2π", _DEG)
     return a
 
@@ -275,16 +300,16 @@ def pulse_separation(T, name: str, pulses: float = 1.0):
     """Warn if an interferometer time ``T`` (s), spanning ``pulses`` pulse separations (2
     for a total interrogation time 2T), exceeds ``pulses`` × :data:`MAX_PULSE_SEPARATION`:
     it is in ms. Returns ``T``."""
-    if np.isfinite(T) and T > pulses * MAX_PULSE_SEPARATION:
-        _warn(name, "pulse timing", "ms", "s", f"{T:.4g} s, beyond {pulses * MAX_PULSE_SEPARATION:g} s", _MS)
+    if _converts(_value(T), pulses * MAX_PULSE_SEPARATION, _MS):
+        _warn(name, "pulse timing", "ms", "s", f"{_value(T):.4g} s, beyond {pulses * MAX_PULSE_SEPARATION:g} s", _MS)
     return T
 
 
 def wavelength(x, name: str):
     """Warn if a laser wavelength (m) exceeds :data:`MAX_WAVELENGTH`: it is in nm. Returns
     ``x``."""
-    if np.isfinite(x) and x > MAX_WAVELENGTH:
-        _warn(name, "wavelength", "nm", "m", f"{x:.6g} m, beyond {MAX_WAVELENGTH:g} m", 1e-9)
+    if _converts(_value(x), MAX_WAVELENGTH, 1e-9):
+        _warn(name, "wavelength", "nm", "m", f"{_value(x):.6g} m, beyond {MAX_WAVELENGTH:g} m", 1e-9)
     return x
 
 
@@ -292,7 +317,7 @@ def fraction(x, name: str, quantity: str = "fraction"):
     """Warn if a contrast, offset or probability (any shape) exceeds :data:`MAX_FRACTION`:
     it is in %. Returns ``x``."""
     peak = _max_abs(x)
-    if peak > MAX_FRACTION:
+    if _converts(peak, MAX_FRACTION, 0.01):
         _warn(name, quantity, "%", "a fraction in [0, 1]", f"{peak:.4g}", 0.01)
     return x
 
@@ -301,6 +326,6 @@ def population(p, name: str):
     """Warn if a measured population (any shape) exceeds :data:`MAX_POPULATION`: it is in
     %. Returns ``p``."""
     peak = _max_abs(p)
-    if peak > MAX_POPULATION:
+    if _converts(peak, MAX_POPULATION, 0.01):
         _warn(name, "population", "%", "a fraction in [0, 1]", f"max {peak:.4g}", 0.01)
     return p

@@ -19,7 +19,7 @@ from contextlib import contextmanager
 import numpy as np
 import pandas as pd
 
-from . import _core
+from . import _core, plausibility
 from ._validate import as_floats, flag, input_error, rows, scalar, seconds, table, timestamp, vector
 from .trajectory import COLUMNS, IMU_COLUMNS
 
@@ -143,6 +143,7 @@ class Strapdown:
                                      vector(q_nb, 4, "q_nb"), kind=kind, ellipsoid=ellipsoid, vertical=vertical,
                                      zeta=None if zeta is None else scalar(zeta, "zeta"),
                                      omega=None if omega is None else scalar(omega, "omega"))
+        plausibility.lla(lla, "lla")
         self._rows = 0
 
     @property
@@ -182,6 +183,7 @@ class Strapdown:
             at which it diverged. Restart with :meth:`reset`.
         """
         t, g, a = _imu_arrays(imu, self.kind, self.epoch)
+        plausibility.imu(t, g, a, self.kind)
         first = self._rows
         try:
             with _imu_errors(self.kind, g, a, first):
@@ -228,6 +230,7 @@ class Strapdown:
             raise TypeError(f"state: expected a one-row DataFrame or a dict, got {type(state).__name__}")
         t0, lla, vel, q = fields
         self._core.reset(scalar(t0, "state"), vector(lla, 3, "state"), vector(vel, 3, "state"), vector(q, 4, "state"))
+        plausibility.lla(lla, "state")
         self._rows = 0
 
 
@@ -266,6 +269,7 @@ def integrate(imu, t0, lla, vel_ned, q_nb, *, kind: str = "increments", ellipsoi
     """
     sd = Strapdown(t0, lla, vel_ned, q_nb, kind=kind, ellipsoid=ellipsoid, vertical=vertical, zeta=zeta, omega=omega, epoch=epoch)
     t, g, a = _imu_arrays(imu, sd.kind, sd.epoch)
+    plausibility.imu(t, g, a, sd.kind)
     h = _h_ref(h_ref, len(t))
     show = len(t) > 1_000_000 if progress is None else flag(progress, "progress")
     # one table for the whole record, filled chunk by chunk in place (no concatenation)

@@ -13,10 +13,10 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from . import _core
+from . import _core, plausibility
 from ._validate import (FIRST_SAMPLE, check_numbers, finite_scalar, increasing, input_error, instance, locate, path as checked_path,
                         positive, renamed, rows, table, timestamp, vector)
-from .rotation import euler_from_quat, quat_from_euler
+from .rotation import euler_from_quat
 
 #: Column names of a trajectory table (units in the names).
 COLUMNS = ["time_s", "lat_rad", "lon_rad", "h_m", "vn_mps", "ve_mps", "vd_mps", "qw", "qx", "qy", "qz", "roll_rad", "pitch_rad", "yaw_rad"]
@@ -97,11 +97,12 @@ class Trajectory:
         if epoch is None and pd.api.types.is_datetime64_any_dtype(df["time_s"].dtype):
             epoch = df["time_s"].iloc[0]  # the conversion's reference (table() has checked the column)
         t, lla, vel = a[:, 0], a[:, 1:4], a[:, 4:7]
-        q = a[:, 7:] if len(attitude) == 4 else quat_from_euler(np.ascontiguousarray(a[:, 7:]))
+        q = a[:, 7:] if len(attitude) == 4 else _core.quat_from_euler_rows(plausibility.angles(np.ascontiguousarray(a[:, 7:]), "df", "roll_rad, pitch_rad, yaw_rad"))
         increasing(t, "df", "time_s")
         bad = np.nonzero(np.abs(lla[:, 0]) > np.pi / 2)[0]
         if bad.size:
             raise input_error("df", f"lat_rad: latitude {lla[bad[0], 0]} rad at index {bad[0]} is outside [-pi/2, pi/2]", bad[0])
+        plausibility.lla(lla, "df")
         return cls(nav_table(t, lla, vel, q), None, ellipsoid, epoch)
 
     @classmethod
@@ -217,12 +218,12 @@ class Trajectory:
 # ---- generators -----------------------------------------------------------------------
 
 def _origin(origin):
-    return vector(origin, 3, "origin")
+    return plausibility.lla(vector(origin, 3, "origin"), "origin")
 
 
 def stationary(duration: float, rate_hz: float = 100.0, origin=MOSCOW, euler=(0.0, 0.0, 0.0), ellipsoid: str = "WGS84") -> Trajectory:
     """At rest at ``origin`` (lat rad, lon rad, h m) with constant (roll, pitch, yaw) rad."""
-    return Trajectory.from_motion(_core.Motion.stationary(_origin(origin), finite_scalar(duration, "duration"), vector(euler, 3, "euler")), rate_hz, ellipsoid)
+    return Trajectory.from_motion(_core.Motion.stationary(_origin(origin), finite_scalar(duration, "duration"), plausibility.angles(vector(euler, 3, "euler"), "euler")), rate_hz, ellipsoid)
 
 
 def sinusoidal(duration: float, rate_hz: float = 100.0, *, origin=MOSCOW, amp_ned=(20.0, 15.0, 2.0), period_ned=(60.0, 45.0, 30.0),
@@ -230,15 +231,17 @@ def sinusoidal(duration: float, rate_hz: float = 100.0, *, origin=MOSCOW, amp_ne
     """Sinusoidal motion: NED displacement amplitudes (m) and periods (s), roll/pitch/yaw
     oscillation amplitudes (rad) and periods (s) about ``heading`` (rad)."""
     m = _core.Motion.sinusoidal(_origin(origin), finite_scalar(duration, "duration"), vector(amp_ned, 3, "amp_ned"), vector(period_ned, 3, "period_ned"),
-                                vector(amp_euler, 3, "amp_euler"), vector(period_euler, 3, "period_euler"), finite_scalar(heading, "heading"))
+                                plausibility.angles(vector(amp_euler, 3, "amp_euler"), "amp_euler", "Euler amplitudes"), vector(period_euler, 3, "period_euler"),
+                                plausibility.angles(finite_scalar(heading, "heading"), "heading", "heading"))
     return Trajectory.from_motion(m, rate_hz, ellipsoid)
 
 
 def hexapod(rate_hz: float = 1000.0, origin=MOSCOW, max_tilt: float = 0.0654, pitch_delay: float = 5.0, heading: float = 0.0, ellipsoid: str = "WGS84") -> Trajectory:
     """Seed 000 §5.3 hexapod: 170 s of roll/pitch tilt steps up to ``max_tilt`` rad
     (0.0654 rad = 3.75°), pitch delayed by ``pitch_delay`` s (spec cai-ekf decision 13)."""
-    return Trajectory.from_motion(_core.Motion.hexapod(_origin(origin), finite_scalar(max_tilt, "max_tilt"), finite_scalar(pitch_delay, "pitch_delay"),
-                                                      finite_scalar(heading, "heading")), rate_hz, ellipsoid)
+    return Trajectory.from_motion(_core.Motion.hexapod(_origin(origin), plausibility.angles(finite_scalar(max_tilt, "max_tilt"), "max_tilt", "tilt"),
+                                                      finite_scalar(pitch_delay, "pitch_delay"),
+                                                      plausibility.angles(finite_scalar(heading, "heading"), "heading", "heading")), rate_hz, ellipsoid)
 
 
 def drive_with_yaw(rate_hz: float = 200.0, origin=MOSCOW, speed: float = 1.0, yaw_rate_amp: float = 0.05, period: float = 50.0,
@@ -246,7 +249,8 @@ def drive_with_yaw(rate_hz: float = 200.0, origin=MOSCOW, speed: float = 1.0, ya
     """Seed 003 Fig. 7: straight drive at ``speed`` m/s with yaw rate
     ``yaw_rate_amp``·sin(2πt/``period``) rad/s."""
     m = _core.Motion.drive_with_yaw(_origin(origin), finite_scalar(speed, "speed"), finite_scalar(yaw_rate_amp, "yaw_rate_amp"),
-                                    finite_scalar(period, "period"), finite_scalar(duration, "duration"), finite_scalar(heading, "heading"))
+                                    finite_scalar(period, "period"), finite_scalar(duration, "duration"),
+                                    plausibility.angles(finite_scalar(heading, "heading"), "heading", "heading"))
     return Trajectory.from_motion(m, rate_hz, ellipsoid)
 
 
@@ -261,7 +265,7 @@ def slalom(rate_hz: float = 200.0, origin=MOSCOW, speed: float = 5.0, amp: float
 def car(rate_hz: float = 200.0, origin=MOSCOW, heading: float = 0.0, vibration: bool = True, ellipsoid: str = "WGS84") -> Trajectory:
     """Seed 003 Fig. 9 car-like 40 s profile: static, accelerating, sliding and
     coordinated turns, a shock at 26 s, vibration at 4.3/9.7/15.1 Hz."""
-    return Trajectory.from_motion(_core.Motion.car(_origin(origin), finite_scalar(heading, "heading"), bool(instance(vibration, (bool, np.bool_), "vibration"))), rate_hz, ellipsoid)
+    return Trajectory.from_motion(_core.Motion.car(_origin(origin), plausibility.angles(finite_scalar(heading, "heading"), "heading", "heading"), bool(instance(vibration, (bool, np.bool_), "vibration"))), rate_hz, ellipsoid)
 
 
 def rotary_stand(states, move_starts, move_duration: float, duration: float, rate_hz: float = 200.0, origin=MOSCOW, ellipsoid: str = "WGS84") -> Trajectory:

@@ -12,7 +12,7 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from .. import _core
+from .. import _core, plausibility
 from .._validate import as_floats, choice, finite_scalar, flag, generator, input_error, integer, nonnegative, table, vector
 
 _NAMES = ("p0", "phi", "A")
@@ -37,7 +37,7 @@ def fringe_track(p, psi, *, zeta0=(0.5, 0.0, 0.1), sigma0=(0.1, 1.0, 0.1), q=(1e
     """Fringe-tracking EKF (E15)/(E16) on ζ = [p0, φ, A]: columns ``p0``, ``phi_rad``, ``A``
     after each readout (A kept > 0, φ wrapped to (−π, π]). q: random-walk variance per
     shot, r: readout variance."""
-    z = _core.cai_fringe_track(vector(p, None, "p"), vector(psi, None, "psi"), vector(zeta0, 3, "zeta0"),
+    z = _core.cai_fringe_track(plausibility.population(vector(p, None, "p"), "p"), vector(psi, None, "psi"), vector(zeta0, 3, "zeta0"),
                                vector(sigma0, 3, "sigma0"), vector(q, 3, "q"), finite_scalar(r, "r"))
     return pd.DataFrame({"p0": z[:, 0], "phi_rad": z[:, 1], "A": z[:, 2]})
 

@@ -14,7 +14,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import pandas as pd
 
-from .. import _core
+from .. import _core, plausibility
 from .._validate import (as_floats, broadcast, finite, finite_result, finite_scalar, flag, input_error, instance, nonnegative,
                          positive, renamed, rows, shaped, vector)
 from ._config import ConfigMixin
@@ -33,7 +33,7 @@ JACOBIAN_PARAMS = tuple(_core.CAI_JACOBIAN_PARAMS)
 def k_eff(wavelength: float = LAMBDA_RB87) -> float:
     """Effective two-photon wave number 4π/λ (rad/m) of a wavelength λ (m)."""
     with np.errstate(over="ignore"):
-        return float(finite_result(4.0 * np.pi / np.float64(positive(wavelength, "wavelength")), "wavelength", "the wave number 4π/λ"))
+        return float(finite_result(4.0 * np.pi / np.float64(plausibility.wavelength(positive(wavelength, "wavelength"), "wavelength")), "wavelength", "the wave number 4π/λ"))
 
 
 @dataclass
@@ -102,13 +102,15 @@ def _setup(t, specific_force, angular_rate, shots, T, channels, angular_accelera
     for name, a in (("specific_force", f), ("angular_rate", w)):
         if a.shape != (len(t), 3):
             raise input_error(name, f"expected shape ({len(t)}, 3), got {a.shape}")
+    plausibility.time_steps(t, "t")
+    plausibility.angular_rate(w, "angular_rate")
     wd = None
     if angular_acceleration is not None:
         wd = np.ascontiguousarray(as_floats(angular_acceleration, "angular_acceleration"))
         if wd.shape != (len(t), 3):
             raise input_error("angular_acceleration", f"expected shape ({len(t)}, 3), got {wd.shape}")
     shots = np.ascontiguousarray(np.atleast_1d(as_floats(shots, "shots")))
-    return shots, _core.CaiSetup(t, f, w, shots, channels._native(), finite_scalar(T, "T"), omega_dot=omega_dot, angular_acceleration=wd,
+    return shots, _core.CaiSetup(t, f, w, shots, channels._native(), plausibility.pulse_separation(finite_scalar(T, "T"), "T"), omega_dot=omega_dot, angular_acceleration=wd,
                                  savgol_half_width=savgol_half_width, interpolation=interpolation, substeps=substeps,
                                  gradient=_gradient(gradient),
                                  bias_a=vector(broadcast(bias_a, (3,), "bias_a"), 3, "bias_a"),
@@ -190,7 +192,7 @@ def readout_jacobian(phase_jac, phi_hat, phi0, contrast: float = 1.0) -> np.ndar
     phi_hat, phi0 = as_floats(phi_hat, "phi_hat"), as_floats(phi0, "phi0")
     for a, name in ((jac, "phase_jac"), (phi_hat, "phi_hat"), (phi0, "phi0")):
         finite(a.reshape(-1), name)
-    s = 0.5 * finite_scalar(contrast, "contrast") * np.sin(broadcast(phi_hat, jac.shape[:-1], "phi_hat")
+    s = 0.5 * plausibility.fraction(finite_scalar(contrast, "contrast"), "contrast", "contrast") * np.sin(broadcast(phi_hat, jac.shape[:-1], "phi_hat")
                                                           + broadcast(phi0, jac.shape[:-1], "phi0"))
     return s[..., None] * jac
 
@@ -256,7 +258,7 @@ def oracle_phase(motion, shots, T: float, channels: Channels, *, gravity=(0.0, 0
     instance(channels, Channels, "channels")
     g = _gravity(gravity, gradient, t_ref)
     shots = np.atleast_1d(as_floats(shots, "shots"))
-    out = motion._native().oracle(vector(shots, None, "shots"), finite_scalar(T, "T"), channels._native(), g)
+    out = motion._native().oracle(vector(shots, None, "shots"), plausibility.pulse_separation(finite_scalar(T, "T"), "T"), channels._native(), g)
     return out.reshape(len(shots), len(channels))
 
 
@@ -275,13 +277,14 @@ def _closed(kind, k, v0, angular_rate, specific_force, T, angular_acceleration=(
 def phase_constant(k, v0, angular_rate, specific_force, T: float) -> np.ndarray:
     """Exact phase (rad) per row of k (C, 3) for constant ω_s (rad/s) and f_s (m/s²) in s
     (spec (E10))."""
-    return _closed("exact", k, v0, angular_rate, specific_force, T)
+    return _closed("exact", k, v0, plausibility.angular_rate(angular_rate, "angular_rate"), specific_force, plausibility.pulse_separation(T, "T"))
 
 
 def phase_series(k, v0, angular_rate, specific_force, T: float, angular_acceleration=(0.0, 0.0, 0.0),
                  gradient=None) -> np.ndarray:
     """Fourth-order series (spec (E11)) incl. ω̇ (rad/s²) and gradient Γ (1/s²) terms."""
-    return _closed("series", k, v0, angular_rate, specific_force, T, angular_acceleration, gradient)
+    return _closed("series", k, v0, plausibility.angular_rate(angular_rate, "angular_rate"), specific_force, plausibility.pulse_separation(T, "T"),
+                   angular_acceleration, gradient)
 
 
 def phase_seed000(k, vbar, angular_rate, specific_force, T_total: float) -> np.ndarray:
@@ -289,34 +292,35 @@ def phase_seed000(k, vbar, angular_rate, specific_force, T_total: float) -> np.n
     interrogation time. Equals the library's first-order phase with k → −k, v0 = −v̄,
     T = T0/2."""
     with renamed(v0="vbar", T="T_total"):
-        return _closed("seed000", k, vbar, angular_rate, specific_force, T_total)
+        return _closed("seed000", k, vbar, plausibility.angular_rate(angular_rate, "angular_rate"), specific_force,
+                       plausibility.pulse_separation(T_total, "T_total", pulses=2))
 
 
 def sagnac_phase(k, v0, angular_rate, T: float) -> np.ndarray:
     """Sagnac (Coriolis) term −2T² k·(ω×v0) (rad)."""
     k = rows(np.atleast_2d(as_floats(k, "k")), 3, "k")
     v0 = rows(broadcast(v0, k.shape, "v0"), 3, "v0")
-    w = vector(angular_rate, 3, "angular_rate")
+    w = plausibility.angular_rate(vector(angular_rate, 3, "angular_rate"), "angular_rate")
     with np.errstate(over="ignore", invalid="ignore"):
-        phase = -2.0 * np.float64(finite_scalar(T, "T")) ** 2 * np.einsum("ij,ij->i", k, np.cross(w, v0))
+        phase = -2.0 * np.float64(plausibility.pulse_separation(finite_scalar(T, "T"), "T")) ** 2 * np.einsum("ij,ij->i", k, np.cross(w, v0))
     return finite_result(phase, "T", "the Sagnac phase")
 
 
 def t_sep_from_total(T_total: float) -> float:
     """Pulse separation T = T0/2 of seed 000's total interrogation time T0 (s)."""
-    return 0.5 * positive(T_total, "T_total")
+    return 0.5 * plausibility.pulse_separation(positive(T_total, "T_total"), "T_total", pulses=2)
 
 
 def total_from_t_sep(T: float) -> float:
     """Seed 000's total interrogation time T0 = 2T (s)."""
     with np.errstate(over="ignore"):
-        return float(finite_result(2.0 * np.float64(positive(T, "T")), "T", "2T"))
+        return float(finite_result(2.0 * np.float64(plausibility.pulse_separation(positive(T, "T"), "T")), "T", "2T"))
 
 
 def scale_factors(T: float, k: float = K_RB87, v0: float = 2.8) -> dict:
     """Phase scale factors: ``acceleration`` kT² (rad per m/s²), ``sagnac`` 2kv0T² (rad per
     rad/s), ``euler`` kv0T³ (rad per rad/s²)."""
-    T, k, v0 = np.float64(positive(T, "T")), finite_scalar(k, "k"), finite_scalar(v0, "v0")
+    T, k, v0 = np.float64(plausibility.pulse_separation(positive(T, "T"), "T")), finite_scalar(k, "k"), finite_scalar(v0, "v0")
     with np.errstate(over="ignore"):
         out = {"acceleration": k * T**2, "sagnac": 2 * k * v0 * T**2, "euler": k * v0 * T**3}
     return {key: float(finite_result(v, "T", f"the {key} scale factor")) for key, v in out.items()}
@@ -330,7 +334,7 @@ def dynamic_range(T: float, k: float = K_RB87) -> float:
 def _kt2(k: float, T: float) -> float:
     """The acceleration scale factor kT² (rad per m/s²), checked to be a positive float."""
     with np.errstate(over="ignore", under="ignore"):
-        scale = positive(k, "k") * np.float64(positive(T, "T")) ** 2
+        scale = positive(k, "k") * np.float64(plausibility.pulse_separation(positive(T, "T"), "T")) ** 2
     if not 0 < scale < np.inf:
         raise input_error("T", f"kT² = {scale} rad/(m/s²) is outside the range of floats")
     return scale
@@ -349,7 +353,7 @@ def in_shot_noise_phase(q_accel: float, q_gyro: float, T: float, k: float = K_RB
     """Phase standard deviation (rad) caused by IMU white noise inside one shot (seed 003
     spec (E38)): ``accel`` k√(2q_a/3) T^{3/2} and ``gyro`` (Sagnac) 2kv0√(2q_g/3) T^{3/2},
     with q the white-noise PSDs (m²/s³, rad²/s), from Var = q k² ∫w² dt, ∫w² = 2T³/3."""
-    T = np.float64(positive(T, "T"))
+    T = np.float64(plausibility.pulse_separation(positive(T, "T"), "T"))
     q_accel, q_gyro = nonnegative(q_accel, "q_accel"), nonnegative(q_gyro, "q_gyro")
     k, v0 = finite_scalar(k, "k"), finite_scalar(v0, "v0")
     with np.errstate(over="ignore", invalid="ignore"):
@@ -360,7 +364,7 @@ def in_shot_noise_phase(q_accel: float, q_gyro: float, T: float, k: float = K_RB
 def phase_noise(sigma_p: float, contrast: float = 1.0) -> float:
     """Phase noise (rad) of a mid-fringe readout with population noise σ_p: 2σ_p/C."""
     with np.errstate(over="ignore"):
-        noise = 2.0 * np.float64(positive(sigma_p, "sigma_p")) / positive(contrast, "contrast")
+        noise = 2.0 * np.float64(positive(sigma_p, "sigma_p")) / plausibility.fraction(positive(contrast, "contrast"), "contrast", "contrast")
     return float(finite_result(noise, "sigma_p", "2σ_p/C"))
 
 

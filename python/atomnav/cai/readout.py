@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .. import _core
+from .. import _core, plausibility
 from .._validate import as_floats, finite, finite_scalar, generator, input_error, nonnegative
 
 
@@ -26,7 +26,7 @@ def readout(phi, phi0=0.0, *, offset=0.5, contrast=1.0, sigma_p: float = 0.0, si
     finite(np.atleast_1d(phi).reshape(-1), "phi")
     phi0 = as_floats(phi0, "phi0")
     finite(np.atleast_1d(phi0).reshape(-1), "phi0")
-    offset = finite_scalar(offset, "offset")
+    offset = plausibility.fraction(finite_scalar(offset, "offset"), "offset", "offset")
     c = _contrast(contrast)
     sigma_p, sigma_phi, sigma_contrast = (nonnegative(s, name) for name, s in (
         ("sigma_p", sigma_p), ("sigma_phi", sigma_phi), ("sigma_contrast", sigma_contrast)))
@@ -58,10 +58,11 @@ def invert_readout(p, phi0=0.0, *, offset=0.5, contrast=1.0, flank: str = "risin
     c = _contrast(contrast)
     p = as_floats(p, "p")
     finite(np.atleast_1d(p).reshape(-1), "p")
+    plausibility.population(p, "p")
     phi0 = as_floats(phi0, "phi0")
     finite(np.atleast_1d(phi0).reshape(-1), "phi0")
     try:
-        u = np.clip(2.0 * (finite_scalar(offset, "offset") - p) / c, -1.0, 1.0)
+        u = np.clip(2.0 * (plausibility.fraction(finite_scalar(offset, "offset"), "offset", "offset") - p) / c, -1.0, 1.0)
         psi = np.arccos(u)
         return (psi if flank == "rising" else -psi) - phi0
     except ValueError:

@@ -7,19 +7,19 @@ from __future__ import annotations
 
 import numpy as np
 
-from .. import _core
+from .. import _core, plausibility
 from .._validate import as_floats, finite_scalar, vector
 
 
 def sensitivity(t, t_dark: float, tau: float):
     """Phase response g(t) (dimensionless) and acceleration response f(t) (s) at times t (s)."""
-    return _core.cai_sensitivity(vector(np.atleast_1d(as_floats(t, "t")), None, "t"), finite_scalar(t_dark, "t_dark"),
+    return _core.cai_sensitivity(vector(np.atleast_1d(as_floats(t, "t")), None, "t"), plausibility.pulse_separation(finite_scalar(t_dark, "t_dark"), "t_dark"),
                                finite_scalar(tau, "tau"))
 
 
 def response_area(t_dark: float, tau: float) -> float:
     """∫ f dt = (T_d + 2τ)(T_d + 4τ/π) (s²)."""
-    return _core.cai_response_area(finite_scalar(t_dark, "t_dark"), finite_scalar(tau, "tau"))
+    return _core.cai_response_area(plausibility.pulse_separation(finite_scalar(t_dark, "t_dark"), "t_dark"), finite_scalar(tau, "tau"))
 
 
 def convolution_phase(t, acceleration, centres, *, t_dark: float, tau: float, k: float) -> np.ndarray:
@@ -27,11 +27,11 @@ def convolution_phase(t, acceleration, centres, *, t_dark: float, tau: float, k:
     (spec (E20)). ``acceleration`` (m/s²) of the atoms relative to the sensor along k,
     sampled at any rate at times t (s), linear between samples (the atom strapdown
     equivalent is a = −k̂·f_s)."""
-    return _core.cai_convolution_phase(finite_scalar(t_dark, "t_dark"), finite_scalar(tau, "tau"), finite_scalar(k, "k"),
+    return _core.cai_convolution_phase(plausibility.pulse_separation(finite_scalar(t_dark, "t_dark"), "t_dark"), finite_scalar(tau, "tau"), finite_scalar(k, "k"),
                                        vector(t, None, "t"), np.ascontiguousarray(as_floats(acceleration, "acceleration")),
                                        vector(np.atleast_1d(as_floats(centres, "centres")), None, "centres"))
 
 
 def ideal_transfer(T: float, omega) -> np.ndarray:
     """∫ (T − |t|) cos(ωt) dt = 4 sin²(ωT/2)/ω² (s²) for angular frequencies ω (rad/s)."""
-    return _core.cai_ideal_transfer(finite_scalar(T, "T"), vector(np.atleast_1d(as_floats(omega, "omega")), None, "omega"))
+    return _core.cai_ideal_transfer(plausibility.pulse_separation(finite_scalar(T, "T"), "T"), vector(np.atleast_1d(as_floats(omega, "omega")), None, "omega"))

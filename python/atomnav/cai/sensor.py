@@ -15,7 +15,7 @@ from dataclasses import KW_ONLY, dataclass
 
 import numpy as np
 
-from .. import _core
+from .. import _core, plausibility
 from .._core import InputError
 from .._validate import as_floats, finite_scalar, flag, input_error, instance, integer, nonnegative, positive, scalar, vector
 from ._config import ConfigMixin
@@ -85,7 +85,11 @@ class CaiSensor(ConfigMixin):
 
     def _checked(self, name: str):
         """:meth:`_native` for the argument ``name`` of a call: a bad field is an
-        :class:`atomnav.InputError` naming ``name.field`` (e.g. ``sensor.T``)."""
+        :class:`atomnav.InputError` naming ``name.field`` (e.g. ``sensor.T``); a T in ms, or
+        a contrast or offset in %, is an :class:`atomnav.UnitWarning` naming it alike."""
+        plausibility.pulse_separation(self.T, f"{name}.T")
+        plausibility.fraction(self.contrast, f"{name}.contrast", "contrast")
+        plausibility.fraction(self.offset, f"{name}.offset", "offset")
         try:
             return self._native()
         except InputError as e:
@@ -141,7 +145,7 @@ def in_shot_noise(sensor: CaiSensor, dt: float, q_accel: float, q_gyro: float, f
     f = np.zeros((0, 15, 15)) if f is None else np.ascontiguousarray(as_floats(f, "f"))
     if f.ndim != 3:
         raise input_error("f", f"expected an (S, 15, 15) stack, got shape {f.shape}")
-    return _core.cai_in_shot_noise(sensor._checked("sensor"), positive(dt, "dt"), nonnegative(q_accel, "q_accel"),
+    return _core.cai_in_shot_noise(sensor._checked("sensor"), plausibility.sample_interval(positive(dt, "dt"), "dt"), nonnegative(q_accel, "q_accel"),
                                    nonnegative(q_gyro, "q_gyro"), f)
 
 
@@ -194,7 +198,10 @@ def cai_aided_ins(t0: float, lla0, vel0, q0, sensor: CaiSensor, shots, *, phase=
         if x.ndim != 2:
             raise input_error(name, f"expected a (shots, interferometers) array, got shape {x.shape}")
         tables.append(np.ascontiguousarray(x))
+    if not emulated:
+        plausibility.population(tables[0], "population")
     setup = setup or seed003_filter()
+    plausibility.lla(lla0, "lla0")
     n_extra = sensor.n_extra()
     ins = InsSetup(t0=t0, lla0=lla0, vel0=vel0, q0=q0, kind=kind, p0=setup.p0(n_extra) if p0 is None else p0,
                    accel_psd=setup.accel_psd, gyro_psd=setup.gyro_psd,
