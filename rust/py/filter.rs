@@ -204,7 +204,7 @@ impl PyAidedIns {
     /// Run `f` on the engine with the GIL released. When it stops on an error, the epochs
     /// computed before it are not lost: the raised exception carries them as `partial`.
     fn call<'py>(&self, py: Python<'py>, f: impl FnOnce(&mut AidedIns<Box<dyn Aiding>>, &mut AidedOutput) -> crate::error::Result<()> + Send) -> PyResult<OutputTuple<'py>> {
-        let mut guard = self.inner.lock().map_err(|_| pyo3::exceptions::PyRuntimeError::new_err("AidedIns: a previous call panicked"))?;
+        let mut guard = super::shared::lock(py, &self.inner);
         let (n, n_extra) = (guard.layout().size(), guard.n_extra());
         let mut out = AidedOutput::default();
         let ins: &mut AidedIns<Box<dyn Aiding>> = &mut guard;
@@ -248,20 +248,20 @@ impl PyAidedIns {
 
     /// Labels of the state components, e.g. "velocity[2]".
     #[getter]
-    fn labels(&self) -> Vec<String> {
-        self.inner.lock().map(|g| g.layout().labels()).unwrap_or_default()
+    fn labels(&self, py: Python<'_>) -> Vec<String> {
+        super::shared::lock(py, &self.inner).layout().labels()
     }
 
     /// Measurement times (s) of the sensor.
     #[getter]
-    fn measurement_times(&self) -> Vec<f64> {
-        self.inner.lock().map(|g| g.aiding().times().to_vec()).unwrap_or_default()
+    fn measurement_times(&self, py: Python<'_>) -> Vec<f64> {
+        super::shared::lock(py, &self.inner).aiding().times().to_vec()
     }
 
     /// Number of measurements not applied yet.
     #[getter]
-    fn pending(&self) -> usize {
-        self.inner.lock().map(|g| g.pending()).unwrap_or(0)
+    fn pending(&self, py: Python<'_>) -> usize {
+        super::shared::lock(py, &self.inner).pending()
     }
 }
 

@@ -13,6 +13,8 @@ use nalgebra::{DMatrix, DVector};
 use numpy::ndarray::{Array2, Array3};
 use numpy::{IntoPyArray, PyArray1, PyArray2, PyArray3, PyArrayMethods, PyReadonlyArray1, PyReadonlyArray2, PyReadonlyArray3};
 use pyo3::prelude::*;
+use std::sync::Mutex;
+use super::shared::lock;
 
 /// Filter-form DARE (a-priori P⁻, a-posteriori P⁺, gain K, doubling iterations).
 #[pyfunction]
@@ -93,30 +95,34 @@ fn with_missing(a: &PyReadonlyArray2<'_, f64>) -> DMatrix<f64> {
     DMatrix::from_row_iterator(rows, cols, a.as_array().iter().copied())
 }
 
-/// Error-state Kalman filter (closed or open loop), streaming one call per step.
-#[pyclass(module = "atomnav._core")]
+/// Error-state Kalman filter (closed or open loop), streaming one call per step. Shared
+/// between threads through a mutex (a per-step call from a Python loop: a Python-side
+/// lock would cost 7 % of it).
+#[pyclass(module = "atomnav._core", frozen)]
 pub struct KalmanFilter {
-    inner: Kf,
+    inner: Mutex<Kf>,
 }
-super::pickle::picklable!(KalmanFilter, inner, "KalmanFilter");
+super::pickle::picklable!(KalmanFilter, inner, "KalmanFilter", locked);
 
 #[pymethods]
 impl KalmanFilter {
     #[new]
     #[pyo3(signature = (p0, mode=Wrap(LoopMode::Closed)))]
     fn new(p0: PyReadonlyArray2<'_, f64>, mode: Wrap<LoopMode>) -> PyResult<Self> {
-        Ok(KalmanFilter { inner: Kf::new(mat(&p0, "p0")?, mode.0)? })
+        Ok(KalmanFilter { inner: Mutex::new(Kf::new(mat(&p0, "p0")?, mode.0)?) })
     }
 
-    fn predict(&mut self, phi: PyReadonlyArray2<'_, f64>, qd: PyReadonlyArray2<'_, f64>) -> PyResult<()> {
-        Ok(self.inner.predict_many(&mat(&phi, "phi")?, &mat(&qd, "qd")?, 1)?)
+    fn predict(&self, py: Python<'_>, phi: PyReadonlyArray2<'_, f64>, qd: PyReadonlyArray2<'_, f64>) -> PyResult<()> {
+        let (phi, qd) = (mat(&phi, "phi")?, mat(&qd, "qd")?);
+        Ok(lock(py, &self.inner).predict_many(&phi, &qd, 1)?)
     }
 
     /// `steps` predictions with the same (Φ, Q_d) in one call (the multirate / benchmark path).
-    fn predict_many(&mut self, py: Python<'_>, phi: PyReadonlyArray2<'_, f64>, qd: PyReadonlyArray2<'_, f64>, steps: &Bound<'_, PyAny>) -> PyResult<()> {
+    fn predict_many(&self, py: Python<'_>, phi: PyReadonlyArray2<'_, f64>, qd: PyReadonlyArray2<'_, f64>, steps: &Bound<'_, PyAny>) -> PyResult<()> {
         let steps = count(steps, "steps", 0, riccati::MAX_RECURSION_STEPS)?;
         let (phi, qd) = (mat(&phi, "phi")?, mat(&qd, "qd")?);
-        let kf = &mut self.inner;
+        let mut guard = lock(py, &self.inner);
+        let kf: &mut Kf = &mut guard;
         Ok(py.detach(|| kf.predict_many(&phi, &qd, steps))?)
     }
 
@@ -125,7 +131,7 @@ impl KalmanFilter {
     #[pyo3(signature = (z, h, r, sequential=false, gate=None))]
     #[allow(clippy::type_complexity)]
     fn update<'py>(
-        &mut self,
+        &self,
         py: Python<'py>,
         z: PyReadonlyArray1<'py, f64>,
         h: PyReadonlyArray2<'py, f64>,
@@ -134,28 +140,28 @@ impl KalmanFilter {
         gate: Option<f64>,
     ) -> PyResult<(Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<f64>>, Vec<usize>, Vec<usize>)> {
         let z: Vec<f64> = z.as_array().iter().copied().collect();
-        let rep = self.inner.update(&z, &with_missing(&h), &with_missing(&r), sequential, gate)?;
+        let rep = lock(py, &self.inner).update(&z, &with_missing(&h), &with_missing(&r), sequential, gate)?;
         Ok((rep.innovation.into_pyarray(py), rep.nis.into_pyarray(py), rep.rejected, rep.skipped))
     }
 
     /// Closed loop: returns δx̂ and resets it to 0; open loop: returns δx̂.
-    fn take_correction<'py>(&mut self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
-        self.inner.take_correction().as_slice().to_vec().into_pyarray(py)
+    fn take_correction<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        lock(py, &self.inner).take_correction().as_slice().to_vec().into_pyarray(py)
     }
 
     #[getter]
     fn x<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
-        self.inner.x.as_slice().to_vec().into_pyarray(py)
+        lock(py, &self.inner).x.as_slice().to_vec().into_pyarray(py)
     }
 
     #[getter]
     fn p<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
-        mat_to_py(py, &self.inner.p)
+        mat_to_py(py, &lock(py, &self.inner).p)
     }
 
     #[getter]
-    fn epoch(&self) -> usize {
-        self.inner.epoch
+    fn epoch(&self, py: Python<'_>) -> usize {
+        lock(py, &self.inner).epoch
     }
 }
 

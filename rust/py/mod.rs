@@ -12,6 +12,7 @@ mod imu;
 mod kalman;
 mod noise;
 mod pickle;
+mod shared;
 mod rotation;
 mod strapdown;
 mod trajectory;

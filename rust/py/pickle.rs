@@ -37,8 +37,28 @@ pub fn restore<T: DeserializeOwned>(class: &str, bytes: &[u8]) -> PyResult<T> {
 }
 
 /// `__reduce__` and `_from_state` for pyclass `$class`, whose field `$field` (a name, or 0
-/// for a tuple struct) is the whole state; `$name` is the class name Python sees.
+/// for a tuple struct) is the whole state; `$name` is the class name Python sees. With
+/// `locked`, the field is a `Mutex` taken by `shared::lock` (the state is read whole,
+/// never half way through another thread's call).
 macro_rules! picklable {
+    ($class:ident, $field:tt, $name:literal, locked) => {
+        #[pyo3::pymethods]
+        impl $class {
+            /// Pickle and deepcopy: the whole state, so a copy continues bit for bit like
+            /// this object.
+            fn __reduce__<'py>(slf: &pyo3::Bound<'py, Self>) -> pyo3::PyResult<pyo3::Bound<'py, pyo3::types::PyTuple>> {
+                let this = slf.borrow();
+                let state = $crate::py::shared::lock(slf.py(), &this.$field);
+                $crate::py::pickle::reduce(slf.as_any(), &*state)
+            }
+
+            /// The object saved by `__reduce__`.
+            #[staticmethod]
+            fn _from_state(state: &[u8]) -> pyo3::PyResult<Self> {
+                Ok($class { $field: std::sync::Mutex::new($crate::py::pickle::restore($name, state)?) })
+            }
+        }
+    };
     ($class:ident, $field:tt, $name:literal) => {
         #[pyo3::pymethods]
         impl $class {

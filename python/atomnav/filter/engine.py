@@ -14,7 +14,6 @@ from dataclasses import dataclass
 import numpy as np
 
 from .. import _core
-from .._stateful import Stateful, serialized
 from .._validate import as_floats, finite_scalar, flag, input_error, instance, integer, json_object, renamed, rows
 from .riccati import _mat
 
@@ -185,20 +184,19 @@ class UpdateResult(tuple):
     rejected = property(lambda self: self[2], doc="Rows rejected by the χ² gate.")
 
 
-class KalmanFilter(Stateful):
+class KalmanFilter:
     """Error-state Kalman filter.
 
     p0: initial covariance (PD); mode "closed" (feedback: :meth:`take_correction` hands δx̂
     to the caller and resets it) or "open" (δx̂ propagated by Φ and kept). A covariance
     that loses positive definiteness raises :class:`atomnav.NumericalError` naming the epoch.
-    One filter may be shared by threads (calls run one after another) and pickled or
-    deep-copied between steps: the copy continues bit for bit like the original.
+    One filter may be shared by threads (calls run one after another; the core holds the
+    lock) and pickled or deep-copied between steps: the copy continues bit for bit.
     """
 
     def __init__(self, p0, mode: str = "closed"):
         self._core = _core.KalmanFilter(_mat(p0, "p0"), mode)
 
-    @serialized
     def predict(self, phi, qd, steps: int = 1) -> None:
         """P ← ΦPΦᵀ + Q_d (and δx̂ ← Φδx̂ in open loop), ``steps`` times (multirate: pass
         Φ(ΔT), Q_d(ΔT) for ΔT = MΔt and steps=1)."""
@@ -207,7 +205,6 @@ class KalmanFilter(Stateful):
         else:
             self._core.predict_many(_mat(phi, "phi"), _mat(qd, "qd"), integer(steps, "steps", 0, 2**64 - 1))
 
-    @serialized
     def update(self, z, h, r, sequential: bool = False, gate: float | None = None) -> UpdateResult:
         """Update with z = Hδx + v (z = predicted − measured), R = cov(v).
 
@@ -249,22 +246,18 @@ class KalmanFilter(Stateful):
                                              None if gate is None else finite_scalar(gate, "gate"))
         return UpdateResult(values, skipped)
 
-    @serialized
     def take_correction(self) -> np.ndarray:
         return self._core.take_correction()
 
     @property
-    @serialized
     def x(self) -> np.ndarray:
         return self._core.x
 
     @property
-    @serialized
     def p(self) -> np.ndarray:
         return self._core.p
 
     @property
-    @serialized
     def epoch(self) -> int:
         return self._core.epoch
 
