@@ -9,6 +9,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+import allantools  # a test dependency (pyproject "test" extra)
+
 import atomnav
 from atomnav import InputError
 from atomnav.filter import KalmanFilter
@@ -130,3 +132,157 @@ def test_kalman_update_result_unpacks_as_before_and_pickles():
     assert len(res) == 3
     back = pickle.loads(pickle.dumps(res))
     assert back.skipped == [1] and np.array_equal(back[0], res.innovation, equal_nan=True)
+
+
+# ---------------------------------------------------------------- Allan family with gaps
+
+from atomnav.noise.allan import AllanStream, allan_variance  # noqa: E402
+
+#: atomnav kind → allantools function (overlapping Allan, modified Allan, overlapping Hadamard)
+AT = {"allan": allantools.oadev, "modified": allantools.mdev, "hadamard": allantools.ohdev}
+#: rate samples one term spans (2m, 3m − 1, 3m)
+SPAN = {"allan": lambda m: 2 * m, "modified": lambda m: 3 * m - 1, "hadamard": lambda m: 3 * m}
+
+
+def _white_fm(n, seed):
+    return np.random.default_rng(seed).normal(1e-3, 2e-4, n)
+
+
+def _brute(y, m, kind):
+    """Mean over every window of rate samples without NaN of the term of ``kind``, from
+    the window's own phase x (x₀ = 0, x_{k+1} = x_k + y_k): the textbook sums term by term."""
+    span, terms = SPAN[kind](m), []
+    for j in range(len(y) - span + 1):
+        w = y[j:j + span]
+        if np.isnan(w).any():
+            continue
+        x = np.concatenate([[0.0], np.cumsum(w)])
+        if kind == "allan":
+            terms.append((x[2 * m] - 2 * x[m] + x[0]) ** 2 / (2 * m**2))
+        elif kind == "hadamard":
+            terms.append((x[3 * m] - 3 * x[2 * m] + 3 * x[m] - x[0]) ** 2 / (6 * m**2))
+        else:
+            v = sum(x[i + 2 * m] - 2 * x[i + m] + x[i] for i in range(m))
+            terms.append(v**2 / (2 * m**4))
+    return np.mean(terms), len(terms)
+
+
+@pytest.mark.parametrize("kind", ["allan", "modified", "hadamard"])
+def test_allan_leading_and_trailing_nan_equal_allantools(kind):
+    # allantools trims leading and trailing NaN of frequency data (frequency2phase)
+    tau0, ms = 0.5, [1, 2, 4, 8, 16]
+    y = _white_fm(1000, 5)
+    y[:3] = y[-2:] = np.nan
+    t = allan_variance(y, tau0, m=ms, kind=kind)
+    taus, dev, _, ns = AT[kind](y, rate=1 / tau0, data_type="freq", taus=np.array(ms) * tau0)
+    np.testing.assert_allclose(t["tau_s"], taus, rtol=1e-15)
+    np.testing.assert_allclose(t["var"], dev**2, rtol=1e-9)
+    np.testing.assert_array_equal(t["n_terms"], ns)
+    assert t.attrs["n_missing"] == 5
+
+
+@pytest.mark.parametrize("kind", ["allan", "modified", "hadamard"])
+def test_allan_interior_gaps_pool_allantools_over_the_gap_free_stretches(kind):
+    # allantools returns NaN for interior NaN; atomnav leaves out the terms that span a
+    # gap, i.e. pools allantools' result of each gap-free stretch by its number of terms
+    tau0, ms = 0.5, [1, 2, 4, 8]
+    y = _white_fm(1200, 6)
+    gaps = [100, 101, 102, 430, 700, 701, 1100]  # every stretch is longer than 3·8 + 1
+    y[gaps] = np.nan
+    t = allan_variance(y, tau0, m=ms, kind=kind)
+    assert np.isnan(AT[kind](y, rate=1 / tau0, data_type="freq", taus=np.array(ms) * tau0)[1]).all()
+    stretches = [s for s in np.split(y, gaps) if s.size and not np.isnan(s).all()]
+    stretches = [s[~np.isnan(s)] for s in stretches]
+    num, den = np.zeros(len(ms)), np.zeros(len(ms))
+    for s in stretches:
+        _, dev, _, ns = AT[kind](s, rate=1 / tau0, data_type="freq", taus=np.array(ms) * tau0)
+        assert len(ns) == len(ms)
+        num += ns * dev**2
+        den += ns
+    np.testing.assert_allclose(t["var"], num / den, rtol=1e-9)
+    np.testing.assert_array_equal(t["n_terms"], den)
+    assert t.attrs["n_missing"] == len(gaps)
+
+
+@pytest.mark.parametrize("kind", ["allan", "modified", "hadamard"])
+def test_allan_random_gaps_equal_the_brute_force_oracle(kind):
+    # random gaps, some stretches shorter than a term: the term-by-term definition
+    rng = np.random.default_rng(9)
+    y = _white_fm(400, 7)
+    y[rng.choice(400, 40, replace=False)] = np.nan
+    t = allan_variance(y, 1.0, m=[1, 2, 3], kind=kind)
+    for m, var, n in zip(t["m"], t["var"], t["n_terms"]):
+        want, n_want = _brute(y, m, kind)
+        assert n == n_want
+        assert var == pytest.approx(want, rel=1e-9)
+    assert t.attrs["n_missing"] == 40
+
+
+@pytest.mark.parametrize("kind", ["allan", "modified", "hadamard"])
+def test_allan_constant_series_is_zero(kind):
+    # a stuck or quantised sensor: allantools and Stable32 give 0 (allantools exactly
+    # when the rounded mean is the value, as for 3.25; atomnav for any value, e.g.
+    # 0.6851, whose rounded mean of 300 copies is not 0.6851)
+    for value in (3.25, 0.6851):
+        y = np.full(300, value)
+        t = allan_variance(y, 0.1, kind=kind)
+        np.testing.assert_array_equal(t["var"], 0.0)
+        np.testing.assert_array_equal(t["dev"], 0.0)
+        s = AllanStream(list(t["m"]), tau0=0.1)
+        s.update(y)
+        np.testing.assert_array_equal(s.result(kind)["var"], 0.0)
+    _, dev, _, _ = AT[kind](np.full(300, 3.25), rate=10.0, data_type="freq", taus=t["tau_s"].to_numpy())
+    np.testing.assert_array_equal(dev, 0.0)
+
+
+@pytest.mark.parametrize("kind", ["allan", "modified", "hadamard"])
+def test_allan_stream_with_gaps_equals_batch(kind):
+    rng = np.random.default_rng(12)
+    y = _white_fm(900, 8)
+    y[rng.choice(900, 30, replace=False)] = np.nan
+    y[:2] = np.nan
+    ms = [1, 2, 4, 8]
+    batch = allan_variance(y, 0.5, m=ms, kind=kind)
+    s = AllanStream(ms, tau0=0.5)
+    for chunk in np.array_split(y, 13):
+        s.update(chunk)
+    stream = s.result(kind)
+    np.testing.assert_array_equal(stream["n_terms"], batch["n_terms"])
+    np.testing.assert_allclose(stream["var"], batch["var"], rtol=1e-9)
+    np.testing.assert_allclose(stream["edf"], batch["edf"], rtol=1e-12)
+    assert stream.attrs["n_missing"] == batch.attrs["n_missing"] == 32
+
+
+def test_allan_stream_and_batch_reject_the_same_factor():
+    # AllanStream([1, 2, 4], tau0=1.0) fed 5 samples used to drop m = 4 silently
+    s = AllanStream([1, 2, 4], tau0=1.0)
+    s.update([1.0, 3.0, 2.0, 5.0, 4.0])
+    with pytest.raises(InputError) as stream_error:
+        s.result()
+    with pytest.raises(InputError) as batch_error:
+        allan_variance([1.0, 3.0, 2.0, 5.0, 4.0], 1.0, m=[1, 2, 4])
+    for e in (stream_error, batch_error):
+        assert (e.value.parameter, e.value.index) == ("m", 2)
+        assert "9 consecutive samples" in str(e.value)  # 2m + 1 rate samples give two terms
+    assert str(stream_error.value) == str(batch_error.value)
+    s.update([0.0] * 4)
+    assert list(s.result()["m"]) == [1, 2, 4]
+
+
+@pytest.mark.parametrize("bad, parameter, index", [([1.0, np.inf, 2.0, 3.0], "data", 1)])
+def test_allan_infinite_and_phase_nan_are_input_errors(bad, parameter, index):
+    with pytest.raises(InputError) as e:
+        allan_variance(bad, 1.0)
+    assert (e.value.parameter, e.value.index) == (parameter, index)
+    with pytest.raises(InputError) as e:
+        allan_variance([0.0, 1.0, np.nan, 3.0, 4.0], 1.0, data_type="phase")
+    assert (e.value.parameter, e.value.index) == ("data", 2)
+    with pytest.raises(InputError) as e:
+        AllanStream([1], 1.0).update([0.0, -np.inf])
+    assert (e.value.parameter, e.value.index) == ("chunk", 1)
+
+
+def test_allan_gaps_leaving_no_term_name_data():
+    with pytest.raises(InputError) as e:
+        allan_variance([1.0, np.nan, 2.0, np.nan, 3.0, np.nan, 4.0], 1.0)
+    assert e.value.parameter == "data"

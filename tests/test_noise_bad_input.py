@@ -19,9 +19,10 @@ def test_series_shorter_than_model_needs():
 
 def test_nan_names_index():
     x = W.copy()
-    x[17] = np.nan
-    with pytest.raises(ValueError, match=r"data: non-finite value (?i:nan) at index 17$"):
+    x[17] = np.inf  # a NaN rate sample is a gap to the Allan family (tests/test_nan_missing.py)
+    with pytest.raises(ValueError, match=r"data: non-finite value inf at index 17$"):
         allan.allan_variance(x, 1.0)
+    x[17] = np.nan
     with pytest.raises(ValueError, match=r"omega: non-finite value nan at index 17"):
         filters.kalman(x, filters.ArimaStateSpace.paper())
     with pytest.raises(ValueError, match=r"omega: non-finite value nan at index 17"):
@@ -30,16 +31,15 @@ def test_nan_names_index():
 
 def test_constant_series():
     c = np.full(300, 0.6851)
-    with pytest.raises(ValueError, match=r"data: constant series"):
-        allan.allan_variance(c, 52.0)
+    # a stuck sensor has zero Allan variance (allantools and Stable32 give 0)
+    assert (allan.allan_variance(c, 52.0)["var"] == 0.0).all()
     with pytest.raises(ValueError, match=r"omega: constant series"):
         arma.fit_arma(c)
-    with pytest.raises(ValueError, match=r"data: phase is a straight line"):
-        allan.allan_variance(np.arange(50.0), 1.0, data_type="phase")
+    assert (allan.allan_variance(np.arange(50.0), 1.0, data_type="phase")["var"] == 0.0).all()
 
 
 def test_tau_larger_than_half_the_record():
-    with pytest.raises(ValueError, match=r"m: averaging factor 100 at index 2 leaves 1 terms"):
+    with pytest.raises(ValueError, match=r"m: averaging factor 100 at index 2 has 1 terms"):
         allan.allan_variance(W, 1.0, m=[1, 2, 100])
     with pytest.raises(ValueError, match=r"index 1"):
         allan.allan_variance(W, 2.0, taus=[2.0, 202.0])

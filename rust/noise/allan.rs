@@ -32,13 +32,32 @@ impl Choice for Kind {
 }
 
 impl Kind {
-    /// Number of terms in the sum at averaging factor m with `np` phase points.
-    pub fn terms(self, np: usize, m: usize) -> usize {
+    /// Phase points one term of the sum reaches beyond its first (m ≥ 1): 2m (Allan),
+    /// 3m − 1 (modified), 3m (Hadamard); a term uses the rate samples of that span.
+    fn span(self, m: usize) -> usize {
         match self {
-            Kind::Allan => np.saturating_sub(m.saturating_mul(2)),
-            Kind::Modified => (np + 1).saturating_sub(m.saturating_mul(3)),
-            Kind::Hadamard => np.saturating_sub(m.saturating_mul(3)),
+            Kind::Allan => m.saturating_mul(2),
+            Kind::Modified => m.saturating_mul(3).saturating_sub(1),
+            Kind::Hadamard => m.saturating_mul(3),
         }
+    }
+
+    /// Number of terms in the sum at averaging factor m ≥ 1 with `np` phase points.
+    pub fn terms(self, np: usize, m: usize) -> usize {
+        np.saturating_sub(self.span(m))
+    }
+
+    /// The error for a factor `m` (index `i` of the caller's list) that has only `terms`
+    /// terms: names `m` and the number of consecutive samples that give `MIN_TERMS`.
+    fn too_few_terms(self, data_type: DataType, m: usize, i: usize, terms: usize) -> NavError {
+        let need = self.span(m).saturating_add(MIN_TERMS) - usize::from(data_type == DataType::Rate);
+        invalid_at(
+            "m",
+            i,
+            format!(
+                "averaging factor {m} at index {i} has {terms} terms (< {MIN_TERMS}): τ is too large for the record; {need} consecutive samples without a gap give {MIN_TERMS} terms (about twice τ for the Allan variance, three times for modified/Hadamard)"
+            ),
+        )
     }
 }
 
@@ -100,17 +119,28 @@ pub struct AllanResult {
     pub var: Vec<f64>,
     /// Number of terms in each sum.
     pub n: Vec<usize>,
+    /// Number of NaN (missing) rate samples left out.
+    pub missing: usize,
 }
 
 /// Minimum number of terms for a variance to be reported (as allantools).
 pub const MIN_TERMS: usize = 2;
 
-/// Resolve a τ set into the averaging factors that leave at least `MIN_TERMS` terms.
-/// A user list with a factor that is too large is an error naming its index.
-pub fn resolve_m(set: &TauSet, kind: Kind, np: usize) -> Result<Vec<usize>> {
-    let ok = |m: usize| m >= 1 && kind.terms(np, m) >= MIN_TERMS;
-    let gen = |f: &dyn Fn(usize) -> usize| -> Vec<usize> { (0..).map(f).take_while(|&m| ok(m)).collect() };
-    Ok(match set {
+/// Resolve a τ set into the averaging factors that leave at least `MIN_TERMS` terms in
+/// a record of gap-free stretches of `np` phase points each. A user list with a factor
+/// that is too large is an error naming its index; a named set of which no factor has
+/// enough terms is an error naming `data`.
+pub fn resolve_m(set: &TauSet, kind: Kind, data_type: DataType, np: &[usize]) -> Result<Vec<usize>> {
+    let terms = |m: usize| np.iter().map(|&p| kind.terms(p, m)).sum::<usize>();
+    let ok = |m: usize| m >= 1 && terms(m) >= MIN_TERMS;
+    let gen = |f: &dyn Fn(usize) -> usize| -> Result<Vec<usize>> {
+        let ms: Vec<usize> = (0..).map(f).take_while(|&m| ok(m)).collect();
+        match ms.is_empty() {
+            true => Err(invalid("data", format!("no averaging factor has {MIN_TERMS} terms: the stretches between NaN samples are too short (at most {} samples)", np.iter().max().map_or(0, |p| p - usize::from(data_type == DataType::Rate))))),
+            false => Ok(ms),
+        }
+    };
+    match set {
         TauSet::Octave => gen(&|k| 1usize << k),
         TauSet::All => gen(&|k| k + 1),
         TauSet::Decade => gen(&|k| {
@@ -130,22 +160,15 @@ pub fn resolve_m(set: &TauSet, kind: Kind, np: usize) -> Result<Vec<usize>> {
                     return Err(invalid_at("m", i, format!("averaging factor 0 at index {i}; τ must be ≥ τ₀")));
                 }
                 if !ok(m) {
-                    return Err(invalid_at(
-                        "m",
-                        i,
-                        format!(
-                            "averaging factor {m} at index {i} leaves {} terms (< {MIN_TERMS}) in a record of {np} phase points: τ is too large for the record (larger than about half the record for the Allan variance, a third for modified/Hadamard)",
-                            kind.terms(np, m)
-                        ),
-                    ));
+                    return Err(kind.too_few_terms(data_type, m, i, terms(m)));
                 }
             }
             let mut v = ms.clone();
             v.sort_unstable();
             v.dedup();
-            v
+            Ok(v)
         }
-    })
+    }
 }
 
 /// Fixed number of parts that long loops are split into: results are combined in part
@@ -186,6 +209,11 @@ fn lane_sum(v: &[f64], f: impl Fn(f64) -> f64) -> f64 {
 /// Two passes over PARTS contiguous parts: part sums, then each part's running sum.
 fn rate_to_phase(y: &[f64]) -> Vec<f64> {
     let n = y.len();
+    // a constant series (a stuck or quantised sensor) has phase 0 about its mean, and so
+    // every variance exactly 0 (the rounded part sums would leave ~1e-31)
+    if y.split_first().is_some_and(|(&y0, rest)| rest.iter().all(|&v| v == y0)) {
+        return vec![0.0; n + 1];
+    }
     let len = n.div_ceil(PARTS);
     let part = |p: usize| y.get((p * len).min(n)..((p + 1) * len).min(n)).unwrap_or_default();
     let sums = par_parts(n, |p| lane_sum(part(p), |v| v));
@@ -262,7 +290,7 @@ fn sum_sq<const K: usize>(s: [&[f64]; K], c: [f64; K]) -> f64 {
 /// terms and each block is visited once for all m, so the windows x_{i+km} of
 /// neighbouring octave factors (2m_k = m_{k+1}) are read from cache rather than memory.
 /// The range is split into `PARTS` fixed parts (see [`par_parts`]).
-// invariant: resolve_m keeps only m with x.len() − (K−1)m ≥ MIN_TERMS, and end ≤ terms(m),
+// invariant: variance passes only the m with x.len() − (K−1)m ≥ 1 term, and end ≤ terms(m),
 // so x[i0 + km .. end + km] ends at most at x.len().
 #[allow(clippy::indexing_slicing)]
 fn difference_sums<const K: usize>(x: &[f64], ms: &[usize], c: [f64; K]) -> Vec<f64> {
@@ -291,7 +319,7 @@ fn difference_sums<const K: usize>(x: &[f64], ms: &[usize], c: [f64; K]) -> Vec<
 
 /// Σ_j v_j², v_j = Σ_{i=j}^{j+m−1} (x_{i+2m} − 2x_{i+m} + x_i), updated by
 /// v_{j+1} = v_j + x_{j+3m} − 3x_{j+2m} + 3x_{j+m} − x_j (NIST SP 1065 Eq. 15).
-// invariant: resolve_m keeps only m with x.len() + 1 − 3m ≥ MIN_TERMS, so i + 2m and
+// invariant: variance passes only the m with x.len() + 1 − 3m ≥ 1 term, so i + 2m and
 // j + 3m stay below x.len().
 #[allow(clippy::indexing_slicing)]
 fn modified_sum(x: &[f64], m: usize) -> f64 {
@@ -314,48 +342,77 @@ fn divisor(kind: Kind, m: usize, n: usize) -> f64 {
     }
 }
 
-fn check_series(data: &[f64], data_type: DataType, tau0: f64) -> Result<()> {
+/// Checks the series and returns its number of NaN (missing) samples: allowed in rate
+/// data only; ±inf is invalid everywhere.
+fn check_series(data: &[f64], data_type: DataType, tau0: f64) -> Result<usize> {
     check_positive("tau0", tau0)?;
     // v·0 is NaN exactly for NaN/±inf: one vectorised pass, the indexed search only on failure.
-    if lane_sum(data, |v| v * 0.0).is_nan() {
-        check_finite("data", data, 1)?;
-    }
-    let min = if data_type == DataType::Rate { 3 } else { 4 };
-    if data.len() < min {
-        return Err(invalid("data", format!("series of {} samples is too short; at least {min} are needed for one Allan point", data.len())));
-    }
-    // A constant rate (or a phase ramp) has identically zero variance at every τ.
-    let constant = match data_type {
-        DataType::Rate => data.split_first().is_some_and(|(d0, rest)| rest.iter().all(|v| v == d0)),
-        DataType::Phase => data.windows(3).all(|w| matches!(w, [a, b, c] if c - 2.0 * b + a == 0.0)),
+    let missing = match lane_sum(data, |v| v * 0.0).is_nan() {
+        true => check_missing("data", data, data_type)?,
+        false => 0,
     };
-    if constant {
-        let what = if data_type == DataType::Rate { "constant series" } else { "phase is a straight line (constant rate)" };
-        return Err(invalid("data", format!("{what}: every Allan-family variance is zero")));
+    let min = if data_type == DataType::Rate { 3 } else { 4 };
+    if data.len() - missing < min {
+        let what = if missing > 0 { " non-NaN" } else { "" };
+        return Err(invalid("data", format!("series of {}{what} samples is too short; at least {min} are needed for one Allan point", data.len() - missing)));
     }
-    Ok(())
+    Ok(missing)
+}
+
+/// The number of NaN samples of a rate series (missing samples); ±inf, or NaN in phase
+/// data, is invalid input naming `field` and its first index.
+fn check_missing(field: &str, data: &[f64], data_type: DataType) -> Result<usize> {
+    let phase = data_type == DataType::Phase;
+    if let Some((i, v)) = data.iter().enumerate().find(|(_, v)| v.is_infinite() || (phase && v.is_nan())) {
+        let why = if v.is_nan() { " (a missing sample is a NaN of rate data; a phase record's gap leaves the phase across it unknown)" } else { "" };
+        return Err(invalid_at(field, i, format!("non-finite value {v} at index {i}{why}")));
+    }
+    Ok(data.iter().filter(|v| v.is_nan()).count())
 }
 
 /// Batch Allan-family variance of rate data (any unit) or phase data (angle; the
 /// variance is then in angle/s²) sampled every `tau0` seconds.
+///
+/// A NaN rate sample is missing (a gap is marked, not filled: Riley, NIST SP 1065, "Gaps,
+/// jumps, and outliers"; the rule of allantools' gap-resistant `gradev`, which applies it
+/// to phase points): every term whose span of rate
+/// samples ([`Kind::span`]: 2m for the Allan, 3m − 1 for the modified, 3m for the
+/// Hadamard variance) holds a NaN is left out, and the variance is the mean of the other
+/// terms. This is the terms of each gap-free stretch pooled, so the record is cut at its
+/// NaN samples and each stretch is summed as a record of its own; leading and trailing
+/// NaN are trimmed as allantools' `frequency2phase` does. A constant series gives 0.
 pub fn variance(data: &[f64], tau0: f64, data_type: DataType, kind: Kind, set: &TauSet) -> Result<AllanResult> {
-    check_series(data, data_type, tau0)?;
-    let (x, scale) = match data_type {
-        DataType::Rate => (std::borrow::Cow::Owned(rate_to_phase(data)), 1.0),
-        DataType::Phase => (std::borrow::Cow::Borrowed(data), 1.0 / (tau0 * tau0)),
+    let missing = check_series(data, data_type, tau0)?;
+    let stretches: Vec<&[f64]> = match missing {
+        0 => vec![data],
+        _ => data.split(|v| v.is_nan()).filter(|s| !s.is_empty()).collect(),
     };
-    let ms = resolve_m(set, kind, x.len())?;
-    let sums = match kind {
-        Kind::Allan => difference_sums(&x, &ms, [1.0, -2.0, 1.0]),
-        Kind::Hadamard => difference_sums(&x, &ms, [-1.0, 3.0, -3.0, 1.0]),
-        Kind::Modified => ms.iter().map(|&m| modified_sum(&x, m)).collect(),
-    };
-    let n: Vec<usize> = ms.iter().map(|&m| kind.terms(x.len(), m)).collect();
+    // a rate stretch of L samples is L + 1 phase points
+    let np: Vec<usize> = stretches.iter().map(|y| y.len() + usize::from(data_type == DataType::Rate)).collect();
+    let scale = if data_type == DataType::Phase { 1.0 / (tau0 * tau0) } else { 1.0 };
+    let ms = resolve_m(set, kind, data_type, &np)?;
+    let mut sums = vec![0.0; ms.len()];
+    for y in stretches {
+        let x = match data_type {
+            DataType::Rate => std::borrow::Cow::Owned(rate_to_phase(y)),
+            DataType::Phase => std::borrow::Cow::Borrowed(y),
+        };
+        // ms ascending: the factors with a term in this stretch are a prefix of it
+        let here: Vec<usize> = ms.iter().copied().take_while(|&m| kind.terms(x.len(), m) >= 1).collect();
+        let part = match kind {
+            Kind::Allan => difference_sums(&x, &here, [1.0, -2.0, 1.0]),
+            Kind::Hadamard => difference_sums(&x, &here, [-1.0, 3.0, -3.0, 1.0]),
+            Kind::Modified => here.iter().map(|&m| modified_sum(&x, m)).collect(),
+        };
+        sums.iter_mut().zip(part).for_each(|(s, p)| *s += p);
+    }
+    let n: Vec<usize> = ms.iter().map(|&m| np.iter().map(|&p| kind.terms(p, m)).sum()).collect();
     let res = AllanResult {
         tau: ms.iter().map(|&m| m as f64 * tau0).collect(),
         var: sums.iter().zip(&ms).zip(&n).map(|((s, &m), &nj)| s * scale / divisor(kind, m, nj)).collect(),
         m: ms,
         n,
+        missing,
     };
     check_overflow(&res)?;
     Ok(res)
@@ -364,15 +421,20 @@ pub fn variance(data: &[f64], tau0: f64, data_type: DataType, kind: Kind, set: &
 /// Streaming accumulation of all three variances at fixed averaging factors, for
 /// records that do not fit in memory. Memory is a ring of 3·max(m)+1 phase points.
 /// Rate data are integrated about their first sample instead of their mean (unknown in
-/// advance); the variances do not depend on that offset.
+/// advance); the variances do not depend on that offset. A NaN rate sample is missing,
+/// as in [`variance`]: it ends the current gap-free stretch, whose terms are kept, and
+/// the next sample starts a new one, so the stream equals the batch on the same record.
 #[derive(Debug, Clone)]
 pub struct AllanStream {
+    /// The factors as given (errors name an index of this list).
+    given: Vec<usize>,
+    /// The factors sorted, without repeats.
     ms: Vec<usize>,
     tau0: f64,
     data_type: DataType,
     ring: Vec<f64>,
     mask: usize,
-    /// Phase points seen so far.
+    /// Phase points of the current gap-free stretch.
     np: usize,
     /// Running phase (rate data) and the rate offset.
     phase: f64,
@@ -381,7 +443,22 @@ pub struct AllanStream {
     sum_m: Vec<f64>,
     sum_h: Vec<f64>,
     v: Vec<f64>,
+    /// Terms of the finished stretches per factor: (Allan, modified, Hadamard).
+    done: Vec<[usize; 3]>,
+    /// NaN (missing) rate samples seen.
+    missing: usize,
 }
+
+/// The slot of `kind` in [`AllanStream`]'s per-kind arrays.
+fn slot(kind: Kind) -> usize {
+    match kind {
+        Kind::Allan => 0,
+        Kind::Modified => 1,
+        Kind::Hadamard => 2,
+    }
+}
+
+const KINDS: [Kind; 3] = [Kind::Allan, Kind::Modified, Kind::Hadamard];
 
 impl AllanStream {
     /// A stream at the averaging factors `ms` (each ≥ 1; the ring of 3·max(m)+1 phase
@@ -400,11 +477,13 @@ impl AllanStream {
         // reserved, not touched: the pages fill as the stream runs
         let mut ring = Vec::new();
         ring.try_reserve_exact(cap).map_err(|_| NavError::OutOfMemory { field: "m".into(), bytes: cap as u128 * 8 })?;
+        let given = ms.to_vec();
         let mut ms = ms.to_vec();
         ms.sort_unstable();
         ms.dedup();
         let k = ms.len();
         Ok(AllanStream {
+            given,
             ms,
             tau0,
             data_type,
@@ -417,6 +496,8 @@ impl AllanStream {
             sum_m: vec![0.0; k],
             sum_h: vec![0.0; k],
             v: vec![0.0; k],
+            done: vec![[0; 3]; k],
+            missing: 0,
         })
     }
 
@@ -452,13 +533,31 @@ impl AllanStream {
         self.np += 1;
     }
 
-    /// Feed the next chunk of samples (rate or phase, as constructed). Samples so large that
-    /// the sums overflow the f64 range are an error.
+    /// Close the current gap-free stretch: its terms are counted, its phase forgotten.
+    fn end_stretch(&mut self) {
+        for (d, &m) in self.done.iter_mut().zip(&self.ms) {
+            d.iter_mut().zip(KINDS).for_each(|(t, kind)| *t += kind.terms(self.np, m));
+        }
+        (self.np, self.phase) = (0, 0.0);
+        self.ring.clear();
+        self.v.fill(0.0);
+    }
+
+    /// Feed the next chunk of samples (rate or phase, as constructed; NaN marks a missing
+    /// rate sample). Samples so large that the sums overflow the f64 range are an error.
     pub fn update(&mut self, chunk: &[f64]) -> Result<()> {
-        check_finite("chunk", chunk, 1)?;
+        if lane_sum(chunk, |v| v * 0.0).is_nan() {
+            check_missing("chunk", chunk, self.data_type)?;
+        }
         for &y in chunk {
             match self.data_type {
                 DataType::Phase => self.push_phase(y),
+                DataType::Rate if y.is_nan() => {
+                    self.missing += 1;
+                    if self.np > 0 {
+                        self.end_stretch();
+                    }
+                }
                 DataType::Rate => {
                     let off = *self.offset.get_or_insert(y);
                     if self.np == 0 {
@@ -475,25 +574,33 @@ impl AllanStream {
         Ok(())
     }
 
-    /// The variances so far at the factors that already have at least `MIN_TERMS` terms.
-    pub fn result(&self, kind: Kind) -> AllanResult {
+    /// Terms so far at factor `ms[j]` of `kind`.
+    fn terms(&self, kind: Kind, j: usize, m: usize) -> usize {
+        self.done.get(j).and_then(|d| d.get(slot(kind))).copied().unwrap_or_default() + kind.terms(self.np, m)
+    }
+
+    /// The variances so far, at every factor, as [`variance`] gives them for the same
+    /// samples: a factor with fewer than `MIN_TERMS` terms yet is an error naming `m`, its
+    /// index in the list given and the number of samples it needs.
+    pub fn result(&self, kind: Kind) -> Result<AllanResult> {
+        let terms = |m: usize| self.ms.iter().position(|&v| v == m).map_or(0, |j| self.terms(kind, j, m));
+        if let Some((i, &m)) = self.given.iter().enumerate().find(|(_, &m)| terms(m) < MIN_TERMS) {
+            return Err(kind.too_few_terms(self.data_type, m, i, terms(m)));
+        }
         let scale = if self.data_type == DataType::Phase { 1.0 / (self.tau0 * self.tau0) } else { 1.0 };
         let sums = match kind {
             Kind::Allan => &self.sum_a,
             Kind::Modified => &self.sum_m,
             Kind::Hadamard => &self.sum_h,
         };
-        let mut out = AllanResult { m: Vec::new(), tau: Vec::new(), var: Vec::new(), n: Vec::new() };
-        for (&m, s) in self.ms.iter().zip(sums) {
-            let n = kind.terms(self.np, m);
-            if n >= MIN_TERMS {
-                out.m.push(m);
-                out.tau.push(m as f64 * self.tau0);
-                out.var.push(s * scale / divisor(kind, m, n));
-                out.n.push(n);
-            }
-        }
-        out
+        let n: Vec<usize> = self.ms.iter().enumerate().map(|(j, &m)| self.terms(kind, j, m)).collect();
+        Ok(AllanResult {
+            tau: self.ms.iter().map(|&m| m as f64 * self.tau0).collect(),
+            var: sums.iter().zip(&self.ms).zip(&n).map(|((s, &m), &nj)| s * scale / divisor(kind, m, nj)).collect(),
+            m: self.ms.clone(),
+            n,
+            missing: self.missing,
+        })
     }
 }
 
@@ -683,19 +790,74 @@ mod tests {
     #[test]
     fn streaming_equals_batch_for_all_kinds() {
         let y: Vec<f64> = (0..1000).map(|k| ((k * 7919) % 1013) as f64 * 0.01 + (k as f64 * 0.1).sin()).collect();
-        let ms = resolve_m(&TauSet::Octave, Kind::Hadamard, y.len() + 1).unwrap();
+        let ms = resolve_m(&TauSet::Octave, Kind::Hadamard, DataType::Rate, &[y.len() + 1]).unwrap();
         let mut s = AllanStream::new(&ms, 2.0, DataType::Rate).unwrap();
         for c in y.chunks(77) {
             s.update(c).unwrap();
         }
         for kind in [Kind::Allan, Kind::Modified, Kind::Hadamard] {
             let b = variance(&y, 2.0, DataType::Rate, kind, &TauSet::List(ms.clone())).unwrap();
-            let st = s.result(kind);
+            let st = s.result(kind).unwrap();
             assert_eq!(b.m, st.m);
             for (u, v) in b.var.iter().zip(&st.var) {
                 assert!((u - v).abs() <= 1e-10 * u.abs(), "{kind:?}: {u} vs {v}");
             }
         }
+    }
+
+    /// NaN rate samples: the batch pools the gap-free stretches (each summed as its own
+    /// record), the stream fed in any chunks gives the same, and a constant series gives 0.
+    #[test]
+    fn gaps_pool_the_stretches_in_batch_and_stream() {
+        let mut y: Vec<f64> = (0..600).map(|k| ((k * 7919) % 1013) as f64 * 0.01 + (k as f64 * 0.3).sin()).collect();
+        for i in [0, 1, 40, 41, 42, 300, 599] {
+            y[i] = f64::NAN;
+        }
+        let ms = vec![1, 2, 8, 20];
+        let mut s = AllanStream::new(&ms, 0.5, DataType::Rate).unwrap();
+        for c in y.chunks(41) {
+            s.update(c).unwrap();
+        }
+        let stretches: Vec<&[f64]> = y.split(|v| v.is_nan()).filter(|s| !s.is_empty()).collect();
+        for kind in [Kind::Allan, Kind::Modified, Kind::Hadamard] {
+            let b = variance(&y, 0.5, DataType::Rate, kind, &TauSet::List(ms.clone())).unwrap();
+            assert_eq!(b.missing, 7);
+            let (mut sum, mut n) = (vec![0.0; ms.len()], vec![0; ms.len()]);
+            for part in &stretches {
+                for (j, &m) in ms.iter().enumerate() {
+                    let t = kind.terms(part.len() + 1, m);
+                    if t >= MIN_TERMS {
+                        let r = variance(part, 0.5, DataType::Rate, kind, &TauSet::List(vec![m])).unwrap();
+                        sum[j] += r.var[0] * t as f64;
+                    }
+                    n[j] += t;
+                }
+            }
+            assert_eq!(b.n, n, "{kind:?}");
+            let st = s.result(kind).unwrap();
+            assert_eq!((&st.n, st.missing), (&b.n, 7));
+            for j in 0..ms.len() {
+                // stretches with a single term are in b but not in the per-stretch sum
+                if stretches.iter().all(|p| kind.terms(p.len() + 1, ms[j]) != 1) {
+                    assert!((b.var[j] - sum[j] / n[j] as f64).abs() <= 1e-12 * b.var[j], "{kind:?} m = {}", ms[j]);
+                }
+                assert!((b.var[j] - st.var[j]).abs() <= 1e-10 * b.var[j], "{kind:?}: {} vs {}", b.var[j], st.var[j]);
+            }
+            let c = variance(&[2.5; 50], 1.0, DataType::Rate, kind, &TauSet::Octave).unwrap();
+            assert!(c.var.iter().all(|&v| v == 0.0), "{kind:?}: {:?}", c.var);
+        }
+    }
+
+    /// A factor without MIN_TERMS terms yet is the same error from the stream as from the
+    /// batch, naming m at its index in the list given.
+    #[test]
+    fn stream_and_batch_reject_the_same_factor() {
+        let y = [1.0, 3.0, 2.0, 5.0, 4.0];
+        let mut s = AllanStream::new(&[4, 1, 2], 1.0, DataType::Rate).unwrap();
+        s.update(&y).unwrap();
+        let want = variance(&y, 1.0, DataType::Rate, Kind::Allan, &TauSet::List(vec![4, 1, 2])).unwrap_err();
+        assert_eq!(s.result(Kind::Allan).unwrap_err(), want);
+        assert!(matches!(&want, NavError::InvalidInput { field, index: Some(0), reason } if field == "m" && reason.contains("9 consecutive samples")), "{want}");
     }
 
     #[test]
@@ -712,7 +874,7 @@ mod tests {
         let m: Vec<usize> = (0..12).map(|k| 1 << k).collect();
         let tau: Vec<f64> = m.iter().map(|&m| m as f64).collect();
         let var = tau.iter().map(|t| (0..5).map(|k| coeffs[k] * t.powi(k as i32 - 2)).sum()).collect();
-        let r = AllanResult { m, tau, var, n: vec![10; 12] };
+        let r = AllanResult { m, tau, var, n: vec![10; 12], missing: 0 };
         let f = fit(&r, 100_000, [true; 5], 0.0, f64::INFINITY).unwrap();
         for k in 0..5 {
             assert!((f.coeffs[k] - coeffs[k]).abs() < 1e-9 * (1.0 + coeffs[k]), "{k}: {:?}", f.coeffs);
@@ -734,7 +896,7 @@ mod tests {
         assert_eq!(field(AllanStream::new(&[4, 1 << 62], 1.0, DataType::Rate).unwrap_err()), "m");
         assert_eq!(field(AllanStream::new(&[usize::MAX / 4], 1.0, DataType::Rate).unwrap_err()), "m");
         assert_eq!(field(edf(Kind::Modified, NoiseType::WhiteFm, 64, &[1, 0]).unwrap_err()), "m");
-        let r = AllanResult { m: vec![1, 0], tau: vec![1.0, 2.0], var: vec![1.0, 0.5], n: vec![0, 0] };
+        let r = AllanResult { m: vec![1, 0], tau: vec![1.0, 2.0], var: vec![1.0, 0.5], n: vec![0, 0], missing: 0 };
         assert_eq!(field(fit(&r, 100, [true; 5], 0.0, 10.0).unwrap_err()), "m");
         assert_eq!(field(fit(&AllanResult { m: vec![1], ..r }, 100, [true; 5], 0.0, 10.0).unwrap_err()), "var");
     }

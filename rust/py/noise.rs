@@ -12,14 +12,14 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
 type Arr<'py> = Bound<'py, PyArray1<f64>>;
-type AllanArrays<'py> = (Bound<'py, PyArray1<usize>>, Arr<'py>, Arr<'py>, Bound<'py, PyArray1<usize>>);
+type AllanArrays<'py> = (Bound<'py, PyArray1<usize>>, Arr<'py>, Arr<'py>, Bound<'py, PyArray1<usize>>, usize);
 
 fn result_to_py<'py>(py: Python<'py>, r: AllanResult) -> AllanArrays<'py> {
-    (r.m.into_pyarray(py), r.tau.into_pyarray(py), r.var.into_pyarray(py), r.n.into_pyarray(py))
+    (r.m.into_pyarray(py), r.tau.into_pyarray(py), r.var.into_pyarray(py), r.n.into_pyarray(py), r.missing)
 }
 
 /// Allan-family variance at the named τ grid `set`, or at the factors `m` when given:
-/// returns (m, tau_s, var, n_terms).
+/// returns (m, tau_s, var, n_terms, missing samples).
 #[pyfunction]
 #[pyo3(signature = (data, tau0, data_type=Wrap(DataType::Rate), kind=Wrap(Kind::Allan), set=Wrap(TauGrid::Octave), m=None))]
 fn allan_var<'py>(
@@ -63,7 +63,7 @@ fn allan_fit<'py>(
 ) -> PyResult<Bound<'py, PyDict>> {
     let m = counts(m, "m", 1, usize::MAX)?;
     let n = vec![0; m.len()];
-    let res = AllanResult { m, tau: vector(&tau, "tau")?, var: vector(&var, "var")?, n };
+    let res = AllanResult { m, tau: vector(&tau, "tau")?, var: vector(&var, "var")?, n, missing: 0 };
     let f = allan::fit(&res, index_count(n_samples, "n_samples", 1, usize::MAX)?, flags(terms, "terms")?, tau_min, tau_max)?;
     let d = PyDict::new(py);
     d.set_item("coeffs", f.coeffs.to_vec())?;
@@ -102,7 +102,7 @@ impl PyAllanStream {
     }
 
     fn result<'py>(&self, py: Python<'py>, kind: Wrap<Kind>) -> PyResult<AllanArrays<'py>> {
-        Ok(result_to_py(py, self.0.result(kind.0)))
+        Ok(result_to_py(py, self.0.result(kind.0)?))
     }
 }
 

@@ -14,6 +14,7 @@ import numpy as np
 import pandas as pd
 
 from .. import _core, units
+from .._stateful import Stateful, serialized
 from .._validate import as_floats, finite_result, flag, input_error, instance, integer, positive, probability, renamed, scalar, table as read_table, vector
 
 #: Option names, listed (and checked) by the Rust core.
@@ -53,14 +54,16 @@ def _m_list(m, taus, tau0: float):
     return None if isinstance(m, str) else m
 
 
-def _table(m, tau, var, n, kind: str, n_phase: int, noise: str, confidence: float) -> pd.DataFrame:
+def _table(m, tau, var, n, missing: int, kind: str, n_phase: int, noise: str, confidence: float) -> pd.DataFrame:
     from scipy.stats import chi2
 
     edf = _core.allan_edf(kind, noise, n_phase, m.tolist())
     alpha = 1.0 - confidence
     lo = var * edf / chi2.ppf(1.0 - alpha / 2.0, edf)
     hi = var * edf / chi2.ppf(alpha / 2.0, edf)
-    return pd.DataFrame({"m": m, "tau_s": tau, "var": var, "dev": np.sqrt(var), "n_terms": n, "edf": edf, "dev_lo": np.sqrt(lo), "dev_hi": np.sqrt(hi)})
+    table = pd.DataFrame({"m": m, "tau_s": tau, "var": var, "dev": np.sqrt(var), "n_terms": n, "edf": edf, "dev_lo": np.sqrt(lo), "dev_hi": np.sqrt(hi)})
+    table.attrs["n_missing"] = int(missing)
+    return table
 
 
 def allan_variance(data, tau0: float, m="octave", kind: str = "allan", data_type: str = "rate", taus=None, noise: str = "white_fm", confidence: float = 0.683) -> pd.DataFrame:
@@ -75,24 +78,45 @@ def allan_variance(data, tau0: float, m="octave", kind: str = "allan", data_type
     ``data_type="phase"``: data are the integral of the rate (e.g. angle in rad), the
     variance is then of the rate (rad/s)².
 
+    **Gaps.** A NaN rate sample is missing (a gap is marked, not filled: Riley, NIST
+    SP 1065, "Gaps, jumps, and outliers"). Every term of the sum whose rate samples
+    include a NaN is left out and the variance is the mean of the others, the rule of
+    allantools' gap-resistant ``gradev``: a term spans 2m rate samples for the Allan,
+    3m − 1 for the modified and 3m for the Hadamard variance, so the result is the terms
+    of each gap-free stretch pooled. Leading and trailing NaN are trimmed, as allantools
+    does (for a record without interior NaN the result equals allantools' ``oadev``,
+    ``mdev`` and ``ohdev``; with interior NaN those return NaN). ``n_terms`` counts the
+    terms used, and ``table.attrs["n_missing"]`` the NaN samples. NaN in phase data, and
+    ±inf anywhere, raise :class:`atomnav.InputError`. A constant series (a stuck or
+    quantised sensor) has variance 0 at every τ.
+
     Columns: ``m``, ``tau_s``, ``var`` (rate unit²), ``dev``, ``n_terms``, ``edf``
     (equivalent degrees of freedom: Howe's approximation for the overlapping Allan
     variance with the given ``noise`` type; the conservative non-overlapping count for
-    modified and Hadamard), and the χ² confidence interval ``dev_lo``, ``dev_hi`` at
-    ``confidence``.
+    modified and Hadamard; with gaps, that of a gap-free record of the same number of
+    samples), and the χ² confidence interval ``dev_lo``, ``dev_hi`` at ``confidence``.
     """
     tau0 = positive(tau0, "tau0")
     confidence = probability(confidence, "confidence")
     x = _series(data, "data", check_finite=False)
     ms = _m_list(m, taus, tau0)
-    mm, tau, var, n = _core.allan_var(x, tau0, data_type, kind, **({"set": m} if ms is None else {"m": ms}))
-    n_phase = x.size + 1 if data_type == "rate" else x.size
-    return _table(mm, tau, var, n, kind, n_phase, noise, confidence)
+    mm, tau, var, n, missing = _core.allan_var(x, tau0, data_type, kind, **({"set": m} if ms is None else {"m": ms}))
+    return _table(mm, tau, var, n, missing, kind, _phase_points(x.size - missing, data_type), noise, confidence)
 
 
-class AllanStream:
+def _phase_points(samples: int, data_type: str) -> int:
+    """Phase points of a gap-free record of ``samples`` samples (rate: one more)."""
+    return samples + 1 if data_type == "rate" else samples
+
+
+class AllanStream(Stateful):
     """Streaming Allan, modified Allan and Hadamard variance at fixed averaging factors,
     for records that do not fit in memory (memory: 3·max(m)+1 samples).
+
+    The stream gives what :func:`allan_variance` gives for the samples fed so far, NaN
+    rate samples (gaps) included; :meth:`result` raises :class:`atomnav.InputError`
+    naming ``m`` while a factor has fewer than two terms, as the batch does. One object
+    may be shared by threads (calls run one after another) and pickled mid-record.
 
     >>> s = AllanStream([1, 2, 4], tau0=1.0)
     >>> for chunk in chunks: s.update(chunk)
@@ -110,17 +134,21 @@ class AllanStream:
         self._s = _core.AllanStream(ms, self.tau0, self.data_type)
         self.n_samples = 0
 
+    @serialized
     def update(self, chunk) -> None:
-        """Add the next samples (same units as construction)."""
-        c = _series(chunk, "chunk")
+        """Add the next samples (same units as construction; NaN marks a missing rate
+        sample)."""
+        c = _series(chunk, "chunk", check_finite=False)
         self._s.update(c)
         self.n_samples += c.size
 
+    @serialized
     def result(self, kind: str = "allan") -> pd.DataFrame:
-        """The table of :func:`allan_variance` for the samples seen so far."""
-        mm, tau, var, n = self._s.result(kind)
-        n_phase = self.n_samples + 1 if self.data_type == "rate" else self.n_samples
-        return _table(mm, tau, var, n, kind, n_phase, self.noise, self.confidence)
+        """The table of :func:`allan_variance` for the samples seen so far (an
+        :class:`atomnav.InputError` naming ``m`` and the samples it needs while a factor
+        has fewer than two terms)."""
+        mm, tau, var, n, missing = self._s.result(kind)
+        return _table(mm, tau, var, n, missing, kind, _phase_points(self.n_samples - missing, self.data_type), self.noise, self.confidence)
 
 
 @dataclass(kw_only=True)
