@@ -3,7 +3,8 @@ declared SI unit, because they were given in another unit (g for m/s², °/s for
 for s, degrees for rad, nm for m, % for a fraction).
 
 Such a value passes every range check and gives a wrong answer without a word (an IMU
-table in g instead of m/s² integrates to a height error of −245 m after 10 s), so each
+table in g instead of m/s² at rest integrates to a height error of ½(9.8 − 1) m/s² × (10 s)²
+= −440 m after 10 s), so each
 check below raises a :class:`UnitWarning` naming the argument, the likely unit and the
 factor that converts it to SI. The warning goes through the standard :mod:`warnings`
 machinery and points at the user's line (the first frame outside atomnav)::
@@ -13,8 +14,9 @@ machinery and points at the user's line (the first frame outside atomnav)::
     warnings.simplefilter("error", atomnav.UnitWarning)    # make it an exception
 
 Every threshold is a constant of this module, with the reason for its value. The checks
-read cheap statistics computed once per call (a median time step, a mean or a spread over
-at most :data:`SAMPLE_ROWS` evenly spaced rows, a maximum over the array); non-finite
+read cheap statistics computed once per call (the median of the first :data:`STEP_ROWS`
+time steps, a mean or a spread over at most :data:`SAMPLE_ROWS` evenly spaced rows, a
+maximum over the array); non-finite
 values are left to the input checks, which reject them. A value is flagged only when it
 is beyond its SI limit and, multiplied by the factor, within it (a T of 100 is 100 ms; a T
 of 1e300 is no plausible time in any unit, and is left to the input checks).
@@ -90,9 +92,13 @@ MAX_FRACTION: float = 1.0
 #: percentage.
 MAX_POPULATION: float = 1.5
 
-#: Statistics of long records (means, spreads, median steps) are read from at most this
-#: many evenly spaced rows, so a check costs the same on any record length.
-SAMPLE_ROWS: int = 100_000
+#: Statistics of long records (means, spreads) are read from at most this many evenly
+#: spaced rows, so a check costs the same on any record length.
+SAMPLE_ROWS: int = 10_000
+
+#: The sample interval of a record is the median of its first this many time steps (10 s
+#: at 100 Hz: any gap or jitter is outvoted).
+STEP_ROWS: int = 1_000
 
 _DEG = units.DEG
 _MS = 1e-3
@@ -123,7 +129,8 @@ class UnitWarning(UserWarning):
 
 def _warn(parameter: str, quantity: str, unit: str | None, si: str, evidence: str, factor: float) -> None:
     """Warn that ``quantity`` of argument ``parameter`` is likely in ``unit`` rather than
-    ``si`` (or, with no ``unit``, contradicts ``si``), shown at the first frame outside atomnav (the user's line)."""
+    ``si`` (or, with no ``unit``, contradicts ``si``), shown at the first frame outside
+    atomnav (the user's line)."""
     frame, level = sys._getframe(0), 1
     while frame is not None and frame.f_code.co_filename.startswith(_PACKAGE):
         frame, level = frame.f_back, level + 1
@@ -140,10 +147,13 @@ def _floats(x) -> np.ndarray:
         return np.empty(0)
 
 
-def _sample(a) -> np.ndarray:
-    """At most :data:`SAMPLE_ROWS` evenly spaced rows of ``a`` as floats."""
+def _columns(a) -> np.ndarray:
+    """The columns (3, n) of at most :data:`SAMPLE_ROWS` evenly spaced rows of an (N, 3)
+    array ``a``, each contiguous (empty if ``a`` is not such an array of numbers)."""
     a = _floats(a)
-    return a[:: max(1, len(a) // SAMPLE_ROWS)] if a.ndim else a
+    if a.ndim != 2 or a.shape[1] != 3 or not len(a):
+        return np.empty((3, 0))
+    return np.ascontiguousarray(a[:: max(1, len(a) // SAMPLE_ROWS)].T)
 
 
 def _max_abs(a) -> float:
@@ -162,9 +172,9 @@ def _value(x) -> float:
 
 
 def _median_step(t: np.ndarray) -> float:
-    """Median time step (s) of the first :data:`SAMPLE_ROWS` steps of ``t`` (NaN for fewer
+    """Median time step (s) of the first :data:`STEP_ROWS` steps of ``t`` (NaN for fewer
     than two samples or non-finite stamps)."""
-    t = _floats(t).reshape(-1)[: SAMPLE_ROWS + 1]
+    t = _floats(t).reshape(-1)[: STEP_ROWS + 1]
     if len(t) < 2:
         return np.nan
     with np.errstate(all="ignore"):
@@ -185,11 +195,11 @@ def _near(value: float, target: float, tolerance: float) -> bool:
 def specific_force(f: np.ndarray, name: str, scale: float = 1.0) -> None:
     """Warn if the specific force ``f`` (N, 3) times ``scale`` (1 for m/s², 1/Δt for Δv
     in m/s) has a mean magnitude in :data:`ACCEL_G_BAND`: the record is in g."""
-    s = _sample(f)
-    if s.ndim != 2 or s.size == 0:
+    x, y, z = _columns(f)
+    if not len(x):
         return
     with np.errstate(all="ignore"):
-        mean = float(np.sqrt((s * s).sum(axis=1)).mean()) * scale
+        mean = float(np.sqrt(x * x + y * y + z * z).mean()) * _value(scale)
     if ACCEL_G_BAND[0] <= mean <= ACCEL_G_BAND[1]:
         _warn(name, "specific force", "g", "m/s²", f"mean |f| = {mean:.3g}, Earth's gravity is 9.8 m/s²", units.G0)
 
@@ -198,28 +208,41 @@ def angular_rate(w, name: str, scale: float = 1.0, *, static: bool = False):
     """Warn if an angular rate ``w`` (rad/s; times ``scale``, 1/Δt for Δθ in rad) exceeds
     :data:`MAX_ANGULAR_RATE` anywhere or, with ``static`` (a full IMU record that may be
     at rest), if it is static with a mean of 57.3 × Earth rate: it is in °/s. Returns ``w``."""
+    scale = _value(scale)
     peak = _max_abs(w) * scale
     if _converts(peak, MAX_ANGULAR_RATE, _DEG):
         _warn(name, "angular rate", "deg/s", "rad/s", f"max |ω| = {peak:.4g}, beyond {MAX_ANGULAR_RATE} rad/s", _DEG)
-    elif static and (s := _sample(w)).ndim == 2 and len(s):
+    elif static is True and (s := _columns(w)).size:
         with np.errstate(all="ignore"):
-            mean = s.mean(axis=0) * scale
-            variance = float(s.var(axis=0).sum())
-            noise = float((np.diff(s, axis=0) ** 2).mean(axis=0).sum()) / 2 if len(s) > 1 else 0.0
-        norm = float(np.sqrt(mean @ mean))
-        if variance <= STATIC_VARIANCE_RATIO * noise and _near(norm, EARTH_RATE / _DEG, EARTH_RATE_TOLERANCE):
+            mean = s.mean(axis=1)
+            norm = float(np.sqrt(mean @ mean)) * scale
+        if _near(norm, EARTH_RATE / _DEG, EARTH_RATE_TOLERANCE) and _static(s, mean):
             _warn(name, "angular rate", "deg/s", "rad/s",
                   f"static mean |ω| = {norm:.4g}, Earth rate is {EARTH_RATE:.4g} rad/s = {EARTH_RATE / _DEG:.4g} °/s", _DEG)
     return w
 
 
+def _static(s: np.ndarray, mean: np.ndarray) -> bool:
+    """Rates ``s`` (3, n) with means ``mean`` (3,) vary about them by no more than
+    :data:`STATIC_VARIANCE_RATIO` times their white noise (or by rounding only)."""
+    with np.errstate(all="ignore"):
+        variance = float(s.var(axis=1).sum())
+        noise = float((np.diff(s, axis=1) ** 2).mean(axis=1).sum()) / 2 if s.shape[1] > 1 else 0.0
+    rounding = float(1e-9**2 * (mean @ mean))  # a noise-free constant rate varies by its rounding only
+    return variance <= STATIC_VARIANCE_RATIO * noise + rounding
+
+
 def time_steps(t, name: str):
     """Warn if the median step of the IMU time stamps ``t`` (s) exceeds
     :data:`MAX_IMU_STEP`: they are in ms. Returns ``t``."""
-    step = _median_step(t)
+    _step(_median_step(t), name)
+    return t
+
+
+def _step(step: float, name: str) -> None:
+    """:func:`time_steps` of a median step ``step`` (s)."""
     if _converts(step, MAX_IMU_STEP, _MS):
         _warn(name, "time stamps", "ms", "s", f"median step {step:.4g}, an IMU samples at least every {MAX_IMU_STEP} s", _MS)
-    return t
 
 
 def sample_interval(dt, name: str):
@@ -230,11 +253,10 @@ def sample_interval(dt, name: str):
     return dt
 
 
-def _stated_interval(t, dt: float, name: str, dt_name: str) -> None:
-    """Warn if the stated interval ``dt`` (argument ``dt_name``) and the median step of the
-    time stamps ``t`` (argument ``name``) differ by more than :data:`STEP_TOLERANCE`,
-    naming the one in ms when they differ by a factor 1000."""
-    step = _median_step(t)
+def _stated_interval(step: float, dt: float, name: str, dt_name: str) -> None:
+    """Warn if the stated interval ``dt`` (argument ``dt_name``) and the median ``step`` of
+    the time stamps (argument ``name``) differ by more than :data:`STEP_TOLERANCE`, naming
+    the one in ms when they differ by a factor 1000."""
     if not (np.isfinite(step) and step > 0 and np.isfinite(dt) and dt > 0):
         return
     ratio = step / dt
@@ -253,15 +275,17 @@ def imu(time, gyro, accel, kind: str, name: str = "imu", *, gyro_name: str | Non
     sample interval). ``name`` is the argument holding the record (and its accelerations),
     ``gyro_name`` the one holding the gyro if it differs; ``dt`` the stated sample interval
     (s), compared with the time stamps when both are given."""
-    gyro_name = gyro_name or name
-    if time is not None and dt is not None:
-        _stated_interval(time, dt, name, "dt")
-    elif time is not None:
-        time_steps(time, name)
-    if kind == "rates":
+    gyro_name = name if gyro_name is None else gyro_name
+    step = np.nan if time is None else _median_step(time)
+    if dt is not None:
+        dt = _value(dt)
+        _stated_interval(step, dt, name, "dt")
+        step = dt
+    else:
+        _step(step, name)
+    if isinstance(kind, str) and kind == "rates":
         scale = 1.0
     else:
-        step = dt if dt is not None else _median_step(time) if time is not None else np.nan
         if not (np.isfinite(step) and step > 0):
             return  # no interval to turn increments into rates
         scale = 1.0 / step
@@ -300,8 +324,9 @@ def pulse_separation(T, name: str, pulses: float = 1.0):
     """Warn if an interferometer time ``T`` (s), spanning ``pulses`` pulse separations (2
     for a total interrogation time 2T), exceeds ``pulses`` × :data:`MAX_PULSE_SEPARATION`:
     it is in ms. Returns ``T``."""
-    if _converts(_value(T), pulses * MAX_PULSE_SEPARATION, _MS):
-        _warn(name, "pulse timing", "ms", "s", f"{_value(T):.4g} s, beyond {pulses * MAX_PULSE_SEPARATION:g} s", _MS)
+    limit = _value(pulses) * MAX_PULSE_SEPARATION
+    if _converts(_value(T), limit, _MS):
+        _warn(name, "pulse timing", "ms", "s", f"{_value(T):.4g} s, beyond {limit:g} s", _MS)
     return T
 
 
