@@ -50,12 +50,13 @@ impl Choice for GyroErrorMode {
 
 /// Gyro error budget of E1: σ_φG misalignment (rad), σ_kG scale factor (–), σ_wG angle
 /// random walk (rad/√s), σ_bG bias (rad/s).
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct GyroErrorModel {
     pub sigma_phi: f64,
     pub sigma_k: f64,
     pub sigma_w: f64,
     pub sigma_b: f64,
+    #[serde(with = "crate::options::by_name")]
     pub mode: GyroErrorMode,
 }
 

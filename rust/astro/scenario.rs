@@ -23,7 +23,7 @@ use rand_distr::StandardNormal;
 const T_SWAP: Mat3 = Mat3::new(0.0, 1.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, -1.0);
 
 /// Everything fixed across Monte-Carlo runs: truth and sensor configuration.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
 pub struct Scenario {
     /// Camera epochs t_En (s) and the IMU record (t_start, period T, true increments ρ̆ in MF).
     pub epochs: Vec<f64>,

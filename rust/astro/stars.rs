@@ -54,7 +54,7 @@ impl Xoshiro256 {
 }
 
 /// Star catalog: GCRS unit vectors (aberration already applied), magnitudes, identifiers.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
 pub struct Catalog {
     pub dirs: Vec<Vec3>,
     pub mags: Vec<f64>,
@@ -185,7 +185,7 @@ pub fn aberration(s: &Vec3, v: &Vec3) -> Vec3 {
 
 /// A rigid camera of the set: C_VF^CFⁱ (maps camera into VF) and the covariance P_aⁱ of
 /// its Euler angles αⁱ (rad², zero for camera 1 which defines VF).
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug, Clone, Copy, serde::Serialize, serde::Deserialize)]
 pub struct Camera {
     pub c_vf_cf: Mat3,
     pub p_alpha: Mat3,

@@ -40,7 +40,7 @@ pub const LEVER_BLOCK: &str = "cai_lever_arm";
 pub const FORCE_BLOCK: &str = "cai_force";
 
 /// Where the populations come from.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 pub enum CaiData {
     /// Emulated instrument: the true phase (rad) and the population noise of every shot and
     /// channel (row-major, shots × channels); the population is formed inside the loop with
@@ -102,7 +102,7 @@ impl Choice for ForceKind {
 }
 
 /// How the CAI corrects the IMU (Tennstedt et al. 2021, Eq. 11).
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub enum ForceMode {
     /// Option b (default): the readout observes the accelerometer (and gyro) bias states.
     Bias,
@@ -131,7 +131,7 @@ impl ForceMode {
 }
 
 /// Configuration of the CAI aiding.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 pub struct CaiConfig {
     /// Interferometer channels (nominal lever arm and C_sb).
     pub channels: Vec<Channel>,
@@ -148,6 +148,7 @@ pub struct CaiConfig {
     /// (Tennstedt et al. 2021, §2.4); None = no inflation.
     pub inflation: Option<(f64, f64)>,
     pub omega_dot: OmegaDot,
+    #[serde(with = "crate::options::by_name")]
     pub interpolation: Interpolation,
     pub substeps: usize,
     /// Keep the Euler terms in the Jacobian (Tennstedt et al. 2023, Eq. 31; default false).
@@ -158,11 +159,12 @@ pub struct CaiConfig {
     pub lever_arm: Option<f64>,
     pub force: ForceMode,
     /// Kind of the IMU record the engine runs on (increments become interval-mean rates).
+    #[serde(with = "crate::options::by_name")]
     pub kind: ImuKind,
 }
 
 /// Per shot and channel, what the instrument and the filter saw.
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Debug, Default, serde::Serialize, serde::Deserialize)]
 pub struct ShotLog {
     /// Predicted phase at the filter's best estimate (rad).
     pub predicted: Vec<f64>,
@@ -174,6 +176,7 @@ pub struct ShotLog {
 }
 
 /// The CAI as an `Aiding` of the engine.
+#[derive(serde::Serialize, serde::Deserialize)]
 pub struct CaiAiding {
     cfg: CaiConfig,
     data: CaiData,
@@ -478,6 +481,7 @@ impl CaiAiding {
     }
 }
 
+#[typetag::serde]
 impl Aiding for CaiAiding {
     fn name(&self) -> &str {
         "cai"

@@ -106,7 +106,7 @@ impl HybridConfig {
 }
 
 /// How the instrument's true phase is produced.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 pub enum PhaseSource {
     /// A perfect CAI on the true motion: the predictor applied to the ideal IMU sampled
     /// `oversample` times faster than the navigation IMU, with the exact ω̇ and cubic
@@ -120,7 +120,9 @@ pub enum PhaseSource {
 }
 
 /// Everything a run needs; built once, shared by all runs.
+#[derive(serde::Serialize, serde::Deserialize)]
 pub struct HybridScenario {
+    #[serde(with = "crate::options::by_name")]
     pub ell: Ellipsoid,
     /// IMU sample times (s) and the truth at each.
     pub t: Vec<f64>,

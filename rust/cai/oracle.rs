@@ -25,7 +25,7 @@ pub trait BodyMotion {
 }
 
 /// One scalar signal c0 + c1 t + c2 t² + Σ A sin(2π f t + φ).
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Debug, Default, serde::Serialize, serde::Deserialize)]
 pub struct Signal {
     pub poly: [f64; 3],
     /// (amplitude, frequency Hz, phase rad)
@@ -61,7 +61,7 @@ impl Signal {
 
 /// Position per inertial axis and attitude as z-y-x Euler angles (roll, pitch, yaw), each
 /// a [`Signal`]: C_ib = Rz(yaw) Ry(pitch) Rx(roll).
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Debug, Default, serde::Serialize, serde::Deserialize)]
 pub struct SineMotion {
     pub position: [Signal; 3],
     pub euler: [Signal; 3],
@@ -133,7 +133,7 @@ impl YawDrive {
 
 /// Seed-003 Fig. 7 drive (spec §2.8 `fig7_yaw_sine`): constant forward speed V along the
 /// body x axis, level, yaw rate ω_z = A sin(2πt/P), yaw ψ = A P/(2π)(1 − cos(2πt/P)).
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 pub struct YawDrive {
     pub speed: f64,
     pub yaw_rate_amplitude: f64,
@@ -191,8 +191,41 @@ impl BodyMotion for YawDrive {
     }
 }
 
+/// One of the analytic motions above, as a value that can be saved (pickle of
+/// `atomnav.cai` motions). The set is closed: a new motion needs its exact derivatives
+/// here anyway, and adds a variant.
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
+pub enum AnalyticMotion {
+    Sine(Box<SineMotion>),
+    YawDrive(YawDrive),
+}
+
+impl AnalyticMotion {
+    fn motion(&self) -> &dyn BodyMotion {
+        match self {
+            AnalyticMotion::Sine(m) => m.as_ref(),
+            AnalyticMotion::YawDrive(m) => m,
+        }
+    }
+}
+
+impl BodyMotion for AnalyticMotion {
+    fn attitude(&self, t: f64) -> (Mat3, Vec3, Vec3) {
+        self.motion().attitude(t)
+    }
+    fn velocity(&self, t: f64) -> Vec3 {
+        self.motion().velocity(t)
+    }
+    fn acceleration(&self, t: f64) -> Vec3 {
+        self.motion().acceleration(t)
+    }
+    fn displacement(&self, t0: f64, t1: f64) -> Vec3 {
+        self.motion().displacement(t0, t1)
+    }
+}
+
 /// Gravity field g(r) = g0 + Γ (r − r_ref), r_ref = IMU position at `t_ref`.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 pub struct Gravity {
     pub g0: Vec3,
     pub gradient: Option<Mat3>,

@@ -25,7 +25,7 @@ use crate::options::Choice;
 /// One interferometer channel: effective wave vector k (rad/m, in s), lever arm l from the
 /// IMU to the release point (m, in b), C_sb (rotation b → s, may carry misalignment) and
 /// the initial atom velocity v0 relative to s (m/s, in s).
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Channel {
     pub k: Vec3,
     pub lever: Vec3,
@@ -34,7 +34,7 @@ pub struct Channel {
 }
 
 /// Source of the angular acceleration ω̇_b used in the Euler terms (spec §2.2).
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub enum OmegaDot {
     /// Euler terms omitted (ω̇ ≡ 0).
     Zero,
@@ -150,7 +150,7 @@ pub fn channels_from_rows(k: &[Vec3], lever: &[Vec3], c_sb: &[nalgebra::DMatrix<
 }
 
 /// Settings shared by all shots of a record.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 pub struct PredictorConfig {
     /// Pulse separation T (s).
     pub t_sep: f64,
@@ -163,6 +163,7 @@ pub struct PredictorConfig {
     /// Estimated gyro bias (rad/s) subtracted from the angular rate.
     pub bias_g: Vec3,
     pub omega_dot: OmegaDot,
+    #[serde(with = "crate::options::by_name")]
     pub interpolation: Interpolation,
 }
 

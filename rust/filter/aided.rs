@@ -57,6 +57,11 @@ pub struct AidingContext<'a> {
 }
 
 /// An aiding sensor's measurement model.
+///
+/// Each implementation is saved and restored by its type name (`#[typetag::serde]` on
+/// the `impl`, with serde derives on the sensor), so an aided INS pickles whole, its
+/// sensor included.
+#[typetag::serde]
 pub trait Aiding: Send {
     /// Field name used in error messages about the measurements (e.g. "fixes").
     fn name(&self) -> &str {
@@ -104,13 +109,20 @@ impl Aiding for Box<dyn Aiding> {
     fn propagate_extra(&self, layout: &Layout, dt: f64, extra: &mut [f64]) {
         (**self).propagate_extra(layout, dt, extra)
     }
+    // what #[typetag::serde] adds to an impl: the boxed sensor is saved under its own name
+    fn typetag_name(&self) -> &'static str {
+        (**self).typetag_name()
+    }
+    fn typetag_deserialize(&self) {}
 }
 
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct AidedConfig {
     pub noise: InsNoise,
     pub predict_every: usize,
+    #[serde(with = "crate::options::by_name")]
     pub method: Discretization,
+    #[serde(with = "crate::options::by_name")]
     pub mode: LoopMode,
     pub sequential: bool,
     pub gate: Option<f64>,
@@ -145,7 +157,7 @@ pub fn ned_diff(ell: &Ellipsoid, a: &Vec3, b: &Vec3) -> Vec3 {
 
 /// Start index of every INS block in the layout, and the number of INS states (the
 /// index of the first extra block); read once from the layout.
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug, Clone, Copy, serde::Serialize, serde::Deserialize)]
 struct InsIndex {
     position: usize,
     velocity: usize,
@@ -180,7 +192,7 @@ fn block(x: &DVector<f64>, start: usize) -> Vec3 {
 
 /// The baro loop of a damped vertical channel: damping ratio ζ, natural frequency ω_v
 /// (rad/s) and the error model of the reference altitude.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct DampedVertical {
     pub zeta: f64,
     pub omega: f64,
@@ -190,10 +202,12 @@ pub struct DampedVertical {
 /// The INS part every aided-INS run shares (initial state, IMU kind, Earth model, initial
 /// bias estimates, P₀, noise and filter options, vertical channel), checked once by
 /// [`InsSetup::new`]; a sensor adds its measurement model ([`AidedIns::from_setup`]).
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct InsSetup {
     pub initial: NavState,
+    #[serde(with = "crate::options::by_name")]
     pub kind: ImuKind,
+    #[serde(with = "crate::options::by_name")]
     pub ell: Ellipsoid,
     pub accel_bias0: Vec3,
     pub gyro_bias0: Vec3,
@@ -255,10 +269,13 @@ fn check_config(cfg: &AidedConfig) -> Result<()> {
     Ok(())
 }
 
+/// The whole run state derives serde (pickle of `atomnav.filter.AidedIns` mid-record).
+#[derive(serde::Serialize, serde::Deserialize)]
 pub struct AidedIns<A: Aiding> {
     sd: Strapdown,
     kf: Kf,
     layout: Layout,
+    #[serde(with = "crate::options::by_name")]
     ell: Ellipsoid,
     cfg: AidedConfig,
     aiding: A,
@@ -574,7 +591,7 @@ pub fn run_aided<A: Aiding>(mut ins: AidedIns<A>, t: &[f64], gyro: &[Vec3], acce
 }
 
 /// A position fix: time (s), (lat rad, lon rad, h m) and its NED covariance (m²).
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug, Clone, Copy, serde::Serialize, serde::Deserialize)]
 pub struct PositionFix {
     pub t: f64,
     pub lla: Vec3,
@@ -582,6 +599,7 @@ pub struct PositionFix {
 }
 
 /// Position fixes as an aiding sensor: z = NED(INS − fix), H = [I 0 ...].
+#[derive(serde::Serialize, serde::Deserialize)]
 pub struct PositionAiding {
     times: Vec<f64>,
     fixes: Vec<PositionFix>,
@@ -613,6 +631,7 @@ impl PositionAiding {
     }
 }
 
+#[typetag::serde]
 impl Aiding for PositionAiding {
     fn name(&self) -> &str {
         "fixes"
@@ -690,8 +709,10 @@ mod tests {
 
     /// No measurements, one extra block (bias, drift) with ḃ = drift: the nominal bias
     /// follows the drift through the `propagate_extra` hook, in both loop modes.
+    #[derive(serde::Serialize, serde::Deserialize)]
     struct Drift;
 
+    #[typetag::serde]
     impl Aiding for Drift {
         fn extra_blocks(&self) -> Vec<(String, usize)> {
             vec![("clk".to_string(), 2)]

@@ -26,7 +26,7 @@ use rayon::prelude::*;
 /// the two differ by no more than their scatter at 150.
 pub const ANALYSIS_FAER_MIN: usize = 56;
 
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
 pub struct Scenario {
     /// Filter transition and process noise per step (k → k+1).
     phi: Vec<DMatrix<f64>>,

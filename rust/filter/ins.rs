@@ -13,7 +13,7 @@ use crate::strapdown::NavState;
 use nalgebra::DMatrix;
 
 /// A bias process per axis (spec gnss-ins-tight Eq. 28 "F_bb"; atom-strapdown E23).
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub enum BiasModel {
     /// ḃ = 0.
     RandomConstant,
@@ -74,7 +74,7 @@ impl BiasModel {
 
 /// Noise of the 15-state model: white accelerometer/gyro noise PSD (VRW² in (m/s²)²/Hz,
 /// ARW² in rad²/s) and the two bias processes.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct InsNoise {
     pub accel_psd: f64,
     pub gyro_psd: f64,
@@ -187,7 +187,7 @@ pub fn baro_gains(ell: &Ellipsoid, lat: f64, h: f64, zeta: f64, omega: f64) -> (
 /// short against the loop's 1/ω_v) and, when `bias` is given, a bias b carried as the
 /// one-component state `baro_bias` (m; δb = b̂ − b, the engine compensates h_b − b̂) with
 /// its process and initial σ (m). Without `bias` the filter assumes b = 0.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct BaroModel {
     pub noise_psd: f64,
     pub bias: Option<(BiasModel, f64)>,

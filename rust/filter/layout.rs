@@ -34,7 +34,7 @@ pub fn ins_size() -> usize {
     INS15.iter().filter_map(|b| standard_size(b)).sum()
 }
 
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Layout {
     blocks: Vec<(String, Range<usize>)>,
 }

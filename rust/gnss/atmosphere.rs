@@ -5,7 +5,7 @@ use super::{C_LIGHT, GPS_L1_HZ};
 use std::f64::consts::PI;
 
 /// Broadcast Klobuchar coefficients α (s/semicircleⁿ) and β (s/semicircleⁿ).
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Klobuchar {
     pub alpha: [f64; 4],
     pub beta: [f64; 4],

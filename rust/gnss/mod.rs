@@ -27,14 +27,14 @@ pub const GPS_L1_HZ: f64 = 1575.42e6;
 /// Earth rotation rate of the GPS ICD (rad/s), used for the Sagnac rotation of both systems.
 pub const OMEGA_E_GPS: f64 = 7.2921151467e-5;
 
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, serde::Serialize, serde::Deserialize)]
 pub enum System {
     Gps,
     Glonass,
 }
 
 /// A satellite: system and PRN (GPS) or orbital slot (GLONASS), 1-based.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, serde::Serialize, serde::Deserialize)]
 pub struct SatId {
     pub system: System,
     pub prn: u8,

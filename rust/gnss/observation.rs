@@ -16,7 +16,7 @@ use rand_distr::StandardNormal;
 use std::collections::HashSet;
 
 /// One satellite's measurements at one epoch. GLONASS code has c·ΔT_leap removed (Eq. 15).
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Observation {
     pub sat: SatId,
     /// FDMA channel (GLONASS), 0 for GPS.
@@ -28,7 +28,7 @@ pub struct Observation {
 }
 
 /// The atmosphere models applied (both in simulation and in correction).
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Atmosphere {
     pub iono: Option<Klobuchar>,
     pub tropo: bool,

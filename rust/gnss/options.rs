@@ -11,7 +11,7 @@ use crate::error::{invalid, Result};
 use crate::imu::ImuKind;
 use crate::math::Vec3;
 
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct GnssOptions {
     /// Code σ (m) of GPS and GLONASS, pseudorange-rate σ (m/s).
     pub sigma_code_gps: f64,
@@ -25,6 +25,7 @@ pub struct GnssOptions {
     pub elevation_weight: bool,
     /// Tight coupling: measurement formulation, IMU → antenna lever arm (body, m), use the
     /// pseudorange rates.
+    #[serde(with = "crate::options::by_name")]
     pub formulation: Formulation,
     pub lever_arm: Vec3,
     pub use_rate: bool,

@@ -35,8 +35,9 @@ impl crate::options::Choice for Formulation {
     const CHOICES: &'static [(&'static str, Self)] = &[("first_difference", Formulation::FirstDifference), ("clock_states", Formulation::ClockStates)];
 }
 
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug, Clone, Copy, serde::Serialize, serde::Deserialize)]
 pub struct TightConfig {
+    #[serde(with = "crate::options::by_name")]
     pub formulation: Formulation,
     /// IMU → antenna lever arm in the body frame (m).
     pub lever_arm: Vec3,
@@ -51,9 +52,11 @@ pub struct TightConfig {
     pub clock_h0: f64,
     pub clock_hm2: f64,
     /// IMU record kind: the gyro sample gives the body rate for the lever-arm velocity.
+    #[serde(with = "crate::options::by_name")]
     pub kind: ImuKind,
 }
 
+#[derive(serde::Serialize, serde::Deserialize)]
 pub struct TightAiding {
     eph: Ephemerides,
     times: Vec<f64>,
@@ -232,6 +235,7 @@ fn stack(z: &[f64], h: &[&RowDVector<f64>], s: &[f64], r0: Option<usize>, n: usi
     (zz, hm, r)
 }
 
+#[typetag::serde]
 impl Aiding for TightAiding {
     fn name(&self) -> &str {
         "gnss"

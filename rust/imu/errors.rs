@@ -28,14 +28,14 @@ use rand_chacha::ChaCha12Rng;
 use rand_distr::StandardNormal;
 
 /// First-order Gauss–Markov term: stationary σ (m/s² or rad/s) and correlation time τ (s).
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct GaussMarkovSpec {
     pub sigma: f64,
     pub tau: f64,
 }
 
 /// Flicker term: bias instability B (m/s² or rad/s, IEEE 952) valid in [f_lo, f_hi] Hz.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct FlickerSpec {
     pub b: f64,
     pub f_lo: f64,
@@ -44,7 +44,7 @@ pub struct FlickerSpec {
 
 /// Errors of one sensor triad. Units: accelerometer m/s², gyro rad/s (rates), densities
 /// as in noise.rs (continuous, two-sided).
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct TriadErrors {
     /// Fixed constant bias per axis.
     pub bias: Vec3,
@@ -129,7 +129,7 @@ impl TriadErrors {
 }
 
 /// The full IMU error model: accelerometer and gyro triads.
-#[derive(Debug, Clone, PartialEq, Default)]
+#[derive(Debug, Clone, PartialEq, Default, serde::Serialize, serde::Deserialize)]
 pub struct ImuErrorModel {
     pub accel: TriadErrors,
     pub gyro: TriadErrors,

@@ -359,6 +359,8 @@ fn astro_vasilyuk2024_gyro_budget() -> (f64, f64, f64, f64) {
 pub struct PyScenario {
     inner: Scenario,
 }
+// the whole truth (catalog, cameras, rotations), so a copy skips the ~1 s build
+super::pickle::picklable!(PyScenario, inner, "AstroScenario");
 
 fn scenario_dict<'py>(py: Python<'py>, s: &Scenario) -> PyResult<Bound<'py, PyDict>> {
     let d = PyDict::new(py);

@@ -11,7 +11,7 @@ use crate::cai::aiding::{shot_times, CaiAiding, CaiConfig, CaiData, DataKind, Fo
 use crate::cai::closed_form::{closed_form_phases, ClosedForm};
 use crate::cai::hybrid::{GravityModel, HybridConfig, HybridScenario, PhaseSourceKind};
 use crate::cai::noise_id::{fringe_track, ml_windows, FringeEkf, Method, MlConfig, MAX_ML_ITER};
-use crate::cai::oracle::{imu_from_motion, oracle_phase, BodyMotion, Gravity, SineMotion, YawDrive};
+use crate::cai::oracle::{imu_from_motion, oracle_phase, AnalyticMotion, Gravity, SineMotion, YawDrive};
 use crate::cai::predictor::{
     channels_from_rows, jacobian, jacobian_fd, predict, Channel, Imu, Interpolation, OmegaDot, OmegaDotKind, PredictorConfig, JACOBIAN_PARAMS,
     MAX_SAVGOL_HALF_WIDTH, MAX_SUBSTEPS, TERM_NAMES,
@@ -54,6 +54,7 @@ fn cube<'py>(py: Python<'py>, flat: Vec<f64>, shape: [usize; 3]) -> PyResult<Arr
 /// Interferometer channels, validated once; shared by the predictor and the oracle.
 #[pyclass(module = "atomnav._core", frozen)]
 struct CaiChannels(Vec<Channel>);
+super::pickle::picklable!(CaiChannels, 0, "CaiChannels");
 
 #[pymethods]
 impl CaiChannels {
@@ -79,6 +80,7 @@ fn raw3(a: &PyReadonlyArray2<'_, f64>, field: &str) -> PyResult<Vec<Vec3>> {
 
 /// Predictor inputs, validated once at construction; `predict` and `jacobian` run on them.
 #[pyclass(module = "atomnav._core", frozen)]
+#[derive(serde::Serialize, serde::Deserialize)]
 struct CaiSetup {
     t: Vec<f64>,
     f: Vec<Vec3>,
@@ -93,6 +95,7 @@ impl CaiSetup {
         Imu { t: &self.t, f: &self.f, w: &self.w }
     }
 }
+super::pickle::picklable!(CaiSetup, self, "CaiSetup");
 
 #[pymethods]
 impl CaiSetup {
@@ -158,6 +161,7 @@ impl CaiSetup {
 /// position at t_ref (s), validated once.
 #[pyclass(module = "atomnav._core", frozen)]
 struct CaiGravity(Gravity);
+super::pickle::picklable!(CaiGravity, 0, "CaiGravity");
 
 #[pymethods]
 impl CaiGravity {
@@ -170,7 +174,8 @@ impl CaiGravity {
 /// An analytic body motion, validated once; its ideal IMU (`imu`) and the inertial-oracle
 /// phases (`oracle`) under a gravity model.
 #[pyclass(module = "atomnav._core", frozen)]
-struct CaiMotion(Box<dyn BodyMotion + Send + Sync>);
+struct CaiMotion(AnalyticMotion);
+super::pickle::picklable!(CaiMotion, 0, "CaiMotion");
 
 #[pymethods]
 impl CaiMotion {
@@ -185,19 +190,19 @@ impl CaiMotion {
     ) -> PyResult<Self> {
         let (pp, ps) = (rows::<3>(&position_poly, "position_poly")?, rows::<4>(&position_sines, "position_sines")?);
         let (ap, as_) = (rows::<3>(&attitude_poly, "attitude_poly")?, rows::<4>(&attitude_sines, "attitude_sines")?);
-        Ok(CaiMotion(Box::new(SineMotion::from_rows(&pp, &ps, &ap, &as_)?)))
+        Ok(CaiMotion(AnalyticMotion::Sine(Box::new(SineMotion::from_rows(&pp, &ps, &ap, &as_)?))))
     }
 
     /// Forward speed (m/s), yaw-rate amplitude (rad/s), period (s) of the yaw rate sine.
     #[staticmethod]
     fn yaw_drive(speed: f64, yaw_rate_amplitude: f64, period: f64) -> PyResult<Self> {
-        Ok(CaiMotion(Box::new(YawDrive::new(speed, yaw_rate_amplitude, period)?)))
+        Ok(CaiMotion(AnalyticMotion::YawDrive(YawDrive::new(speed, yaw_rate_amplitude, period)?)))
     }
 
     /// Ideal IMU (f_b, ω_b, ω̇_b) at times t.
     fn imu<'py>(&self, py: Python<'py>, t: PyReadonlyArray1<'py, f64>, gravity: &CaiGravity) -> PyResult<(Arr2<'py>, Arr2<'py>, Arr2<'py>)> {
         let t = vector(&t, "t")?;
-        let (f, w, wd) = py.detach(|| imu_from_motion(self.0.as_ref(), &t, &gravity.0))?;
+        let (f, w, wd) = py.detach(|| imu_from_motion(&self.0, &t, &gravity.0))?;
         Ok((vec3_to_py(py, &f), vec3_to_py(py, &w), vec3_to_py(py, &wd)))
     }
 
@@ -205,7 +210,7 @@ impl CaiMotion {
     #[allow(non_snake_case)]
     fn oracle<'py>(&self, py: Python<'py>, shots: PyReadonlyArray1<'py, f64>, T: f64, channels: &CaiChannels, gravity: &CaiGravity) -> PyResult<Arr1<'py>> {
         let shots = vector(&shots, "shots")?;
-        let out = py.detach(|| oracle_phase(self.0.as_ref(), &shots, T, &channels.0, &gravity.0))?;
+        let out = py.detach(|| oracle_phase(&self.0, &shots, T, &channels.0, &gravity.0))?;
         Ok(vec_to_py(py, out))
     }
 }
@@ -357,6 +362,7 @@ fn error_model(accel: &Bound<'_, PyDict>, gyro: &Bound<'_, PyDict>, name: &str) 
 /// (`CaiHybrid`), `cai_aided_ins` and `cai_in_shot_noise`.
 #[pyclass(name = "CaiSensor", module = "atomnav._core", frozen)]
 pub struct CaiSensor(CaiConfig);
+super::pickle::picklable!(CaiSensor, 0, "CaiSensor");
 
 #[pymethods]
 impl CaiSensor {
@@ -429,6 +435,8 @@ fn cai_in_shot_noise<'py>(py: Python<'py>, sensor: &CaiSensor, dt: f64, q_a: f64
 /// (`HybridScenario::new`); `monte_carlo` runs seeded runs in parallel with the GIL released.
 #[pyclass(module = "atomnav._core", frozen)]
 struct CaiHybrid(HybridScenario);
+// the built truth and models, so a copy skips the build and runs the same Monte Carlo
+super::pickle::picklable!(CaiHybrid, 0, "CaiHybrid");
 
 #[pymethods]
 impl CaiHybrid {
@@ -529,7 +537,7 @@ fn cai_aided_ins(
     data_b: PyReadonlyArray2<'_, f64>,
 ) -> PyResult<PyAidedIns> {
     let mut cfg = sensor.with_shots(&shots)?;
-    cfg.kind = ins.kind;
+    cfg.kind = ins.setup.kind;
     // (shots, channels) tables, read row-major; the aiding checks their sizes
     let flat = |a: &PyReadonlyArray2<'_, f64>| a.as_array().iter().copied().collect::<Vec<f64>>();
     let widths = (data_a.shape()[1], data_b.shape()[1]);

@@ -101,6 +101,9 @@ fn ins_error_dynamics<'py>(
 pub struct PyAidedIns {
     inner: std::sync::Mutex<AidedIns<Box<dyn Aiding>>>,
 }
+// the whole run (strapdown, filter, pending measurements and the sensor by its registered
+// name), so a copy taken between chunks continues bit for bit
+super::pickle::picklable!(PyAidedIns, inner, "AidedIns", locked);
 
 type OutputTuple<'py> = Bound<'py, pyo3::types::PyTuple>;
 
@@ -111,8 +114,8 @@ type OutputTuple<'py> = Bound<'py, pyo3::types::PyTuple>;
 #[pyclass(name = "AidedSetup", module = "atomnav._core", frozen)]
 pub struct AidedSetup {
     pub(crate) setup: InsSetup,
-    pub(crate) kind: crate::imu::ImuKind,
 }
+super::pickle::picklable!(AidedSetup, setup, "AidedSetup");
 
 #[pymethods]
 impl AidedSetup {
@@ -166,7 +169,7 @@ impl AidedSetup {
             Vertical::Damped { zeta, omega } => Some(DampedVertical { zeta, omega, baro: BaroModel { noise_psd: baro_psd, bias } }),
         };
         let setup = InsSetup::new(initial, kind.0, ellipsoid.0, ba0.into(), bg0.into(), mat(&p0, "p0")?, cfg, damped)?;
-        Ok(AidedSetup { setup, kind: kind.0 })
+        Ok(AidedSetup { setup })
     }
 }
 

@@ -102,6 +102,7 @@ fn glonass_propagate<'py>(py: Python<'py>, pos: PyReadonlyArray1<'py, f64>, vel:
 pub struct PyGnssOptions {
     inner: GnssOptions,
 }
+super::pickle::picklable!(PyGnssOptions, inner, "GnssOptions");
 
 #[pymethods]
 impl PyGnssOptions {
@@ -208,7 +209,7 @@ fn gnss_tight_ins<'py>(
     let o = &options.inner;
     let (x0, var) = o.tight_initial();
     let p0 = ins.setup.p0_with_extra(&var)?;
-    let aiding = TightAiding::new(eph.inner.clone(), ep, o.tight(ins.kind))?;
+    let aiding = TightAiding::new(eph.inner.clone(), ep, o.tight(ins.setup.kind))?;
     PyAidedIns::from_aiding_with(&ins, DVector::from_vec(x0), Some(p0), Box::new(aiding))
 }
 

@@ -191,6 +191,7 @@ fn rts<'py>(
 pub struct Scenario {
     inner: CoreScenario,
 }
+super::pickle::picklable!(Scenario, inner, "Scenario");
 
 #[pymethods]
 impl Scenario {

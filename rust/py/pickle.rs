@@ -39,8 +39,25 @@ pub fn restore<T: DeserializeOwned>(class: &str, bytes: &[u8]) -> PyResult<T> {
 /// `__reduce__` and `_from_state` for pyclass `$class`, whose field `$field` (a name, or 0
 /// for a tuple struct) is the whole state; `$name` is the class name Python sees. With
 /// `locked`, the field is a `Mutex` taken by `shared::lock` (the state is read whole,
-/// never half way through another thread's call).
+/// never half way through another thread's call). With `self` in place of the field, the
+/// (frozen) pyclass derives serde itself: a binding object of several checked fields.
 macro_rules! picklable {
+    ($class:ident, self, $name:literal) => {
+        #[pyo3::pymethods]
+        impl $class {
+            /// Pickle and deepcopy: the whole state, so a copy behaves bit for bit like
+            /// this object.
+            fn __reduce__<'py>(slf: &pyo3::Bound<'py, Self>) -> pyo3::PyResult<pyo3::Bound<'py, pyo3::types::PyTuple>> {
+                $crate::py::pickle::reduce(slf.as_any(), slf.get())
+            }
+
+            /// The object saved by `__reduce__`.
+            #[staticmethod]
+            fn _from_state(state: &[u8]) -> pyo3::PyResult<Self> {
+                $crate::py::pickle::restore($name, state)
+            }
+        }
+    };
     ($class:ident, $field:tt, $name:literal, locked) => {
         #[pyo3::pymethods]
         impl $class {

@@ -150,7 +150,7 @@ pub fn euler_chain(roll: Profile, pitch: Profile, yaw: Profile) -> Vec<AxisRotat
     ]
 }
 
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug, Clone, Copy, serde::Serialize, serde::Deserialize)]
 pub struct TruthState {
     pub t: f64,
     pub lla: Vec3,
