@@ -358,6 +358,14 @@ pub fn check_latitudes(field: &str, lla: &[Vec3]) -> Result<()> {
     lla.iter().enumerate().try_for_each(|(i, p)| check_latitude_row(field, p.x, i))
 }
 
+/// [`check_height`] of row `index` of an array (the error carries the row).
+fn check_height_row(field: &str, h: f64, index: usize) -> Result<()> {
+    check_height(field, h).map_err(|e| match e {
+        NavError::InvalidInput { field, reason, .. } => NavError::InvalidInput { field, reason: format!("{reason} at index {index}"), index: Some(index) },
+        other => other,
+    })
+}
+
 impl Ellipsoid {
     /// [`Ellipsoid::ecef_to_lla`] of each row; a position whose geodetic coordinates are
     /// undefined (the Earth's centre, where the iteration divides N − N) is an
@@ -375,13 +383,31 @@ impl Ellipsoid {
             .collect()
     }
 
+    /// Per row of (lat, lon, h): [M, N, γ, ∂γ/∂φ, ω_s] (m, m, m/s², m/s²/rad, rad/s). A
+    /// latitude outside [−π/2, π/2] names `field`, a height outside [`HEIGHT_RANGE`]
+    /// (where γ and ω_s lose their meaning: at h = −7e6 m γ is 66.9 m/s² and ω_s NaN)
+    /// names `h_field`, each with the first bad row.
+    pub fn parameters_rows(&self, field: &str, h_field: &str, lla: &[Vec3]) -> Result<Vec<[f64; 5]>> {
+        lla.iter()
+            .enumerate()
+            .map(|(i, p)| {
+                check_latitude_row(field, p.x, i)?;
+                check_height_row(h_field, p.z, i)?;
+                let (m, n) = self.radii(p.x);
+                Ok([m, n, self.gravity(p.x, p.z), self.gravity_dlat(p.x, p.z), self.schuler_frequency(p.x, p.z)])
+            })
+            .collect()
+    }
+
     /// Per row of (lat, lon, h, v_N, v_E, v_D): [ω_ie^n (3), ω_en^n (3)] in rad/s; a
-    /// latitude outside [−π/2, π/2] names `field` and the row.
+    /// latitude outside [−π/2, π/2] or a height outside [`HEIGHT_RANGE`] (the transport
+    /// rate divides by the radius plus h) names `field` and the row.
     pub fn nav_rates_rows(&self, field: &str, rows: &[[f64; 6]]) -> Result<Vec<[f64; 6]>> {
         rows.iter()
             .enumerate()
             .map(|(i, r)| {
                 check_latitude_row(field, r[0], i)?;
+                check_height_row(field, r[2], i)?;
                 let wie = self.earth_rate_ned(r[0]);
                 let wen = self.transport_rate_ned(r[0], r[2], &Vec3::new(r[3], r[4], r[5]));
                 Ok([wie.x, wie.y, wie.z, wen.x, wen.y, wen.z])

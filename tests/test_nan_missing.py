@@ -286,3 +286,50 @@ def test_allan_gaps_leaving_no_term_name_data():
     with pytest.raises(InputError) as e:
         allan_variance([1.0, np.nan, 2.0, np.nan, 3.0, np.nan, 4.0], 1.0)
     assert e.value.parameter == "data"
+
+
+# ---------------------------------------------------------------- finite input, finite output
+
+
+def test_schuler_period_below_the_model_range_names_h():
+    # returned NaN (and earth.parameters a gravity of 66.9 m/s²) at h = −7e6 m
+    lo, hi = atomnav.earth.HEIGHT_RANGE
+    assert (lo, hi) == (-1e4, 1e6)  # the strapdown state check's range, from the core
+    with pytest.raises(InputError) as e:
+        atomnav.earth.schuler_period(0.9, -7e6)
+    assert e.value.parameter == "h"
+    with pytest.raises(InputError) as e:
+        atomnav.earth.gravity([0.9, 0.9, 0.9], [0.0, 2e6, 0.0])
+    assert (e.value.parameter, e.value.index) == ("h", 1)
+    with pytest.raises(InputError) as e:
+        atomnav.earth.parameters([[0.9, 0.0, 0.0], [0.9, 0.0, -7e6]])
+    assert (e.value.parameter, e.value.index) == ("lla", 1)
+    with pytest.raises(InputError) as e:
+        atomnav.earth.navigation_rates([[0.9, 0.0, -7e6]], [[100.0, 0.0, 0.0]])
+    assert (e.value.parameter, e.value.index) == ("lla", 0)
+
+
+def test_earth_model_at_the_ends_of_the_height_range_is_finite():
+    lo, hi = atomnav.earth.HEIGHT_RANGE
+    p = atomnav.earth.parameters([[0.9, 0.0, lo], [0.9, 0.0, hi]])
+    assert np.isfinite(p.to_numpy()).all()
+    # Schuler period √(R₀/γ)·2π from the table's own radii and gravity, at both ends
+    for h, row in zip((lo, hi), p.itertuples()):
+        r0 = np.sqrt(row.M_m * row.N_m) + h
+        assert atomnav.earth.schuler_period(0.9, h) == pytest.approx(2 * np.pi * np.sqrt(r0 / row.gravity_mps2), rel=1e-12)
+
+
+def test_glonass_propagate_inside_the_earth_names_pos():
+    # returned NaN
+    from atomnav.gnss.ephemeris import glonass_propagate
+    with pytest.raises(InputError) as e:
+        glonass_propagate([0, 0, 0], [0, 0, 0], [0, 0, 0], 100.0)
+    assert e.value.parameter == "pos"
+    with pytest.raises(InputError) as e:
+        glonass_propagate([6.0e6, 0, 0], [0, 0, 0], [0, 0, 0], 100.0)  # below a_e = 6378136 m
+    assert e.value.parameter == "pos"
+    with pytest.raises(InputError) as e:  # falls from 7000 km at rest: inside within the hour
+        glonass_propagate([7.0e6, 0, 0], [0, 0, 0], [0, 0, 0], 3600.0)
+    assert e.value.parameter == "vel"
+    out = glonass_propagate([25.5e6, 0, 0], [0, 3.0e3, 1.0e3], [0, 0, 0], 900.0)
+    assert np.isfinite(out).all()

@@ -13,6 +13,10 @@ import pandas as pd
 from . import _core, plausibility
 from ._validate import floats, input_error, renamed, rows, scalar, vector
 
+#: Heights (m) a navigation state may have, from the deepest ocean trench to low Earth
+#: orbit: (min, max). A height outside is an :class:`InputError`.
+HEIGHT_RANGE = _core.HEIGHT_RANGE
+
 
 def ellipsoid(name: str = "WGS84") -> dict:
     """Constants of an ellipsoid: a (m), f, gm (m³/s²), omega (rad/s), e2, b (m),
@@ -60,21 +64,24 @@ def parameters(lla, ellipsoid: str = "WGS84") -> pd.DataFrame:
 
     Columns: ``M_m`` (meridian radius), ``N_m`` (prime-vertical radius), ``gravity_mps2``
     (Somigliana with height correction), ``dgravity_dlat_mps2_per_rad``,
-    ``schuler_rad_s`` (√(γ/(√(MN)+h)))."""
+    ``schuler_rad_s`` (√(γ/(√(MN)+h))). A height outside :data:`HEIGHT_RANGE`, where
+    normal gravity and the Schuler frequency lose their meaning, is an
+    :class:`atomnav.InputError` naming ``lla`` and the row."""
     p = _core.earth_params_rows(plausibility.lla(rows(lla, 3, "lla"), "lla"), ellipsoid)
     return pd.DataFrame(p, columns=["M_m", "N_m", "gravity_mps2", "dgravity_dlat_mps2_per_rad", "schuler_rad_s"])
 
 
 def gravity(lat, h=0.0, ellipsoid: str = "WGS84") -> np.ndarray:
     """Normal gravity magnitude γ (m/s², positive down) at latitude(s) ``lat`` (rad) and
-    height(s) ``h`` (m)."""
+    height(s) ``h`` (m); a height outside :data:`HEIGHT_RANGE` is an
+    :class:`atomnav.InputError` naming ``h``."""
     lat, h = _series(lat, "lat"), _series(h, "h")
     try:
         lat, h = np.broadcast_arrays(lat, h)
     except ValueError:
         raise input_error("h", f"{h.size} heights for {lat.size} latitudes") from None
     with renamed(lla="lat"):
-        g = _core.earth_params_rows(np.column_stack([lat, np.zeros_like(lat), h]), ellipsoid)[:, 2]
+        g = _core.earth_params_rows(np.column_stack([lat, np.zeros_like(lat), h]), ellipsoid, h_field="h")[:, 2]
     return g[0] if g.size == 1 else g
 
 
@@ -96,17 +103,20 @@ def radii(lat, ellipsoid: str = "WGS84"):
 
 
 def schuler_period(lat: float, h: float = 0.0, ellipsoid: str = "WGS84") -> float:
-    """Schuler period 2π/ω_s (s) with ω_s = √(γ/R₀), R₀ = √(MN) + h."""
+    """Schuler period 2π/ω_s (s) with ω_s = √(γ/R₀), R₀ = √(MN) + h, at latitude ``lat``
+    (rad) and height ``h`` (m); a height outside :data:`HEIGHT_RANGE` is an
+    :class:`atomnav.InputError` naming ``h``."""
     lla = np.array([[scalar(lat, "lat"), 0.0, scalar(h, "h")]])
     floats(lla[:, 0], "lat"), floats(lla[:, 2], "h")
     with renamed(lla="lat"):
-        w = _core.earth_params_rows(lla, ellipsoid)[0, 4]
+        w = _core.earth_params_rows(lla, ellipsoid, h_field="h")[0, 4]
     return 2 * np.pi / w
 
 
 def navigation_rates(lla, vel_ned, ellipsoid: str = "WGS84") -> pd.DataFrame:
     """Earth rate ω_ie^n and transport rate ω_en^n (rad/s) in NED for each position and
-    NED velocity (m/s)."""
+    NED velocity (m/s); a height outside :data:`HEIGHT_RANGE` is an
+    :class:`atomnav.InputError` naming ``lla`` and the row."""
     p, v = plausibility.lla(rows(lla, 3, "lla"), "lla"), rows(vel_ned, 3, "vel_ned")
     if len(v) != len(p):
         raise input_error("vel_ned", f"expected {len(p)} rows like lla, got {len(v)}")

@@ -1,6 +1,6 @@
 //! GLONASS satellite orbit and clock from a broadcast state vector: RK4 integration of the
 //! PZ-90 equations of motion with J₂ and the luni-solar acceleration (GLONASS ICD 2008,
-//! Appendix A.3.1.2; spec gnss-ins-tight §2.4 Eqs. 10–11).
+//! Appendix A.3.1.2).
 
 use crate::error::{invalid, Result};
 use crate::math::Vec3;
@@ -68,7 +68,14 @@ pub fn acceleration(pos: &Vec3, vel: &Vec3, acc_ls: &Vec3, j2: f64) -> Vec3 {
     )
 }
 
-/// [`propagate`] with the step checked (finite, > 0) and the inputs finite.
+/// Least orbit radius (m) of a satellite state: the Earth's equatorial radius a_e of
+/// PZ-90.11 (GLONASS ICD 2008). A state below it is inside the Earth, where the
+/// equations of motion, a point mass with J₂, do not hold (at r = 0 they give NaN).
+pub const MIN_RADIUS: f64 = AE_GLO;
+
+/// [`propagate`] with the step checked (finite, > 0), the inputs finite, and the orbit
+/// outside the Earth: a position below [`MIN_RADIUS`] names `pos`; an orbit that descends
+/// below it at an RK4 step point, or leaves the floating-point range, names `vel`.
 pub fn propagate_checked(pos: Vec3, vel: Vec3, acc_ls: &Vec3, dt: f64, max_step: f64, j2: f64) -> Result<(Vec3, Vec3)> {
     crate::error::check_positive("step", max_step)?;
     for (field, v) in [("pos", &pos), ("vel", &vel), ("acc", acc_ls)] {
@@ -81,7 +88,19 @@ pub fn propagate_checked(pos: Vec3, vel: Vec3, acc_ls: &Vec3, dt: f64, max_step:
     if !(steps <= MAX_RK4_STEPS as f64) {
         return Err(invalid("step", format!("|dt| / step = {steps} RK4 steps, at most {MAX_RK4_STEPS}")));
     }
-    Ok(propagate(pos, vel, acc_ls, dt, max_step, j2))
+    let r0 = pos.norm();
+    if r0 < MIN_RADIUS {
+        return Err(invalid("pos", format!("radius {r0} m is inside the Earth (below a_e = {MIN_RADIUS} m): not a satellite state")));
+    }
+    let ((r, v), lowest) = propagate_lowest(pos, vel, acc_ls, dt, max_step, j2);
+    // a NaN step point carries on to the end: the first check catches it
+    if !r.iter().chain(v.iter()).all(|x| x.is_finite()) {
+        return Err(invalid("vel", "the orbit of pos and vel leaves the floating-point range within dt"));
+    }
+    if lowest < MIN_RADIUS {
+        return Err(invalid("vel", format!("the orbit of pos and vel descends inside the Earth within dt (radius {lowest} m, below a_e = {MIN_RADIUS} m)")));
+    }
+    Ok((r, v))
 }
 
 /// Most RK4 steps of one checked propagation (a broadcast set is valid for ±15 min, 30 steps
@@ -90,9 +109,15 @@ pub const MAX_RK4_STEPS: usize = 10_000_000;
 
 /// Classical RK4 of (r, v) over `dt` seconds in equal steps no longer than `max_step`.
 pub fn propagate(pos: Vec3, vel: Vec3, acc_ls: &Vec3, dt: f64, max_step: f64, j2: f64) -> (Vec3, Vec3) {
+    propagate_lowest(pos, vel, acc_ls, dt, max_step, j2).0
+}
+
+/// [`propagate`] and the least radius |r| (m) of its step points after the first.
+fn propagate_lowest(pos: Vec3, vel: Vec3, acc_ls: &Vec3, dt: f64, max_step: f64, j2: f64) -> ((Vec3, Vec3), f64) {
     let n = ((dt.abs() / max_step).ceil() as usize).max(1);
     let h = dt / n as f64;
     let (mut r, mut v) = (pos, vel);
+    let mut lowest = f64::INFINITY;
     for _ in 0..n {
         let k1r = v;
         let k1v = acceleration(&r, &v, acc_ls, j2);
@@ -104,8 +129,9 @@ pub fn propagate(pos: Vec3, vel: Vec3, acc_ls: &Vec3, dt: f64, max_step: f64, j2
         let k4v = acceleration(&(r + k3r * h), &k4r, acc_ls, j2);
         r += (k1r + k2r * 2.0 + k3r * 2.0 + k4r) * (h / 6.0);
         v += (k1v + k2v * 2.0 + k3v * 2.0 + k4v) * (h / 6.0);
+        lowest = lowest.min(r.norm());
     }
-    (r, v)
+    ((r, v), lowest)
 }
 
 impl GloEphemeris {
@@ -147,6 +173,20 @@ mod tests {
             }
         }
         assert!(propagate_checked(r, v, &Vec3::zeros(), 900.0, 30.0, J2_GLO).is_ok());
+    }
+
+    /// A state inside the Earth names pos; one that falls into it names vel.
+    #[test]
+    fn states_inside_the_earth_are_rejected() {
+        let field = |p: Vec3, v: Vec3, dt: f64| match propagate_checked(p, v, &Vec3::zeros(), dt, 30.0, J2_GLO) {
+            Err(crate::error::NavError::InvalidInput { field, .. }) => field,
+            other => format!("{other:?}"),
+        };
+        assert_eq!(field(Vec3::zeros(), Vec3::zeros(), 100.0), "pos");
+        assert_eq!(field(Vec3::new(6.0e6, 0.0, 0.0), Vec3::zeros(), 100.0), "pos");
+        // dropped from 7000 km at rest: below a_e after about 15 min
+        assert_eq!(field(Vec3::new(7.0e6, 0.0, 0.0), Vec3::zeros(), 3600.0), "vel");
+        assert!(propagate_checked(Vec3::new(7.0e6, 0.0, 0.0), Vec3::zeros(), &Vec3::zeros(), 60.0, 30.0, J2_GLO).is_ok());
     }
 
     fn circular(u: f64) -> (Vec3, Vec3) {

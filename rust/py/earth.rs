@@ -49,20 +49,13 @@ fn ned_to_ecef_rows<'py>(py: Python<'py>, ned: PyReadonlyArray2<'py, f64>, origi
     Ok(vec3_to_py(py, &r.iter().map(|x| e.ned_to_ecef(x, &o)).collect::<Vec<_>>()))
 }
 
-/// Per row of (lat, lon, h): [M, N, gravity γ, ∂γ/∂φ, Schuler ω_s].
+/// Per row of (lat, lon, h): [M, N, gravity γ, ∂γ/∂φ, Schuler ω_s]; a height outside the
+/// model's range names `h_field` (the caller's height argument).
 #[pyfunction]
-#[pyo3(signature = (lla, ellipsoid=Wrap(crate::earth::WGS84)))]
-fn earth_params_rows<'py>(py: Python<'py>, lla: PyReadonlyArray2<'py, f64>, ellipsoid: Wrap<Ellipsoid>) -> PyResult<Bound<'py, PyArray2<f64>>> {
-    let e = ellipsoid.0;
-    let p = lla_rows(&lla, "lla")?;
-    let out: Vec<[f64; 5]> = p
-        .iter()
-        .map(|x| {
-            let (m, n) = e.radii(x.x);
-            [m, n, e.gravity(x.x, x.z), e.gravity_dlat(x.x, x.z), e.schuler_frequency(x.x, x.z)]
-        })
-        .collect();
-    Ok(to_py_rows(py, &out))
+#[pyo3(signature = (lla, ellipsoid=Wrap(crate::earth::WGS84), h_field="lla"))]
+fn earth_params_rows<'py>(py: Python<'py>, lla: PyReadonlyArray2<'py, f64>, ellipsoid: Wrap<Ellipsoid>, h_field: &str) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    let p = vec3_rows(&lla, "lla")?;
+    Ok(to_py_rows(py, &ellipsoid.0.parameters_rows("lla", h_field, &p)?))
 }
 
 /// Per row of (lat, lon, h, v_N, v_E, v_D): [ω_ie^n (3), ω_en^n (3)] in rad/s.

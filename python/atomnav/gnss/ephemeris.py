@@ -89,7 +89,12 @@ class Ephemerides:
 
 def glonass_propagate(pos, vel, acc, dt: float, step: float = 30.0, j2: float = 1082625.75e-9) -> np.ndarray:
     """RK4 propagation of a GLONASS PZ-90 state (m, m/s) with constant luni-solar
-    acceleration ``acc`` (m/s²) over ``dt`` s in steps ≤ ``step`` s (spec Eq. 10).
-    Returns [x, y, z, vx, vy, vz]."""
+    acceleration ``acc`` (m/s²) over ``dt`` s in steps ≤ ``step`` s (GLONASS ICD 2008,
+    A.3.1.2). Returns [x, y, z, vx, vy, vz].
+
+    The equations of motion hold outside the Earth: a position whose radius is below
+    the equatorial radius a_e = 6 378 136 m is an :class:`atomnav.InputError` naming
+    ``pos``, and an orbit that descends below it (at an RK4 step point) or leaves the
+    floating-point range within ``dt`` one naming ``vel``."""
     return _core.glonass_propagate(vector(pos, 3, "pos"), vector(vel, 3, "vel"), vector(acc, 3, "acc"),
                                    finite_scalar(dt, "dt"), finite_scalar(step, "step"), finite_scalar(j2, "j2"))
