@@ -134,7 +134,9 @@ class AidedResult:
 
 
 class AidedIns:
-    """A running aided INS; build it with a sensor's factory function."""
+    """A running aided INS; build it with a sensor's factory function. It may be pickled
+    or deep-copied between chunks (a checkpoint, or a Dask task): the copy, fed the rest of
+    the record, continues bit for bit like the original."""
 
     def __init__(self, core: _core.AidedIns, setup: InsSetup):
         self._core = instance(core, _core.AidedIns, "core")
