@@ -46,6 +46,7 @@ import numpy as np
 import pandas as pd
 
 from . import _core, plausibility, units
+from ._stateful import Stateful, serialized
 from ._validate import as_floats, choice, input_error, instance, locate, renamed, rows, scalar, seconds, table, vector
 
 KINDS = tuple(_core.OPTIONS["ImuKind"])
@@ -218,23 +219,44 @@ def register_preset(name: str, errors: ImuErrors) -> None:
     _USER_PRESETS[str(name)] = copy.deepcopy(instance(errors, ImuErrors, "errors").validate())
 
 
-class ImuSimulator:
+class ImuSimulator(Stateful):
     """Seeded, stateful corruption of an ideal IMU stream with sampling interval ``dt``
     (s) and output ``kind`` (``"rates"`` or ``"increments"``). Successive :meth:`corrupt`
-    calls continue the random processes, so chunks give the numbers of one batch call."""
+    calls continue the random processes, so chunks give the numbers of one batch call.
+
+    ``kind``, ``dt`` and ``errors`` are fixed at construction (read-only: build a new
+    simulator for another kind). One simulator may be shared by threads (calls run one
+    after another) and pickled or deep-copied mid-record: the copy continues the same
+    random streams bit for bit."""
 
     def __init__(self, errors: ImuErrors | str, dt: float, kind: str = "rates", seed: int = 0):
         if isinstance(errors, str):
             with renamed(preset="errors"):
                 errors = ImuErrors.preset(errors)
         instance(errors, ImuErrors, "errors")
-        self.kind = kind
-        self.dt = scalar(dt, "dt")
-        self.errors = copy.deepcopy(errors)
-        self._sim = _core.ImuErrorSimulator(*errors._to_core(), self.dt, self.kind, seed)
-        plausibility.sample_interval(self.dt, "dt")
+        self._dt = scalar(dt, "dt")
+        self._errors = copy.deepcopy(errors)
+        self._sim = _core.ImuErrorSimulator(*errors._to_core(), self._dt, kind, seed)
+        self._kind = kind
+        plausibility.sample_interval(self._dt, "dt")
         self._k = 0
 
+    @property
+    def kind(self) -> str:
+        """Output kind, ``"rates"`` or ``"increments"`` (read-only)."""
+        return self._kind
+
+    @property
+    def dt(self) -> float:
+        """Sampling interval (s, read-only)."""
+        return self._dt
+
+    @property
+    def errors(self) -> ImuErrors:
+        """A copy of the error model (changing it does not change this simulator)."""
+        return copy.deepcopy(self._errors)
+
+    @serialized
     def corrupt(self, accel, gyro=None) -> pd.DataFrame:
         """Corrupt the next chunk. ``accel``, ``gyro``: (N, 3) true specific force (m/s²)
         and angular rate (rad/s), or Δv (m/s) and Δθ (rad) for increments; or one DataFrame

@@ -20,7 +20,8 @@ import numpy as np
 import pandas as pd
 
 from . import _core, plausibility
-from ._validate import as_floats, flag, input_error, rows, scalar, seconds, table, timestamp, vector
+from ._stateful import Stateful, serialized
+from ._validate import as_floats, flag, input_error, renamed, rows, scalar, seconds, table, timestamp, vector
 from .trajectory import COLUMNS, IMU_COLUMNS
 
 #: Rows per call into Rust: the progress bar's granularity for long runs.
@@ -101,7 +102,7 @@ def _diverged(err, table: np.ndarray, done: int, first_row: int, time: np.ndarra
     return err
 
 
-class Strapdown:
+class Strapdown(Stateful):
     """Streaming strapdown INS from an initial state: time ``t0`` (s), ``lla`` (lat rad,
     lon rad, h m), NED velocity ``vel_ned`` (m/s) and attitude ``q_nb`` (scalar first).
 
@@ -110,6 +111,11 @@ class Strapdown:
     ``t0`` given as a datetime (then time 0 is ``t0``); every time in and out (``t0``, the
     solution's ``time_s``) is then in seconds since it, and without one a datetime64
     column is a ``TypeError``. Datetimes and the epoch must be both tz-aware or both naive.
+
+    The initial state is checked: finite values, latitude within ±90°, height within
+    [−10 km, 1000 km] (``atomnav.earth.HEIGHT_RANGE``), and ``q_nb`` a rotation, of unit
+    norm within 1e-6 (``atomnav.rotation.ROTATION_TOLERANCE``): ``[1, .1, .1, .1]`` is an
+    :class:`InputError` naming ``q_nb``, not a quaternion to rescale silently.
 
     Parameters
     ----------
@@ -132,6 +138,9 @@ class Strapdown:
 
     Rows are numbered in the whole record: the DataFrames of successive :meth:`run` calls
     continue each other's index, as do error indices.
+
+    One object may be shared by threads (their calls run one after another) and pickled
+    or deep-copied mid-record: the copy continues bit for bit like the original.
     """
 
     def __init__(self, t0, lla, vel_ned, q_nb, *, kind: str = "increments", ellipsoid: str = "WGS84",
@@ -147,10 +156,12 @@ class Strapdown:
         self._rows = 0
 
     @property
+    @serialized
     def kind(self) -> str:
         """The IMU kind, ``"rates"`` or ``"increments"``."""
         return self._core.kind
 
+    @serialized
     def run(self, imu, h_ref=None) -> pd.DataFrame:
         """Integrate the next chunk of the record.
 
@@ -194,10 +205,12 @@ class Strapdown:
         self._rows = first + len(t)
         return _table(table, first)
 
+    @serialized
     def state(self) -> pd.DataFrame:
         """The current state as a one-row DataFrame (the columns of :meth:`run`)."""
         return _table(self._core.state())
 
+    @serialized
     def reset(self, state) -> None:
         """Restart from ``state`` as a new :class:`Strapdown` with this one's options would
         (coning/sculling history cleared, rate priming anew, rows numbered from 0).
@@ -207,13 +220,13 @@ class Strapdown:
         state : DataFrame or dict
             A one-row DataFrame with the columns of :meth:`state` (e.g. a row of a
             :meth:`run` result), or a dict with ``t0`` (s), ``lla`` (rad, rad, m),
-            ``vel_ned`` (m/s) and ``q_nb`` (unit norm within 1e-6).
+            ``vel_ned`` (m/s) and ``q_nb``, checked as by the constructor.
 
         Raises
         ------
         InputError
-            ``parameter == "state"``: a missing field, non-unit ``q_nb``, latitude outside
-            ±90° or height outside [−10 km, 1000 km]. The object is then unchanged.
+            ``parameter == "state"``: a missing field or a state the constructor rejects.
+            The object is then unchanged.
         """
         if isinstance(state, pd.DataFrame):
             missing = [c for c in COLUMNS[:11] if c not in state.columns]
@@ -229,7 +242,8 @@ class Strapdown:
         else:
             raise TypeError(f"state: expected a one-row DataFrame or a dict, got {type(state).__name__}")
         t0, lla, vel, q = fields
-        self._core.reset(scalar(t0, "state"), vector(lla, 3, "state"), vector(vel, 3, "state"), vector(q, 4, "state"))
+        with renamed(t0="state", lla="state", vel_ned="state", q_nb="state"):
+            self._core.reset(scalar(t0, "state"), vector(lla, 3, "state"), vector(vel, 3, "state"), vector(q, 4, "state"))
         plausibility.lla(lla, "state")
         self._rows = 0
 

@@ -203,6 +203,7 @@ impl<R: Copy + Into<Vec3> + Sync> ImuRecord<'_, R> {
         // One branch-free pass before looking for the first bad row: x − x is 0 for a finite
         // x and NaN for ±inf or NaN, so the sum over the record is 0 exactly when every
         // value is finite.
+        #[allow(clippy::eq_op)] // v − v is the finiteness test, not a mistake
         let any_bad = self.rho.iter().fold(0.0, |sum, &v| {
             let v: Vec3 = v.into();
             sum + (v - v).sum()

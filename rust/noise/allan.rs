@@ -424,13 +424,14 @@ pub fn variance(data: &[f64], tau0: f64, data_type: DataType, kind: Kind, set: &
 /// advance); the variances do not depend on that offset. A NaN rate sample is missing,
 /// as in [`variance`]: it ends the current gap-free stretch, whose terms are kept, and
 /// the next sample starts a new one, so the stream equals the batch on the same record.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
 pub struct AllanStream {
     /// The factors as given (errors name an index of this list).
     given: Vec<usize>,
     /// The factors sorted, without repeats.
     ms: Vec<usize>,
     tau0: f64,
+    #[serde(with = "crate::options::by_name")]
     data_type: DataType,
     ring: Vec<f64>,
     mask: usize,

@@ -86,6 +86,7 @@ fn nnls_solve<'py>(py: Python<'py>, a: PyReadonlyArray2<'py, f64>, b: PyReadonly
 /// Streaming Allan, modified Allan and Hadamard variance at fixed averaging factors.
 #[pyclass(name = "AllanStream", module = "atomnav._core")]
 struct PyAllanStream(AllanStream);
+super::pickle::picklable!(PyAllanStream, 0, "AllanStream");
 
 #[pymethods]
 impl PyAllanStream {
@@ -128,6 +129,7 @@ fn arima_state_space<'py>(py: Python<'py>, ar: Vec<f64>, ma: Vec<f64>, sigma2: f
 /// checked when built; Python's `atomnav.noise.filters.ArmaFilterConfig` mirrors it.
 #[pyclass(name = "ArmaFilterConfig", module = "atomnav._core", frozen)]
 struct PyArmaFilterConfig(ArmaFilterConfig);
+super::pickle::picklable!(PyArmaFilterConfig, 0, "ArmaFilterConfig");
 
 #[pymethods]
 impl PyArmaFilterConfig {
@@ -176,6 +178,7 @@ fn kalman_filter<'py>(py: Python<'py>, omega: PyReadonlyArray1<'py, f64>, config
 /// Streaming Kalman filter: feed chunks, get the filtered chunk back.
 #[pyclass(name = "KalmanStream", module = "atomnav._core")]
 struct PyKalmanStream(Kalman);
+super::pickle::picklable!(PyKalmanStream, 0, "KalmanStream");
 
 #[pymethods]
 impl PyKalmanStream {

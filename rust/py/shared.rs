@@ -11,12 +11,14 @@ use std::sync::{Mutex, MutexGuard, TryLockError};
 /// it back to finish (waiting with the GIL held would deadlock). A poisoned mutex is used
 /// as it is: no panic is reachable in the core, and the state is what the last call left.
 pub fn lock<'a, T: Send>(py: Python<'_>, m: &'a Mutex<T>) -> MutexGuard<'a, T> {
-    loop {
-        match m.try_lock() {
-            Ok(guard) => return guard,
-            Err(TryLockError::Poisoned(p)) => return p.into_inner(),
-            // wait, without the GIL, until the holder lets go; then try again with it
-            Err(TryLockError::WouldBlock) => py.detach(|| drop(m.lock())),
+    match m.try_lock() {
+        Ok(guard) => guard,
+        Err(TryLockError::Poisoned(p)) => p.into_inner(),
+        // wait, without the GIL, until the holder lets go; then try again with it (another
+        // thread may take it first: then wait again)
+        Err(TryLockError::WouldBlock) => {
+            py.detach(|| drop(m.lock()));
+            lock(py, m)
         }
     }
 }
