@@ -14,7 +14,7 @@ import numpy as np
 import pandas as pd
 
 from . import _core, plausibility
-from ._validate import (FIRST_SAMPLE, check_numbers, finite_scalar, increasing, input_error, instance, locate, path as checked_path,
+from ._validate import (FIRST_SAMPLE, finite_scalar, increasing, input_error, instance, locate, path as checked_path,
                         positive, renamed, rows, table, timestamp, vector)
 from .rotation import euler_from_quat
 
@@ -32,12 +32,28 @@ MAX_SAMPLES = 100_000_000
 
 
 def nav_table(time, lla, vel_ned, q_nb) -> pd.DataFrame:
-    """A trajectory / navigation-solution table from arrays (Euler angles added)."""
-    q = rows(q_nb, 4, "q_nb")
-    with renamed(q="q_nb"):
+    """A trajectory / navigation-solution table from arrays (Euler angles added): ``time``
+    (N,) s, ``lla`` (N, 3) of (lat rad, lon rad, h m), ``vel_ned`` (N, 3) m/s, ``q_nb``
+    (N, 4) scalar first. A latitude beyond ±π/2 is an :class:`atomnav.InputError`, a
+    longitude beyond 2π a :class:`atomnav.UnitWarning` (degrees)."""
+    p = rows(lla, 3, "lla")
+    _check_positions(p, "lla")
+    return _frame(vector(time, None, "time"), p, rows(vel_ned, 3, "vel_ned"), rows(q_nb, 4, "q_nb"), "q_nb")
+
+
+def _check_positions(lla: np.ndarray, name: str) -> None:
+    """The core's latitude check of positions ``lla`` (N, 3) (an :class:`atomnav.InputError`
+    naming argument ``name`` and the first bad row) and the longitude unit warning."""
+    _core.check_latitudes_rows(np.ascontiguousarray(lla, dtype=float), name)
+    plausibility.lla(lla, name)
+
+
+def _frame(time: np.ndarray, lla: np.ndarray, vel_ned: np.ndarray, q: np.ndarray, q_name: str) -> pd.DataFrame:
+    """The table of :data:`COLUMNS` from checked arrays; the quaternions ``q`` are checked by
+    the Euler conversion (errors naming ``q_name``)."""
+    with renamed(q=q_name):
         e = euler_from_quat(q) if len(q) else np.zeros((0, 3))
-    data = np.column_stack([vector(time, None, "time"), rows(lla, 3, "lla"), rows(vel_ned, 3, "vel_ned"), q, e])
-    return pd.DataFrame(data, columns=COLUMNS)
+    return pd.DataFrame(np.column_stack([time, lla, vel_ned, q, e]), columns=COLUMNS)
 
 
 class Trajectory:
@@ -45,16 +61,30 @@ class Trajectory:
     (:data:`COLUMNS`), optionally backed by an exact motion model.
 
     Build from data with :meth:`from_dataframe` / :meth:`from_csv`, or with the
-    generators of this module (:func:`sinusoidal`, :func:`hexapod`, ...)."""
+    generators of this module (:func:`sinusoidal`, :func:`hexapod`, ...).
+
+    The constructor reads ``df`` by column name (:data:`COLUMNS`; extra columns are kept
+    but not read). A table of float64 columns is kept as given (no copy); otherwise the
+    columns of :data:`COLUMNS` are converted in a copy: nullable dtypes with ``pd.NA`` read
+    as NaN, and ``time_s`` as in :meth:`from_dataframe` (a timedelta64 as its seconds, a
+    datetime64 as seconds since ``epoch``, by default since the first sample, which then
+    becomes :attr:`epoch`). Without a ``motion`` (whose samples come from its checked
+    origin), positions must be finite with latitudes within ±π/2 (an
+    :class:`atomnav.InputError` naming ``df`` and the row); a longitude beyond 2π warns
+    (:class:`atomnav.UnitWarning`: degrees)."""
 
     def __init__(self, df: pd.DataFrame, motion: _core.Motion | None = None, ellipsoid: str = "WGS84", epoch=None):
-        # the table is kept as given (no copy): its columns are checked by name and type here
-        for name, k in zip(COLUMNS, locate(instance(df, pd.DataFrame, "df"), COLUMNS, "df")):
-            check_numbers(df.iloc[:, k], "df", name)
+        where = locate(instance(df, pd.DataFrame, "df"), COLUMNS, "df")
         if motion is not None:
             instance(motion, _core.Motion, "motion")
-        if epoch is not None and timestamp(epoch) is None:
-            raise TypeError(f"epoch: expected a datetime (pandas.Timestamp, datetime or numpy.datetime64), got {type(epoch).__name__}")
+        epoch = _epoch(df, epoch)
+        if not all(df.dtypes.iloc[k] == np.float64 for k in where):
+            values = table(df, COLUMNS, "df", epoch=FIRST_SAMPLE if epoch is None else epoch, finite=False)
+            df = df.copy()
+            for j, name in enumerate(COLUMNS):
+                df[name] = values[:, j]
+        if motion is None:  # a motion's samples come from its checked origin
+            _check_positions(df[["lat_rad", "lon_rad", "h_m"]].to_numpy(dtype=float), "df")
         self.df = df
         self.motion = motion
         self.ellipsoid = instance(ellipsoid, str, "ellipsoid")
@@ -73,37 +103,37 @@ class Trajectory:
         n = int(n)
         t = np.arange(n) / rate_hz
         tr = motion.truth(t, ellipsoid)
-        return cls(nav_table(tr["time"], tr["lla"], tr["vel_ned"], tr["q_nb"]), motion, ellipsoid)
+        return cls(_frame(tr["time"], tr["lla"], tr["vel_ned"], tr["q_nb"], "q_nb"), motion, ellipsoid)
 
     @classmethod
     def from_dataframe(cls, df: pd.DataFrame, ellipsoid: str = "WGS84", *, epoch=None) -> "Trajectory":
         """From a table with ``time_s, lat_rad, lon_rad, h_m, vn_mps, ve_mps, vd_mps`` and
         either ``qw, qx, qy, qz`` or ``roll_rad, pitch_rad, yaw_rad`` (the quaternion when
-        both are there), read by column name (extra columns ignored). Validated: finite
-        values, strictly increasing time, latitude within ±π/2.
+        both are there), read by column name (extra columns ignored). Some but not all of
+        the quaternion columns is an :class:`atomnav.InputError` naming ``df`` and the
+        missing ones (a misspelled column, never a switch to the Euler angles). Validated:
+        finite values, strictly increasing time, latitude within ±π/2.
 
         ``time_s`` holds seconds, a timedelta64 (read as seconds) or a datetime64: then
         seconds since ``epoch`` (a datetime), by default since the first sample. The
         trajectory keeps that datetime as :attr:`epoch`, which :meth:`initial_state` passes
         on and :meth:`errors` reads datetime solutions against."""
         need = ["time_s", "lat_rad", "lon_rad", "h_m", "vn_mps", "ve_mps", "vd_mps"]
-        attitudes = (["qw", "qx", "qy", "qz"], ["roll_rad", "pitch_rad", "yaw_rad"])
-        attitude = next((a for a in attitudes if all(c in instance(df, pd.DataFrame, "df").columns for c in a)), None)
-        if attitude is None:
+        quaternion, euler = ["qw", "qx", "qy", "qz"], ["roll_rad", "pitch_rad", "yaw_rad"]
+        columns = instance(df, pd.DataFrame, "df").columns
+        given = [c for c in quaternion if c in columns]
+        if given and len(given) < len(quaternion):  # a misspelled or lost quaternion column, not a request for Euler angles
+            raise input_error("df", f"has quaternion column(s) {given} but not {[c for c in quaternion if c not in given]}: give all "
+                                    "of qw, qx, qy, qz, or none of them and roll_rad, pitch_rad, yaw_rad")
+        attitude = quaternion if given else euler
+        if not given and not all(c in columns for c in euler):
             raise input_error("df", f"needs attitude columns qw, qx, qy, qz or roll_rad, pitch_rad, yaw_rad (and {need})")
-        if epoch is not None and timestamp(epoch) is None:
-            raise TypeError(f"epoch: expected a datetime (pandas.Timestamp, datetime or numpy.datetime64), got {type(epoch).__name__}")
+        epoch = _epoch(df, epoch)
         a = table(df, need + attitude, "df", epoch=FIRST_SAMPLE if epoch is None else epoch)
-        if epoch is None and pd.api.types.is_datetime64_any_dtype(df["time_s"].dtype):
-            epoch = df["time_s"].iloc[0]  # the conversion's reference (table() has checked the column)
         t, lla, vel = a[:, 0], a[:, 1:4], a[:, 4:7]
         q = a[:, 7:] if len(attitude) == 4 else _core.quat_from_euler_rows(plausibility.angles(np.ascontiguousarray(a[:, 7:]), "df", "roll_rad, pitch_rad, yaw_rad"))
         increasing(t, "df", "time_s")
-        bad = np.nonzero(np.abs(lla[:, 0]) > np.pi / 2)[0]
-        if bad.size:
-            raise input_error("df", f"lat_rad: latitude {lla[bad[0], 0]} rad at index {bad[0]} is outside [-pi/2, pi/2]", bad[0])
-        plausibility.lla(lla, "df")
-        return cls(nav_table(t, lla, vel, q), None, ellipsoid, epoch)
+        return cls(_frame(t, lla, vel, np.ascontiguousarray(q), "df"), None, ellipsoid, epoch)
 
     @classmethod
     def from_csv(cls, path, ellipsoid: str = "WGS84", **read_csv_kwargs) -> "Trajectory":
@@ -186,6 +216,7 @@ class Trajectory:
         a = table(nav, ["time_s", "lat_rad", "lon_rad", "h_m", "vn_mps", "ve_mps", "vd_mps", "qw", "qx", "qy", "qz"], "nav",
                   epoch=self.epoch, epoch_name="epoch (Trajectory.from_dataframe's)")
         tn = a[:, 0]
+        plausibility.lla(a[:, 1:4], "nav")
         idx = np.clip(np.searchsorted(self.time, tn), 0, len(self.time) - 1)
         off = np.nonzero(np.abs(self.time[idx] - tn) > 1e-9)[0]
         if off.size:
@@ -213,6 +244,22 @@ class Trajectory:
         ax.set_aspect("equal", adjustable="datalim")
         ax.figure.colorbar(sc, ax=ax, label="time (s)")
         return ax
+
+
+def _epoch(df: pd.DataFrame, epoch):
+    """The datetime a datetime64 ``time_s`` of ``df`` counts from: ``epoch`` if given (a
+    datetime, else a ``TypeError``), else the column's first sample; None for a time in
+    seconds (or timedelta64) with no ``epoch``."""
+    if epoch is not None:
+        if timestamp(epoch) is None:
+            raise TypeError(f"epoch: expected a datetime (pandas.Timestamp, datetime or numpy.datetime64), got {type(epoch).__name__}")
+        return epoch
+    if "time_s" not in df.columns:
+        return None  # the table read reports the missing column with the others
+    column = df.iloc[:, locate(df, ["time_s"], "df")[0]]
+    if pd.api.types.is_datetime64_any_dtype(column.dtype) and column.notna().any():
+        return column.dropna().iloc[0]  # the first sample, the reference of the conversion
+    return None
 
 
 # ---- generators -----------------------------------------------------------------------

@@ -111,6 +111,7 @@ pub fn simulate(eph: &Ephemerides, t: &[f64], lla: &[Vec3], vel_ned: &[Vec3], cf
     if lla.len() != t.len() || vel_ned.len() != t.len() {
         return Err(invalid("lla", format!("{} positions and {} velocities for {} epochs", lla.len(), vel_ned.len(), t.len())));
     }
+    crate::earth::check_latitudes("lla", lla)?;
     let mut rng = ChaCha8Rng::seed_from_u64(cfg.seed);
     let sats = eph.satellites();
     let mut out = Vec::with_capacity(t.len());

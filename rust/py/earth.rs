@@ -66,6 +66,14 @@ fn nav_rates_rows<'py>(py: Python<'py>, lla_vel: PyReadonlyArray2<'py, f64>, ell
     Ok(to_py_rows(py, &ellipsoid.0.nav_rates_rows("lla_vel", &p)?))
 }
 
+/// The core's latitude check of (lat, lon, h) rows: an `InputError` naming `field` and the
+/// first row whose latitude is not finite within [−π/2, π/2].
+#[pyfunction]
+fn check_latitudes_rows(lla: PyReadonlyArray2<'_, f64>, field: &str) -> PyResult<()> {
+    lla_rows(&lla, field)?;
+    Ok(())
+}
+
 /// C_n^e for one (lat, lon) as a (3, 3) array.
 #[pyfunction]
 fn dcm_ned_to_ecef_py<'py>(py: Python<'py>, lat: f64, lon: f64) -> PyResult<Bound<'py, PyArray2<f64>>> {
@@ -90,6 +98,7 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(earth_params_rows, m)?)?;
     m.add_function(wrap_pyfunction!(nav_rates_rows, m)?)?;
     m.add_function(wrap_pyfunction!(dcm_ned_to_ecef_py, m)?)?;
+    m.add_function(wrap_pyfunction!(check_latitudes_rows, m)?)?;
     m.add_function(wrap_pyfunction!(ellipsoid_constants, m)?)?;
     m.add("HEIGHT_RANGE", crate::earth::HEIGHT_RANGE)?;
     Ok(())

@@ -7,8 +7,8 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from .. import _core
-from .._validate import as_floats, finite, finite_scalar, input_error, instance, integer, locate, rows, table, vector
+from .. import _core, plausibility
+from .._validate import as_floats, finite, finite_scalar, input_error, instance, integer, locate, renamed, rows, table, vector
 from .ephemeris import Ephemerides
 from .options import GnssOptions, split_options
 
@@ -20,7 +20,8 @@ def simulate(eph: Ephemerides, time, lla, vel_ned, options: GnssOptions | None =
              clock_bias: float = 0.0, clock_drift: float = 0.0, mask_deg: float = 10.0, only: list[str] | None = None,
              outages=(), sat_outages=(), seed: int = 0, **option_fields) -> pd.DataFrame:
     """Observations of a receiver at ``lla`` (N, 3) rad/rad/m with NED velocity ``vel_ned``
-    (N, 3) m/s at GPS times ``time`` (N,) s.
+    (N, 3) m/s at GPS times ``time`` (N,) s. A latitude beyond ±π/2 is an
+    :class:`atomnav.InputError`, a longitude beyond 2π a :class:`atomnav.UnitWarning`.
 
     Noise and atmosphere from ``options`` (:class:`GnssOptions`; its fields may also be
     given as keywords, e.g. ``sigma_code=1.0, iono=False``): code σ, rate σ, Klobuchar
@@ -39,11 +40,12 @@ def simulate(eph: Ephemerides, time, lla, vel_ned, options: GnssOptions | None =
     if isinstance(sat_outages, (str, bytes)) or not all(isinstance(o, (tuple, list)) and len(o) == 3 for o in sat_outages):
         raise TypeError("sat_outages: expected a list of (sat, start, end) tuples")
     sat_out = [(str(s), finite_scalar(a, "sat_outages"), finite_scalar(b, "sat_outages")) for s, a, b in sat_outages]
-    d = _core.gnss_simulate(eph._core, t, rows(lla, 3, "lla"), rows(vel_ned, 3, "vel_ned"), opts.native,
-                            tau_gps=finite_scalar(tau_gps, "tau_gps"), clock_bias=finite_scalar(clock_bias, "clock_bias"),
-                            clock_drift=finite_scalar(clock_drift, "clock_drift"),
-                            mask=float(np.radians(finite_scalar(mask_deg, "mask_deg"))), only=only, outages=out,
-                            sat_outages=sat_out, seed=integer(seed, "seed", 0, 2**64 - 1))
+    with renamed(t="time"):  # the core names the epochs t
+        d = _core.gnss_simulate(eph._core, t, plausibility.lla(rows(lla, 3, "lla"), "lla"), rows(vel_ned, 3, "vel_ned"), opts.native,
+                                tau_gps=finite_scalar(tau_gps, "tau_gps"), clock_bias=finite_scalar(clock_bias, "clock_bias"),
+                                clock_drift=finite_scalar(clock_drift, "clock_drift"),
+                                mask=float(np.radians(finite_scalar(mask_deg, "mask_deg"))), only=only, outages=out,
+                                sat_outages=sat_out, seed=integer(seed, "seed", 0, 2**64 - 1))
     return pd.DataFrame({c: d[c] for c in OBS_COLUMNS + ["elevation_rad"]})
 
 
