@@ -108,5 +108,5 @@ def test_ephemeris_older_than_its_validity_is_rejected():
     eph = g.Ephemerides.nominal(0.0, 3600.0)
     obs = g.simulate(eph, [600.0], [LLA], [[0, 0, 0]])
     late = obs.assign(time_s=30000.0)
-    with pytest.raises(ValueError, match="ephemeris: G.. at t = 30000 s: nearest set is .* s away"):
+    with pytest.raises(ValueError, match="obs: G.. at t = 30000 s: nearest set is .* s away .*: the time does not overlap the ephemerides"):
         g.solve(eph, late)

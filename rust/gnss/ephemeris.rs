@@ -96,7 +96,7 @@ impl Ephemerides {
     }
 
     fn stale(sat: SatId, t: f64, age: f64, max: f64) -> crate::error::NavError {
-        invalid("ephemeris", format!("{} at t = {t} s: nearest set is {age:.0} s away (validity ±{max} s)", sat.name()))
+        invalid("t", format!("{} at t = {t} s: nearest set is {age:.0} s away (validity ±{max} s): the time does not overlap the ephemerides", sat.name()))
     }
 
     /// Rows [x, y, z, vx, vy, vz (WGS-84 ECEF m, m/s), clock s, clock rate s/s] of `sat`

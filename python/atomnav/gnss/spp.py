@@ -7,7 +7,7 @@ from __future__ import annotations
 import pandas as pd
 
 from .. import _core
-from .._validate import instance
+from .._validate import instance, renamed
 from .ephemeris import Ephemerides
 from .observations import obs_arrays
 from .options import GnssOptions, split_options
@@ -30,4 +30,5 @@ def solve(eph: Ephemerides, obs: pd.DataFrame, options: GnssOptions | None = Non
     opts, rest = split_options(options, option_fields)
     if rest:
         raise TypeError(f"solve() got an unexpected keyword argument {sorted(rest)[0]!r}")
-    return pd.DataFrame(_core.gnss_spp(eph._core, *obs_arrays(obs), opts.native), columns=SPP_COLUMNS)
+    with renamed(t="obs"):  # an observation time outside the ephemerides' span is the table's
+        return pd.DataFrame(_core.gnss_spp(eph._core, *obs_arrays(obs), opts.native), columns=SPP_COLUMNS)
