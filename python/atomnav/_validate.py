@@ -252,8 +252,8 @@ def increasing(t: np.ndarray, name: str, what: str = "time") -> None:
 
 
 def scalar(x, name: str) -> float:
-    """``x`` as a float; a non-number or an array is a ``TypeError`` naming ``name``."""
-    if isinstance(x, (str, bytes)) or np.ndim(x) != 0:
+    """``x`` as a float; a non-number, a bool or an array is a ``TypeError`` naming ``name``."""
+    if isinstance(x, (str, bytes, bool, np.bool_)) or np.ndim(x) != 0:
         raise TypeError(f"{name}: expected a number, got {type(x).__name__}")
     return float(as_floats(x, name))
 

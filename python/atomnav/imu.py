@@ -264,7 +264,8 @@ class ImuSimulator(Stateful):
         (extra columns ignored); its errors name ``accel`` and the column. Returns a
         DataFrame indexed by the running sample number with the measured columns (same
         names) and the bias truth columns; a ``time_s`` column is carried through as given
-        (datetime64 included)."""
+        (datetime64 included). No other column is carried: a time column under another
+        name (``time``) is ignored like any extra column, and the output then has none."""
         fcols, wcols = COLUMNS[self.kind]
         gyro_name = "accel" if gyro is None else "gyro"  # a DataFrame in accel holds the gyro too
         t = None

@@ -52,6 +52,12 @@ MAX_ANGULAR_RATE: float = 35.0
 #: 1 °/h) over 100 s at 100 Hz; a navigation-grade one is within 1 %.
 EARTH_RATE_TOLERANCE: float = 0.15
 
+#: The static mean is compared with Earth rate in °/s within :data:`EARTH_RATE_TOLERANCE`
+#: plus this many standard errors of the mean (the white-noise variance of the record over
+#: its row count): a short record's mean scatters by its noise (a tactical gyro over 10 s
+#: at 100 Hz: 12 % of Earth rate per axis), a long one's by its bias only.
+EARTH_RATE_SIGMAS: float = 3.0
+
 #: A record is static for the Earth-rate test when the variance of its angular rate about
 #: the mean is at most this many times its white-noise variance (half the mean square of
 #: successive differences, von Neumann 1941): at rest the rate varies by its sensor noise
@@ -216,10 +222,21 @@ def angular_rate(w, name: str, scale: float = 1.0, *, static: bool = False):
         with np.errstate(all="ignore"):
             mean = s.mean(axis=1)
             norm = float(np.sqrt(mean @ mean)) * scale
-        if _near(norm, EARTH_RATE / _DEG, EARTH_RATE_TOLERANCE) and _static(s, mean):
+            noise = _white_variance(s) * scale * scale
+            spread = EARTH_RATE_SIGMAS * float(np.sqrt(noise / s.shape[1]))
+        if abs(norm - EARTH_RATE / _DEG) <= EARTH_RATE_TOLERANCE * EARTH_RATE / _DEG + spread and _static(s, mean):
             _warn(name, "angular rate", "deg/s", "rad/s",
                   f"static mean |ω| = {norm:.4g}, Earth rate is {EARTH_RATE:.4g} rad/s = {EARTH_RATE / _DEG:.4g} °/s", _DEG)
     return w
+
+
+def _white_variance(s: np.ndarray) -> float:
+    """White-noise variance of rates ``s`` (3, n), summed over the axes: half the mean square
+    of successive differences (von Neumann 1941); 0 for one row."""
+    if s.shape[1] < 2:
+        return 0.0
+    with np.errstate(all="ignore"):
+        return float((np.diff(s, axis=1) ** 2).mean(axis=1).sum()) / 2
 
 
 def _static(s: np.ndarray, mean: np.ndarray) -> bool:
@@ -227,7 +244,7 @@ def _static(s: np.ndarray, mean: np.ndarray) -> bool:
     :data:`STATIC_VARIANCE_RATIO` times their white noise (or by rounding only)."""
     with np.errstate(all="ignore"):
         variance = float(s.var(axis=1).sum())
-        noise = float((np.diff(s, axis=1) ** 2).mean(axis=1).sum()) / 2 if s.shape[1] > 1 else 0.0
+    noise = _white_variance(s)
     rounding = float(1e-9**2 * (mean @ mean))  # a noise-free constant rate varies by its rounding only
     return variance <= STATIC_VARIANCE_RATIO * noise + rounding
 

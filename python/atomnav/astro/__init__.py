@@ -21,7 +21,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .. import _core
+from .. import _core, plausibility
 from .._validate import as_floats, input_error, instance, path as checked_path, positive, renamed, rows, scalar, vector
 from .results import D17_CAVEAT, Calibration, Observations
 from .scenario import Vasilyuk2024
@@ -48,8 +48,9 @@ def _rows3_unchecked(x, name: str) -> np.ndarray:
 
 
 def _single(fn, x):
+    """``fn`` of Euler angles ``beta`` (rad; (3,) or (N, 3)), warned if they look like degrees."""
     a = as_floats(x, "beta")
-    out = fn(rows(a, 3, "beta"))
+    out = fn(plausibility.angles(rows(a, 3, "beta"), "beta"))
     return out[0] if a.ndim == 1 else out
 
 

@@ -370,4 +370,6 @@ def phase_noise(sigma_p: float, contrast: float = 1.0) -> float:
 
 def acceleration_noise(sigma_phi: float, T: float, k: float = K_RB87) -> float:
     """Acceleration noise (m/s²) of a phase noise σ_φ (rad): σ_φ/(kT²)."""
-    return finite_scalar(sigma_phi, "sigma_phi") / _kt2(k, T)
+    with np.errstate(over="ignore"):
+        noise = finite_scalar(sigma_phi, "sigma_phi") / np.float64(_kt2(k, T))
+    return float(finite_result(noise, "T", "σ_φ/(kT²) (kT² too small)"))

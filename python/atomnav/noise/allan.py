@@ -188,7 +188,7 @@ def fit_allan_table(table: pd.DataFrame, n_samples: int, terms=TERMS, tau_min: f
     weighted NNLS with weights 1/σ_j², σ_j = AVAR_j/√max(1, ⌊N/m_j⌋ − 1); only the
     named ``terms`` are free, only points with tau_min ≤ τ ≤ tau_max (s) and positive
     variance are used."""
-    m, tau, var = read_table(table, ["m", "tau_s", "var"], "table", finite=False).T  # an allan_variance table, by name
+    m, tau, var = read_table(table, ["m", "tau_s", "var"], "table").T  # an allan_variance table, by name
     bad = np.flatnonzero(~(m >= 1) | (m != np.round(m)))
     if bad.size:
         raise input_error("table", f"column 'm': averaging factor {m[bad[0]]} at index {bad[0]} is not an integer >= 1", bad[0])
