@@ -349,6 +349,6 @@ mod tests {
         let e = solve_position(&eph, 600.0, &dup, &cfg, None).unwrap_err().to_string();
         assert!(e.contains("duplicated satellite") && e.contains(&format!("index {}", obs.len())), "{e}");
         let e = solve_position(&eph, 30000.0, &obs, &cfg, None).unwrap_err().to_string();
-        assert!(e.contains("ephemeris") && e.contains("validity"), "{e}");
+        assert!(e.contains("does not overlap the ephemerides") && e.contains("validity"), "{e}");
     }
 }
