@@ -62,10 +62,15 @@ def floats(x, name: str) -> np.ndarray:
     return a
 
 
+_FLOAT64 = np.dtype(np.float64)
+
+
 def as_floats(x, name: str) -> np.ndarray:
     """``x`` as a float64 array; anything that is not numbers (None, strings even when
     they spell numbers, datetimes, complex numbers, ragged nesting) is a ``TypeError``
     naming ``name``. A pandas object's ``pd.NA`` becomes NaN."""
+    if type(x) is np.ndarray and x.dtype is _FLOAT64:
+        return x  # the common case first: a per-step call from a Python loop pays no more checks
     if x is None or isinstance(x, (str, bytes)):
         raise TypeError(f"{name}: expected numbers, got {type(x).__name__} {x!r}")
     if isinstance(x, (pd.Series, pd.DataFrame)):
@@ -302,6 +307,26 @@ def integer(x, name: str, low: int = 0, high: int = 2**63 - 1) -> int:
     if not low <= int(x) <= high:
         raise input_error(name, f"must be an integer in [{low}, {high}], got {x}")
     return int(x)
+
+
+def integers(x, name: str) -> np.ndarray:
+    """``x`` as a 1-D C-contiguous int64 array (row indices, ids); anything that is not
+    integers (floats, bools, strings, ragged nesting) is a ``TypeError``, another shape or
+    a value beyond int64 an :class:`InputError`, both naming ``name``."""
+    try:
+        a = np.asarray(x)
+    except ValueError as e:  # ragged nesting
+        raise TypeError(f"{name}: expected integers in a regular (N,) shape, got {type(x).__name__} ({e})") from None
+    if a.size == 0 and a.dtype.kind == "f":  # an empty list reads as float64
+        a = a.astype(np.int64)
+    if a.dtype.kind not in "iu":
+        raise TypeError(f"{name}: expected integers, got an array of {a.dtype}")
+    if a.ndim != 1:
+        raise input_error(name, f"expected shape (N,), got {a.shape}")
+    big = np.flatnonzero(a > np.iinfo(np.int64).max) if a.dtype.kind == "u" else ()
+    if len(big):
+        raise input_error(name, f"value {a[big[0]]} at index {big[0]} is beyond int64", big[0])
+    return np.ascontiguousarray(a, dtype=np.int64)
 
 
 def flag(x, name: str) -> bool:
