@@ -8,10 +8,10 @@
 - :mod:`.arma` — differencing, ADF/KPSS, ACF/PACF, AIC/BIC order grid, exact-ML
   ARMA fit and residual diagnostics (statsmodels).
 - :mod:`.baselines` — Butterworth low-pass and wavelet-threshold denoising.
-- :mod:`.synth` — the spec's synthetic data, model A and model B.
+- :mod:`.synth` — seeded synthetic data, model A and model B.
 - :mod:`.report` — the paper's Tables 2–4 beside atomnav's values, Allan and PSD plots.
 
-Notation (spec §2): ω_k is the raw rate (°/h in the paper; the paper's x(n), y(n) in
+Notation: ω_k is the raw rate (°/h in the paper; the paper's x(n), y(n) in
 Eqs. 9, 11–12), d_k = ω_k − ω_{k−1} the differenced series (the paper's y(n) in Eqs.
 10–11, and the "y" of the differenced reading of Eq. 17), a_k the ARMA innovation.
 """

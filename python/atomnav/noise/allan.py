@@ -184,7 +184,7 @@ class AllanFit:
 
 
 def fit_allan_table(table: pd.DataFrame, n_samples: int, terms=TERMS, tau_min: float | None = None, tau_max: float | None = None) -> AllanFit:
-    """Five-term fit to an :func:`allan_variance` table (overlapping Allan, spec D15):
+    """Five-term fit to an :func:`allan_variance` table (overlapping Allan, docs/departures.md#allan-fit):
     weighted NNLS with weights 1/σ_j², σ_j = AVAR_j/√max(1, ⌊N/m_j⌋ − 1); only the
     named ``terms`` are free, only points with tau_min ≤ τ ≤ tau_max (s) and positive
     variance are used."""
@@ -231,7 +231,7 @@ def ss_deg_per_sqrt_hour(fit: AllanFit) -> float:
 
 
 def bias(omega) -> float:
-    """Bias: the mean of the series (spec E17), in the rate unit."""
+    """Bias: the mean of the series, in the rate unit."""
     return float(np.mean(_series(omega, "omega")))
 
 
@@ -254,7 +254,7 @@ def bias_stability(omega, window: int = 1) -> float:
 
 def improvement_ratio(before, after, absolute: bool = False):
     """Improvement ratio in percent (Niu et al. 2025 Eq. 18): (M_raw − M_filt)/M_raw·100, signed
-    by default (spec D11: negative means the filter made the metric worse);
+    by default (docs/departures.md#signed-improvement-ratio: negative means the filter made the metric worse);
     ``absolute=True`` gives the paper's |M_raw − M_filt|/M_raw·100."""
     b = as_floats(before, "before")
     a = as_floats(after, "after")

@@ -1,4 +1,5 @@
-"""ARMA identification on statsmodels (spec E2–E6, E19, D2–D3): differencing and its
+"""ARMA identification on statsmodels (Niu et al. 2025 Eqs. 6–13; settings in
+docs/departures.md#statsmodels-defaults): differencing and its
 inverse, ADF and KPSS with a plain verdict, ACF/PACF with bands, the AIC/BIC order grid,
 exact-ML fit and residual diagnostics. Nothing here re-implements statsmodels."""
 
@@ -23,7 +24,7 @@ def _series(x, name: str, min_len: int) -> np.ndarray:
 
 
 def difference(omega, d: int = 1) -> np.ndarray:
-    """d-th difference (spec E2, D1): d_k = ω_k − ω_{k−1}, length N − d."""
+    """d-th difference (Niu et al. 2025 Eq. 11; docs/departures.md#first-difference): d_k = ω_k − ω_{k−1}, length N − d."""
     d = integer(d, "d")
     x = vector(omega, None, "omega")
     if x.size <= d:
@@ -41,7 +42,7 @@ def undifference(diffs, initial) -> np.ndarray:
 @dataclass
 class Stationarity:
     """ADF (H₀: unit root) and KPSS (H₀: level-stationary) results. ``passed`` when ADF
-    rejects its null (p < alpha) and KPSS does not reject its null (p > alpha) (spec E3).
+    rejects its null (p < alpha) and KPSS does not reject its null (p > alpha).
     KPSS p-values are clipped by statsmodels to [0.01, 0.10]."""
 
     adf_stat: float
@@ -71,7 +72,7 @@ class Stationarity:
 
 def stationarity(z, regression: str = "c", alpha: float = 0.05) -> Stationarity:
     """ADF (``adfuller(regression, autolag='AIC')``) and KPSS (``kpss(regression,
-    nlags='auto')``) on the series z (spec D2). ``regression``: "c" (level) or "ct"
+    nlags='auto')``) on the series z (docs/departures.md#statsmodels-defaults). ``regression``: "c" (level) or "ct"
     (trend); Matlab's defaults differ, hence exposed."""
     from statsmodels.tsa.stattools import adfuller, kpss
     from statsmodels.tools.sm_exceptions import InterpolationWarning
@@ -114,7 +115,7 @@ def _arima(d, p: int, q: int):
 
 def select_arma(d, max_p: int = 3, max_q: int = 3) -> pd.DataFrame:
     """AIC and BIC of ARMA(p, q) fits to the (already differenced) series d for every
-    p ≤ max_p, q ≤ max_q (spec D3). AIC = 2n_p − 2 ln L, BIC = n_p ln n − 2 ln L, n_p
+    p ≤ max_p, q ≤ max_q (docs/departures.md#order-selection). AIC = 2n_p − 2 ln L, BIC = n_p ln n − 2 ln L, n_p
     including σ². Columns: p, q, llf, aic, bic, sorted by BIC."""
     max_p, max_q = integer(max_p, "max_p"), integer(max_q, "max_q")
     x = _series(d, "d", _min_len(max_p, max_q))
@@ -148,7 +149,7 @@ class ArmaFit:
 def fit_arma(omega, order=(2, 1), differenced: bool = False, lags: int = 10) -> ArmaFit:
     """Fit ARMA(p, q) = ``order`` by exact ML to the first difference of ``omega`` (i.e.
     ARIMA(p,1,q) on ω), or to ``omega`` itself when ``differenced=True``.
-    ``ARIMA(d, order=(p,0,q), trend='n')`` (spec D2)."""
+    ``ARIMA(d, order=(p,0,q), trend='n')`` (docs/departures.md#statsmodels-defaults)."""
     try:
         p, q = order
     except (TypeError, ValueError):

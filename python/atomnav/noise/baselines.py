@@ -14,7 +14,7 @@ MAX_BUTTERWORTH_ORDER = 24
 def butterworth_lowpass(omega, tau0: float, fc: float = 0.002, order: int = 2, zero_phase: bool = True) -> np.ndarray:
     """Butterworth low-pass at cutoff ``fc`` (Hz) of a series sampled every ``tau0`` s:
     ``butter(order, fc, fs=1/tau0, output='sos')`` with ``sosfiltfilt`` (zero phase, the
-    default: |H|⁴, no lag) or causal ``sosfilt`` started at the first sample (spec D13)."""
+    default: |H|⁴, no lag) or causal ``sosfilt`` started at the first sample (docs/departures.md#low-pass-baseline)."""
     from scipy.signal import butter, sosfilt, sosfilt_zi, sosfiltfilt
 
     x = vector(omega, None, "omega")
@@ -37,7 +37,7 @@ def butterworth_lowpass(omega, tau0: float, fc: float = 0.002, order: int = 2, z
 
 
 def wavelet_denoise(omega, wavelet: str = "db4", level: int = 5, threshold: str = "universal", mode: str = "soft") -> np.ndarray:
-    """Wavelet-threshold denoising (VisuShrink, spec E13/D14): ``wavedec(ω, wavelet,
+    """Wavelet-threshold denoising (VisuShrink, docs/departures.md#wavelet-baseline): ``wavedec(ω, wavelet,
     level, mode='symmetric')``; σ̂ = median|cD₁|/0.6745; λ = σ̂√(2 ln N); ``mode``
     ("soft" or "hard") threshold on every detail level, approximation kept; inverse
     transform truncated to N."""

@@ -1,12 +1,12 @@
 """ARIMA state-space form and Kalman filters of Niu et al. 2025; the
 numerical work runs in Rust.
 
-Eq. 17 has two readings (spec E10, D7): ``"literal"`` takes y = ω (the raw rate);
+Eq. 17 has two readings (docs/departures.md#reading-of-eq-17): ``"literal"`` takes y = ω (the raw rate);
 ``"differenced"`` takes y = d = ω_k − ω_{k−1}, the symbol's meaning everywhere else in
 the paper. The default adaptive reading is ``"differenced"``: on model-B data only it
-reproduces the paper's "adaptive better than fixed" (100/100 seeds, spec §4b.5); the
+reproduces the paper's "adaptive better than fixed" (100/100 seeds); the
 literal reading ties with the fixed filter, or loses to it with the paper's Q.
-Sage–Husa is the standard form (spec E11) — the paper gives no equations for it.
+Sage–Husa is the standard form (docs/departures.md#sage-husa-filter) — the paper gives no equations for it.
 """
 
 from __future__ import annotations
@@ -20,7 +20,7 @@ from .. import _core
 from .._stateful import Stateful, serialized
 from .._validate import as_floats, finite, input_error, instance, positive, vector
 
-#: The default reading of Eq. 17 (spec D7, binding).
+#: The default reading of Eq. 17 (docs/departures.md#reading-of-eq-17).
 DEFAULT_READING = "differenced"
 READINGS = ("differenced", "literal")
 #: Niu et al. 2025 Eq. 10: φ₁, φ₂, β₁, σ_a² (°/h)².
@@ -34,9 +34,9 @@ class ArimaStateSpace:
     """ARIMA(p,d,q) in state-space form X_k = Φ X_{k−1} + B W_{k−1}, Y_k = H X_k + V_k
     (Niu et al. 2025 Eqs. 14, 16) with H = [1 0 … 0].
 
-    ``ar`` = φ, ``ma`` = β (statsmodels' sign convention, spec E4), ``sigma2`` = σ_a² in
+    ``ar`` = φ, ``ma`` = β (statsmodels' sign convention, Niu et al. 2025 Eqs. 6–8), ``sigma2`` = σ_a² in
     the rate unit squared. ``noise_form="paper"``: the paper's B with Q = σ²I
-    (default); ``"exact"``: X = [ω…, a_k…], G = e₀ + e_r, scalar Q = σ² (spec D5)."""
+    (default); ``"exact"``: X = [ω…, a_k…], G = e₀ + e_r, scalar Q = σ² (docs/departures.md#arma-noise-form)."""
 
     ar: tuple
     ma: tuple

@@ -2,9 +2,9 @@
 differenced data, fixed and adaptive Kalman filters, Sage–Husa, low-pass and wavelet
 baselines; bias, bias stability, SS, LS and improvement ratios; Allan and PSD plots.
 
-Units (spec D16): rate in °/h, τ in s, SS in °/√h, LS and BS in °/h.
+Units (docs/departures.md#units-of-the-report): rate in °/h, τ in s, SS in °/√h, LS and BS in °/h.
 
-Unit caveat (spec §5): the paper's headline numbers are mutually inconsistent. With τ
+Unit caveat: the paper's headline numbers are mutually inconsistent. With τ
 in hours, SS = 0.015 °/√h means white noise of 0.1248 °/h per 52 s sample, above the
 reported BS = 0.0766 °/h, so the paper's BS must average at least 3 samples; model B
 therefore matches SS at w = 1 and BS at w = 3, and does not attempt LS = 3.56e-4 °/h
@@ -64,7 +64,7 @@ class Comparison:
 
 def compare(omega, tau0: float = 52.0, order=(2, 1), bs_windows=(1, 3)) -> Comparison:
     """Run the paper's pipeline on the rate series ``omega`` (°/h): fit ARMA(``order``)
-    to its first difference, Q = R₀ = σ̂_a² (spec D9), then filter with every method."""
+    to its first difference, Q = R₀ = σ̂_a² (docs/departures.md#q-from-the-data), then filter with every method."""
     w = vector(omega, None, "omega")
     tau0 = positive(tau0, "tau0")
     fit = arma.fit_arma(w, order)

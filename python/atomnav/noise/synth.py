@@ -1,8 +1,8 @@
-"""Seeded synthetic data of the spec (§5): model A (ARIMA(2,1,1) with the paper's
+"""Seeded synthetic data: model A (ARIMA(2,1,1) with the paper's
 coefficients) and model B (white + flicker + rate random walk + trend calibrated to the
 paper's raw metrics). Rates in °/h, τ₀ = 52 s, mean shifted to exactly 0.6851 °/h.
 Both draw from ``numpy.random.default_rng(seed)`` in the documented order, so the
-spec's reference numbers reproduce."""
+same seed gives the same series on every machine."""
 
 from __future__ import annotations
 

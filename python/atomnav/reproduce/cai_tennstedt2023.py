@@ -1,4 +1,4 @@
-"""Seed 003 (Tennstedt et al. 2023, atom strapdown) and seed 000 §3 (fringe noise
+"""Tennstedt et al. 2023 (atom strapdown) and Tennstedt et al. 2021 §3 (fringe noise
 identification): predictor vs inertial oracle, Fig. 7 term magnitudes along the
 drive-with-yaw trajectory, Fig. 8 bias-induced term errors vs lever arm against the
 dynamic range, finite pulses / convolution, and ML noise-identification convergence."""
@@ -89,7 +89,7 @@ def _fig7(report):
     axes[0, 0].legend(fontsize=7, ncol=3)
     axes[1, 0].set_xlabel("t (s)")
     axes[1, 1].set_xlabel("t (s)")
-    report.figure(fig, "fig7_terms", "Seed 003 Fig. 7 analogue: phase terms along the drive with yaw (T = 25 ms, 1 m/s, 0.05 rad/s yaw-rate amplitude), l = 0 and [1, 0, 0] m")
+    report.figure(fig, "fig7_terms", "Tennstedt et al. 2023 Fig. 7 analogue: phase terms along the drive with yaw (T = 25 ms, 1 m/s, 0.05 rad/s yaw-rate amplitude), l = 0 and [1, 0, 0] m")
 
 
 def _fig8(report):
@@ -118,8 +118,8 @@ def _fig8(report):
     e_eul = max(np.abs(err[a]["eul"]).max() for a in range(3))
     report.row("Fig. 8 Euler-term error from biases only [rad]", 0.0, e_eul, bool(e_eul < 1e-9))
     slope = max(abs(np.polyfit(ells, err[a]["cen"], 1)[0]) for a in range(3))
-    report.row("Fig. 8 centrifugal-term error slope [rad/m]", "≈ 0.6 (spec); paper: 0.4 m exceeds range", slope,
-               "not reproducible from bias errors (spec Decision 13)")
+    report.row("Fig. 8 centrifugal-term error slope [rad/m]", "≈ 0.6 (independent computation); paper: 0.4 m exceeds range", slope,
+               "not reproducible from bias errors (docs/departures.md#lever-arm-error-of-fig-8)")
     import matplotlib.pyplot as plt
 
     fig, axes = plt.subplots(1, 3, figsize=(12, 3.6), sharey=True)
@@ -133,7 +133,7 @@ def _fig8(report):
         axes[ax].set_ylim(1e-4, 10)
     axes[0].set_ylabel("|bias-induced phase error| (rad), channel x_A")
     axes[0].legend(fontsize=7)
-    report.figure(fig, "fig8_lever", "Seed 003 Fig. 8 analogue: bias-induced error per term vs lever arm (ω = 0.5, ω̇ = 1, f = 3 per axis; b_a = 1e-4 m/s², b_g = 3e-5 rad/s)")
+    report.figure(fig, "fig8_lever", "Tennstedt et al. 2023 Fig. 8 analogue: bias-induced error per term vs lever arm (ω = 0.5, ω̇ = 1, f = 3 per axis; b_a = 1e-4 m/s², b_g = 3e-5 rad/s)")
 
 
 def _scalars(report):
@@ -176,7 +176,7 @@ def _noise_id(report):
     report.row("R at mid-fringe = a + b", r_true, nr.R_mid.mean(), bool(abs(nr.R_mid.mean() / r_true - 1) < 0.1))
     report.row("iterations per batch, gradient ascent / Newton (mean)", "≈ 50 (paper, GA)",
                f"{ga.iterations.mean():.1f} / {nr.iterations.mean():.1f}", bool(nr.iterations.mean() < ga.iterations.mean()))
-    report.row("full triple (σ_p0, σ_φ, σ_A)", "paper: all recovered", "unidentifiable (reported)", "spec §2.5")
+    report.row("full triple (σ_p0, σ_φ, σ_A)", "paper: all recovered", "unidentifiable (reported)", "docs/departures.md#identifiable-readout-noise")
     import matplotlib.pyplot as plt
 
     fig, axes = plt.subplots(1, 3, figsize=(12, 3.4))
@@ -192,10 +192,10 @@ def _noise_id(report):
     axes[0].legend(fontsize=7)
     axes[2].bar(["gradient", "Newton"], [ga.iterations.mean(), nr.iterations.mean()])
     axes[2].set_ylabel("iterations per batch (mean)")
-    report.figure(fig, "noise_id", "Seed 000 Fig. 5 analogue: ML noise identification (σ_A fixed at 0.02) over 4200 readouts, batches of 200 and sliding window")
+    report.figure(fig, "noise_id", "Tennstedt et al. 2021 Fig. 5 analogue: ML noise identification (σ_A fixed at 0.02) over 4200 readouts, batches of 200 and sliding window")
 
 
-@section("cai_tennstedt2023", "Atom strapdown (seed 003) and CAI noise identification (seed 000 §3)")
+@section("cai_tennstedt2023", "Atom strapdown (Tennstedt et al. 2023) and CAI noise identification (Tennstedt et al. 2021 §3)")
 def run(report):
     _scalars(report)
     _oracle_error(report)

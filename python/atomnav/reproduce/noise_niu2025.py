@@ -1,6 +1,6 @@
 """Niu et al. 2025: ARMA-model Kalman filtering of atom-interferometer-gyro
 noise. Deterministic oracles of the paper's model, then the paper's Tables 2–4 beside
-atomnav's values on model-B data (spec §5; the paper's data are not public), the
+atomnav's values on model-B data (:mod:`atomnav.noise.synth`; the paper's data are not public), the
 paper's directional claims over seeds, and the Allan / PSD plots."""
 
 from __future__ import annotations
@@ -18,13 +18,13 @@ def _oracles(report) -> None:
     m = filters.ArimaStateSpace.paper()
     report.row("Eq. 12 coefficients [1+φ1, φ2−φ1, −φ2]", "[0.982, 0.047, -0.029]", str(np.round(m.phi[0], 6).tolist()), bool(np.allclose(m.phi[0], [0.982, 0.047, -0.029], rtol=1e-9)))
     ev = np.sort(m.eigenvalues.real)
-    report.row("eigenvalues of Φ", "1, 0.1615315, -0.1795315 (spec)", str(np.round(ev, 7).tolist()), bool(np.allclose(ev, [-0.1795315, 0.1615315, 1.0], atol=1e-7)))
+    report.row("eigenvalues of Φ", "1, 0.1615315, -0.1795315 (closed form)", str(np.round(ev, 7).tolist()), bool(np.allclose(ev, [-0.1795315, 0.1615315, 1.0], atol=1e-7)))
     q00 = m.process_noise[0, 0]
     report.row("(BQBᵀ)₀₀ = σ²(1+β1²)", 0.0693035, q00, bool(abs(q00 - 0.0693035) < 1e-12))
     k, _, _ = filters.steady_state_gain(m, 0.035)
-    report.row("steady-state gain K∞ (R = Q = 0.035)", "[0.730, 0.196, 0.058] (spec)", str(np.round(k, 6).tolist()), bool(np.allclose(np.round(k, 3), [0.730, 0.196, 0.058])))
+    report.row("steady-state gain K∞ (R = Q = 0.035)", "[0.730, 0.196, 0.058] (scipy solve_discrete_are)", str(np.round(k, 6).tolist()), bool(np.allclose(np.round(k, 3), [0.730, 0.196, 0.058])))
     r = filters.kalman(np.array([1.0, 3, 2, 5, 4]), m, adaptive="literal").r[1:]
-    report.row("Eq. 17 R̂(2…5) for y = [1,3,2,5,4]", "2, 1.25, 7/3, 1.875 (spec)", str(np.round(r, 6).tolist()), bool(np.allclose(r, [2, 1.25, 7 / 3, 1.875], rtol=1e-12)))
+    report.row("Eq. 17 R̂(2…5) for y = [1,3,2,5,4]", "2, 1.25, 7/3, 1.875 (by hand)", str(np.round(r, 6).tolist()), bool(np.allclose(r, [2, 1.25, 7 / 3, 1.875], rtol=1e-12)))
     ir = lambda a, b: float(allan.improvement_ratio(a, b, absolute=True))
     for what, paper, val in [
         ("BS improvement, adaptive KF (Table 2)", "28.2 %", ir(0.0766, 0.0550)),
@@ -47,11 +47,11 @@ def _tables(report, cmp) -> None:
             pv = paper.loc[pname, pcol]
             av = float(t.loc[aname, acol])
             if np.isnan(pv):
-                verdict = "not in paper" if pname not in ("LPF", "WD") or pcol != "bs_dph" else "paper prints the bias here (D18)"
+                verdict = "not in paper" if pname not in ("LPF", "WD") or pcol != "bs_dph" else "paper prints the bias here (docs/departures.md#table-4-misprints)"
             else:
                 verdict = f"ratio {av / pv:.2f}"
                 if pcol == "ls_dph":
-                    verdict += " (model B is not calibrated to the paper's LS: 13 h cannot measure it, spec §5)"
+                    verdict += " (model B is not calibrated to the paper's LS: 13 h cannot measure it)"
             report.row(f"model B: {pname} {label}", pv if not np.isnan(pv) else "–", av, verdict)
     for name in ("adaptive KF (literal)", "Sage-Husa"):
         report.row(f"model B: {name} BS₁ / SS (not in the paper's tables)", "–", f"{t.loc[name, 'bs1_dph']:.5f} / {t.loc[name, 'ss_dpsh']:.5f}", "extra")
@@ -79,9 +79,9 @@ def _claims(report, cmp, seeds) -> None:
         wins["WD ≥ adaptive on BS₁"] += allan.bias_stability(baselines.wavelet_denoise(w)) <= met["diff"][0]
         worst_bias = max(worst_bias, max(abs(x.mean() - w.mean()) for x in out.values()))
     n = len(seeds)
-    spec = {"differenced > fixed (BS₁, BS₃, SS)": "100 %", "literal > fixed (BS₁, BS₃, SS)": "41 %", "adaptive raises LS": "100 %", "WD ≥ adaptive on BS₁": "100 %"}
+    expected = {"differenced > fixed (BS₁, BS₃, SS)": "100 %", "literal > fixed (BS₁, BS₃, SS)": "41 %", "adaptive raises LS": "100 %", "WD ≥ adaptive on BS₁": "100 %"}
     for k, v in wins.items():
-        report.row(f"seeds {seeds[0]}–{seeds[-1]}: {k}", f"spec: {spec[k]} of 100", f"{100 * v / n:.0f} % of {n}", "seed count")
+        report.row(f"seeds {seeds[0]}–{seeds[-1]}: {k}", f"expected: {expected[k]} of 100", f"{100 * v / n:.0f} % of {n}", "seed count")
     report.row("worst |Δbias| of the KFs over the seeds (°/h)", "≤ 0.001 (paper shifts 0.0003, 0.0009)", worst_bias, bool(worst_bias <= 0.001))
 
 

@@ -31,7 +31,7 @@ def reproduce(report) -> None:
         ss = dare(1.0, q, h, R_CAI)
         _, post = kalman_recursion(1.0, q, h, R_CAI, np.array([[1e4 * closed]]), steps)
         p_dare = float(ss.p_post[0, 0])
-        report.row(f"P+ {label} closed form (E27) {unit}", paper, closed, f"ratio {closed / paper:.4f}")
+        report.row(f"P+ {label} closed form (Eqs. 32–33) {unit}", paper, closed, f"ratio {closed / paper:.4f}")
         report.row(f"P+ {label} DARE {unit}", paper, p_dare, bool(abs(p_dare / paper - 1) < 5e-3))
         report.row(f"P+ {label} Kalman recursion, {steps} steps {unit}", paper, float(post[-1, 0, 0]),
                    bool(abs(post[-1, 0, 0] / p_dare - 1) < 1e-6))
