@@ -170,10 +170,10 @@ class ImuErrors:
 
     @classmethod
     def preset(cls, preset: str) -> "ImuErrors":
-        """A copy of the named ``preset``: built-in ``navigation`` (seed-003 RLG IMU),
-        ``tactical`` (typical class values), ``mems`` (seed-000 hexapod MEMS),
-        ``electrostatic_space`` / ``electrostatic_space_drift`` (seed-000 satellite
-        accelerometer), ``precise`` / ``medium`` / ``coarse`` (Demidov 2009 classes), or a
+        """A copy of the named ``preset``: built-in ``navigation`` (RLG IMU of Tennstedt et al. 2023),
+        ``tactical`` (typical class values), ``mems`` (hexapod MEMS of Tennstedt et al. 2021),
+        ``electrostatic_space`` / ``electrostatic_space_drift`` (satellite accelerometer
+        of Tennstedt et al. 2021), ``precise`` / ``medium`` / ``coarse`` (Demidov 2009 classes), or a
         name added with :func:`register_preset`. Sources are in ``rust/imu/presets.rs``."""
         if not isinstance(preset, str):
             raise TypeError(f"preset: expected a str, got {type(preset).__name__}")

@@ -25,7 +25,7 @@ IMU_COLUMNS = {
     "rates": ["time_s", "gyro_x_rad_s", "gyro_y_rad_s", "gyro_z_rad_s", "accel_x_mps2", "accel_y_mps2", "accel_z_mps2"],
     "increments": ["time_s", "dtheta_x_rad", "dtheta_y_rad", "dtheta_z_rad", "dv_x_mps", "dv_y_mps", "dv_z_mps"],
 }
-#: Default site: Moscow, 55.75°N 37.6°E, 200 m (spec gnss-ins-tight §3).
+#: Default site: Moscow, 55.75°N 37.6°E, 200 m.
 MOSCOW = (np.deg2rad(55.75), np.deg2rad(37.6), 200.0)
 #: Most samples of a generated trajectory (a table of 14 float columns: 11 GB).
 MAX_SAMPLES = 100_000_000
@@ -284,8 +284,8 @@ def sinusoidal(duration: float, rate_hz: float = 100.0, *, origin=MOSCOW, amp_ne
 
 
 def hexapod(rate_hz: float = 1000.0, origin=MOSCOW, max_tilt: float = 0.0654, pitch_delay: float = 5.0, heading: float = 0.0, ellipsoid: str = "WGS84") -> Trajectory:
-    """Seed 000 §5.3 hexapod: 170 s of roll/pitch tilt steps up to ``max_tilt`` rad
-    (0.0654 rad = 3.75°), pitch delayed by ``pitch_delay`` s (spec cai-ekf decision 13)."""
+    """Hexapod of Tennstedt et al. 2021, §5.3: 170 s of roll/pitch tilt steps up to ``max_tilt`` rad
+    (0.0654 rad = 3.75°), pitch delayed by ``pitch_delay`` s (docs/departures.md#hexapod-scenario)."""
     return Trajectory.from_motion(_core.Motion.hexapod(_origin(origin), plausibility.angles(finite_scalar(max_tilt, "max_tilt"), "max_tilt", "tilt"),
                                                       finite_scalar(pitch_delay, "pitch_delay"),
                                                       plausibility.angles(finite_scalar(heading, "heading"), "heading", "heading")), rate_hz, ellipsoid)
@@ -293,7 +293,7 @@ def hexapod(rate_hz: float = 1000.0, origin=MOSCOW, max_tilt: float = 0.0654, pi
 
 def drive_with_yaw(rate_hz: float = 200.0, origin=MOSCOW, speed: float = 1.0, yaw_rate_amp: float = 0.05, period: float = 50.0,
                    duration: float = 50.0, heading: float = 0.0, ellipsoid: str = "WGS84") -> Trajectory:
-    """Seed 003 Fig. 7: straight drive at ``speed`` m/s with yaw rate
+    """Tennstedt et al. 2023, Fig. 7: straight drive at ``speed`` m/s with yaw rate
     ``yaw_rate_amp``·sin(2πt/``period``) rad/s."""
     m = _core.Motion.drive_with_yaw(_origin(origin), finite_scalar(speed, "speed"), finite_scalar(yaw_rate_amp, "yaw_rate_amp"),
                                     finite_scalar(period, "period"), finite_scalar(duration, "duration"),
@@ -303,14 +303,14 @@ def drive_with_yaw(rate_hz: float = 200.0, origin=MOSCOW, speed: float = 1.0, ya
 
 def slalom(rate_hz: float = 200.0, origin=MOSCOW, speed: float = 5.0, amp: float = 2.0, period: float = 10.0, duration: float = 60.0,
            ellipsoid: str = "WGS84") -> Trajectory:
-    """Seed 003 smooth slalom: north = speed·t, east = amp·sin(2πt/period), level, heading
+    """Smooth slalom (Tennstedt et al. 2023): north = speed·t, east = amp·sin(2πt/period), level, heading
     along the path."""
     return Trajectory.from_motion(_core.Motion.slalom(_origin(origin), finite_scalar(speed, "speed"), finite_scalar(amp, "amp"),
                                                      finite_scalar(period, "period"), finite_scalar(duration, "duration")), rate_hz, ellipsoid)
 
 
 def car(rate_hz: float = 200.0, origin=MOSCOW, heading: float = 0.0, vibration: bool = True, ellipsoid: str = "WGS84") -> Trajectory:
-    """Seed 003 Fig. 9 car-like 40 s profile: static, accelerating, sliding and
+    """Car-like 40 s profile after Tennstedt et al. 2023, Fig. 9: static, accelerating, sliding and
     coordinated turns, a shock at 26 s, vibration at 4.3/9.7/15.1 Hz."""
     return Trajectory.from_motion(_core.Motion.car(_origin(origin), plausibility.angles(finite_scalar(heading, "heading"), "heading", "heading"), bool(instance(vibration, (bool, np.bool_), "vibration"))), rate_hz, ellipsoid)
 
@@ -325,6 +325,6 @@ def rotary_stand(states, move_starts, move_duration: float, duration: float, rat
 
 
 def vasilyuk2024_stand(rate_hz: float = 200.0, origin=(np.deg2rad(55.6), np.deg2rad(38.2), 200.0), ellipsoid: str = "WGS84") -> Trajectory:
-    """Seed 001 calibration stand schedule: 13 states, 12 quintic moves, 73 camera epochs
-    21.0007 s apart (spec astro-calibration §5.1)."""
+    """Calibration stand schedule after Vasilyuk et al. 2024: 13 states, 12 quintic moves, 73 camera epochs
+    21.0007 s apart."""
     return Trajectory.from_motion(_core.Motion.vasilyuk2024_stand(_origin(origin)), rate_hz, ellipsoid)

@@ -5,7 +5,7 @@ whole IMU record in chunks with a progress bar, :meth:`AidedIns.process` /
 :meth:`AidedIns.finish` stream it yourself. Closed loop (feedback) or open loop
 (estimation) is chosen at construction, and so is the vertical channel: free, or
 damped by a reference (barometric) altitude per IMU sample (``vertical="damped"``, the
-third-order baro loop of Demidov 2009, Eq. 26), which :meth:`AidedIns.run` then takes as
+third-order baro loop, docs/departures.md#baro-damped-vertical-channel), which :meth:`AidedIns.run` then takes as
 ``h_ref``. The INS part of every factory is one frozen configuration, :class:`InsSetup`,
 checked by the core when it is built and convertible to and from dict and JSON."""
 
@@ -46,7 +46,7 @@ class InsSetup(Config):
     "damped", then :meth:`AidedIns.run` needs ``h_ref``, the reference (barometric)
     altitude (m) per IMU sample; ``zeta``, ``omega`` (rad/s) of the baro loop (default None:
     the core's 0.707 and 0.01 rad/s)
-    (K_v1 = 2ζω, K_v2 = ω² + 2γ/R₀; Demidov 2009, Eq. 26); the reference-altitude error
+    (K_v1 = 2ζω, K_v2 = ω² + 2γ/R₀, the gains of Demidov 2009); the reference-altitude error
     h_b − h = b + n: ``baro_psd`` the PSD of the white part n (m²·s; σ²Δt for independent
     samples of σ every Δt), ``baro_bias`` a :class:`BiasModel` of b carried as the state
     ``baro_bias`` (m, after the sensor's extra states) with initial σ

@@ -152,7 +152,7 @@ class BiasModel(Config):
 def ins_error_model(lla, vel_ned, q_nb, f_b, accel_psd: float, gyro_psd: float,
                     accel_bias: BiasModel = BiasModel(), gyro_bias: BiasModel = BiasModel(), *,
                     layout: Layout | None = None, ellipsoid: str = "WGS84") -> tuple[np.ndarray, np.ndarray]:
-    """Continuous INS error model F, Q_c (Demidov 2009, Eq. 28) along a trajectory.
+    """Continuous 15-state NED INS error model F, Q_c (docs/departures.md#error-states-in-metres) along a trajectory.
 
     lla (N, 3) rad/rad/m, vel_ned (N, 3) m/s, q_nb (N, 4), f_b (N, 3) compensated specific
     force m/s²; accel_psd ((m/s²)²/Hz = VRW²) and gyro_psd (rad²/s = ARW²) white noise.

@@ -1,4 +1,4 @@
-"""GNSS for tight GPS + GLONASS / INS integration (spec gnss-ins-tight-demidov2009):
+"""GNSS for tight GPS + GLONASS / INS integration (Demidov 2009):
 broadcast orbits, nominal constellations, observation simulation, single-point
 positioning with the system-time offset τ_GPS, and the tightly coupled aided INS."""
 

@@ -1,5 +1,5 @@
 """Broadcast ephemerides of GPS (Keplerian elements, IS-GPS-200) and GLONASS (state
-vectors, GLONASS ICD) and the nominal constellations of spec gnss-ins-tight §2.5.
+vectors, GLONASS ICD) and nominal constellations (circular orbits of the nominal planes and slots).
 
 Times are GPS system time in seconds (t = 0 at the start of a GPS week); GLONASS sets are
 referenced to GLONASS time, T_GPS − T_GLO = ΔT_leap + τ_GPS with ΔT_leap = n_leap − 10800 s.
@@ -79,7 +79,7 @@ class Ephemerides:
         return pd.DataFrame(a, columns=["elevation_rad", "azimuth_rad"])
 
     def top(self, n: int, t: float, lla, mask_deg: float = 10.0) -> list[str]:
-        """The ``n`` highest satellites above the mask at time ``t`` (fixed subsets, spec §4 row 13)."""
+        """The ``n`` highest satellites above the mask at time ``t`` (fixed subsets)."""
         n, t, lla = integer(n, "n", 0), finite_scalar(t, "t"), vector(lla, 3, "lla")
         mask = np.radians(finite_scalar(mask_deg, "mask_deg"))
         el = {s: self.look_angles(s, [t], lla)["elevation_rad"].iloc[0] for s in self.satellites}

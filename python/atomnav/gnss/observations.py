@@ -1,6 +1,6 @@
-"""Simulated code and pseudorange-rate observations (spec gnss-ins-tight §2.6) as a table
+"""Simulated code and pseudorange-rate observations as a table
 with one row per satellite and epoch: ``time_s, sat, channel, code_m, rate_mps``.
-GLONASS code is delivered with c·ΔT_leap removed (Eq. 15)."""
+GLONASS code is delivered with c·ΔT_leap removed (as in Demidov 2009)."""
 
 from __future__ import annotations
 
@@ -50,7 +50,7 @@ def simulate(eph: Ephemerides, time, lla, vel_ned, options: GnssOptions | None =
 
 
 def doppler_to_rate(doppler_hz, sat, channel) -> np.ndarray:
-    """Pseudorange rate (m/s) = −λ·D with the per-channel GLONASS wavelength (spec Eq. 16)."""
+    """Pseudorange rate (m/s) = −λ·D with the per-channel GLONASS wavelength (FDMA: each channel has its own carrier)."""
     d = np.atleast_1d(as_floats(doppler_hz, "doppler_hz")).reshape(-1)
     finite(d, "doppler_hz")
     sats = np.atleast_1d(np.asarray(sat, dtype=object)).reshape(-1)

@@ -29,7 +29,7 @@ class GnssOptions(Config):
     differences with c·τ_GPS as an extra state; "clock_states": undifferenced rows with
     the receiver clock states), ``lever_arm`` IMU → antenna in body axes (m), ``use_rate``;
     τ_GPS initial value ``tau0`` ± ``sigma_tau0`` (s) and random-walk PSD ``tau_psd``
-    (s²/s; Demidov 2009, Eq. 42: (0.1 ns)²/h); clock states (c·δt_r m, c·δṫ_r m/s)
+    (s²/s; default (0.1 ns)²/h); clock states (c·δt_r m, c·δṫ_r m/s)
     ``clock0`` ± ``sigma_clock0`` with oscillator h₀ ``clock_h0`` (s), h₋₂ ``clock_hm2``
     (1/s) (Brown & Hwang 2012, Table 9.1: a TCXO)."""
 

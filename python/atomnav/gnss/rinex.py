@@ -1,5 +1,5 @@
 """RINEX 3 observation and navigation files through georinex (optional extra
-``atomnav[gnss]``; spec decision 4: no parser of our own), and a small RINEX 3 writer for
+``atomnav[gnss]``; no parser of our own, docs/departures.md#rinex-through-georinex), and a small RINEX 3 writer for
 simulated data (tests and exchange).
 
 Time: GPS seconds since the start of the GPS week of ``week_start`` (a datetime in GPS

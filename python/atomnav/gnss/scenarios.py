@@ -3,10 +3,10 @@ satellite count, GNSS outages, open- vs closed-loop, all on the tightly coupled 
 
 ``STAT``: stationary at 55.75°N, 37.6°E, 200 m, heading 30°. ``MOVE``: level drive at
 100 m/s whose heading swings with yaw rate 3 °/s·sin(2πt/600 s) (turns of up to 3 °/s, the
-manoeuvres that make heading observable; a smooth stand-in for the spec's legs and 180°
+manoeuvres that make heading observable; a smooth stand-in for straight legs and 180°
 turns). GPS nominal constellation, 10° mask, code/rate σ 3 m / 0.05 m/s, ΔT = 1 s.
-The INS's vertical channel is baro-damped (Demidov 2009, Eq. 26: ζ = 0.707,
-ω_v = 0.01 rad/s): a barometric altitude at 1 Hz with white error σ = 1 m (Demidov 2009, §3), held
+The INS's vertical channel is baro-damped (docs/departures.md#baro-damped-vertical-channel: ζ = 0.707,
+ω_v = 0.01 rad/s): a barometric altitude at 1 Hz with white error σ = 1 m, held
 over each second to the IMU rate, is the loop's reference; the filter models it as white
 noise of PSD σ²·1 s = 1 m²·s (the loop's time constants, ~100 s, are far longer than the
 1 s hold) and no bias, as simulated.

@@ -26,7 +26,7 @@ def tight_ins(eph: Ephemerides, obs: pd.DataFrame, options: GnssOptions | None =
     INS block; the extra states' initial σ come from the options). Every field of either
     may instead be given as a keyword (``p0_ins`` for the INS ``p0``); here
     ``sequential`` defaults to True and ``gate`` to 10.83 (χ²₁ at 0.999 per decorrelated
-    row, Demidov 2009, Eq. 40). Extra states are carried in metres: ``c_tau_gps`` =
+    row; sequential scalar updates as in Demidov 2009). Extra states are carried in metres: ``c_tau_gps`` =
     c·τ_GPS and ``clock`` = (c·δt_r, c·δṫ_r); the nominal clock bias follows the drift
     between epochs. A barometric altimeter damps the vertical channel through the
     ``vertical`` fields of :class:`InsSetup` (then ``run(..., h_ref=...)``)."""
