@@ -50,7 +50,7 @@ def simulate(eph: Ephemerides, time, lla, vel_ned, options: GnssOptions | None =
 
 
 def doppler_to_rate(doppler_hz, sat, channel) -> np.ndarray:
-    """Pseudorange rate (m/s) = −λ·D with the per-channel GLONASS wavelength (FDMA: each channel has its own carrier)."""
+    """Pseudorange rate (m/s) = −λ·D with the per-channel GLONASS wavelength (FDMA carrier)."""
     d = np.atleast_1d(as_floats(doppler_hz, "doppler_hz")).reshape(-1)
     finite(d, "doppler_hz")
     sats = np.atleast_1d(np.asarray(sat, dtype=object)).reshape(-1)
