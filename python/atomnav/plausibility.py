@@ -31,6 +31,7 @@ import warnings
 import numpy as np
 
 from . import _core, units
+from ._validate import as_floats
 
 #: Earth's rotation rate ω_ie (rad/s, WGS-84), from the core's ellipsoid constants.
 EARTH_RATE: float = _core.ellipsoid_constants("WGS84")["omega"]
@@ -200,8 +201,9 @@ def _near(value: float, target: float, tolerance: float) -> bool:
 
 def specific_force(f: np.ndarray, name: str, scale: float = 1.0) -> None:
     """Warn if the specific force ``f`` (N, 3) times ``scale`` (1 for m/s², 1/Δt for Δv
-    in m/s) has a mean magnitude in :data:`ACCEL_G_BAND`: the record is in g."""
-    x, y, z = _columns(f)
+    in m/s) has a mean magnitude in :data:`ACCEL_G_BAND`: the record is in g. An ``f``
+    that is not numbers (strings included) is a ``TypeError`` naming ``f``."""
+    x, y, z = _columns(as_floats(f, "f"))
     if not len(x):
         return
     with np.errstate(all="ignore"):
@@ -286,20 +288,25 @@ def _stated_interval(step: float, dt: float, name: str, dt_name: str) -> None:
         _warn(dt_name, "sample interval", None, "the time stamps", evidence, ratio)
 
 
-def imu(time, gyro, accel, kind: str, name: str = "imu", *, gyro_name: str | None = None, dt: float | None = None) -> None:
+def imu(time, gyro, accel, kind: str, name: str = "imu", *, gyro_name: str | None = None, time_name: str | None = None,
+        dt: float | None = None) -> None:
     """All checks of one IMU record: ``time`` (N,) s or None, ``gyro`` and ``accel``
     (N, 3) of ``kind`` ``"rates"`` (rad/s, m/s²) or ``"increments"`` (rad, m/s over the
     sample interval). ``name`` is the argument holding the record (and its accelerations),
-    ``gyro_name`` the one holding the gyro if it differs; ``dt`` the stated sample interval
-    (s), compared with the time stamps when both are given."""
+    ``gyro_name`` and ``time_name`` the ones holding the gyro and the time stamps if they
+    differ; ``dt`` the stated sample interval (s), compared with the time stamps when both
+    are given. A ``time``, ``gyro`` or ``accel`` that is not numbers (strings included)
+    is a ``TypeError`` naming it."""
+    time, gyro, accel = (None if time is None else as_floats(time, "time")), as_floats(gyro, "gyro"), as_floats(accel, "accel")
     gyro_name = name if gyro_name is None else gyro_name
+    time_name = name if time_name is None else time_name
     step = np.nan if time is None else _median_step(time)
     if dt is not None:
         dt = _value(dt)
-        _stated_interval(step, dt, name, "dt")
+        _stated_interval(step, dt, time_name, "dt")
         step = dt
     else:
-        _step(step, name)
+        _step(step, time_name)
     if isinstance(kind, str) and kind == "rates":
         scale = 1.0
     else:

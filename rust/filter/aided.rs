@@ -606,7 +606,8 @@ pub struct PositionAiding {
 }
 
 impl PositionFix {
-    /// Fixes from columns: times (s), (lat, lon, h) and NED covariances (3 × 3, m²).
+    /// Fixes from columns: times (s), (lat, lon, h) and NED covariances (3 × 3, m²); a
+    /// latitude outside ±π/2 is an error naming `fix_lla` and its row.
     pub fn table(t: &[f64], lla: &[Vec3], cov: &[DMatrix<f64>]) -> Result<Vec<PositionFix>> {
         if lla.len() != t.len() || cov.len() != t.len() {
             return Err(invalid("fixes", format!("fix_t has {} entries but fix_lla {} and fix_cov {}", t.len(), lla.len(), cov.len())));
@@ -614,6 +615,8 @@ impl PositionFix {
         if let Some((i, c)) = cov.iter().enumerate().find(|(_, c)| c.nrows() != 3 || c.ncols() != 3) {
             return Err(invalid("fix_cov", format!("expected (M, 3, 3), entry {i} is {}x{}", c.nrows(), c.ncols())));
         }
+        // a latitude beyond ±π/2 (one in degrees) would pull the filter off the Earth
+        crate::earth::check_latitudes("fix_lla", lla)?;
         // each covariance is 3 × 3 (checked above): its 9 column-major values
         Ok(t.iter().zip(lla).zip(cov).map(|((&t, &lla), c)| PositionFix { t, lla, cov_ned: Mat3::from_iterator(c.iter().copied()) }).collect())
     }
@@ -715,6 +718,17 @@ mod tests {
         assert_eq!(want.sigma, got.sigma);
         assert_eq!(want.innovation, got.innovation);
         assert_eq!(want.meas_time.len(), 7);
+    }
+
+    /// A fix latitude in degrees (45.8 "rad") is an error naming `fix_lla` and its row.
+    #[test]
+    fn fix_latitude_beyond_half_pi_names_fix_lla_and_its_row() {
+        let lla = [Vec3::new(0.8, 0.2, 100.0), Vec3::new(45.8, 0.2, 100.0)];
+        let cov = vec![DMatrix::<f64>::identity(3, 3); 2];
+        match PositionFix::table(&[0.5, 1.0], &lla, &cov) {
+            Err(NavError::InvalidInput { field, index, .. }) => assert_eq!((field.as_str(), index), ("fix_lla", Some(1))),
+            other => panic!("expected an invalid fix_lla, got {:?}", other.map(|f| f.len())),
+        }
     }
 
     #[test]

@@ -1,7 +1,7 @@
 """Astro-inertial calibration: star-camera (virtual camera VF) to IMU (MF) mount from
 attitude increments (Vasilyuk et al. 2024).
 
-Conventions of this module (the paper's, spec §2): ENU navigation frame, body axes
+Conventions of this module (the paper's): ENU navigation frame, body axes
 right-forward-up (MF), ``S_X2^X1`` maps X1 coordinates into X2, small errors are
 right-multiplicative in the body frame, S = S̆ (I + [θ×]). The mount C = C_MF^VF maps VF into
 MF. Euler angles β = (ψ, ϑ, γ) use C(β) = R_ψ R_ϑ R_γ (heading clockwise from North,
@@ -11,7 +11,7 @@ pitch nose-up) and appear only in reports. Project NED/FRD data converts with
 
 P_β is the precision of the mount *conditional on the IMU calibration*: a constant
 rotation of the gyro triad is indistinguishable from a mount error, so accuracy against
-the nominal MF cannot beat about σ_φG/√2 per axis (spec D17).
+the nominal MF cannot beat about σ_φG/√2 per axis (docs/departures.md#precision-not-accuracy).
 """
 
 from __future__ import annotations
@@ -60,7 +60,7 @@ def euler_dcm(beta) -> np.ndarray:
 
 
 def euler_from_dcm(c) -> np.ndarray:
-    """Canonical (ψ ∈ [0, 2π), ϑ, γ) in rad of rotation matrices (spec D3)."""
+    """Canonical (ψ ∈ [0, 2π), ϑ, γ) in rad of rotation matrices (docs/departures.md#rotations-not-euler-angles)."""
     c = as_floats(c, "c")
     out = _core.astro_euler_from_dcm(_mats(c, "c"))
     return out[0] if c.ndim == 2 else out
@@ -78,9 +78,9 @@ def d2(beta) -> np.ndarray:
 
 @dataclass(frozen=True)
 class GyroErrorModel:
-    """Gyro errors of spec E1: misalignment σ_φ (rad), scale factor σ_k (–), angle random
-    walk σ_w (rad/√s), bias σ_b (rad/s); ``mode`` "paper" (white per sample, E2/E7) or
-    "consistent" (constant over the calibration, E8) (spec D2)."""
+    """Gyro errors of Vasilyuk et al. 2024: misalignment σ_φ (rad), scale factor σ_k (–), angle random
+    walk σ_w (rad/√s), bias σ_b (rad/s); ``mode`` "paper" (white per sample, as the paper propagates them) or
+    "consistent" (constant over the calibration) (docs/departures.md#constant-gyro-errors)."""
 
     sigma_phi_rad: float
     sigma_k: float
@@ -117,11 +117,13 @@ class Increments:
 
 def gyro_increments(t_start: float, period: float, rho, epochs, model: GyroErrorModel,
                     taylor_variant: str = "corrected") -> Increments:
-    """Third-order asynchronous quaternion integration between camera epochs (spec E3–E8).
+    """Third-order asynchronous quaternion integration between camera epochs
+    (Vasilyuk et al. 2024), with the increment covariance of the gyro error ``model``.
 
     ``rho`` (K, 3) rad: gyro increments in MF, row j over [t_start + jT, t_start + (j+1)T]
     with T = ``period`` (s); ``epochs`` (N,) s strictly increasing inside the record.
-    ``taylor_variant`` "corrected" (c = 1/8, default) or "paper_literal" (c = 1/4) (D1).
+    ``taylor_variant`` "corrected" (c = 1/8, default) or "paper_literal" (c = 1/4)
+    (docs/departures.md#second-order-quaternion-term).
     """
     instance(model, GyroErrorModel, "model")
     with renamed(gyro_increments="rho"):
@@ -133,7 +135,7 @@ def gyro_increments(t_start: float, period: float, rho, epochs, model: GyroError
 
 
 def dead_reckoning_cov(t_start: float, period: float, rho, epochs, model: GyroErrorModel) -> np.ndarray:
-    """P^imu at every epoch (rad², (N, 3, 3)): E7/E8 run from the first epoch (spec E20)."""
+    """P^imu at every epoch (rad², (N, 3, 3)): the increment covariance recursion run from the first epoch."""
     instance(model, GyroErrorModel, "model")
     with renamed(gyro_increments="rho"):
         return _core.astro_dead_reckoning_cov(scalar(t_start, "t_start"), positive(period, "period"),
@@ -142,7 +144,8 @@ def dead_reckoning_cov(t_start: float, period: float, rho, epochs, model: GyroEr
 
 
 def observability(ds_avu) -> dict:
-    """Identifiability of the mount (spec E15, D16): axes_vf, angles (rad), cluster labels
+    """Identifiability of the mount (Vasilyuk et al. 2024; thresholds in
+    docs/departures.md#identifiability-thresholds): axes_vf, angles (rad), cluster labels
     (−1 below 0.5°), n_clusters (5° radius), eigenvalues/eigenvectors of
     G = Σ(I − ΔS)(I − ΔS)ᵀ, kappa = λ_min/λ_max, weak_axis_vf and verdict "ok" | "warn"
     (κ < 1e-4) | "reject" (κ < 1e-12)."""
@@ -233,13 +236,13 @@ def refractive_index(height_m: float) -> float:
 
 def refraction_correct(s, up, n: float) -> np.ndarray:
     """Remove refraction from observed unit directions about the local vertical ``up``
-    (same frame, (N, 3)) (spec E10)."""
+    (same frame, (N, 3)), plane-parallel atmosphere (Snell's law, sin z_true = n sin z_obs)."""
     with renamed(directions="s", n_refr="n"):
         return _core.astro_refraction(rows(s, 3, "s"), rows(up, 3, "up"), scalar(n, "n"), False)
 
 
 def refraction_apply(s, up, n: float) -> np.ndarray:
-    """Apparent directions of true unit directions (inverse of E10, for simulation)."""
+    """Apparent directions of true unit directions (inverse of :func:`refraction_correct`, for simulation)."""
     with renamed(directions="s", n_refr="n"):
         return _core.astro_refraction(rows(s, 3, "s"), rows(up, 3, "up"), scalar(n, "n"), True)
 
@@ -248,9 +251,10 @@ def star_attitudes(obs: Observations, n_epochs: int, cameras, sigma_s_rad: float
                    up_gcrs=None, n_refr: float = 1.0, p_avu=None):
     """Merge the cameras into VF (``cameras`` (I, 3, 3) = C_VF^CFⁱ, camera 0 = identity), remove
     refraction about ``up_gcrs`` (N, 3) with index ``n_refr``, solve Wahba per epoch and form
-    P^avu = σ_s²K + K(Σ Cᵢ Aᵢ D1(αⁱ) P_aⁱ D1ᵀ Aᵢ Cᵢᵀ)K (spec E9–E12; ``p_alpha`` (I, 3, 3) rad²),
+    P^avu = σ_s²K + K(Σ Cᵢ Aᵢ D1(αⁱ) P_aⁱ D1ᵀ Aᵢ Cᵢᵀ)K (docs/departures.md#star-attitude-covariance;
+    ``p_alpha`` (I, 3, 3) rad²),
     or take the user's ``p_avu`` (N, 3, 3) rad² in VF (finite, symmetric, PSD) in place of that
-    default model (E12, D11); it then flows into :func:`astro_increments`,
+    default model; it then flows into :func:`astro_increments`,
     :func:`model_covariance` and :meth:`Calibration.p_mfa`.
 
     Returns (S_GCRS^VF (N, 3, 3), P^avu (N, 3, 3) rad², stars per epoch (N,)).
@@ -269,16 +273,16 @@ def star_attitudes(obs: Observations, n_epochs: int, cameras, sigma_s_rad: float
 
 
 def astro_increments(s_vf, p_avu):
-    """ΔS_n^avu = S_{n−1}ᵀ S_n and E_n^avu = P_n + ΔS_nᵀ P_{n−1} ΔS_n (spec E13)."""
+    """ΔS_n^avu = S_{n−1}ᵀ S_n and E_n^avu = P_n + ΔS_nᵀ P_{n−1} ΔS_n (Vasilyuk et al. 2024)."""
     return _core.astro_astro_increments(_mats(s_vf, "s_vf"), _mats(p_avu, "p_avu"))
 
 
 def model_covariance(cal: Calibration, ds_imu, ds_avu, e_imu, p_avu, increments: Increments | None = None,
                      model: GyroErrorModel | None = None):
-    """Model-form (P_β^model, P_β^sys) in rad² at ``cal``'s mount (spec E18): the sandwich
+    """Model-form (P_β^model, P_β^sys) in rad² at ``cal``'s mount: the sandwich
     (HᵀH)⁻¹HᵀΣ_fH(HᵀH)⁻¹ with Σ_f built from the gyro interval covariances ``e_imu``
     (M, 3, 3) and the star-attitude covariances ``p_avu`` (M + 1, 3, 3) — diagonal blocks
-    CᵀE_n^imuC + E_n^avu and the E13 neighbour correlations — converted to Euler angles.
+    CᵀE_n^imuC + E_n^avu and the neighbour correlations of shared star attitudes — converted to Euler angles.
     With ``model.mode == "consistent"`` the constant-error cross terms use
     ``increments.j_m``/``j_b``; P_β^sys is their part (zero otherwise)."""
     instance(cal, Calibration, "cal")
@@ -296,7 +300,7 @@ def aberration(directions, velocity_mps) -> np.ndarray:
     """First-order stellar aberration: apparent unit directions normalize(s + v/c) of stars
     with geometric unit directions ``directions`` (N, 3) seen by an observer moving with
     ``velocity_mps`` ((3,) or (N, 3), m/s, same frame, |v| < 1e-3 c); exact special
-    relativity differs by O((v/c)²) ≈ 1e-8 rad at Earth's orbital 30 km/s (spec §7)."""
+    relativity differs by O((v/c)²) ≈ 1e-8 rad at Earth's orbital 30 km/s."""
     with renamed(velocity="velocity_mps"):
         return _core.astro_aberration(rows(directions, 3, "directions"), rows(velocity_mps, 3, "velocity_mps"))
 

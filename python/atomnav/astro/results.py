@@ -21,7 +21,7 @@ class Calibration:
     """Calibrated mount C = C_MF^VF with β (rad), Gauss–Newton iterations, residuals f_n
     (rad), P_S, P_θ (VF), P_β, P^clb (MF) (rad²), singular values and condition number
     of the stacked Jacobian, the weakest direction in MF with σ_weak = σ̂_f/√λ_min (rad),
-    the identifiability report (E15) and the gyro-model provenance."""
+    the identifiability report (:func:`observability`) and the gyro-model provenance."""
 
     c: np.ndarray
     beta: np.ndarray

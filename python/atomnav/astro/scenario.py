@@ -1,7 +1,7 @@
 """The synthetic reproduction ``vasilyuk2024_like`` (Vasilyuk et al. 2024) and its Monte-Carlo runner.
 
 73 epochs 21.0007 s apart, 3 cameras (12° half-angle) on the mount β̆ = (10°, −25°, 2°),
-~108 stars per epoch from the D4 catalog to m = 5.6, σ_s = 16″, refraction at 150 m,
+~108 stars per epoch from the synthetic catalog (docs/departures.md#synthetic-star-catalog) to m = 5.6, σ_s = 16″, refraction at 150 m,
 200 Hz gyro with the paper's error budget, on main's two-axis stand
 (``trajectory.vasilyuk2024_stand``, converted from NED/FRD to ENU/right-forward-up).
 """
@@ -18,8 +18,8 @@ class Vasilyuk2024:
     """Scenario truth built once (~1 s); :meth:`run` and :meth:`monte_carlo` reuse it. A
     pickled or deep-copied scenario keeps the built truth (no rebuild) and gives the same runs.
 
-    The default catalog seed 3 gives 108.8 stars per epoch (88–122), as in spec row 16
-    (108.7, 88–123); other seeds give 108–125 (uniform-sky expectation 111.8)."""
+    The default catalog seed 3 gives 108.8 stars per epoch (88–122), as an independent
+    computation found (108.7, 88–123); other seeds give 108–125 (uniform-sky expectation 111.8)."""
 
     def __init__(self, catalog_seed: int = 3, gyro_error_model: str = "paper"):
         self._core = _core.AstroScenario(catalog_seed, gyro_error_model)
@@ -32,8 +32,9 @@ class Vasilyuk2024:
 
     def run(self, seed: int, init: str = "axes", p_diff: str = "full") -> dict:
         """One full chain with noise seed ``seed``: observations, star attitudes and P^avu,
-        ΔS^imu/E^imu, ΔS^avu/E^avu, the :class:`Calibration`, P_β^model and P_β^sys (rad², E18), β̂ − β̆ (rad), the VF rotation
-        error (rad), θ^diff (N−1, 3) rad and P^diff (``p_diff`` "full" | "paper", D10)."""
+        ΔS^imu/E^imu, ΔS^avu/E^avu, the :class:`Calibration`, P_β^model and P_β^sys (rad²), β̂ − β̆ (rad), the VF rotation
+        error (rad), θ^diff (N−1, 3) rad and P^diff (``p_diff`` "full" | "paper",
+        docs/departures.md#full-covariance-of-the-dead-reckoning-difference)."""
         d = self._core.run(seed, init, p_diff)
         d["calibration"] = Calibration(**d["calibration"], gyro_error_model=self.gyro_error_model)
         d["observations"] = Observations(**d["observations"])

@@ -201,7 +201,6 @@ def cai_aided_ins(t0: float, lla0, vel0, q0, sensor: CaiSensor, shots, *, phase=
     if not emulated:
         plausibility.population(tables[0], "population")
     setup = setup or seed003_filter()
-    plausibility.lla(lla0, "lla0")
     n_extra = sensor.n_extra()
     ins = InsSetup(t0=t0, lla0=lla0, vel0=vel0, q0=q0, kind=kind, p0=setup.p0(n_extra) if p0 is None else p0,
                    accel_psd=setup.accel_psd, gyro_psd=setup.gyro_psd,

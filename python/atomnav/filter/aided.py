@@ -17,8 +17,8 @@ import numpy as np
 import pandas as pd
 from tqdm.auto import tqdm
 
-from .. import _core
-from .._validate import as_floats, finite_scalar, flag, input_error, instance, integer, positive, rows
+from .. import _core, plausibility
+from .._validate import as_floats, finite_scalar, flag, input_error, instance, integer, positive, renamed, rows
 from ..strapdown import _table
 from .engine import BiasModel, Config, _floats
 from .riccati import _mat
@@ -91,20 +91,22 @@ class InsSetup(Config):
             if v.shape != (n,):
                 raise input_error(name, f"expected shape ({n},), got {v.shape}")
             object.__setattr__(self, name, _floats(v))
+        plausibility.lla(self.lla0, "lla0")
         p0 = _mat(self.p0, "p0")
         object.__setattr__(self, "p0", _floats(p0))
         for name in ("accel_bias", "gyro_bias") + (() if self.baro_bias is None else ("baro_bias",)):
             instance(getattr(self, name), BiasModel, name)
         opt = {name: None if getattr(self, name) is None else finite_scalar(getattr(self, name), name)
                for name in ("gate", "zeta", "omega", "baro_bias_sigma0")}
-        native = _core.AidedSetup(
-            t0=finite_scalar(self.t0, "t0"), lla0=list(self.lla0), vel0=list(self.vel0), q0=list(self.q0), kind=self.kind, p0=p0,
-            accel_psd=finite_scalar(self.accel_psd, "accel_psd"), gyro_psd=finite_scalar(self.gyro_psd, "gyro_psd"),
-            accel_bias=self.accel_bias._parts(), gyro_bias=self.gyro_bias._parts(), ba0=list(self.ba0), bg0=list(self.bg0),
-            predict_every=integer(self.predict_every, "predict_every", 1, 2**63 - 1),
-            method=self.method, mode=self.mode, sequential=flag(self.sequential, "sequential"), ellipsoid=self.ellipsoid, vertical=self.vertical,
-            baro_psd=finite_scalar(self.baro_psd, "baro_psd"),
-            baro_bias=None if self.baro_bias is None else self.baro_bias._parts(), **opt)
+        with renamed(lla="lla0", vel_ned="vel0", q_nb="q0"):  # the core checks the initial state as a strapdown state
+            native = _core.AidedSetup(
+                t0=finite_scalar(self.t0, "t0"), lla0=list(self.lla0), vel0=list(self.vel0), q0=list(self.q0), kind=self.kind, p0=p0,
+                accel_psd=finite_scalar(self.accel_psd, "accel_psd"), gyro_psd=finite_scalar(self.gyro_psd, "gyro_psd"),
+                accel_bias=self.accel_bias._parts(), gyro_bias=self.gyro_bias._parts(), ba0=list(self.ba0), bg0=list(self.bg0),
+                predict_every=integer(self.predict_every, "predict_every", 1, 2**63 - 1),
+                method=self.method, mode=self.mode, sequential=flag(self.sequential, "sequential"), ellipsoid=self.ellipsoid, vertical=self.vertical,
+                baro_psd=finite_scalar(self.baro_psd, "baro_psd"),
+                baro_bias=None if self.baro_bias is None else self.baro_bias._parts(), **opt)
         object.__setattr__(self, "_native", native)
 
     @property
@@ -176,7 +178,13 @@ class AidedIns:
         positive definiteness), the exception's ``partial`` attribute is the
         :class:`AidedResult` of the epochs computed before it."""
         t, g, a, h = _imu(time, gyro, accel, h_ref)
+        self._plausible(t, g, a)
         return self._call(self._core.process, t, g, a, h)
+
+    def _plausible(self, t, g, a) -> None:
+        """The unit warnings of an IMU record (:func:`atomnav.plausibility.imu`): accelerations
+        in g, gyro rates in °/s, time stamps in ms."""
+        plausibility.imu(t, g, a, self.kind, "accel", gyro_name="gyro", time_name="time")
 
     def _call(self, fn, *args) -> AidedResult:
         try:
@@ -198,6 +206,7 @@ class AidedIns:
         their index in the record (the Rust engine checks them chunk by chunk). On an
         error the exception's ``partial`` attribute holds every epoch computed before it."""
         t, g, a, h = _imu(time, gyro, accel, h_ref)
+        self._plausible(t, g, a)  # once, on the whole record (a chunk may look static while the record moves)
         positive(chunk_s, "chunk_s")
         progress = flag(progress, "progress")
         n = len(t)
@@ -217,7 +226,7 @@ class AidedIns:
         try:
             for lo, hi in tqdm(list(zip(bounds[:-1], bounds[1:])), desc="aided INS", unit="chunk",
                                disable=not progress or len(bounds) <= 2):
-                parts.append(self.process(t[lo:hi], g[lo:hi], a[lo:hi], None if h is None else h[lo:hi]))
+                parts.append(self._call(self._core.process, t[lo:hi], g[lo:hi], a[lo:hi], None if h is None else h[lo:hi]))
             parts.append(self.finish())
         except (ValueError, _core.NumericalError) as e:
             if isinstance(getattr(e, "partial", None), AidedResult):
@@ -267,10 +276,11 @@ def position_aided_ins(t0: float, lla0, vel0, q0, kind: str, fix_time, fix_lla, 
     """
     setup = InsSetup(t0=t0, lla0=lla0, vel0=vel0, q0=q0, kind=kind, p0=p0, accel_psd=accel_psd, gyro_psd=gyro_psd,
                      **options)
+    fix_lla = plausibility.lla(rows(fix_lla, 3, "fix_lla"), "fix_lla")
     cov = as_floats(fix_cov, "fix_cov")
     if cov.size % 9:
         raise input_error("fix_cov", f"expected an (M, 3, 3) stack, got shape {cov.shape}")
     core = _core.position_aided_ins(
-        setup.native, np.ascontiguousarray(as_floats(fix_time, "fix_time").ravel()), rows(fix_lla, 3, "fix_lla"),
+        setup.native, np.ascontiguousarray(as_floats(fix_time, "fix_time").ravel()), fix_lla,
         np.ascontiguousarray(cov.reshape(-1, 3, 3)))
     return AidedIns(core, setup)
