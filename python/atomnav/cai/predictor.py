@@ -103,6 +103,7 @@ def _setup(t, specific_force, angular_rate, shots, T, channels, angular_accelera
         if a.shape != (len(t), 3):
             raise input_error(name, f"expected shape ({len(t)}, 3), got {a.shape}")
     plausibility.time_steps(t, "t")
+    plausibility.specific_force(f, "specific_force")
     plausibility.angular_rate(w, "angular_rate")
     wd = None
     if angular_acceleration is not None:
@@ -215,10 +216,11 @@ class SineMotion:
     attitude_sines: np.ndarray = field(default_factory=lambda: _EMPTY_SINES)
 
     def _native(self):
+        attitude_poly, attitude_sines = rows(self.attitude_poly, 3, "attitude_poly"), rows(self.attitude_sines, 4, "attitude_sines")
+        plausibility.angles(attitude_poly[:, 0], "attitude_poly")  # c0: the Euler angles at t = 0
+        plausibility.angles(attitude_sines[:, 1], "attitude_sines", "Euler angle amplitudes")
         return _core.CaiMotion.sine(rows(self.position_poly, 3, "position_poly"),
-                                    rows(self.position_sines, 4, "position_sines"),
-                                    rows(self.attitude_poly, 3, "attitude_poly"),
-                                    rows(self.attitude_sines, 4, "attitude_sines"))
+                                    rows(self.position_sines, 4, "position_sines"), attitude_poly, attitude_sines)
 
 
 @dataclass

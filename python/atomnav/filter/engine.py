@@ -13,7 +13,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .. import _core
+from .. import _core, plausibility
 from .._validate import as_floats, finite_scalar, flag, input_error, instance, integer, json_object, renamed, rows
 from .riccati import _mat
 
@@ -161,9 +161,11 @@ def ins_error_model(lla, vel_ned, q_nb, f_b, accel_psd: float, gyro_psd: float,
     layout = Layout() if layout is None else instance(layout, Layout, "layout")
     instance(accel_bias, BiasModel, "accel_bias")
     instance(gyro_bias, BiasModel, "gyro_bias")
+    f_b = rows(f_b, 3, "f_b")
+    plausibility.specific_force(f_b, "f_b")
     with renamed(blocks="layout"):
         return _core.ins_error_dynamics(layout.spec, rows(lla, 3, "lla"), rows(vel_ned, 3, "vel_ned"),
-                                        rows(q_nb, 4, "q_nb"), rows(f_b, 3, "f_b"),
+                                        rows(q_nb, 4, "q_nb"), f_b,
                                         accel_psd=finite_scalar(accel_psd, "accel_psd"),
                                         gyro_psd=finite_scalar(gyro_psd, "gyro_psd"), accel_bias=accel_bias._parts(),
                                         gyro_bias=gyro_bias._parts(), ellipsoid=ellipsoid)
