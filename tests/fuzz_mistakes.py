@@ -697,15 +697,18 @@ def _eq(a, b) -> bool:
     return type(a) is type(b) and a == b
 
 
-FORWARDS = {"atomnav.cai.predictor.check_jacobian": "atomnav.cai.predictor.phase_jacobian"}
-"""Callables that pass ``*args``/``**kwargs`` on to another public callable, whose
-parameters are then the names of the call's arguments."""
+FORWARDS = {"atomnav.cai.predictor.check_jacobian": "atomnav.cai.predictor.phase_jacobian",
+            "atomnav.astro.star_attitudes": "atomnav.astro.results.Observations"}
+"""Callables that pass ``*args``/``**kwargs`` on to another public callable, or whose clean
+call builds its argument with one (``star_attitudes(Observations(epoch, camera, s_cf, g),
+...)``: a mutated ``s_cf`` is rejected by ``Observations``), whose parameters are then the
+names of the call's arguments."""
 
 
 def error_names(target: str) -> set[str]:
     """The names an error of a call of ``target`` may give (fuzz's rule: its parameters and,
     for a method, its instance's constructor parameters; those of the callable it forwards
-    its arguments to, ``FORWARDS``)."""
+    its arguments to or builds its argument with, ``FORWARDS``)."""
     fuzz._init_targets()
     names = fuzz.TARGETS_BY_NAME[target].param_names()
     return names | (error_names(FORWARDS[target]) if target in FORWARDS else set())

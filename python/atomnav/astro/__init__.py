@@ -22,8 +22,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from .. import _core, plausibility
-from .._validate import as_floats, input_error, instance, path as checked_path, positive, renamed, rows, scalar, vector
-from .results import D17_CAVEAT, Calibration, Observations
+from .._validate import as_floats, input_error, instance, integers, path as checked_path, positive, renamed, rows, scalar, vector
+from .results import D17_CAVEAT, Calibration, Observations, _store_rows
 from .scenario import Vasilyuk2024
 
 NED_TO_ENU = np.array([[0.0, 1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, -1.0]])
@@ -181,11 +181,17 @@ def calibrate(ds_imu, ds_avu, *, init: str = "axes", c0=None, solver: str = "so3
 
 @dataclass(frozen=True)
 class Catalog:
-    """Star catalog: GCRS unit vectors (N, 3) (annual aberration applied), magnitudes, ids."""
+    """Star catalog: GCRS unit vectors ``dirs`` (N, 3) (annual aberration applied),
+    magnitudes ``mags`` (N,), integer ``ids`` (N,). Converted on construction to float64
+    and int64 arrays: numbers given as strings are a ``TypeError``, a wrong shape or row
+    count an :class:`atomnav.InputError`, both naming the field."""
 
     dirs: np.ndarray
     mags: np.ndarray
     ids: np.ndarray
+
+    def __post_init__(self):
+        _store_rows(self, dirs=rows(self.dirs, 3, "dirs"), mags=vector(self.mags, None, "mags"), ids=integers(self.ids, "ids"))
 
 
 def synthetic_catalog(m_lim: float = 5.6, seed: int = 1) -> Catalog:

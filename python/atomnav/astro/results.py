@@ -7,7 +7,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .._validate import input_error, path as checked_path
+from .._validate import input_error, integers, path as checked_path, rows
 
 D17_CAVEAT = ("P_beta is precision conditional on the IMU calibration: a constant rotation of the gyro "
               "triad is indistinguishable from a mount error (accuracy vs the nominal MF >= ~sigma_phiG/sqrt(2)).")
@@ -72,12 +72,29 @@ class Calibration:
             raise input_error("path", f"{path} is not a calibration saved by Calibration.save ({type(e).__name__}: {e})") from None
 
 
+def _store_rows(obj, **fields) -> None:
+    """Store the checked arrays ``fields`` (name → array) on the frozen dataclass ``obj``;
+    each must have the row count of the first, else an :class:`InputError` naming it."""
+    first, n = next(iter(fields)), len(next(iter(fields.values())))
+    for name, value in fields.items():
+        if len(value) != n:
+            raise input_error(name, f"expected {n} rows like {first}, got {len(value)}")
+        object.__setattr__(obj, name, value)
+
+
 @dataclass(frozen=True)
 class Observations:
-    """Star observations, one row per star: epoch index, camera index, measured unit
-    direction in the camera frame (N, 3), catalog direction in GCRS (N, 3)."""
+    """Star observations, one row per star: epoch index, camera index (N,) integers,
+    measured unit direction in the camera frame ``s_cf`` (N, 3), catalog direction in
+    GCRS ``g`` (N, 3). Converted on construction to int64 and float64 arrays: numbers given
+    as strings are a ``TypeError``, a wrong shape or row count an
+    :class:`atomnav.InputError`, both naming the field."""
 
     epoch: np.ndarray
     camera: np.ndarray
     s_cf: np.ndarray
     g: np.ndarray
+
+    def __post_init__(self):
+        _store_rows(self, epoch=integers(self.epoch, "epoch"), camera=integers(self.camera, "camera"),
+                    s_cf=rows(self.s_cf, 3, "s_cf"), g=rows(self.g, 3, "g"))
