@@ -60,7 +60,8 @@ def euler_dcm(beta) -> np.ndarray:
 
 
 def euler_from_dcm(c) -> np.ndarray:
-    """Canonical (ψ ∈ [0, 2π), ϑ, γ) in rad of rotation matrices (docs/departures.md#rotations-not-euler-angles)."""
+    """Canonical (ψ ∈ [0, 2π), ϑ, γ) in rad of rotation matrices
+    (docs/departures.md#rotations-not-euler-angles)."""
     c = as_floats(c, "c")
     out = _core.astro_euler_from_dcm(_mats(c, "c"))
     return out[0] if c.ndim == 2 else out
@@ -195,7 +196,7 @@ class Catalog:
 
 
 def synthetic_catalog(m_lim: float = 5.6, seed: int = 1) -> Catalog:
-    """Deterministic uniform sky (spec D4): round(10^(0.985 + 0.455 m_lim)) stars,
+    """Deterministic uniform sky (docs/departures.md#synthetic-star-catalog): round(10^(0.985 + 0.455 m_lim)) stars,
     xoshiro256** seeded through SplitMix64 (identical on every platform)."""
     return Catalog(*_core.astro_synthetic_catalog(scalar(m_lim, "m_lim"), seed))
 
