@@ -1,4 +1,4 @@
-"""Cold-atom interferometer: atom strapdown phase prediction from IMU data (seed 003), the
+"""Cold-atom interferometer: atom strapdown phase prediction from IMU data (Tennstedt et al. 2023), the
 inertial oracle, closed forms, readout and fringe handling, sensitivity function and
 convolution predictor, fringe noise identification (Tennstedt et al. 2021, §3), and the
 CAI-aided INS with its Monte-Carlo scenarios (``sensor``, ``scenarios``, ``campaign``,

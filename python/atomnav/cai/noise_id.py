@@ -34,7 +34,8 @@ def simulate_fringe(n: int, *, p0: float = 0.5, phi: float = 1.0, amplitude: flo
 
 def fringe_track(p, psi, *, zeta0=(0.5, 0.0, 0.1), sigma0=(0.1, 1.0, 0.1), q=(1e-9, 1e-7, 1e-9),
                  r: float = 1e-3) -> pd.DataFrame:
-    """Fringe-tracking EKF (E15)/(E16) on ζ = [p0, φ, A]: columns ``p0``, ``phi_rad``, ``A``
+    """Fringe-tracking EKF (Tennstedt et al. 2021, Sec. 3.2; docs/departures.md#fringe-tracking)
+    on ζ = [p0, φ, A]: columns ``p0``, ``phi_rad``, ``A``
     after each readout (A kept > 0, φ wrapped to (−π, π]). q: random-walk variance per
     shot, r: readout variance."""
     z = _core.cai_fringe_track(plausibility.population(vector(p, None, "p"), "p"), vector(psi, None, "psi"), vector(zeta0, 3, "zeta0"),
@@ -54,9 +55,10 @@ def identify_noise(x, phi, amplitude, *, free=("p0", "phi"), theta0=(0.02, 0.2, 
                    batch: int | None = None, sliding: bool = False, max_iter: int = 100,
                    tol: float = 1e-6) -> pd.DataFrame:
     """Maximum-likelihood (σ_p0, σ_φ, σ_A) from residuals x, fringe phases φ (rad) and
-    amplitudes (E17)–(E20). ``free``: the estimated components (at most two; the others
-    stay at ``theta0``); method "gradient" (E19) or "newton" (E20); ``batch`` samples per
-    estimate (default: all; seed 000 uses 200), consecutive batches or, with ``sliding``, a
+    amplitudes (Tennstedt et al. 2021 Eqs. 18–26; docs/departures.md#identifiable-readout-noise).
+    ``free``: the estimated components (at most two; the others
+    stay at ``theta0``); method "gradient" (Eqs. 22–25) or "newton"; ``batch`` samples per
+    estimate (default: all; Tennstedt et al. 2021 use 200), consecutive batches or, with ``sliding``, a
     window ending at every sample (warm-started).
 
     One row per estimate: ``sigma_p0``, ``sigma_phi_rad``, ``sigma_A``, the identifiable
@@ -84,7 +86,7 @@ def identify_noise(x, phi, amplitude, *, free=("p0", "phi"), theta0=(0.02, 0.2, 
 
 
 def readout_variance(a: float, b: float, phi) -> np.ndarray:
-    """Readout variance σ_p²(φ) = a + b sin²φ (E21), the measurement variance R."""
+    """Readout variance σ_p²(φ) = a + b sin²φ (Tennstedt et al. 2021 Eq. 26), the measurement variance R."""
     a, b, phi = as_floats(a, "a"), as_floats(b, "b"), as_floats(phi, "phi")
     try:
         return a + b * np.sin(phi) ** 2

@@ -1,7 +1,8 @@
-"""Atom strapdown: CAI phase prediction from an IMU stream (seed 003), its Jacobians, the
+"""Atom strapdown: CAI phase prediction from an IMU stream (Tennstedt et al. 2023), its Jacobians, the
 inertial oracle with analytic body motions, and the constant-input closed forms.
 
-Conventions (spec ``atom-strapdown-tennstedt2023.md``): pulses at t_s, t_s + T, t_s + 2T;
+Conventions (Tennstedt et al. 2023 Eqs. 1–8; docs/departures.md#specific-force-drives-the-atoms):
+pulses at t_s, t_s + T, t_s + 2T;
 φ = k·(x(0) − 2x(T) + x(2T)) with x the atom position in the sensor frame s; the atom
 is driven by the SPECIFIC FORCE at the s origin, so a constant specific force f_s gives
 φ = −T² k·f_s. measured = true + bias; estimated biases are subtracted.
@@ -23,7 +24,7 @@ from ._config import ConfigMixin
 LAMBDA_RB87 = 780.241e-9
 K_RB87 = 4.0 * np.pi / LAMBDA_RB87
 
-#: Columns of the phase breakdown (spec (E12)–(E17)); the terms after ``total`` sum to it.
+#: Columns of the phase breakdown (docs/departures.md#per-term-breakdown); the terms after ``total`` sum to it.
 TERMS = tuple(_core.CAI_TERMS)
 #: Columns of the Jacobians: accelerometer bias (m/s²), gyro bias (rad/s), lever arm (m),
 #: misalignment γ (rad, C_sb = exp(−[γ×]) C_sb,0).
@@ -73,8 +74,8 @@ class Channels(ConfigMixin):
 
     @classmethod
     def cyclic(cls, k: float = K_RB87, v0: float = 2.8, lever=(0.0, 0.0, 0.0), c_sb=None) -> "Channels":
-        """Six channels of the seed-003 multi-axis sensor (spec §2.2): k along e_j, ensembles
-        A/B with v0 = ±v0 e_{(j+1) mod 3}; names x_A, x_B, y_A, ..."""
+        """Six channels of the multi-axis sensor of Tennstedt et al. 2023: k along e_j, ensembles
+        A/B with v0 = ±v0 e_{(j+1) mod 3} (docs/departures.md#ensemble-geometry); names x_A, x_B, y_A, ..."""
         k, v0 = finite_scalar(k, "k"), finite_scalar(v0, "v0")
         ks, vs, names = [], [], []
         for j, ax in enumerate("xyz"):
@@ -121,7 +122,7 @@ def _setup(t, specific_force, angular_rate, shots, T, channels, angular_accelera
 @dataclass
 class PhasePrediction:
     """Predicted phases (rad), each array (n_shots, n_channels); ``total`` is the sum of the
-    terms acc, rot, cen, eul, mix, gg (spec (E12)–(E17))."""
+    terms acc, rot, cen, eul, mix, gg (docs/departures.md#per-term-breakdown)."""
 
     shots: np.ndarray
     channels: Channels
@@ -142,7 +143,8 @@ class PhasePrediction:
 def predict_phase(t, specific_force, angular_rate, shots, T: float, channels: Channels, *, angular_acceleration=None,
                   omega_dot: str | None = None, savgol_half_width: int = 2, interpolation: str = "linear",
                   substeps: int = 1, gradient=None, bias_a=0.0, bias_g=0.0) -> PhasePrediction:
-    """Atom strapdown phase of every shot and channel (spec (E5)–(E7)), with breakdown.
+    """Atom strapdown phase of every shot and channel (Tennstedt et al. 2023 Eqs. 5–8;
+    docs/departures.md#full-phase-predictor), with breakdown.
 
     t (N,) s; specific_force (N, 3) m/s² and angular_rate (N, 3) rad/s in the IMU body
     frame; shots: start times (s) of non-overlapping shots (pulses at t_s, t_s + T,
@@ -151,7 +153,7 @@ def predict_phase(t, specific_force, angular_rate, shots, T: float, channels: Ch
     ``angular_acceleration`` (N, 3) rad/s² is passed, e.g. from a simulator), "savgol"
     (default otherwise: 5-point quadratic Savitzky–Golay derivative of the gyro, half width
     ``savgol_half_width``), "pwl"
-    (derivative of the gyro interpolant), "zero" (no Euler terms). interpolation "linear" (spec) or "cubic" (error ∝ h⁴ instead
+    (derivative of the gyro interpolant), "zero" (no Euler terms). interpolation "linear" or "cubic" (error ∝ h⁴ instead
     of h²). gradient: Γ_s (3, 3) 1/s² in s. bias_a (m/s²), bias_g (rad/s): estimated IMU
     biases, subtracted from the inputs.
     """
@@ -187,7 +189,7 @@ def check_jacobian(*args, fd_steps=(1e-3, 1e-4, 1e-3, 1e-4), **kwargs) -> dict:
 
 
 def readout_jacobian(phase_jac, phi_hat, phi0, contrast: float = 1.0) -> np.ndarray:
-    """∂p/∂θ of p = o − (C/2) cos(φ̂ + φ0) (seed 000 (P-10)): (C/2) sin(φ̂ + φ0) ∂φ/∂θ;
+    """∂p/∂θ of p = o − (C/2) cos(φ̂ + φ0) (Tennstedt et al. 2021 Eq. 10): (C/2) sin(φ̂ + φ0) ∂φ/∂θ;
     at mid-fringe (φ̂ + φ0 = π/2) it is (C/2) ∂φ/∂θ. Shapes broadcast over (shots, channels)."""
     jac = as_floats(phase_jac, "phase_jac")
     phi_hat, phi0 = as_floats(phi_hat, "phi_hat"), as_floats(phi0, "phi0")
@@ -225,7 +227,7 @@ class SineMotion:
 
 @dataclass
 class YawDrive:
-    """Seed-003 Fig. 7 drive: forward speed (m/s) along body x, level, yaw rate
+    """Drive of Tennstedt et al. 2023, Fig. 7: forward speed (m/s) along body x, level, yaw rate
     ω_z = amplitude · sin(2πt/period) (rad/s)."""
 
     speed: float = 1.0
@@ -254,7 +256,7 @@ def motion_imu(motion, t, *, gravity=(0.0, 0.0, 0.0), gradient=None, t_ref: floa
 
 def oracle_phase(motion, shots, T: float, channels: Channels, *, gravity=(0.0, 0.0, 0.0), gradient=None,
                  t_ref: float = 0.0) -> np.ndarray:
-    """Exact phase (rad) (n_shots, n_channels) from the inertial oracle (spec (E8)): ballistic
+    """Exact phase (rad) (n_shots, n_channels) from the inertial oracle: ballistic
     atom in the inertial frame, transformed into the rotating sensor frame at the pulses."""
     instance(motion, (SineMotion, YawDrive), "motion")
     instance(channels, Channels, "channels")
@@ -278,21 +280,21 @@ def _closed(kind, k, v0, angular_rate, specific_force, T, angular_acceleration=(
 
 def phase_constant(k, v0, angular_rate, specific_force, T: float) -> np.ndarray:
     """Exact phase (rad) per row of k (C, 3) for constant ω_s (rad/s) and f_s (m/s²) in s
-    (spec (E10))."""
+    (closed-form solution of the atom motion in the rotating sensor frame)."""
     return _closed("exact", k, v0, plausibility.angular_rate(angular_rate, "angular_rate"), specific_force, plausibility.pulse_separation(T, "T"))
 
 
 def phase_series(k, v0, angular_rate, specific_force, T: float, angular_acceleration=(0.0, 0.0, 0.0),
                  gradient=None) -> np.ndarray:
-    """Fourth-order series (spec (E11)) incl. ω̇ (rad/s²) and gradient Γ (1/s²) terms."""
+    """Fourth-order series in T of :func:`phase_constant` incl. ω̇ (rad/s²) and gradient Γ (1/s²) terms."""
     return _closed("series", k, v0, plausibility.angular_rate(angular_rate, "angular_rate"), specific_force, plausibility.pulse_separation(T, "T"),
                    angular_acceleration, gradient)
 
 
 def phase_seed000(k, vbar, angular_rate, specific_force, T_total: float) -> np.ndarray:
-    """Seed 000 (P-52) in the paper's convention: k·(¼ f − ½ ω×v̄) T0², T0 = total
+    """Tennstedt et al. 2021 Eq. 52 in the paper's convention: k·(¼ f − ½ ω×v̄) T0², T0 = total
     interrogation time. Equals the library's first-order phase with k → −k, v0 = −v̄,
-    T = T0/2."""
+    T = T0/2 (docs/departures.md#phase-convention-of-eq-52)."""
     with renamed(v0="vbar", T="T_total"):
         return _closed("seed000", k, vbar, plausibility.angular_rate(angular_rate, "angular_rate"), specific_force,
                        plausibility.pulse_separation(T_total, "T_total", pulses=2))
@@ -309,12 +311,13 @@ def sagnac_phase(k, v0, angular_rate, T: float) -> np.ndarray:
 
 
 def t_sep_from_total(T_total: float) -> float:
-    """Pulse separation T = T0/2 of seed 000's total interrogation time T0 (s)."""
+    """Pulse separation T = T0/2 of Tennstedt et al. 2021's total interrogation time T0 (s)
+    (docs/departures.md#interrogation-time-t0)."""
     return 0.5 * plausibility.pulse_separation(positive(T_total, "T_total"), "T_total", pulses=2)
 
 
 def total_from_t_sep(T: float) -> float:
-    """Seed 000's total interrogation time T0 = 2T (s)."""
+    """Tennstedt et al. 2021's total interrogation time T0 = 2T (s)."""
     with np.errstate(over="ignore"):
         return float(finite_result(2.0 * np.float64(plausibility.pulse_separation(positive(T, "T"), "T")), "T", "2T"))
 
@@ -329,7 +332,7 @@ def scale_factors(T: float, k: float = K_RB87, v0: float = 2.8) -> dict:
 
 
 def dynamic_range(T: float, k: float = K_RB87) -> float:
-    """Acceleration span of one fringe flank, π/(kT²) (m/s²) (spec (E3))."""
+    """Acceleration span of one fringe flank, π/(kT²) (m/s²) (Tennstedt et al. 2023 Eq. 3)."""
     return np.pi / _kt2(k, T)
 
 
@@ -344,7 +347,7 @@ def _kt2(k: float, T: float) -> float:
 
 def capture_limits(T: float, k: float = K_RB87, v0: float = 2.8) -> dict:
     """Largest bias errors keeping the phase error below π/2: accelerometer π/(2kT²) (m/s²),
-    gyro π/(2·2kv0T²) (rad/s) (seed 000 spec §2.8)."""
+    gyro π/(2·2kv0T²) (rad/s) (Tennstedt et al. 2021, Fig. 3)."""
     s = scale_factors(T, positive(k, "k"), positive(v0, "v0"))
     with np.errstate(over="ignore", divide="ignore"):
         limits = {"accelerometer": 0.5 * np.pi / np.float64(s["acceleration"]), "gyro": 0.5 * np.pi / np.float64(s["sagnac"])}
@@ -352,8 +355,8 @@ def capture_limits(T: float, k: float = K_RB87, v0: float = 2.8) -> dict:
 
 
 def in_shot_noise_phase(q_accel: float, q_gyro: float, T: float, k: float = K_RB87, v0: float = 2.8) -> dict:
-    """Phase standard deviation (rad) caused by IMU white noise inside one shot (seed 003
-    spec (E38)): ``accel`` k√(2q_a/3) T^{3/2} and ``gyro`` (Sagnac) 2kv0√(2q_g/3) T^{3/2},
+    """Phase standard deviation (rad) caused by IMU white noise inside one shot:
+    ``accel`` k√(2q_a/3) T^{3/2} and ``gyro`` (Sagnac) 2kv0√(2q_g/3) T^{3/2},
     with q the white-noise PSDs (m²/s³, rad²/s), from Var = q k² ∫w² dt, ∫w² = 2T³/3."""
     T = np.float64(plausibility.pulse_separation(positive(T, "T"), "T"))
     q_accel, q_gyro = nonnegative(q_accel, "q_accel"), nonnegative(q_gyro, "q_gyro")

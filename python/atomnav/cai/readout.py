@@ -1,4 +1,4 @@
-"""CAI readout and fringe handling (spec ``cai-ekf-tennstedt2021.md`` (E3)–(E6), Decision 4):
+"""CAI readout and fringe handling (Tennstedt et al. 2021 Eqs. 8–10; docs/departures.md#one-readout-model):
 population p = o − (C/2) cos(φ + φ0), offset o, contrast C ∈ (0, 1], laser phase φ0."""
 
 from __future__ import annotations
@@ -77,7 +77,7 @@ def fringes_crossed(phi) -> np.ndarray:
 
 
 def capture_region(delta) -> np.ndarray:
-    """Capture region of a true-minus-predicted phase Δ (rad) (seed 000 Fig. 3):
+    """Capture region of a true-minus-predicted phase Δ (rad) (Tennstedt et al. 2021, Fig. 3):
     "A" |Δ| < π/2 (correct update), "B" π/2 ≤ |Δ| < π (right sign, too small), "slip"."""
     a = np.abs(as_floats(delta, "delta"))
     finite(np.atleast_1d(a).reshape(-1), "delta")

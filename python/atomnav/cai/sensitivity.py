@@ -1,5 +1,5 @@
-"""Sensitivity function and convolution predictor with finite rectangular pulses (seed 003
-Eqs. 13–14; spec ``atom-strapdown-tennstedt2023.md`` (E18)–(E20)). Times are relative to
+"""Sensitivity function and convolution predictor with finite rectangular pulses (Tennstedt
+et al. 2023 Eqs. 13–14). Times are relative to
 the centre of the π pulse; dark time T_d (s), π/2-pulse duration τ (s), pulse-centre
 separation T = T_d + 1.5τ."""
 
@@ -24,7 +24,7 @@ def response_area(t_dark: float, tau: float) -> float:
 
 def convolution_phase(t, acceleration, centres, *, t_dark: float, tau: float, k: float) -> np.ndarray:
     """Convolution phase φ = k ∫ f(t − t_c) a(t) dt (rad) of shots centred at ``centres`` (s)
-    (spec (E20)). ``acceleration`` (m/s²) of the atoms relative to the sensor along k,
+    (Tennstedt et al. 2023 Eq. 14). ``acceleration`` (m/s²) of the atoms relative to the sensor along k,
     sampled at any rate at times t (s), linear between samples (the atom strapdown
     equivalent is a = −k̂·f_s)."""
     return _core.cai_convolution_phase(plausibility.pulse_separation(finite_scalar(t_dark, "t_dark"), "t_dark"), finite_scalar(tau, "tau"), finite_scalar(k, "k"),
