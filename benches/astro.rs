@@ -1,4 +1,4 @@
-//! Astro-inertial calibration on the 73-epoch `vasilyuk2024_like` scenario (spec §5.1):
+//! Astro-inertial calibration on the 73-epoch `vasilyuk2024_like` scenario (Vasilyuk et al. 2024):
 //! gyro increments over 302k samples (E3–E7), star attitudes (E9–E12), and Gauss–Newton
 //! with the sandwich covariance (E17–E18), each per iteration.
 

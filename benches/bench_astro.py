@@ -1,4 +1,4 @@
-"""Full 73-epoch astro-inertial calibration (vasilyuk2024_like, spec §5.1): atomnav vs a
+"""Full 73-epoch astro-inertial calibration (vasilyuk2024_like, Vasilyuk et al. 2024): atomnav vs a
 straightforward numpy/scipy implementation of the same chain, in one run.
 
     python benches/bench_astro.py [--repeat 3]

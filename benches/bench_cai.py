@@ -1,5 +1,5 @@
 """Atom strapdown predictor: atomnav (Rust) vs a straightforward numpy implementation of
-the same equations (spec (E5)–(E7): RK4 per IMU interval, linear inputs, ω̇ from the
+the same equations (Tennstedt et al. 2023 Eqs. 5–8: RK4 per IMU interval, linear inputs, ω̇ from the
 piecewise-linear gyro), timed side by side in one run; prints the ratio.
 
     python benches/bench_cai.py [--seconds 10] [--slow-seconds 1]

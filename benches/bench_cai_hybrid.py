@@ -1,7 +1,7 @@
 """CAI-aided INS: atomnav (Rust engine + CAI aiding) vs a pure-numpy reference implementation
 of the same filter loop, timed side by side in one run; prints the ratios.
 
-One 35 s car run (seed-003 car profile, kinematic mode, 200 Hz navigation IMU, 20 Hz CAI,
+One 35 s car run (car profile of Tennstedt et al. 2023, kinematic mode, 200 Hz navigation IMU, 20 Hz CAI,
 6 observations per shot, 15 states), both sides configured alike: strapdown per sample;
 per shot the atom-strapdown RK4 predictor on the compensated IMU (linear inputs, ω̇ of the
 piecewise-linear gyro), mid-fringe steering, nonlinear innovation, stacked 6-row update

@@ -1,4 +1,4 @@
-//! CAI-aided INS throughput: one 35 s seed-003 car run (200 Hz IMU, kinematic mode, one
+//! CAI-aided INS throughput: one 35 s car run of Tennstedt et al. 2023 (200 Hz IMU, kinematic mode, one
 //! shot per 50 ms with 6 channels, 15 states) through the generic engine with `CaiAiding`.
 
 use atomnav::cai::aiding::{shot_times, CaiAiding, CaiConfig, CaiData};

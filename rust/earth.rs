@@ -1,5 +1,5 @@
 //! Earth models: WGS-84 and PZ-90.11 ellipsoids, normal gravity, radii of curvature,
-//! Earth and transport rates, LLA ↔ ECEF ↔ NED. Equations: spec gnss-ins-tight §2.1.
+//! Earth and transport rates, LLA ↔ ECEF ↔ NED (standard geodesy on the ellipsoid).
 //!
 //! Positions are (latitude rad, longitude rad, ellipsoidal height m).
 
@@ -34,19 +34,19 @@ pub const WGS84: Ellipsoid = Ellipsoid {
     gamma_p: 9.8321849378,
 };
 
-/// Kinematic mode (spec atom-strapdown decision 11): WGS-84 geometry without Earth
+/// Kinematic mode (docs/departures.md#kinematic-gravity-mode): WGS-84 geometry without Earth
 /// rotation and with zero normal gravity, so a tilt error does not project gravity into
 /// the velocity and the IMU senses the kinematic acceleration.
 pub const KINEMATIC: Ellipsoid = Ellipsoid { name: "kinematic", omega: 0.0, gamma_e: 0.0, gamma_p: 0.0, ..WGS84 };
 
-/// PZ-90.11 (GLONASS ICD 2016, spec gnss-ins-tight §3).
+/// PZ-90.11 (GLONASS ICD 2016).
 pub const PZ90_11: Ellipsoid = Ellipsoid {
     name: "PZ90.11",
     a: 6378136.0,
     f: 1.0 / 298.25784,
     gm: 3.986004418e14,
     omega: 7.292115e-5,
-    // γ_e as published for PZ-90.11 (spec §3); γ_p from the closed form (no published value)
+    // γ_e as published for PZ-90.11 (GLONASS ICD 2016); γ_p from the closed form (no published value)
     gamma_e: 9.7803284,
     gamma_p: 9.832188005043,
 };
@@ -107,7 +107,7 @@ impl Ellipsoid {
     }
 
     /// Normal gravity magnitude γ (m/s², positive down): Somigliana with the second-order
-    /// height correction, spec gnss-ins-tight §2.1 Eq. 4.
+    /// height correction.
     pub fn gravity(&self, lat: f64, h: f64) -> f64 {
         let ge = self.gamma_e;
         let (a, f, m) = (self.a, self.f, self.m());
@@ -244,7 +244,7 @@ pub struct LocalModel {
     /// Somigliana's k.
     k: f64,
     /// Height correction 1 − (c₁ − c₂ sin²φ) h + c₃ h² with c₁ = 2(1 + f + m)/a,
-    /// c₂ = 4f/a, c₃ = 3/a² (spec gnss-ins-tight §2.1 Eq. 4).
+    /// c₂ = 4f/a, c₃ = 3/a² (Somigliana with the second-order height correction).
     c1: f64,
     c2: f64,
     c3: f64,
@@ -314,7 +314,7 @@ impl AnchoredSinCos {
     }
 }
 
-/// C_n^e: columns are the N, E, D axes in ECEF (spec §2.1 Eq. 2).
+/// C_n^e: columns are the N, E, D axes in ECEF.
 pub fn dcm_ned_to_ecef(lat: f64, lon: f64) -> Mat3 {
     let (sl, cl) = lat.sin_cos();
     let (so, co) = lon.sin_cos();
@@ -455,7 +455,7 @@ impl Ellipsoid {
 
 /// A seven-parameter Helmert transformation r_WGS = T + (1 + s)·Rot·r_PZ with the
 /// coordinate-frame rotation Rot = [[1, r_z, −r_y], [−r_z, 1, r_x], [r_y, −r_x, 1]]
-/// (spec gnss-ins-tight §2.1 Eq. 6). Rotations in rad, scale dimensionless.
+/// (docs/departures.md#datum). Rotations in rad, scale dimensionless.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Helmert {
     pub translation: Vec3,

@@ -389,7 +389,7 @@ mod tests {
 
     #[test]
     fn scalar_part_identity_row3() {
-        // spec §5.2 row 3: r0(x) − (1 − |θ(x)|²/8) = |Δρ|²(x²−x)²/32 exactly for c = 1/8.
+        // r0(x) − (1 − |θ(x)|²/8) = |Δρ|²(x²−x)²/32 exactly for c = 1/8.
         let (rho, d) = (Vec3::new(0.1, 0.05, -0.08), Vec3::new(0.03, -0.02, 0.04));
         let x = 2.0 / 3.0;
         let th = rho * x + d * ((x * x - x) / 2.0);

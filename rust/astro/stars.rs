@@ -9,7 +9,7 @@ use crate::math::{Mat3, Vec3};
 use rand::Rng;
 use rand_distr::StandardNormal;
 
-/// Refraction passes after the uncorrected first solution (D13 iterates once; a third
+/// Refraction passes after the uncorrected first solution (docs/departures.md#refraction iterates once; a third
 /// pass takes the noise-free attitude error from ~1e-11 to the rounding level).
 const REFRACTION_PASSES: usize = 3;
 
@@ -408,7 +408,7 @@ mod tests {
     #[test]
     fn refraction_matches_snell_closed_form() {
         // Oracle: Snell's law z_obs = asin(sin z / n) for the plane-parallel atmosphere.
-        // (spec §5.2 row 15 prints 32.61″, 56.49″, 97.88″; the exact Snell values for
+        // (a reference table printed 32.61″, 56.49″, 97.88″; the exact Snell values for
         // n − 1 = 2.7385e-4 are 32.602″, 56.463″, 97.769″ — the printed ones are not.)
         let n = refractive_index(150.0).unwrap();
         assert!(((n - 1.0) / 2.7385e-4 - 1.0).abs() < 1e-4);

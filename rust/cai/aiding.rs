@@ -558,7 +558,7 @@ mod tests {
 
     const K: f64 = 1.610576e7;
 
-    /// Seed-003 six-channel geometry (cyclic ±v0), lever arm and C_sb as given.
+    /// Six-channel geometry of Tennstedt et al. 2023 (cyclic ±v0), lever arm and C_sb as given.
     fn cyclic(lever: Vec3, c_sb: Mat3) -> Vec<Channel> {
         (0..6).map(|c| Channel { k: Vec3::ith(c / 2, K), lever, c_sb, v0: Vec3::ith((c / 2 + 1) % 3, if c % 2 == 0 { 2.8 } else { -2.8 }) }).collect()
     }

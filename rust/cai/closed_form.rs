@@ -1,11 +1,11 @@
-//! Constant-input closed forms of the CAI phase (spec `atom-strapdown-tennstedt2023.md`
-//! (E10), (E11); spec `cai-ekf-tennstedt2021.md` (E9), (E10)).
+//! Constant-input closed forms of the CAI phase: the exact solution of the atom motion in the
+//! rotating sensor frame, its fourth-order series in T, and Tennstedt et al. 2021 Eq. 52.
 
 use crate::error::{check_positive, invalid, Result};
 use crate::math::{skew, Mat3, Vec3};
 use crate::options::Choice;
 
-/// Which closed form (option `kind`): "exact" (E10), "series" (E11) or "seed000" (P-52).
+/// Which closed form (option `kind`): "exact", "series" or "seed000" (Tennstedt et al. 2021 Eq. 52).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum ClosedForm {
     Exact,
@@ -54,7 +54,7 @@ fn factorial(n: u32) -> f64 {
     (1..=n).map(f64::from).product()
 }
 
-/// Kernels of (E10) for W = [ω×], |ω| = Ω, x = Ωt:
+/// Kernels of the exact form for W = [ω×], |ω| = Ω, x = Ωt:
 /// R(−t) = I − a W + b W², M(t) = t²/2 I − c W + d W² with
 /// a = sin x/Ω, b = (1 − cos x)/Ω², c = (sin x − x cos x)/Ω³,
 /// d = (t²/2 − (cos x + x sin x − 1)/Ω²)/Ω².
@@ -75,7 +75,7 @@ fn kernels(omega: f64, t: f64) -> [f64; 4] {
     }
 }
 
-/// Atom position x(t) in s for constant ω_s, f_s (E10):
+/// Atom position x(t) in s for constant ω_s, f_s:
 /// x(t) = R(−t) v0 t − M(t) f_s (no gradient, ω̇ = 0).
 pub fn position_constant(w: &Vec3, f: &Vec3, v0: &Vec3, t: f64) -> Vec3 {
     let wm = skew(w);
@@ -91,7 +91,7 @@ pub fn phase_constant(k: &Vec3, w: &Vec3, f: &Vec3, v0: &Vec3, t_sep: f64) -> f6
     k.dot(&(position_constant(w, f, v0, 2.0 * t_sep) - 2.0 * position_constant(w, f, v0, t_sep)))
 }
 
-/// Series (E11) to fourth order in T, with optional gradient Γ and angular acceleration:
+/// Series to fourth order in T, with optional gradient Γ and angular acceleration:
 /// φ = −T²k·f − 2T²k·(ω×v0) + 2T³k·(ω×f) + 3T³k·(ω×(ω×v0)) − 3T³k·(ω̇×v0)
 ///     − 7/4 T⁴k·(ω×(ω×f)) − 7/3 T⁴k·(ω×(ω×(ω×v0))) + T³k·Γv0 − 7/12 T⁴k·Γf.
 pub fn phase_series(k: &Vec3, w: &Vec3, wd: &Vec3, f: &Vec3, v0: &Vec3, gradient: &Mat3, t: f64) -> f64 {
@@ -104,7 +104,7 @@ pub fn phase_series(k: &Vec3, w: &Vec3, wd: &Vec3, f: &Vec3, v0: &Vec3, gradient
         - 7.0 / 12.0 * t4 * k.dot(&(gradient * f))
 }
 
-/// Seed-000 phase (P-52) in the paper's own convention: φ = k·(¼ f − ½ ω×v̄) T0², with
+/// Tennstedt et al. 2021 Eq. 52 in the paper's own convention: φ = k·(¼ f − ½ ω×v̄) T0², with
 /// T0 the total interrogation time and v̄ the paper's (negated) atom velocity.
 pub fn phase_seed000(k: &Vec3, w: &Vec3, f: &Vec3, vbar: &Vec3, t_total: f64) -> f64 {
     k.dot(&(0.25 * f - 0.5 * w.cross(vbar))) * t_total * t_total
@@ -114,10 +114,10 @@ pub fn phase_seed000(k: &Vec3, w: &Vec3, f: &Vec3, vbar: &Vec3, t_total: f64) ->
 mod tests {
     use super::*;
 
-    /// Spec §4 "Oracle vs closed form" reference numbers.
+    /// "Oracle vs closed form" reference numbers of an independent computation.
     #[test]
     fn spec_reference_phases() {
-        // k = 4π/780.241 nm unrounded (the spec's reference numbers use it).
+        // k = 4π/780.241 nm unrounded (the reference numbers use it).
         let k0 = 4.0 * std::f64::consts::PI / 780.241e-9;
         let f = Vec3::new(0.3, -0.2, -9.81);
         let w = Vec3::new(0.05, -0.03, 0.2);

@@ -1,24 +1,25 @@
-//! In-shot IMU noise in the predicted CAI phase (seed 000 decision 14, atom-strapdown
-//! decision 12): the predictor is driven by the noisy IMU samples of the shot, so the
+//! In-shot IMU noise in the predicted CAI phase (docs/departures.md#in-shot-imu-noise-in-r):
+//! the predictor is driven by the noisy IMU samples of the shot, so the
 //! predicted phase carries their white noise. To first order
 //!   δφ̂ = Σ_i s_i n_i,   s_i = ∂φ̂/∂(f_i, ω_i)  (channels × 6),
 //! with n_i the noise of sample i (covariance diag(q_a, q_a, q_a, q_g, q_g, q_g)/Δt_i,
-//! spec (E33)), so the phase covariance is Σ = Σ_i s_i Q_i s_iᵀ ("R_eff = R + (C/2)² S Q_u Sᵀ
+//! white PSDs q over the sample interval), so the phase covariance is Σ = Σ_i s_i Q_i s_iᵀ
+//! ("R_eff = R + (C/2)² S Q_u Sᵀ
 //! with S the phase sensitivity to the IMU samples of the shot").
 //!
 //! The sensitivities come from the predictor itself (central differences on a record at
 //! rest), so every path of the configured interpolation and ω̇ option is included. For a
-//! continuous record the paths are (derived from (E9)/(E15), x(0) = 0, w = triangle weight):
-//! - accelerometer: −∫ w k·C_sb n_a dt  (variance (2T³/3) q_a |k|², spec (E38));
+//! continuous record the paths are (derived from the atom motion with x(0) = 0, w = triangle weight):
+//! - accelerometer: −∫ w k·C_sb n_a dt  (variance (2T³/3) q_a |k|²);
 //! - gyro through the rotation of v0, Coriolis plus atom Euler term together: to first order
 //!   x_h = (I − [θ(t)×]) v0 t, so φ_rot = −2T k·((θ(2T) − θ(T)) × v0) — the gyro noise enters
-//!   with weight 2T on [T, 2T] only, variance 4T³ q_g |v0 × k|². (E38)'s 2kv0√(2q_g/3)T^{3/2}
+//!   with weight 2T on [T, 2T] only, variance 4T³ q_g |v0 × k|². The Coriolis-only estimate 2kv0√(2q_g/3)T^{3/2}
 //!   is the Coriolis term alone (weight 2w, variance (8T³/3) q_g |v0 × k|²): with a ω̇
 //!   consistent with the gyro (options "pwl", "savgol") the true variance is 1.5× larger,
-//!   0.3667 rad instead of 0.2994 rad for the seed-003 IMU at T = 25 ms;
+//!   0.3667 rad instead of 0.2994 rad for the IMU of Tennstedt et al. 2023 at T = 25 ms;
 //! - gyro through the lever-arm Euler term: −∫ w k·C_sb(ω̇ × l) dt = ∫ w' (l × C_sbᵀk)·ω dt,
 //!   w' = ±1 on the two halves, variance 2T q_g |l × C_sbᵀk|²: 0.370 rad for l = 0.1 m ⊥ k at
-//!   T = 25 ms — as large as the rest, and absent from (E38).
+//!   T = 25 ms — as large as the rest, and absent from the Coriolis-only estimate.
 
 use super::predictor::{predict, Channel, Imu, OmegaDot, PredictorConfig};
 use crate::error::{check_increasing, invalid, Result};
@@ -173,7 +174,7 @@ mod tests {
         assert!((sig[(4, 4)] / (acc + 4.0 * rot) - 1.0).abs() < 5e-3, "z channel has k ∥ l: {}", sig[(4, 4)]);
         // the lever-arm weight w' jumps from +1 to −1 at T: resolved to O(Δt/T) = 1 % on this grid
         assert!((sig[(0, 0)] / (acc + 4.0 * rot + lever) - 1.0).abs() < 1e-2, "{} vs {}", sig[(0, 0)], acc + 4.0 * rot + lever);
-        // seed-003 numbers (module doc): 0.3667 rad rotation, 0.370 rad lever-arm Euler
+        // Tennstedt et al. 2023 IMU numbers (module doc): 0.3667 rad rotation, 0.370 rad lever-arm Euler
         assert!(((4.0 * rot).sqrt() - 0.3667).abs() < 5e-4 && (lever.sqrt() - 0.370).abs() < 1e-3);
     }
 

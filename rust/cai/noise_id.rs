@@ -19,7 +19,7 @@ pub struct FringeEkf {
     pub zeta0: [f64; 3],
     /// Initial standard deviations of ζ.
     pub sigma0: [f64; 3],
-    /// Random-walk variance of ζ per shot (spec Decision 10: 1e-9, 1e-7, 1e-9).
+    /// Random-walk variance of ζ per shot (docs/departures.md#fringe-tracking: 1e-9, 1e-7, 1e-9).
     pub q: [f64; 3],
     /// Readout noise variance R.
     pub r: f64,
@@ -219,8 +219,8 @@ pub fn ml_identify(x: &[f64], phi: &[f64], amp: &[f64], cfg: &MlConfig) -> Resul
             Method::Newton => {
                 let neg_def = hs.clone().symmetric_eigen().eigenvalues.iter().all(|&e| e < 0.0);
                 let m = if neg_def { -hs } else { fs };
-                // damped pseudo-inverse (spec Decision 9): singular directions (a component
-                // at 0) get no step
+                // damped pseudo-inverse (docs/departures.md#identifiable-readout-noise):
+                // singular directions (a component at 0) get no step
                 let svd = m.svd(true, true);
                 let eps = 1e-12 * svd.singular_values.max();
                 svd.solve(&gs, eps).map_err(|e| NavError::Numerical(format!("ML Newton step: {e}")))?

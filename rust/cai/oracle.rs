@@ -1,4 +1,4 @@
-//! Inertial oracle (spec `atom-strapdown-tennstedt2023.md` (E8)): the atom flies
+//! Inertial oracle (docs/departures.md#full-phase-predictor): the atom flies
 //! ballistically in the inertial frame i (uniform gravity g and optional constant gradient
 //! Γ_i), released at the sensor origin with the sensor's velocity plus C_is v0; its
 //! position is transformed into the moving, rotating sensor frame at the pulse times,
@@ -131,7 +131,7 @@ impl YawDrive {
     }
 }
 
-/// Seed-003 Fig. 7 drive (spec §2.8 `fig7_yaw_sine`): constant forward speed V along the
+/// Drive of Tennstedt et al. 2023, Fig. 7: constant forward speed V along the
 /// body x axis, level, yaw rate ω_z = A sin(2πt/P), yaw ψ = A P/(2π)(1 − cos(2πt/P)).
 #[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 pub struct YawDrive {
@@ -354,7 +354,7 @@ mod tests {
     const K: f64 = 1.610576e7;
 
     fn channels(lever: Vec3, c_sb: Mat3) -> Vec<Channel> {
-        // Cyclic geometry (spec §2.2): k along e_j, v0 = ±2.8 m/s along e_{j+1}.
+        // Cyclic geometry (docs/departures.md#ensemble-geometry): k along e_j, v0 = ±2.8 m/s along e_{j+1}.
         let mut out = Vec::new();
         for j in 0..3 {
             for s in [1.0, -1.0] {

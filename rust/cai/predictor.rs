@@ -1,21 +1,21 @@
-//! Atom strapdown phase predictor (seed 003 §2; spec `atom-strapdown-tennstedt2023.md`
-//! (E5)–(E7), (E12)–(E17)) and its tangent-linear Jacobians ((E29)–(E31), default mode).
+//! Atom strapdown phase predictor (Tennstedt et al. 2023 §2, Eqs. 5–12) and its tangent-linear
+//! Jacobians (default mode; the paper's Eqs. 27, 31–32 in paper mode).
 //!
 //! Per shot (pulses at t_s, t_s + T, t_s + 2T) and per interferometer channel the atom
-//! position x in the sensor frame s obeys (E5)
+//! position x in the sensor frame s obeys (docs/departures.md#specific-force-drives-the-atoms)
 //!   ẍ = −f_s − 2ω×ẋ − ω×(ω×x) − ω̇×x + Γ_s x,   x(0) = 0, ẋ(0) = v0,
-//! with (E6) f_s = C_sb (f_b + ω̇_b×l + ω_b×(ω_b×l)) − Γ_s C_sb l and (E7) ω = C_sb ω_b.
-//! The IMU inputs are interpolated between samples (linear per spec §2.3, or cubic) and
+//! with (Eq. 7) f_s = C_sb (f_b + ω̇_b×l + ω_b×(ω_b×l)) − Γ_s C_sb l and (Eq. 8) ω = C_sb ω_b.
+//! The IMU inputs are interpolated between samples (linear by default, or cubic) and
 //! bias-corrected with the current estimates; the ODE is integrated with RK4 on a grid made
 //! of the IMU sample times and the pulse times (`substeps` RK4 steps per grid interval);
 //! φ = k·D[x].
 //!
-//! Breakdown (exact decomposition of (E9), spec §2.4): the solution of the linear ODE is
+//! Breakdown (exact decomposition, docs/departures.md#per-term-breakdown): the solution of the linear ODE is
 //! x = x_h + x_p, x_h = Φ(t) v0 (homogeneous part; Φ shared by all channels with the same
 //! C_sb and l), x_p the forced part with zero initial state, so
-//!   φ_rot = k·D[x_h] (E15),   φ_acc, φ_cen, φ_eul = −∫ w k·(…) dτ (E12)–(E14) by
+//!   φ_rot = k·D[x_h],   φ_acc, φ_cen, φ_eul = −∫ w k·(…) dτ by
 //!   Simpson's rule (exact for the piecewise-polynomial integrands),
-//!   φ_mix = k·D[x_p] − φ_acc − φ_cen − φ_eul (E16),   φ_gg = φ(Γ) − φ(Γ = 0) (E17),
+//!   φ_mix = k·D[x_p] − φ_acc − φ_cen − φ_eul,   φ_gg = φ(Γ) − φ(Γ = 0),
 //! and the six terms add up to the total by construction.
 
 use crate::error::{check_finite, check_increasing, check_positive, invalid, Result};
@@ -33,7 +33,8 @@ pub struct Channel {
     pub v0: Vec3,
 }
 
-/// Source of the angular acceleration ω̇_b used in the Euler terms (spec §2.2).
+/// Source of the angular acceleration ω̇_b used in the Euler terms
+/// (docs/departures.md#euler-terms-and-angular-acceleration).
 #[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub enum OmegaDot {
     /// Euler terms omitted (ω̇ ≡ 0).
@@ -120,7 +121,7 @@ impl OmegaDot {
 /// Interpolation of the IMU samples between sample times.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Interpolation {
-    /// Piecewise linear (spec §2.3): integrated error ∝ h² (relative (hΩ)²/12 for a
+    /// Piecewise linear: integrated error ∝ h² (relative (hΩ)²/12 for a
     /// sinusoid of angular frequency Ω).
     Linear,
     /// Cubic Hermite with central-difference tangents (Catmull–Rom on non-uniform grids,
@@ -640,7 +641,8 @@ fn tangent(b: &BodyStage, s: &ChStage, ch: &Channel, gradient: Option<&Mat3>) ->
 /// Tangent-linear (forward-mode) derivative of the predicted phase with respect to
 /// [`JACOBIAN_PARAMS`] (b_a, b_g, l, γ) at the configured estimates: row
 /// `shot * channels.len() + channel`. Euler terms (ω̇) are removed from the linearisation
-/// point unless `euler` (spec (E30) item 8, Decision 9); use [`jacobian_fd`] to check.
+/// point unless `euler` (the paper's Eq. 31 item 8;
+/// docs/departures.md#euler-terms-and-angular-acceleration); use [`jacobian_fd`] to check.
 // invariant: fixed-size arrays: y holds 26 = 2 + 2·12 vectors indexed by 2 + 2p and
 // 3 + 2p (p < 12) or 2p (p < 13), mid 13, the stage arrays 3 (i < 3).
 #[allow(clippy::indexing_slicing)]

@@ -1,5 +1,5 @@
 //! Sensitivity function and convolution predictor with finite rectangular pulses
-//! (seed 003 Eqs. 13–14; spec `atom-strapdown-tennstedt2023.md` (E18)–(E20)).
+//! (Tennstedt et al. 2023 Eqs. 13–14).
 //!
 //! π pulse (duration 2τ) centred at t = 0, π/2 pulses (τ) at ±(T_d + 1.5τ), Rabi frequency
 //! Ω_R = π/(2τ), dark time T_d. The phase response g(t) (E18) is odd; the acceleration
@@ -178,7 +178,7 @@ pub fn ideal_transfer(t_sep: f64, omega: f64) -> f64 {
 mod tests {
     use super::*;
 
-    /// Spec §4 "Finite pulses": f(0) = 0.0100095493 s, ∫f = 1.002456362e-4 s².
+    /// "Finite pulses" reference values: f(0) = 0.0100095493 s, ∫f = 1.002456362e-4 s².
     #[test]
     fn spec_finite_pulse_values() {
         let p = Pulses::new(0.01, 7.5e-6).unwrap();

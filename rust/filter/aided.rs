@@ -1,18 +1,18 @@
 //! The aided strapdown INS: one engine for every aiding sensor (position fixes, CAI, GNSS,
 //! star camera). The strapdown of `strapdown.rs` runs on bias-compensated IMU output; the
 //! error-state filter predicts every `predict_every` IMU steps and at each measurement
-//! epoch with F from the current solution (spec gnss-ins-tight Eq. 28,
+//! epoch with F from the current solution (the 15-state NED error model,
 //! `ins::error_dynamics`, plus the sensor's extra blocks); an [`Aiding`] model supplies
 //! z = predicted − measured, H and R. In closed loop the estimate is fed back
 //! (X ← X ⊖ δx̂, b̂ ← b̂ − δb̂, extra ← extra − δx̂_extra, δx̂ ← 0); in open loop the INS
-//! runs free and the output is X ⊖ δx̂ (spec gnss-ins-tight §2.11).
+//! runs free and the output is X ⊖ δx̂ (the estimation and feedback variants of Demidov 2009).
 //!
 //! [`AidedIns::process`] takes the IMU record chunk by chunk (streaming); feeding the
 //! whole record in one call, or in any chunks followed by [`AidedIns::finish`], gives the
 //! same result. Error messages about samples name their index in the whole record.
 //!
 //! The vertical channel is free by default; [`AidedIns::with_damped_vertical`] damps it
-//! with a reference (barometric) altitude per IMU sample (spec decision 13, Eq. 26), and
+//! with a reference (barometric) altitude per IMU sample (docs/departures.md#baro-damped-vertical-channel), and
 //! the filter's F then carries the baro loop (`ins::baro_loop_dynamics`) and, optionally,
 //! a `baro_bias` state appended after the aiding's extra blocks.
 
@@ -370,7 +370,7 @@ impl<A: Aiding> AidedIns<A> {
 
     /// Damp the vertical channel with a reference altitude h_b per IMU sample (then
     /// required by [`Self::process_ref`]): damping ratio ζ, natural frequency ω_v (rad/s)
-    /// of the baro loop (spec Eq. 26) and the error model of h_b. With `baro.bias` a
+    /// of the baro loop and the error model of h_b. With `baro.bias` a
     /// one-component `baro_bias` block (m, initial estimate 0 ± the given σ) is appended
     /// to the layout, after the aiding's blocks; the engine compensates h_b − b̂. Only
     /// before the first sample.

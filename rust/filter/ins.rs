@@ -1,8 +1,8 @@
-//! 15-state INS error model (spec gnss-ins-tight §2.9 Eq. 28, free vertical channel) in the
+//! 15-state INS error model (NED, free vertical channel; docs/departures.md#error-states-in-metres) in the
 //! project conventions: δr = NED position error (m), δv (m/s), ψ with
 //! Ĉ_b^n = (I − [ψ×])C_b^n, δb = b̂ − b for both biases (estimate − true), so the bias
-//! columns are F_vba = −Ĉ_b^n and F_ψbg = +Ĉ_b^n (spec cai-ekf E31; the GNSS spec carries
-//! the uncompensated sensor bias, hence its opposite signs).
+//! columns are F_vba = −Ĉ_b^n and F_ψbg = +Ĉ_b^n (docs/departures.md#sign-of-the-sensor-errors;
+//! a model written for the uncompensated sensor bias has the opposite signs).
 
 use super::layout::Layout;
 use crate::earth::Ellipsoid;
@@ -12,7 +12,7 @@ use crate::options::Choice;
 use crate::strapdown::NavState;
 use nalgebra::DMatrix;
 
-/// A bias process per axis (spec gnss-ins-tight Eq. 28 "F_bb"; atom-strapdown E23).
+/// A bias process per axis (the F_bb block: random constant, random walk or Gauss–Markov).
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub enum BiasModel {
     /// ḃ = 0.
@@ -128,7 +128,7 @@ pub fn error_dynamics(layout: &Layout, ell: &Ellipsoid, nav: &NavState, f_b: &Ve
     let a_er = Mat3::new(0.0, 0.0, v.y / (rp * rp), 0.0, 0.0, -v.x / (rm * rm), -v.y / (rm * rp * c * c), 0.0, -v.y * t / (rp * rp));
     let a_ev = Mat3::new(0.0, 1.0 / rp, 0.0, -1.0 / rm, 0.0, 0.0, 0.0, -t / rp, 0.0);
     let f_rr = Mat3::new(-v.z / rm, 0.0, v.x / rm, v.y * t / rp, -(v.x * t + v.z) / rp, v.y / rp, 0.0, 0.0, 0.0);
-    // Gravity gradient from this Earth model: δγ = γ_φ δr_N/R_M − γ_h δr_D (the spec's
+    // Gravity gradient from this Earth model: δγ = γ_φ δr_N/R_M − γ_h δr_D (the usual
     // 2γ/R₀ approximates −γ_h; the central difference is exact for the quadratic in h).
     let g_h = (ell.gravity(lat, h + 1.0) - ell.gravity(lat, h - 1.0)) / 2.0;
     let mut f_vr = skew(&v) * (2.0 * a_ie + a_er);
@@ -174,7 +174,7 @@ pub fn error_dynamics_along(layout: &Layout, ell: &Ellipsoid, lla: &[Vec3], vel:
         .collect()
 }
 
-/// Gains of the baro loop (spec gnss-ins-tight Eq. 26, as in `strapdown.rs`):
+/// Gains of the baro loop (as in `strapdown.rs`; docs/departures.md#baro-damped-vertical-channel):
 /// K_v1 = 2ζω_v, K_v2 = ω_v² + 2γ/R₀ with R₀ = √(R_M R_P) at (lat, h).
 pub fn baro_gains(ell: &Ellipsoid, lat: f64, h: f64, zeta: f64, omega: f64) -> (f64, f64) {
     let e = ell.local(lat, h);
@@ -206,8 +206,8 @@ impl BaroModel {
     }
 }
 
-/// Add the baro-loop terms of a damped vertical channel to F and Q_c (spec gnss-ins-tight
-/// Eq. 28: F_rr[D,D] = −K_v1, F_vr[D,D] gets −K_v2; baro noise n_b enters as −K_v1·n_b into
+/// Add the baro-loop terms of a damped vertical channel to F and Q_c
+/// (F_rr[D,D] = −K_v1, F_vr[D,D] gets −K_v2; baro noise n_b enters as −K_v1·n_b into
 /// δṙ_D and −K_v2·n_b into δv̇_D). The altitude error seen by the loop is
 /// δh_b = (h_b − b̂) − h = −δb + n, so the `baro_bias` column (when the layout has it) is
 /// +K_v1 on δṙ_D and +K_v2 on δv̇_D. Derivation (δr_D = −δh): the INS integrates
@@ -242,7 +242,7 @@ mod tests {
     use crate::math::dcm_from_euler;
     use nalgebra::DVector;
 
-    /// Continuous mechanization (spec gnss-ins-tight Eq. 26) with the sensor bias errors:
+    /// Continuous NED mechanization with the sensor bias errors:
     /// returns (llȧ, v̇, Ċ) for the state (lla, v, C) and sensed f, ω (body); `baro` =
     /// (ζ, ω_v, h_b) damps the vertical channel.
     fn rates(ell: &Ellipsoid, lla: &Vec3, v: &Vec3, c: &Mat3, f: &Vec3, w: &Vec3, baro: Option<(f64, f64, f64)>) -> (Vec3, Vec3, Mat3) {
@@ -316,7 +316,7 @@ mod tests {
         [0, 3, 6].map(|blk| (fx.rows(blk, 3) - d.rows(blk, 3)).norm() / d.rows(blk, 3).norm())
     }
 
-    /// spec gnss-ins-tight §2.9 acceptance: δr = 5 m, δv = 0.05 m/s, ψ = 1e-4 rad, ≤ 1e-4.
+    /// Acceptance: δr = 5 m, δv = 0.05 m/s, ψ = 1e-4 rad, ≤ 1e-4.
     #[test]
     fn f_matches_central_differences_of_mechanization() {
         let z = Vec3::zeros();
@@ -333,8 +333,9 @@ mod tests {
         assert!(rel[1] < 1e-6 && rel[2] < 1e-6, "{rel:?}");
     }
 
-    /// Damped vertical channel (spec decision 13): F with the baro-loop terms matches the
-    /// mechanization with the loop, at the §2.9 acceptance perturbation plus a 3 m baro
+    /// Damped vertical channel (docs/departures.md#baro-damped-vertical-channel): F with the
+    /// baro-loop terms matches the
+    /// mechanization with the loop, at the acceptance perturbation plus a 3 m baro
     /// bias error; the vertical position and velocity rows are where the loop acts.
     #[test]
     fn f_with_baro_loop_matches_central_differences_of_damped_mechanization() {

@@ -1,5 +1,5 @@
 //! Standard atmosphere delays: Klobuchar ionosphere (IS-GPS-200 20.3.3.5.2.5) and
-//! Saastamoinen troposphere (spec gnss-ins-tight §2.6 Eqs. 17–18).
+//! Saastamoinen troposphere (Saastamoinen 1972).
 
 use super::{C_LIGHT, GPS_L1_HZ};
 use std::f64::consts::PI;
@@ -45,7 +45,7 @@ impl Klobuchar {
 
 /// Saastamoinen tropospheric delay (m) with the standard atmosphere (relative humidity 0.7)
 /// at geodetic latitude `lat` rad, height h m, elevation rad; 0 below the horizon or for
-/// h outside [−100 m, 10 km] (spec Eq. 18).
+/// h outside [−100 m, 10 km].
 pub fn saastamoinen(lat: f64, h: f64, elev: f64) -> f64 {
     if elev <= 0.0 || !(-100.0..=1.0e4).contains(&h) {
         return 0.0;

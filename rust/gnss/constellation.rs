@@ -1,5 +1,5 @@
 //! Nominal GPS (6 planes × 4) and GLONASS (3 planes × 8) constellations with broadcast
-//! products and satellite clocks (spec gnss-ins-tight §2.5 Eq. 12). GPS truth orbits are
+//! products and satellite clocks (circular orbits). GPS truth orbits are
 //! Keplerian (e = 0), so the 2-hourly broadcast sets are exact; GLONASS truth is the J₂
 //! integration of Eq. 10 sampled every 30 min into broadcast state vectors (a_ls = 0), so
 //! the broadcast propagation reproduces it. No broadcast (SISRE) error is simulated.
@@ -16,7 +16,7 @@ use rand_chacha::ChaCha8Rng;
 use rand_distr::StandardNormal;
 use std::f64::consts::PI;
 
-/// GLONASS FDMA channels of slots 1…24; antipodal slots share k (spec Eq. 12).
+/// GLONASS FDMA channels of slots 1…24; antipodal slots share k (GLONASS ICD).
 pub const GLONASS_CHANNELS: [i8; 24] = [1, -4, 5, 6, 1, -4, 5, 6, -2, -7, 0, -1, -2, -7, 0, -1, 4, -3, 3, 2, 4, -3, 3, 2];
 const GPS_PERIOD: f64 = 43082.0;
 const GLO_PERIOD: f64 = 40544.0;

@@ -1,6 +1,6 @@
 //! The broadcast ephemerides of both systems: selection of the set nearest in time, the
 //! validity check, and satellite state in WGS-84 (GLONASS through the datum transformation
-//! of spec Eq. 6).
+//! of docs/departures.md#datum).
 
 use super::glonass_orbit::{GloEphemeris, DEFAULT_STEP};
 use super::gps_orbit::GpsEphemeris;

@@ -1,5 +1,5 @@
 //! Receiver–satellite geometry: light-time iteration, Earth rotation during the signal
-//! flight (Sagnac), range and its exact rate, elevation and azimuth (spec §2.6 Eqs. 13, 16).
+//! flight (Sagnac), range and its exact rate, elevation and azimuth.
 
 use super::ephemeris::{Ephemerides, SatState};
 use super::{SatId, C_LIGHT, OMEGA_E_GPS};

@@ -10,7 +10,7 @@ pub const MU_GLO: f64 = 3.986004418e14;
 pub const AE_GLO: f64 = 6_378_136.0;
 pub const J2_GLO: f64 = 1_082_625.75e-9;
 pub const OMEGA_GLO: f64 = 7.292115e-5;
-/// Default RK4 step (s); the spec allows ≤ 60 s.
+/// Default RK4 step (s); steps up to 60 s are accurate enough.
 pub const DEFAULT_STEP: f64 = 30.0;
 
 /// One broadcast GLONASS ephemeris: state at t_b (GLONASS time, s) in PZ-90, clock terms.
@@ -202,7 +202,7 @@ mod tests {
 
     #[test]
     fn rk4_30s_agrees_with_fine_step_over_15_min_and_j2_matters() {
-        // spec §4 row 9: < 1 mm vs a tight integration; 15–50 m if J₂ is dropped
+        // acceptance: < 1 mm vs a tight integration; 15–50 m if J₂ is dropped
         for u in [0.0f64, 45.0, 90.0] {
             let (r, v) = circular(u.to_radians());
             for dt in [900.0, -900.0] {

@@ -1,5 +1,5 @@
 //! GPS satellite position, velocity and clock from broadcast Keplerian elements
-//! (IS-GPS-200, Table 20-IV; spec gnss-ins-tight §2.3 Eqs. 8–9).
+//! (IS-GPS-200, Table 20-IV and the clock correction of 20.3.3.3.3.1).
 
 use crate::error::{invalid, Result};
 use crate::math::Vec3;

@@ -1,11 +1,11 @@
-//! GNSS for tight GPS + GLONASS / INS integration (spec gnss-ins-tight-demidov2009, seed 004):
+//! GNSS for tight GPS + GLONASS / INS integration (Demidov 2009):
 //! broadcast orbits and clocks, a nominal-constellation simulator, code and Doppler
 //! observables with the system-time offset τ_GPS, atmosphere models, single-point
 //! positioning, and the tightly coupled aiding of the generic aided-INS engine.
 //!
 //! Time: every epoch argument named `t` is GPS system time in seconds (one continuous scale,
 //! t = 0 at the start of a GPS week); GLONASS ephemerides are referenced to GLONASS time,
-//! T_GPS − T_GLO = ΔT_leap + τ_GPS (spec Eq. 7).
+//! T_GPS − T_GLO = ΔT_leap + τ_GPS (docs/departures.md#system-time-offset).
 
 pub mod atmosphere;
 pub mod constellation;
@@ -79,7 +79,7 @@ impl SatId {
     }
 }
 
-/// GLONASS FDMA channel k ∈ [−7, 6] (spec Eq. 11).
+/// GLONASS FDMA channel k ∈ [−7, 6] (GLONASS ICD).
 pub fn check_channel(field: &str, k: i64, index: usize) -> Result<i8> {
     if (-7..=6).contains(&k) {
         Ok(k as i8)
@@ -88,17 +88,17 @@ pub fn check_channel(field: &str, k: i64, index: usize) -> Result<i8> {
     }
 }
 
-/// GLONASS L1 carrier of channel k (Hz): 1602 + 0.5625k MHz (spec Eq. 11).
+/// GLONASS L1 carrier of channel k (Hz): 1602 + 0.5625k MHz (GLONASS ICD).
 pub fn glonass_l1_hz(k: i8) -> f64 {
     (1602.0 + 0.5625 * k as f64) * 1e6
 }
 
-/// GLONASS L2 carrier of channel k (Hz): 1246 + 0.4375k MHz (spec Eq. 11).
+/// GLONASS L2 carrier of channel k (Hz): 1246 + 0.4375k MHz (GLONASS ICD).
 pub fn glonass_l2_hz(k: i8) -> f64 {
     (1246.0 + 0.4375 * k as f64) * 1e6
 }
 
-/// L1 wavelength (m) of a satellite; GLONASS per channel (spec Eq. 16: mandatory).
+/// L1 wavelength (m) of a satellite; GLONASS per channel (FDMA: mandatory).
 pub fn l1_wavelength(sat: SatId, channel: i8) -> f64 {
     match sat.system {
         System::Gps => C_LIGHT / GPS_L1_HZ,
@@ -107,7 +107,7 @@ pub fn l1_wavelength(sat: SatId, channel: i8) -> f64 {
 }
 
 /// Time-scale relation T_GPS − T_GLO = ΔT_leap + τ_GPS with ΔT_leap = n_leap − 10800 s
-/// (spec Eq. 7; n_leap = 15 s in 2009, 18 s since 2017).
+/// (n_leap = 15 s in 2009, 18 s since 2017; docs/departures.md#system-time-offset).
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct TimeScales {
     pub n_leap: f64,

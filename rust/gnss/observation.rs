@@ -1,4 +1,4 @@
-//! Code and pseudorange-rate observations: the measurement model of spec §2.6 Eqs. 14–16
+//! Code and pseudorange-rate observations: the standard measurement model
 //! (receiver clock bias and drift, satellite clock, τ_GPS on GLONASS, ionosphere,
 //! troposphere, noise), its inverse correction used by positioning and the filter, and
 //! the simulator with per-satellite visibility control.

@@ -1,4 +1,4 @@
-//! Single-point positioning (standard mode, spec §2.7 Eqs. 20–24): Gauss–Newton least
+//! Single-point positioning (standard mode, Demidov 2009 Ch. 2): Gauss–Newton least
 //! squares for (position, c·δt_r, τ_GPS) with the exact H rows of our own prediction, the
 //! thesis's residual metric, DOP, and the Doppler velocity solution.
 

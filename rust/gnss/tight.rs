@@ -1,12 +1,12 @@
-//! Tightly coupled GNSS aiding of the generic aided-INS engine (spec gnss-ins-tight §2.12,
-//! Eqs. 37–42). Default: between-satellite first differences of code and pseudorange rate
+//! Tightly coupled GNSS aiding of the generic aided-INS engine (Demidov 2009 Ch. 3).
+//! Default: between-satellite first differences of code and pseudorange rate
 //! against the highest GPS satellite (no receiver-clock states; the correlated FD noise
 //! R = σ₀²11ᵀ + diag(σᵢ²) is decorrelated by the engine in sequential mode) with c·τ_GPS
 //! as an extra state. Option: undifferenced rows with the receiver clock states (c·δt_r,
-//! c·δṫ_r) of Eq. 41. Lever arm l^b from the IMU to the antenna.
+//! c·δṫ_r). Lever arm l^b from the IMU to the antenna.
 //!
 //! Signs: z = predicted − measured; δx = estimate − true. The H rows have no IMU-bias
-//! columns, so the spec's raw-bias sign convention (opposite to the engine's
+//! columns, so a raw-bias sign convention (opposite to the engine's
 //! δb = b̂ − b, see filter/ins.rs) never enters here.
 
 use super::ephemeris::Ephemerides;
@@ -46,7 +46,7 @@ pub struct TightConfig {
     pub sigma_rate: f64,
     pub use_rate: bool,
     pub atm: Atmosphere,
-    /// c·τ_GPS random-walk PSD (m²/s); spec Eq. 42: (0.1 ns)²/h.
+    /// c·τ_GPS random-walk PSD (m²/s); default (0.1 ns)²/h.
     pub tau_psd: f64,
     /// Receiver oscillator h₀ (s) and h₋₂ (1/s) of Eq. 41 (TCXO 2e-19, 2e-20).
     pub clock_h0: f64,
@@ -81,7 +81,7 @@ struct Row {
 impl TightAiding {
     /// `epochs`: (GPS time, observations) with strictly increasing time. A barometric
     /// altimeter damps the INS's vertical channel in the engine
-    /// (`AidedIns::with_damped_vertical`, spec decision 13), not through rows here.
+    /// (`AidedIns::with_damped_vertical`, docs/departures.md#baro-damped-vertical-channel), not through rows here.
     pub fn new(eph: Ephemerides, epochs: Vec<(f64, Vec<Observation>)>, cfg: TightConfig) -> Result<TightAiding> {
         for (field, s) in [("sigma_code_gps", cfg.sigma_code_gps), ("sigma_code_glo", cfg.sigma_code_glo), ("sigma_rate", cfg.sigma_rate)] {
             crate::error::check_positive(field, s)?;
@@ -151,7 +151,7 @@ impl TightAiding {
             for k in 0..3 {
                 h_code[ipsi + k] = hp[k];
             }
-            // g_iᵀ = −(v_s − v̂)ᵀ(I − uuᵀ)C_n^e/ρ̂ (Eq. 37; required in open loop, decision 9)
+            // g_iᵀ = −(v_s − v̂)ᵀ(I − uuᵀ)C_n^e/ρ̂ (required in open loop)
             let dv = g.sat.vel - v_a;
             let gi = -(dv - g.los * g.los.dot(&dv)).transpose() * cne / g.range;
             let gf = gi + u_n.transpose() * frame_term;

@@ -2,7 +2,7 @@
 //! axes, including Earth rate, transport rate and gravity, as instantaneous rates or as
 //! exact increments over each sample interval.
 //!
-//! f^n = v̇^n − g^n + (2ω_ie + ω_en) × v^n, f^b = C_bn f^n (spec gnss-ins-tight Eq. 26);
+//! f^n = v̇^n − g^n + (2ω_ie + ω_en) × v^n, f^b = C_bn f^n (the NED mechanization solved for f);
 //! ω_ib^b = ω_nb^b + C_bn (ω_ie^n + ω_en^n).
 
 use crate::earth::Ellipsoid;

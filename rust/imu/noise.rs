@@ -7,7 +7,7 @@
 //! (the interval-average rate), an increment-kind sample is the increment itself, so both
 //! output kinds come from one code path (errors.rs).
 //!
-//! Density conventions (two-sided, IEEE Std 952-1997 Annex C; seed-003 spec (E33)–(E35)):
+//! Density conventions (two-sided, IEEE Std 952-1997 Annex C):
 //! - white noise of density N (ARW in rad/√s, VRW in m/s/√s = m/s²/√Hz):
 //!   E[w(t) w(s)] = N² δ(t − s); two-sided PSD N², one-sided 2N²;
 //! - bias random walk of density K (rad/s/√s, m/s²/√s): ḃ = w, E[w w] = K² δ, Var b(t) = K² t;
@@ -41,7 +41,7 @@ fn finite(field: &str, value: f64, args: &str) -> Result<f64> {
 }
 
 /// Per-sample σ of white noise of density N at interval Δt: N/√Δt for a rate sample,
-/// N·√Δt for an increment (seed-003 spec (E33): σ_d² = q/Δt, q = N²).
+/// N·√Δt for an increment (σ_d² = q/Δt, q = N²).
 pub fn white_sigma(density: f64, dt: f64, kind: ImuKind) -> Result<f64> {
     check_density("density", density)?;
     check_positive("dt", dt)?;
@@ -56,7 +56,7 @@ pub fn white_density(sigma: f64, dt: f64, kind: ImuKind) -> Result<f64> {
     finite("dt", sigma / (dt.sqrt() * kind.per_increment(dt)), &format!("sigma = {sigma}, dt = {dt} s"))
 }
 
-/// σ of the per-sample bias step of a random walk of density K: K·√Δt (seed-003 spec (E34)).
+/// σ of the per-sample bias step of a random walk of density K: K·√Δt.
 pub fn random_walk_step_sigma(density: f64, dt: f64) -> Result<f64> {
     check_density("density", density)?;
     check_positive("dt", dt)?;
@@ -71,7 +71,7 @@ pub fn random_walk_density(step_sigma: f64, dt: f64) -> Result<f64> {
 }
 
 /// Per-sample driving σ_u of the discrete Gauss–Markov m_{k+1} = e^{−Δt/τ} m_k + u_k with
-/// stationary σ: σ_u = σ·√(1 − e^{−2Δt/τ}) (seed-000 spec (E36)).
+/// stationary σ: σ_u = σ·√(1 − e^{−2Δt/τ}).
 pub fn gauss_markov_driving_sigma(sigma: f64, tau: f64, dt: f64) -> Result<f64> {
     check_density("sigma", sigma)?;
     check_positive("tau", tau)?;
@@ -80,7 +80,7 @@ pub fn gauss_markov_driving_sigma(sigma: f64, tau: f64, dt: f64) -> Result<f64> 
 }
 
 /// Stationary σ of the discrete Gauss–Markov driven by per-sample σ_u at Δt; the inverse of
-/// [`gauss_markov_driving_sigma`] (seed-000 spec (E36): σ_m = σ_gm/√(1 − e^{−2Δt/τ})).
+/// [`gauss_markov_driving_sigma`]: σ_m = σ_gm/√(1 − e^{−2Δt/τ}).
 pub fn gauss_markov_sigma(driving_sigma: f64, tau: f64, dt: f64) -> Result<f64> {
     check_density("driving_sigma", driving_sigma)?;
     check_positive("tau", tau)?;
@@ -89,7 +89,7 @@ pub fn gauss_markov_sigma(driving_sigma: f64, tau: f64, dt: f64) -> Result<f64> 
 }
 
 /// Amplitude spectral density of a Gauss–Markov process at frequencies f ≪ 1/(2πτ):
-/// √(2σ²/τ)·τ = σ√(2τ) (two-sided; seed-000 spec §4 "low-f ASD").
+/// √(2σ²/τ)·τ = σ√(2τ) (two-sided).
 pub fn gauss_markov_low_freq_asd(sigma: f64, tau: f64) -> Result<f64> {
     check_density("sigma", sigma)?;
     check_positive("tau", tau)?;
@@ -300,8 +300,8 @@ mod tests {
     }
 
     #[test]
-    fn seed003_noise_conversions() {
-        // seed-003 spec (E36): 5e-5 m/s² and 1.4544e-5 rad/s per sample at 200 Hz
+    fn tennstedt2023_noise_conversions() {
+        // Tennstedt et al. 2023: 5e-5 m/s² and 1.4544e-5 rad/s per sample at 200 Hz
         let dt = 1.0 / 200.0;
         let qa = white_density(5e-5, dt, ImuKind::Rates).unwrap();
         assert!(rel(qa, 3.5355e-6) < 1e-4);
@@ -315,8 +315,8 @@ mod tests {
     }
 
     #[test]
-    fn seed000_gauss_markov_numbers() {
-        // seed-000 spec §4 "Satellite: GM": Δt = 1 s, τ = 10 s, σ_gm = 2e-12
+    fn tennstedt2021_gauss_markov_numbers() {
+        // Tennstedt et al. 2021 satellite Gauss–Markov: Δt = 1 s, τ = 10 s, σ_gm = 2e-12
         let s = gauss_markov_sigma(2e-12, 10.0, 1.0).unwrap();
         assert!(rel(s, 4.6975e-12) < 1e-4);
         assert!(rel(gauss_markov_driving_sigma(s, 10.0, 1.0).unwrap(), 2e-12) < 1e-14);

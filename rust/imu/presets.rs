@@ -18,12 +18,12 @@ fn triad(bias_sigma: f64, white: f64, bias_rw: f64) -> TriadErrors {
     TriadErrors { bias_sigma, white, bias_rw, ..TriadErrors::default() }
 }
 
-/// Seed-003 (Tennstedt et al. 2023) navigation-grade RLG IMU, spec
-/// atom-strapdown-tennstedt2023.md §3 and (E36), decision 8: white noise σ_d = 5e-5 m/s² and
+/// Navigation-grade RLG IMU of Tennstedt et al. 2023 (units read as in
+/// docs/departures.md#noise-units): white noise σ_d = 5e-5 m/s² and
 /// 1.4544e-5 rad/s per sample at 200 Hz (→ VRW 3.5355e-6 m/s/√s = 0.36 µg/√Hz, ARW
 /// 1.0284e-6 rad/√s = 0.0035 °/√h); bias random-walk PSD q_ra = 9e-10 m²/s⁵, q_rg = 4e-14
 /// rad²/s³ (K = 3e-5 m/s²/√s, 2e-7 rad/s/√s). Turn-on bias σ from the filter initialisation
-/// P0 of decision 15: 2e-5 m/s², 1e-6 rad/s.
+/// P0 of docs/departures.md#scenario-values: 2e-5 m/s², 1e-6 rad/s.
 fn navigation() -> Result<ImuErrorModel> {
     let dt = 1.0 / 200.0;
     Ok(ImuErrorModel {
@@ -46,8 +46,8 @@ fn tactical() -> ImuErrorModel {
     }
 }
 
-/// Tactical MEMS of the seed-000 hexapod scenario, spec cai-ekf-tennstedt2021.md decision 13
-/// (placeholders fixed by the spec): accel white ASD 5e-5 m/s²/√Hz, gyro ARW 1.5e-5 rad/√s,
+/// Tactical MEMS of the hexapod scenario of Tennstedt et al. 2021 (placeholders,
+/// docs/departures.md#hexapod-scenario): accel white ASD 5e-5 m/s²/√Hz, gyro ARW 1.5e-5 rad/√s,
 /// biases (2e-3, −1.5e-3, 1e-3) m/s² and (5e-5, −4e-5, 3e-5) rad/s, bias random-walk PSD
 /// 1e-12 m²/s⁵ and 1e-16 rad²/s³ (K = 1e-6 m/s²/√s and 1e-8 rad/s/√s).
 fn mems() -> ImuErrorModel {
@@ -57,11 +57,11 @@ fn mems() -> ImuErrorModel {
     }
 }
 
-/// Electrostatic space accelerometer of seed 000 (Tennstedt et al. 2021, Sec. 5.2), spec
-/// cai-ekf-tennstedt2021.md (E36) and decision 12: white ASD 1e-10 m/s²/√Hz (σ 1e-10 m/s²
+/// Electrostatic space accelerometer of Tennstedt et al. 2021, Sec. 5.2
+/// (docs/departures.md#satellite-scenario): white ASD 1e-10 m/s²/√Hz (σ 1e-10 m/s²
 /// per sample at 1 Hz) plus a Gauss–Markov process with τ = 10 s driven by σ_gm = 2e-12 m/s²
 /// per 1-s sample, i.e. stationary σ = 2e-12/√(1 − e^{−0.2}) = 4.6975e-12 m/s². `drift`
-/// adds the decision-12 bias random walk q_rw = 1e-21 m²/s⁵. The paper models accelerometer
+/// adds the bias random walk q_rw = 1e-21 m²/s⁵. The paper models accelerometer
 /// axes only, so the gyro triad is error-free.
 fn electrostatic_space(drift: bool) -> Result<ImuErrorModel> {
     let gm = GaussMarkovSpec { sigma: gauss_markov_sigma(2e-12, 10.0, 1.0)?, tau: 10.0 };
@@ -69,7 +69,7 @@ fn electrostatic_space(drift: bool) -> Result<ImuErrorModel> {
     Ok(ImuErrorModel { accel: TriadErrors { gauss_markov: Some(gm), ..triad(0.0, 1e-10, rw) }, gyro: TriadErrors::default() })
 }
 
-/// Demidov (2009) INS accuracy classes, spec gnss-ins-tight-demidov2009.md §3: gyro drift
+/// Demidov (2009) INS accuracy classes (docs/departures.md#accuracy-classes): gyro drift
 /// and accelerometer bias as random turn-on constants of that σ, ARW, VRW; bias process
 /// "constant plus random walk of 1 % of the bias per √h": K = 0.01·σ_b/√(3600 s).
 fn demidov(gyro_drift: f64, accel_bias: f64, arw: f64, vrw: f64) -> ImuErrorModel {
@@ -111,11 +111,11 @@ mod tests {
 
     #[test]
     fn presets_reproduce_their_source_numbers() {
-        // seed-003 spec (E36): per-sample σ at 200 Hz and ARW 0.00354 °/√h
+        // Tennstedt et al. 2023: per-sample σ at 200 Hz and ARW 0.00354 °/√h
         let n = preset("navigation").unwrap();
         assert!((white_sigma(n.accel.white, 1.0 / 200.0, ImuKind::Rates).unwrap() / 5e-5 - 1.0).abs() < 1e-12);
         assert!((n.gyro.white / DEG_PER_SQRT_HOUR / 0.00354 - 1.0).abs() < 2e-3);
-        // seed-000 decision 12: driving σ 2e-12 per 1-s sample
+        // Tennstedt et al. 2021 satellite: driving σ 2e-12 per 1-s sample
         let g = preset("electrostatic_space").unwrap().accel.gauss_markov.unwrap();
         assert!((gauss_markov_driving_sigma(g.sigma, g.tau, 1.0).unwrap() / 2e-12 - 1.0).abs() < 1e-12);
         // Demidov medium: 1 °/h = 4.8481e-6 rad/s, RW 1 % per √h

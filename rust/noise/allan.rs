@@ -1,6 +1,6 @@
 //! Allan family: overlapping Allan, modified Allan and overlapping Hadamard variance of
 //! rate or phase (angle) data, batch and streaming; equivalent degrees of freedom; the
-//! five-term IEEE Std 952 fit (Niu et al. 2025 Eqs. 19–21, spec E14–E16, D15).
+//! five-term IEEE Std 952 fit (Niu et al. 2025 Eqs. 19–21; docs/departures.md#allan-fit).
 //!
 //! Everything works on phase x (the integral of the rate): rate data y become
 //! x₀ = 0, x_{i+1} = x_i + (y_i − ȳ) in units of rate·τ₀, so that all three statistics
@@ -700,7 +700,7 @@ impl AllanFit {
     }
 }
 
-/// Weighted non-negative least-squares fit of the five-term model to AVAR points (spec D15):
+/// Weighted non-negative least-squares fit of the five-term model to AVAR points (docs/departures.md#allan-fit):
 /// weights 1/σ_j², σ_j = AVAR_j/√max(1, ⌊N/m_j⌋ − 1), columns normalised, Lawson–Hanson.
 /// `terms` selects which of A₋₂…A₂ are free (the others are 0); only points with
 /// `tau_min ≤ τ ≤ tau_max` and positive variance are used. `n_samples` is the record length.
@@ -769,7 +769,7 @@ mod tests {
 
     #[test]
     fn ramp_gives_m_squared_over_two() {
-        // spec §4a.7: ω_k = k, N = 32 → σ²(m) = m²/2.
+        // exact case: ω_k = k, N = 32 → σ²(m) = m²/2.
         let y: Vec<f64> = (0..32).map(|k| k as f64).collect();
         let r = avar(&y, TauSet::Octave);
         assert_eq!(r.m, vec![1, 2, 4, 8]);
@@ -780,7 +780,7 @@ mod tests {
 
     #[test]
     fn alternating_sign() {
-        // spec §4a.7: ±1, N = 16 → 2, 0, 2/9, 0 at m = 1…4.
+        // exact case: ±1, N = 16 → 2, 0, 2/9, 0 at m = 1…4.
         let y: Vec<f64> = (0..16).map(|k| if k % 2 == 0 { 1.0 } else { -1.0 }).collect();
         let r = avar(&y, TauSet::List(vec![1, 2, 3, 4]));
         for (v, e) in r.var.iter().zip([2.0, 0.0, 2.0 / 9.0, 0.0]) {

@@ -1,15 +1,15 @@
 //! ARIMA(p,d,q) state-space form and the scalar-measurement Kalman filters of Niu et al. 2025:
 //! fixed R, the measurement-noise-adaptive R of Eq. 17 (both readings of y_k), and
-//! Sage–Husa (standard form, not from the paper; spec E11, D12). Batch and streaming.
+//! Sage–Husa (standard form, not from the paper; docs/departures.md#sage-husa-filter). Batch and streaming.
 //!
-//! Sign convention (spec E4, statsmodels): d_k = Σφ_i d_{k−i} + a_k + Σβ_j a_{k−j},
+//! Sign convention (Niu et al. 2025 Eqs. 6–8, as statsmodels): d_k = Σφ_i d_{k−i} + a_k + Σβ_j a_{k−j},
 //! d = (1−L)^D ω. Measurement H = [1 0 … 0]: the filter observes ω_k directly.
 
 use crate::error::{check_finite, check_positive, invalid, NavError, Result};
 use crate::options::Choice;
 use nalgebra::{DMatrix, SMatrix, SVector};
 
-/// How the ARMA innovations enter the state (spec D5).
+/// How the ARMA innovations enter the state (docs/departures.md#arma-noise-form).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum NoiseForm {
     /// Niu et al. 2025 Eq. 16: X = [ω_k … ω_{k−n+1}], B first row [1, β₁ … β_q, 0 …], Q = σ²I_n.
@@ -123,7 +123,7 @@ impl ArimaStateSpace {
     }
 }
 
-/// How R_k is chosen (spec E9–E11, D7, D12).
+/// How R_k is chosen (Niu et al. 2025 Eqs. 15, 17; docs/departures.md#reading-of-eq-17).
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub enum RMode {
     /// R_k ≡ R₀.
@@ -194,7 +194,7 @@ impl RunningAllanR {
     }
 }
 
-/// Initial state (spec D6).
+/// Initial state (docs/departures.md#initial-values).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum X0 {
     Zeros,
@@ -392,7 +392,7 @@ impl<const N: usize> Core<N> {
         let mut lambda = 1.0;
         if let RMode::SageHusa { b, fading, .. } = rs.mode {
             if fading {
-                // Strong-tracking fading factor (spec E11).
+                // Strong-tracking fading factor.
                 rs.v = if rs.k == 1 { eps * eps } else { (FADING_RHO * rs.v + eps * eps) / (1.0 + FADING_RHO) };
                 if fpf[(0, 0)] > 0.0 {
                     lambda = ((rs.v - self.qd[(0, 0)] - r_prev) / fpf[(0, 0)]).max(1.0);
@@ -405,7 +405,7 @@ impl<const N: usize> Core<N> {
             let r = (1.0 - dk) * r_prev + dk * (eps * eps - pm00);
             rs.r = if r > 0.0 { r } else { (1.0 - dk) * r_prev + dk * eps * eps };
         }
-        // spec D8: R floor.
+        // R floor (docs/departures.md#r-floor).
         rs.r = rs.r.max(rs.r_floor);
         let pm = fpf * lambda + self.qd;
         let s = pm[(0, 0)] + rs.r;
@@ -414,7 +414,7 @@ impl<const N: usize> Core<N> {
         }
         self.gain = pm.column(0) / s;
         self.x = xp + self.gain * eps;
-        // P = (I − K H) P⁻, symmetrised (spec D10).
+        // P = (I − K H) P⁻, symmetrised (Niu et al. 2025 Eq. 15).
         let p = pm - self.gain * pm.row(0);
         self.p = (p + p.transpose()) * 0.5;
         if let RMode::SageHusa { b, adapt_q: true, .. } = rs.mode {
@@ -607,7 +607,7 @@ mod tests {
 
     #[test]
     fn eq17_recursion_oracle() {
-        // spec §4a.5: y = [1, 3, 2, 5, 4].
+        // by hand: y = [1, 3, 2, 5, 4].
         let mut r = RunningAllanR::default();
         let got: Vec<Option<f64>> = [1.0, 3.0, 2.0, 5.0, 4.0].iter().map(|&y| r.update(y)).collect();
         let want = [None, Some(2.0), Some(1.25), Some(7.0 / 3.0), Some(1.875)];

@@ -1,4 +1,4 @@
-//! Sensor noise analysis (spec aig-noise-arma-niu2025): the Allan family with the
+//! Sensor noise analysis (Niu et al. 2025): the Allan family with the
 //! five-term IEEE-952 fit, and ARIMA state-space Kalman filters (fixed, adaptive-R of
 //! Niu et al. 2025 Eq. 17, Sage–Husa).
 

@@ -1,5 +1,5 @@
 //! Non-negative least squares, Lawson & Hanson (1974) active-set algorithm, as in
-//! `scipy.optimize.nnls`. Used by the five-term Allan fit (spec D15).
+//! `scipy.optimize.nnls`. Used by the five-term Allan fit (docs/departures.md#allan-fit).
 
 use crate::error::{NavError, Result};
 use nalgebra::{DMatrix, DVector};

@@ -245,7 +245,7 @@ fn astro_astro_increments<'py>(py: Python<'py>, s_vf: PyReadonlyArray3<'py, f64>
     Ok((mats_to_py(py, &ds), mats_to_py(py, &e)))
 }
 
-/// P_β^model and P_β^sys (rad², E18) at the mount `c` from the interval and epoch
+/// P_β^model and P_β^sys (rad²) at the mount `c` from the interval and epoch
 /// covariances; with the consistent gyro mode's sensitivities `j_m` (M, 3, 9), `j_b`
 /// (M, 3, 3) and the budget `sigmas` the constant-error cross terms are included.
 #[pyfunction]
@@ -403,7 +403,7 @@ fn run_dict<'py>(py: Python<'py>, r: &Run) -> PyResult<Bound<'py, PyDict>> {
 
 #[pymethods]
 impl PyScenario {
-    /// `vasilyuk2024_like` (spec §5.1) with catalog seed and gyro truth "paper" | "consistent".
+    /// `vasilyuk2024_like` (after Vasilyuk et al. 2024) with catalog seed and gyro truth "paper" | "consistent".
     #[new]
     #[pyo3(signature = (catalog_seed=None, gyro_error_model=Wrap(GyroErrorMode::Paper)))]
     fn new(py: Python<'_>, catalog_seed: Option<Bound<'_, PyAny>>, gyro_error_model: Wrap<GyroErrorMode>) -> PyResult<Self> {

@@ -215,7 +215,8 @@ impl CaiMotion {
     }
 }
 
-/// Closed forms per channel row: kind "exact" (E10), "series" (E11), "seed000" (P-52).
+/// Closed forms per channel row: kind "exact" (constant-input solution), "series" (its fourth-order
+/// series in T), "seed000" (Tennstedt et al. 2021 Eq. 52).
 #[pyfunction]
 #[allow(clippy::too_many_arguments)]
 fn cai_phase_closed_form<'py>(
@@ -241,7 +242,7 @@ fn cai_sensitivity<'py>(py: Python<'py>, t: PyReadonlyArray1<'py, f64>, t_dark: 
     Ok((vec_to_py(py, g), vec_to_py(py, f)))
 }
 
-/// Convolution phases (E20) of shots centred at `centres`.
+/// Convolution phases (Tennstedt et al. 2023 Eq. 14) of shots centred at `centres`.
 #[pyfunction]
 fn cai_convolution_phase<'py>(
     py: Python<'py>,

@@ -44,7 +44,7 @@ fn pulse(p: Profile, start: f64, ramp: f64, hold: f64, amp: f64, shape: StepShap
         .with(Term::Step { start: start + ramp + hold, duration: ramp, delta: -amp, shape, integrated: false })
 }
 
-/// Hexapod tilt sequence (seed 000 §5.3; spec cai-ekf-tennstedt2021 decision 13): 10 s
+/// Hexapod tilt sequence (Tennstedt et al. 2021 §5.3; docs/departures.md#hexapod-scenario): 10 s
 /// static, then roll performs [+a, −a, +a/2, −a/2] three times (each: 1 s raised-cosine
 /// ramp, 5 s hold, 1 s ramp back, 5 s at 0; 48 s per block); pitch the same delayed by
 /// `pitch_delay` s; static until 170 s. `max_tilt` = 0.0654 rad (3.75°) by default, below
@@ -77,11 +77,11 @@ pub fn hexapod(origin: Vec3, max_tilt: f64, pitch_delay: f64, heading: f64) -> R
 }
 
 /// Largest hexapod tilt magnitude (rad) accepted by [`hexapod`]: the platform's small-angle
-/// tilt sequence (seed 000 §5.3 uses 3.75°), well inside the Euler-chain's regular range.
+/// tilt sequence (Tennstedt et al. 2021 §5.3 uses 3.75°), well inside the Euler-chain's regular range.
 pub const HEXAPOD_MAX_TILT: f64 = 0.5;
 
 /// Straight drive at constant `speed` (m/s) with sinusoidal yaw rate
-/// ω_z = `yaw_rate_amp`·sin(2πt/`period`) (seed 003 Fig. 7: 1 m/s, 0.05 rad/s, 50 s).
+/// ω_z = `yaw_rate_amp`·sin(2πt/`period`) (Tennstedt et al. 2023 Fig. 7: 1 m/s, 0.05 rad/s, 50 s).
 /// The velocity follows the heading (no side slip).
 pub fn drive_with_yaw(origin: Vec3, speed: f64, yaw_rate_amp: f64, period: f64, duration: f64, heading: f64) -> Result<Motion> {
     check_positive("period", period)?;
@@ -99,7 +99,7 @@ pub fn drive_with_yaw(origin: Vec3, speed: f64, yaw_rate_amp: f64, period: f64, 
     })
 }
 
-/// Level slalom (spec atom-strapdown §2.8 `slalom`): north = `speed`·t,
+/// Level slalom (docs/departures.md#scenario-values): north = `speed`·t,
 /// east = `amp`·sin(2πt/`period`), heading = atan2(ė, ṅ). Defaults 5 m/s, 2 m, 10 s, 60 s.
 pub fn slalom(origin: Vec3, speed: f64, amp: f64, period: f64, duration: f64) -> Result<Motion> {
     check_positive("speed", speed)?;
@@ -120,7 +120,7 @@ pub fn slalom(origin: Vec3, speed: f64, amp: f64, period: f64, duration: f64) ->
     })
 }
 
-/// Car-like profile of seed 003 Fig. 9 (spec atom-strapdown §2.8 `car_mc`), 40 s:
+/// Car-like profile after Tennstedt et al. 2023 Fig. 9 (docs/departures.md#scenario-values), 40 s:
 /// [0,5) static; [5,12) along-track acceleration 1 m/s²; [12,19) sliding right turn, yaw
 /// rate up to +0.15 rad/s with the course unchanged and the acceleration kept;
 /// [19,30) left turn −0.2 rad/s with 0.5 m/s² (course follows yaw, so a_y = vω_z);
@@ -128,7 +128,7 @@ pub fn slalom(origin: Vec3, speed: f64, amp: f64, period: f64, duration: f64) ->
 /// pitch rate, vertical vibration ×3); [30,40] 0.8 m/s², 0.02 rad/s, all vibration ×2 in
 /// 33–35 s. Vibration: 4.3, 9.7, 15.1 Hz sines of 0.05 m/s² (as NED displacement) and
 /// 0.005 rad/s (as Euler-angle oscillation), envelope 0 while static and 1 after (1 s
-/// raised-cosine ramps). Interpretations of the spec's body-frame wording are stated above.
+/// raised-cosine ramps). Interpretations of the paper's body-frame wording are stated above.
 pub fn car(origin: Vec3, heading: f64, vibration: bool) -> Motion {
     let rc = StepShape::RaisedCosine;
     let step = |p: Profile, start: f64, delta: f64, integrated: bool| p.with(Term::Step { start, duration: 1.0, delta, shape: rc, integrated });
@@ -179,7 +179,7 @@ pub fn car(origin: Vec3, heading: f64, vibration: bool) -> Motion {
     Motion { name: "car".into(), origin, duration: 40.0, speed, course, displacement: disp, attitude: euler_chain(roll, pitch, yaw) }
 }
 
-/// Two-axis rotary stand (seed 001, spec astro-calibration §5.1) in NED/FRD:
+/// Two-axis rotary stand (as in Vasilyuk et al. 2024) in NED/FRD:
 /// C_nb = R_y(tilt) R_z(turntable) — tilt about the East axis, turntable about body z.
 /// `states` are (tilt, turntable) in rad; the stand holds each state and moves to the
 /// next at `move_starts[j]` (s) over `move_duration` s with the quintic profile
@@ -222,9 +222,9 @@ pub fn rotary_stand(origin: Vec3, states: &[(f64, f64)], move_starts: &[f64], mo
     })
 }
 
-/// The seed-001 stand schedule: 13 (tilt, turntable) states in degrees, 73 camera
+/// The stand schedule after Vasilyuk et al. 2024: 13 (tilt, turntable) states in degrees, 73 camera
 /// epochs t_n = 0.5023 + 21.0007(n − 1) s, each later state held for 6 epochs, move j
-/// starting 4 s after epoch 6j − 5 and lasting 12 s (spec astro-calibration §5.1).
+/// starting 4 s after epoch 6j − 5 and lasting 12 s.
 pub fn vasilyuk2024_stand(origin: Vec3) -> Result<Motion> {
     const STATES_DEG: [(f64, f64); 13] = [
         (0.0, 50.0), (0.0, 170.0), (0.0, 90.0), (15.0, 90.0), (15.0, 245.0), (15.0, 297.0), (0.0, 297.0),

@@ -23,7 +23,7 @@ impl std::ops::Add for Eval {
 pub enum StepShape {
     /// Raised cosine (1 − cos πu)/2.
     RaisedCosine,
-    /// Quintic 10u³ − 15u⁴ + 6u⁵ (zero rate and acceleration at both ends; seed 001 stand).
+    /// Quintic 10u³ − 15u⁴ + 6u⁵ (zero rate and acceleration at both ends; the stand of Vasilyuk et al. 2024).
     Quintic,
 }
 
