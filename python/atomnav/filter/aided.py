@@ -172,7 +172,10 @@ class AidedIns:
         rates (rad/s, m/s²) or increments (rad, m/s) per the ``kind`` given at
         construction, ``h_ref`` (N,) m the reference altitude of a damped vertical
         channel (required then, refused with a free one); time must keep increasing
-        across chunks. Returns the epochs and measurements of this chunk. Bad samples
+        across chunks. A chunk whose accelerations look like g, gyro rates like °/s or
+        time stamps like ms warns (:class:`atomnav.UnitWarning`, naming ``accel``,
+        ``gyro`` or ``time``; :meth:`run` checks the whole record once). Returns the epochs
+        and measurements of this chunk. Bad samples
         (non-finite, time not increasing) raise ``ValueError`` naming their index in the
         whole streamed record. If it stops on an error (bad sample, divergence, loss of
         positive definiteness), the exception's ``partial`` attribute is the
