@@ -81,7 +81,7 @@ def test_latitude_out_of_range_in_conversion():
 def test_latitude_out_of_range_in_user_trajectory(traj):
     df = traj.df.copy()
     df.loc[3, "lat_rad"] = 1.8
-    with pytest.raises(ValueError, match=r"lat_rad: latitude 1.8 rad at index 3"):
+    with pytest.raises(ValueError, match=r"df: column 'lat_rad': latitude 1.8 rad at index 3"):
         an.trajectory.Trajectory.from_dataframe(df)
 
 

@@ -41,10 +41,16 @@ def nav_table(time, lla, vel_ned, q_nb) -> pd.DataFrame:
     return _frame(vector(time, None, "time"), p, rows(vel_ned, 3, "vel_ned"), rows(q_nb, 4, "q_nb"), "q_nb")
 
 
-def _check_positions(lla: np.ndarray, name: str) -> None:
+def _check_positions(lla: np.ndarray, name: str, columns: bool = False) -> None:
     """The core's latitude check of positions ``lla`` (N, 3) (an :class:`atomnav.InputError`
-    naming argument ``name`` and the first bad row) and the longitude unit warning."""
-    _core.check_latitudes_rows(np.ascontiguousarray(lla, dtype=float), name)
+    naming argument ``name`` and the first bad row, and the column ``lat_rad`` when the
+    positions are the ``columns`` of a table) and the longitude unit warning."""
+    try:
+        _core.check_latitudes_rows(np.ascontiguousarray(lla, dtype=float), name)
+    except _core.InputError as e:
+        if not columns:
+            raise
+        raise input_error(name, f"column 'lat_rad': {str(e)[len(name) + 2:]}", e.index) from None
     plausibility.lla(lla, name)
 
 
@@ -84,7 +90,7 @@ class Trajectory:
             for j, name in enumerate(COLUMNS):
                 df[name] = values[:, j]
         if motion is None:  # a motion's samples come from its checked origin
-            _check_positions(df[["lat_rad", "lon_rad", "h_m"]].to_numpy(dtype=float), "df")
+            _check_positions(df[["lat_rad", "lon_rad", "h_m"]].to_numpy(dtype=float), "df", columns=True)
         self.df = df
         self.motion = motion
         self.ellipsoid = instance(ellipsoid, str, "ellipsoid")
