@@ -5,14 +5,14 @@
 //! driven by the bias-compensated IMU stream the engine hands to `observe`.
 //!
 //! Per shot j with pulses at t_s, t_s + T, t_s + 2T (measurement at t_s + 2T):
-//! - φ̂_j = predictor(compensated IMU over the shot)            (atom-strapdown E5–E7)
+//! - φ̂_j = predictor(compensated IMU over the shot)     (Tennstedt et al. 2023 Eqs. 5–8)
 //! - laser phase steered by the filter's own best prediction:
-//!   φ0_j = π/2 − (φ̂_j − J_j δx̂) mod 2π  (δx̂ = 0 in closed loop)   (atom-strapdown E27)
+//!   φ0_j = π/2 − (φ̂_j − J_j δx̂) mod 2π  (δx̂ = 0 in closed loop)   (Tennstedt et al. 2023 Eq. 24)
 //! - instrument: p_j = o − (C/2) cos(φ_j + φ0_j) + n_j  (emulated from the true phase, or
-//!   recorded together with the laser phase it used)                 (cai-ekf E3)
-//! - z_j = h_j − p_j with h_j = o − (C/2) cos(φ̂_j + φ0_j), no linearisation  (cai-ekf E5)
+//!   recorded together with the laser phase it used)   (docs/departures.md#one-readout-model)
+//! - z_j = h_j − p_j with h_j = o − (C/2) cos(φ̂_j + φ0_j), no linearisation  (Tennstedt et al. 2021 Eq. 9)
 //! - H_j = (C/2) sin(φ̂_j + φ0_j) J_j, J_j = ∂φ̂_j/∂(δb_a, δb_g, δl, δγ) from the
-//!   tangent-linear predictor                                         (cai-ekf E33)
+//!   tangent-linear predictor                          (Tennstedt et al. 2021 Eq. 10)
 //! - R = σ_p² I + (C/2)² sin² · Σ_shot (in-shot IMU white noise, full 6 × 6 with the A/B
 //!   correlation, Tennstedt et al. 2021, §2.4): Σ = Σ_i s_i Q_i s_iᵀ from the predictor's sensitivity s_i to
 //!   each IMU sample (`in_shot.rs`; it includes the atom and lever-arm Euler terms that the
@@ -665,8 +665,8 @@ mod tests {
     }
 
     /// R inflation (Tennstedt et al. 2021, §2.4) at mid-fringe reproduces the in-shot phase noise
-    /// (atom-strapdown §4: 0.1838 rad accelerometer, 0.2994 rad gyro at T = 25 ms, the
-    /// closed form (E38) of a continuous record without Euler terms, as here with ω̇ = 0) and
+    /// (0.1838 rad accelerometer, 0.2994 rad gyro at T = 25 ms, the
+    /// closed form of a continuous record without Euler terms, as here with ω̇ = 0) and
     /// the A/B correlation (common accelerometer, opposite Coriolis part), sampled at 200 Hz:
     /// with linear interpolation the sample weights are c_i = ∫ w ℓ_i dt (ℓ_i the hat
     /// functions): Δt·w(t_i) inside, Δt(T − Δt/3) at the apex, Δt²/6 at the ends, so

@@ -110,7 +110,7 @@ impl HybridConfig {
 pub enum PhaseSource {
     /// A perfect CAI on the true motion: the predictor applied to the ideal IMU sampled
     /// `oversample` times faster than the navigation IMU, with the exact ω̇ and cubic
-    /// interpolation (atom-strapdown §2.8: "truth integrated at 2 kHz"); one set of phases
+    /// interpolation (truth integrated at 2 kHz); one set of phases
     /// serves every run.
     Ideal(Vec<f64>),
     /// A CAI emulated from a better reference IMU (Tennstedt et al. 2021, Eq. 38, hexapod): per run, the

@@ -108,7 +108,7 @@ fn put(f: &mut DMatrix<f64>, r: usize, c: usize, m: &Mat3) {
 /// Continuous F and Q_c = G Q Gᵀ of the INS blocks of `layout` (which must contain
 /// position, velocity, attitude; accel_bias and gyro_bias when present are coupled;
 /// other blocks get zero rows) at the navigation solution `nav` with compensated
-/// specific force `f_b` (m/s², body) — spec gnss-ins-tight Eq. 28.
+/// specific force `f_b` (m/s², body).
 pub fn error_dynamics(layout: &Layout, ell: &Ellipsoid, nav: &NavState, f_b: &Vec3, noise: &InsNoise) -> Result<(DMatrix<f64>, DMatrix<f64>)> {
     let (ir, iv, ip) = (layout.range("position")?.start, layout.range("velocity")?.start, layout.range("attitude")?.start);
     let n = layout.size();

@@ -20,7 +20,7 @@ _NAMES = ("p0", "phi", "A")
 
 def simulate_fringe(n: int, *, p0: float = 0.5, phi: float = 1.0, amplitude: float = 0.15, sigma_p0: float = 0.025,
                     sigma_phi: float = 0.23, sigma_A: float = 0.02, seed=None):
-    """n readouts of the nonlinear model (P-17) p = (p0 + n_p0) + (A + n_A) cos(φ + ψ + n_φ)
+    """n readouts of the nonlinear model (Tennstedt et al. 2021 Eq. 17) p = (p0 + n_p0) + (A + n_A) cos(φ + ψ + n_φ)
     with ψ uniform on [0, 2π) (fringe scanned by vibration). Returns (p, ψ)."""
     n = integer(n, "n", 0, 100_000_000)
     p0, phi, amplitude = (finite_scalar(v, name) for name, v in (("p0", p0), ("phi", phi), ("amplitude", amplitude)))
