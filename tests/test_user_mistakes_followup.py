@@ -174,3 +174,23 @@ def test_acceleration_noise_overflow_names_the_input_and_a_bool_is_a_type_error(
         an.cai.acceleration_noise(sigma_phi=1, T=1.0, k=5e-324)  # 1/(5e-324 · 1²) overflows
     assert e.value.parameter == "T"
     assert an.cai.acceleration_noise(sigma_phi=0.01, T=0.1, k=1.61e7) == pytest.approx(0.01 / (1.61e7 * 0.1**2), rel=1e-15)
+
+
+# ---- findings of the CI fuzz share (seed 20261202) after the table and height changes ----
+
+def test_schuler_test_names_h_for_a_height_out_of_range():
+    # was an InputError naming 'lla', which schuler_test does not take
+    with pytest.raises(an.InputError, match="height 9.22.*e\\+18 m is outside") as e:
+        an.diagnostics.schuler_test(v0=3.5, hours=3.8, h=9223372036854775808)
+    assert e.value.parameter == "h"
+
+
+@pytest.mark.parametrize("bad", [0.5, an.filter.Layout()])
+def test_an_observation_table_that_is_no_dataframe_is_a_type_error(bad, tmp_path):
+    from atomnav.gnss import rinex  # needs georinex, a test dependency
+
+    # was AttributeError: 'float' object has no attribute 'iloc'
+    with pytest.raises(TypeError, match="obs: expected DataFrame"):
+        an.gnss.observations.obs_arrays(bad)
+    with pytest.raises(TypeError, match="obs: expected DataFrame"):
+        rinex.write_obs(tmp_path / "x.obs", bad)

@@ -24,6 +24,9 @@ def stationary_errors(lat: float, hours: float, *, rate_hz: float = 10.0, h: flo
     The vehicle is at rest, so a low ``rate_hz`` is exact; ``hours × 3600 × rate_hz`` may be
     at most :data:`STATIONARY_MAX_SAMPLES` (a 3-day test at 1 Hz)."""
     lat, h = float(floats(scalar(lat, "lat"), "lat")), float(floats(scalar(h, "h"), "h"))
+    lo, hi = earth.HEIGHT_RANGE
+    if not lo <= h <= hi:  # checked here: inside, h reaches the INS as part of lla
+        raise input_error("h", f"height {h} m is outside [{lo:g}, {hi:g}] m")
     hours, rate_hz = positive(hours, "hours"), positive(rate_hz, "rate_hz")
     if not hours * 3600.0 * rate_hz <= STATIONARY_MAX_SAMPLES:
         raise input_error("hours", f"{hours} h at {rate_hz} Hz is more than {STATIONARY_MAX_SAMPLES} samples; "

@@ -87,6 +87,7 @@ def obs_arrays(obs: pd.DataFrame) -> tuple:
     """The observation table as the arrays the core takes, read by column name (extra
     columns ignored). ``time_s`` is GPS seconds of week, or naive GPS-time datetime64
     (converted to seconds since the start of its GPS week)."""
+    instance(obs, pd.DataFrame, "obs")
     numeric = ["time_s", "channel", "code_m", "rate_mps"]
     time, channel, code, rate = (np.ascontiguousarray(c) for c in table(obs, numeric, "obs", epoch=_gps_week_start(obs),
                                                                       epoch_name="GPS week start").T)
