@@ -266,3 +266,15 @@ def test_aided_ins_getters_while_another_thread_runs_it(repeat):
     assert out[-1] == []
     alone = position_aided_ins(**build).process(t, g, a)
     pd.testing.assert_frame_equal(out[0].nav, alone.nav, check_exact=True)
+
+
+def test_imu_simulator_kind_cannot_be_changed_after_construction(record):
+    # setting kind after construction relabelled the output columns without changing the
+    # simulation; kind, dt and errors are now read-only
+    sim = an.imu.ImuSimulator("tactical", 0.01, "rates", seed=1)
+    for name, value in (("kind", "increments"), ("dt", 0.02)):
+        with pytest.raises(AttributeError, match="no setter"):
+            setattr(sim, name, value)
+    sim.errors.gyro.white = 1.0  # a copy: the simulator keeps its own model
+    assert sim.errors.gyro.white == an.imu.ImuErrors.preset("tactical").gyro.white
+    assert sim.kind == "rates"
