@@ -333,3 +333,13 @@ def test_glonass_propagate_inside_the_earth_names_pos():
     assert e.value.parameter == "vel"
     out = glonass_propagate([25.5e6, 0, 0], [0, 3.0e3, 1.0e3], [0, 0, 0], 900.0)
     assert np.isfinite(out).all()
+
+
+@pytest.mark.parametrize("values", [[[0.2, 0.3, 0.7], [0.9, 1.8, 2.6]], []])
+def test_update_result_built_by_hand_needs_its_three_parts(values):
+    # a user-built UpdateResult of two parts raised IndexError from .rejected (fuzz seed 20261202)
+    from atomnav.filter.engine import UpdateResult
+
+    with pytest.raises(atomnav.InputError, match="expected the three parts") as e:
+        UpdateResult(values)
+    assert e.value.parameter == "values"

@@ -177,6 +177,10 @@ class UpdateResult(tuple):
     rows of z that were NaN (missing) and left out of the update."""
 
     def __new__(cls, values, skipped=()):
+        if isinstance(values, (str, bytes)) or not hasattr(values, "__len__"):
+            raise TypeError(f"values: expected the three parts (innovation, nis, rejected), got {type(values).__name__}")
+        if len(values) != 3:
+            raise input_error("values", f"expected the three parts (innovation, nis, rejected), got {len(values)}")
         self = super().__new__(cls, values)
         self.skipped = list(skipped)
         return self
