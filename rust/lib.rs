@@ -14,6 +14,7 @@ pub mod imu;
 pub mod math;
 pub mod noise;
 pub mod options;
+pub mod state;
 pub mod strapdown;
 pub mod trajectory;
 pub mod units;

@@ -674,10 +674,15 @@ mod tests {
     }
 
     fn engine(mode: LoopMode) -> AidedIns<PositionAiding> {
+        engine_with(mode, |a| a)
+    }
+
+    /// The engine of `record` with its position aiding as `wrap` makes it (e.g. boxed).
+    fn engine_with<A: Aiding>(mode: LoopMode, wrap: impl FnOnce(PositionAiding) -> A) -> AidedIns<A> {
         let (s0, _, _, _, fixes) = record();
         let p0 = DMatrix::from_diagonal(&DVector::from_vec([1.0, 1.0, 1.0, 0.01, 0.01, 0.01, 1e-6, 1e-6, 1e-6, 1e-4, 1e-4, 1e-4, 1e-10, 1e-10, 1e-10].to_vec()));
         let ell = crate::earth::WGS84;
-        AidedIns::new(s0, ImuKind::Rates, ell, Vec3::zeros(), Vec3::zeros(), DVector::zeros(0), p0, config(mode), PositionAiding::new(fixes).unwrap()).unwrap()
+        AidedIns::new(s0, ImuKind::Rates, ell, Vec3::zeros(), Vec3::zeros(), DVector::zeros(0), p0, config(mode), wrap(PositionAiding::new(fixes).unwrap())).unwrap()
     }
 
     /// Streaming in uneven chunks equals one batch call, to the last bit.
@@ -692,10 +697,7 @@ mod tests {
                 ins.process(&t[lo..hi], &g[lo..hi], &a[lo..hi], &mut out).unwrap();
             }
             ins.finish(&mut out).unwrap();
-            assert_eq!(batch.nav, out.nav);
-            assert_eq!(batch.sigma, out.sigma);
-            assert_eq!(batch.nis, out.nis);
-            assert_eq!(batch.meas_time.len(), 9);
+            assert_same_output(&batch, &out, 9);
         }
     }
 
@@ -703,21 +705,25 @@ mod tests {
     /// registered name), continues bit for bit like the original.
     #[test]
     fn saved_engine_continues_bit_for_bit() {
-        let (s0, t, g, a, fixes) = record();
-        let p0 = DMatrix::from_diagonal(&DVector::from_element(15, 1e-4));
-        let aiding: Box<dyn Aiding> = Box::new(PositionAiding::new(fixes).unwrap());
-        let mut ins = AidedIns::new(s0, ImuKind::Rates, crate::earth::WGS84, Vec3::zeros(), Vec3::zeros(), DVector::zeros(0), p0, config(LoopMode::Closed), aiding).unwrap();
+        let (_, t, g, a, _) = record();
+        let mut ins = engine_with(LoopMode::Closed, |a| Box::new(a) as Box<dyn Aiding>);
         let mut out = AidedOutput::default();
         ins.process(&t[..123], &g[..123], &a[..123], &mut out).unwrap();
-        let bytes = postcard::to_stdvec(&ins).unwrap();
-        let mut copy: AidedIns<Box<dyn Aiding>> = postcard::from_bytes(&bytes).unwrap();
+        let bytes = crate::state::save("AidedIns", &ins).unwrap();
+        let mut copy: AidedIns<Box<dyn Aiding>> = crate::state::load("AidedIns", &bytes).unwrap();
         let (mut want, mut got) = (AidedOutput::default(), AidedOutput::default());
         ins.process(&t[123..], &g[123..], &a[123..], &mut want).unwrap();
         copy.process(&t[123..], &g[123..], &a[123..], &mut got).unwrap();
+        assert_same_output(&want, &got, 7);
+    }
+
+    /// Two runs' outputs equal to the last bit, with `measurements` measurements applied.
+    fn assert_same_output(want: &AidedOutput, got: &AidedOutput, measurements: usize) {
         assert_eq!(want.nav, got.nav);
         assert_eq!(want.sigma, got.sigma);
+        assert_eq!(want.nis, got.nis);
         assert_eq!(want.innovation, got.innovation);
-        assert_eq!(want.meas_time.len(), 7);
+        assert_eq!((want.meas_time.len(), got.meas_time.len()), (measurements, measurements));
     }
 
     /// A fix latitude in degrees (45.8 "rad") is an error naming `fix_lla` and its row.

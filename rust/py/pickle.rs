@@ -1,39 +1,25 @@
-//! Pickle and deepcopy of the stateful core objects: the object's whole state as bytes
-//! (postcard, every f64 bit for bit), so a copy continues exactly like the original. A
-//! class whose one field holds a serde-serialisable core value becomes picklable with
-//! `picklable!(Class, field, "PythonName")`, which adds `__reduce__` (built by [`reduce`])
-//! and a static `_from_state` (by [`restore`]).
+//! Pickle and deepcopy of the core objects: `__reduce__` returns `_from_state` and the
+//! object's saved state (`crate::state`: whole, every f64 bit for bit), so a copy continues
+//! exactly like the original. A class whose one field holds a serde-serialisable core value
+//! becomes picklable with `picklable!(Class, field, "PythonName")`.
 
-use crate::error::invalid;
 use pyo3::prelude::*;
 use pyo3::types::{PyBytes, PyTuple};
 use serde::{de::DeserializeOwned, Serialize};
 
-/// Format version of the state bytes: a pickle from another version is an `InputError`
-/// rather than a misread state.
-const VERSION: u32 = 1;
-
 /// `(type(obj)._from_state, (bytes,))`: what `__reduce__` returns for `obj`, whose core
-/// state is `state`, tagged with the class name and the format version.
+/// state is `state`, saved under the class's name.
 pub fn reduce<'py, T: Serialize>(obj: &Bound<'py, PyAny>, state: &T) -> PyResult<Bound<'py, PyTuple>> {
     let py = obj.py();
     let class = obj.get_type();
-    let tag = class.qualname()?.to_string();
-    let bytes = postcard::to_stdvec(&(VERSION, tag.as_str(), state)).map_err(|e| invalid("state", format!("cannot be saved: {e}")))?;
+    let bytes = crate::state::save(&class.qualname()?.to_string(), state)?;
     let restore = class.getattr("_from_state")?;
     PyTuple::new(py, [restore, PyTuple::new(py, [PyBytes::new(py, &bytes)])?.into_any()])
 }
 
-/// The state saved by [`reduce`] for class `class`; bytes of another class or version, or
-/// not a state at all, are an `InputError` naming `state`.
+/// The state saved by [`reduce`] for class `class`.
 pub fn restore<T: DeserializeOwned>(class: &str, bytes: &[u8]) -> PyResult<T> {
-    let not_a_state = |e: postcard::Error| invalid("state", format!("not a saved {class} state ({e})"));
-    // the tuple (version, tag, state) is the concatenation of its parts: read the header first
-    let ((version, tag), rest): ((u32, String), &[u8]) = postcard::take_from_bytes(bytes).map_err(not_a_state)?;
-    if version != VERSION || tag != class {
-        return Err(invalid("state", format!("a saved {tag} state of format {version}, expected {class} of format {VERSION}")).into());
-    }
-    Ok(postcard::from_bytes(rest).map_err(not_a_state)?)
+    Ok(crate::state::load(class, bytes)?)
 }
 
 /// `__reduce__` and `_from_state` for pyclass `$class`, whose field `$field` (a name, or 0
