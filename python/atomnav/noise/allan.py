@@ -14,6 +14,7 @@ import numpy as np
 import pandas as pd
 
 from .. import _core, units
+from ..imu import Flicker, TriadErrors
 from .._stateful import Stateful, serialized
 from .._validate import as_floats, finite_result, flag, input_error, instance, integer, positive, probability, renamed, scalar, table as read_table, vector
 
@@ -181,6 +182,42 @@ class AllanFit:
         ``units.DEG_PER_HOUR``), ``arw_unit`` the SI factor of the wanted unit (e.g.
         ``units.DEG_PER_SQRT_HOUR``, or 1.0 for rad/√s)."""
         return self.arw * rate_unit / arw_unit
+
+    def to_triad(self, rate_unit: float = 1.0, *, f_lo: float | None = None, f_hi: float | None = None) -> TriadErrors:
+        """The fitted noise as the error model of one triad, for :class:`atomnav.imu.ImuErrors`
+        and :class:`atomnav.imu.ImuSimulator`.
+
+        Parameters
+        ----------
+        rate_unit : float
+            SI factor of the fitted data's unit (``units.DEG_PER_HOUR`` for a gyro log in
+            °/h, ``units.MICRO_G`` for an accelerometer log in µg; 1.0 for rad/s or m/s²).
+        f_lo, f_hi : float, optional
+            Band (Hz) of the flicker term that gives the bias-instability floor. Defaults:
+            ``f_lo`` = 1/(10 τ_max), a decade below the longest τ of the table, so the floor
+            holds over every fitted τ; ``f_hi`` = 1/(2τ₀), the Nyquist frequency of the log
+            (τ₀ its sampling interval; a simulator with a longer interval needs a lower ``f_hi``).
+
+        Returns
+        -------
+        TriadErrors
+            The same ARW, bias instability and RRW in SI (IEEE Std 952-1997, Annex C):
+            ``white`` N (rad/√s or m/s/√s), ``flicker`` of bias instability B (rad/s or
+            m/s²), ``bias_rw`` K (rad/s/√s or m/s²/√s); no fixed bias, scale factor or
+            misalignment. A fit with a quantization or ramp term, which the IMU error model
+            does not have, is an :class:`atomnav.InputError` naming ``terms`` (fit with
+            ``terms=("arw", "bias_instability", "rrw")``).
+        """
+        extra = [t for t in ("quantization", "ramp") if getattr(self, t) > 0]
+        if extra:
+            raise input_error("terms", f"the fit has a {extra[0]} term, which the IMU error model lacks; "
+                                       "fit with terms=('arw', 'bias_instability', 'rrw')")
+        unit = positive(rate_unit, "rate_unit")
+        m, tau = read_table(self.table, ["m", "tau_s"], "table").T
+        f_lo = float(0.1 / tau.max()) if f_lo is None else positive(f_lo, "f_lo")
+        f_hi = float(0.5 * m[0] / tau[0]) if f_hi is None else positive(f_hi, "f_hi")
+        flicker = Flicker(self.bias_instability * unit, f_lo, f_hi) if self.bias_instability > 0 else None
+        return TriadErrors(white=self.arw * unit, bias_rw=self.rrw * unit, flicker=flicker)
 
 
 def fit_allan_table(table: pd.DataFrame, n_samples: int, terms=TERMS, tau_min: float | None = None, tau_max: float | None = None) -> AllanFit:
