@@ -15,7 +15,6 @@ from dataclasses import dataclass
 
 import numpy as np
 import pandas as pd
-from tqdm.auto import tqdm
 
 from .. import _core, plausibility
 from .._validate import as_floats, finite_scalar, flag, input_error, instance, integer, positive, renamed, rows
@@ -226,6 +225,8 @@ class AidedIns:
         size = max(1, int(chunk_s / step)) if np.isfinite(step) and step > 0 else n
         bounds = list(range(0, n, size)) + [n]
         parts = []
+        from tqdm.auto import tqdm  # imported here: tqdm.auto pulls in asyncio, which slows `import atomnav`
+
         try:
             for lo, hi in tqdm(list(zip(bounds[:-1], bounds[1:])), desc="aided INS", unit="chunk",
                                disable=not progress or len(bounds) <= 2):

@@ -13,7 +13,6 @@ from dataclasses import dataclass
 
 import numpy as np
 import pandas as pd
-from scipy.stats import chi2
 
 from .. import _core
 from .._validate import as_floats, flag, input_error, instance, integer, scalar
@@ -107,6 +106,8 @@ def chi2_band(dof: int, runs: int, p: float = 0.95) -> tuple[float, float]:
     p = scalar(p, "p")
     if not 0 < p < 1:
         raise input_error("p", f"must be a probability in (0, 1), got {p}")
+    from scipy.stats import chi2  # imported here: scipy.stats alone takes longer than `import atomnav` may
+
     lo, hi = chi2.ppf([(1 - p) / 2, (1 + p) / 2], runs * dof)
     return float(lo / runs), float(hi / runs)
 
