@@ -34,7 +34,7 @@ STATIC_ACCEL = np.array([0.0, 0.0, -9.81])          # specific force at rest, FR
 
 def static_gyro_log(seed):
     """Gyro rates (°/h) of an N-sample static record of the TRUTH noise."""
-    sim = an.imu.ImuSimulator(TRUTH, DT, seed=seed)
+    sim = an.imu.ImuSimulator(TRUTH, DT, kind="rates", seed=seed)
     out = sim.corrupt(np.tile(STATIC_ACCEL, (N, 1)), np.tile(EARTH_RATE, (N, 1)))
     return out[["gyro_x_rad_s", "gyro_y_rad_s", "gyro_z_rad_s"]].to_numpy() / an.units.DEG_PER_HOUR
 
@@ -52,7 +52,7 @@ fit = an.noise.allan.fit_allan(log["gyro_x_deg_h"], tau0, terms=("arw", "bias_in
 errors = an.imu.ImuErrors.preset("tactical")         # keep the accelerometer of a datasheet ...
 errors.gyro = fit.to_triad(an.units.DEG_PER_HOUR)    # ... and use the measured gyro noise (SI)
 print(errors.summary().query("sensor == 'gyro'").to_string())  # ARW °/√h, RRW °/h/√h, bias instability °/h
-sim = an.imu.ImuSimulator(errors, dt=0.01, seed=7)   # a 100 Hz IMU with that gyro, for any motion
+sim = an.imu.ImuSimulator(errors, dt=0.01, kind="rates", seed=7)   # a 100 Hz IMU with that gyro, any motion
 
 # --- check against the simulated noise ------------------------------------------------
 def fitted(rates):

@@ -52,7 +52,7 @@ def test_simulated_triad_has_the_fitted_allan_deviation():
     each term, within the 99 % χ² interval of the estimate."""
     triad = closed_form_fit().to_triad(units.DEG_PER_HOUR, f_lo=1e-5, f_hi=1.0)
     n = 8 * 3600 * 10
-    sim = an.imu.ImuSimulator(an.imu.ImuErrors(gyro=triad), TAU0, seed=3)
+    sim = an.imu.ImuSimulator(an.imu.ImuErrors(gyro=triad), TAU0, kind="rates", seed=3)
     accel = np.tile([0.0, 0.0, -9.81], (n, 1))
     gyro = sim.corrupt(accel, np.zeros((n, 3)))["gyro_x_rad_s"] / units.DEG_PER_HOUR
     table = allan.allan_variance(gyro, TAU0, m=[1, 512, 16384], confidence=0.99)
