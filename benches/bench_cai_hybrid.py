@@ -163,7 +163,7 @@ def car_run(seconds: float = 35.0) -> dict:
 def run_atomnav(d: dict):
     """One CAI-aided INS run of atomnav on the inputs of :func:`car_run`."""
     ins = cai.cai_aided_ins(0.0, d["lla0"], d["vel0"], d["q0"], d["sensor"], d["shots"], phase=d["phase"],
-                            noise=d["noise"], setup=d["setup"], ellipsoid="kinematic")
+                            noise=d["noise"], setup=d["setup"], kind="rates", ellipsoid="kinematic")
     return ins.run(d["t"], d["gyro"], d["accel"], progress=False)
 
 

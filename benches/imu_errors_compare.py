@@ -48,7 +48,7 @@ def main():
     t = imu.TriadErrors(white=WHITE, bias_rw=K, gauss_markov=imu.GaussMarkov(SIGMA, TAU))
     e = imu.ImuErrors(t, t)
     best = {}
-    for name, fn in (("atomnav", lambda: imu.corrupt(f, w, errors=e, dt=DT, seed=1)), ("numpy/scipy", lambda: peer(f, w, 1))):
+    for name, fn in (("atomnav", lambda: imu.corrupt(f, w, errors=e, dt=DT, kind="rates", seed=1)), ("numpy/scipy", lambda: peer(f, w, 1))):
         fn()
         times = []
         for _ in range(3):

@@ -285,7 +285,7 @@ CATALOGUE: tuple[Clean, ...] = (
        AIDED_UNITS),
     _c("atomnav.cai.sensor.cai_aided_ins",
        'an.cai.cai_aided_ins(t0, lla, vel_ned, q_nb, an.cai.seed003_sensor(), shots, phase=phase, noise=noise, '
-       'ellipsoid="kinematic").run(*[slalom_imu[c].to_numpy() for c in CAI_IMU], progress=False)',
+       'kind="rates", ellipsoid="kinematic").run(*[slalom_imu[c].to_numpy() for c in CAI_IMU], progress=False)',
        't0, lla, vel_ned, q_nb = slalom_init["t0"], slalom_init["lla"], slalom_init["vel_ned"], slalom_init["q_nb"]\n'
        'shots, phase, noise = cai_shots, cai_phase, cai_noise\n'
        'CAI_IMU = ["time_s", ["gyro_x_rad_s", "gyro_y_rad_s", "gyro_z_rad_s"], ["accel_x_mps2", "accel_y_mps2", "accel_z_mps2"]]',

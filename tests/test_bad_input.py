@@ -36,7 +36,7 @@ def test_inf_sample_names_field_and_index(traj, imu):
 
 def test_wrong_array_shape(traj, imu):
     with pytest.raises(ValueError, match=r"imu: expected shape \(N, 7\)"):
-        _integrate(traj, imu.to_numpy()[:, :6])
+        _integrate(traj, imu.to_numpy()[:, :6], kind="increments")
 
 
 def test_missing_column(traj, imu):

@@ -23,7 +23,7 @@ def _ins(record, shots, n_channels=6, **kw):
     init, _ = record
     sensor = cai.seed003_sensor()
     data = np.zeros((len(shots), n_channels))
-    return cai.cai_aided_ins(*init, sensor, shots, phase=data, noise=data, ellipsoid="kinematic", **kw)
+    return cai.cai_aided_ins(*init, sensor, shots, phase=data, noise=data, ellipsoid="kinematic", **{"kind": "rates", **kw})
 
 
 def _run(ins, record):
@@ -60,16 +60,16 @@ def test_mismatched_number_of_interferometers(record):
 def test_mismatched_number_of_shots(record):
     init, _ = record
     with pytest.raises(ValueError, match=r"noise: expected 2 shots"):
-        cai.cai_aided_ins(*init, cai.seed003_sensor(), [0.1, 0.2], phase=np.zeros((2, 6)), noise=np.zeros((3, 6)))
+        cai.cai_aided_ins(*init, cai.seed003_sensor(), [0.1, 0.2], phase=np.zeros((2, 6)), noise=np.zeros((3, 6)), kind="rates")
 
 
 def test_recorded_and_emulated_data_are_exclusive(record):
     init, _ = record
     with pytest.raises(InputError, match=r"population: give either") as e:
-        cai.cai_aided_ins(*init, cai.seed003_sensor(), [0.1], phase=np.zeros((1, 6)), noise=np.zeros((1, 6)), population=np.zeros((1, 6)))
+        cai.cai_aided_ins(*init, cai.seed003_sensor(), [0.1], phase=np.zeros((1, 6)), noise=np.zeros((1, 6)), population=np.zeros((1, 6)), kind="rates")
     assert e.value.parameter == "population"
     with pytest.raises(InputError, match=r"phase: give either") as e:
-        cai.cai_aided_ins(*init, cai.seed003_sensor(), [0.1])
+        cai.cai_aided_ins(*init, cai.seed003_sensor(), [0.1], kind="rates")
     assert e.value.parameter == "phase"
 
 

@@ -156,7 +156,7 @@ def test_bias_random_walk_variance_grows_as_k2_t_across_seeds():
 
 def test_gauss_markov_stationary_variance_and_autocorrelation_at_tau():
     sigma, tau, dt, n = 2e-3, 1.0, 0.01, 400_000
-    out = imu.corrupt(*_zeros(n), errors=_errors(gauss_markov=imu.GaussMarkov(sigma, tau)), dt=dt, seed=3)
+    out = imu.corrupt(*_zeros(n), errors=_errors(gauss_markov=imu.GaussMarkov(sigma, tau)), dt=dt, kind="rates", seed=3)
     b = _bias_truth(out)
     x = dt / tau  # interval averaging: Var = 2σ²(x − 1 + e^{−x})/x² (≈ σ²(1 − x/3))
     var_avg = 2 * sigma**2 * (x - 1 + math.exp(-x)) / x**2
@@ -183,7 +183,7 @@ def test_gauss_markov_increment_variance_is_the_integrated_ou_closed_form():
 def test_flicker_psd_has_slope_minus_one_and_ieee_level_in_its_band():
     b, f_lo, f_hi, dt, n = 1e-3, 1e-3, 1.0, 0.1, 2**20
     e = imu.ImuErrors(accel=imu.TriadErrors(flicker=imu.Flicker(b, f_lo, f_hi)))
-    x = _bias_truth(imu.corrupt(*_zeros(n), errors=e, dt=dt, seed=4))[:, :3]
+    x = _bias_truth(imu.corrupt(*_zeros(n), errors=e, dt=dt, kind="rates", seed=4))[:, :3]
     # averaged Hann-windowed periodogram (numpy), one-sided: 2|X|²Δt/Σw²
     seg = 2**14
     win = np.hanning(seg)
@@ -215,9 +215,9 @@ def test_navigation_preset_allan_deviation_matches_seed003_spec():
     nav.accel.bias_sigma = 0.0
     f_cols = imu.COLUMNS["rates"][0]
     white_only = imu.ImuErrors(imu.TriadErrors(white=nav.accel.white))
-    a = imu.corrupt(*_zeros(n), errors=white_only, dt=dt, seed=13)[f_cols].to_numpy()
+    a = imu.corrupt(*_zeros(n), errors=white_only, dt=dt, kind="rates", seed=13)[f_cols].to_numpy()
     assert np.mean(_overlapping_adev(a, dt, 200)) == pytest.approx(3.5355e-6, rel=0.05)
-    a = imu.corrupt(*_zeros(n), errors=nav, dt=dt, seed=13)[f_cols].to_numpy()
+    a = imu.corrupt(*_zeros(n), errors=nav, dt=dt, kind="rates", seed=13)[f_cols].to_numpy()
     for tau in (1.0, 10.0):
         expect = math.sqrt(1.25e-11 / tau + 9e-10 * tau / 3)
         assert np.mean(_overlapping_adev(a, dt, round(tau / dt))) == pytest.approx(expect, rel=0.05)
@@ -237,9 +237,9 @@ def _full():
 
 def test_same_seed_same_numbers_different_seed_different_numbers():
     f, w = np.ones((300, 3)), np.ones((300, 3))
-    a = imu.corrupt(f, w, errors=_full(), dt=0.01, seed=123)
-    b = imu.corrupt(f, w, errors=_full(), dt=0.01, seed=123)
-    c = imu.corrupt(f, w, errors=_full(), dt=0.01, seed=124)
+    a = imu.corrupt(f, w, errors=_full(), dt=0.01, kind="rates", seed=123)
+    b = imu.corrupt(f, w, errors=_full(), dt=0.01, kind="rates", seed=123)
+    c = imu.corrupt(f, w, errors=_full(), dt=0.01, kind="rates", seed=124)
     pd.testing.assert_frame_equal(a, b)
     assert not np.any(a.to_numpy() == c.to_numpy())
 
@@ -269,7 +269,7 @@ def test_dataframe_stream_in_and_out():
 def test_accel_and_gyro_are_independent_streams():
     n = 100_000
     e = _errors(white=1.0)
-    out = _measured(imu.corrupt(*_zeros(n), errors=e, dt=1.0, seed=10))
+    out = _measured(imu.corrupt(*_zeros(n), errors=e, dt=1.0, kind="rates", seed=10))
     r = np.corrcoef(out.T)[:3, 3:]
     assert np.all(np.abs(r) < 5 / math.sqrt(n)), r
     # changing the accelerometer model leaves the gyro realisation untouched, and adding a
@@ -277,7 +277,7 @@ def test_accel_and_gyro_are_independent_streams():
     e2 = _errors(white=1.0)
     e2.accel.white = 3.0
     e2.accel.gauss_markov = imu.GaussMarkov(0.5, 2.0)
-    df2 = imu.corrupt(*_zeros(n), errors=e2, dt=1.0, seed=10)
+    df2 = imu.corrupt(*_zeros(n), errors=e2, dt=1.0, kind="rates", seed=10)
     out2, bias2 = _measured(df2), _bias_truth(df2)
     np.testing.assert_array_equal(out2[:, 3:], out[:, 3:])
     # true input is zero, so measured − bias truth is the white noise alone
@@ -288,7 +288,7 @@ def test_turn_on_bias_is_constant_per_run_with_the_given_sigma():
     sigma, seeds = 2e-3, 400
     draws = []
     for s in range(seeds):
-        b = _bias_truth(imu.corrupt(*_zeros(5), errors=_errors(bias_sigma=sigma, bias=(1.0, 0, 0)), dt=0.1, seed=s))
+        b = _bias_truth(imu.corrupt(*_zeros(5), errors=_errors(bias_sigma=sigma, bias=(1.0, 0, 0)), dt=0.1, kind="rates", seed=s))
         assert np.all(b == b[0])
         draws.append(b[0] - [1.0, 0, 0, 1.0, 0, 0])
     m = seeds * 6
@@ -347,7 +347,7 @@ def test_user_presets_extend_the_registry():
     got = imu.ImuErrors.preset("test_quantum_grade")
     assert got.accel.white == 1e-4 and got is not e
     f = np.zeros((3, 3))
-    pd.testing.assert_frame_equal(imu.corrupt(f, f, errors="test_quantum_grade", dt=0.1), imu.corrupt(f, f, errors=e, dt=0.1))
+    pd.testing.assert_frame_equal(imu.corrupt(f, f, errors="test_quantum_grade", dt=0.1, kind="rates"), imu.corrupt(f, f, errors=e, dt=0.1, kind="rates"))
 
 
 # --------------------------------------------------------------------------- bad input, one test per case
@@ -361,25 +361,25 @@ def _raises(match, fn, *a, **kw):
 def test_bad_nan_in_accel_names_field_and_index():
     f, w = _zeros(10)
     f[7, 1] = np.nan
-    _raises(r"accel: non-finite value nan at index 7", imu.corrupt, f, w, errors="mems", dt=0.01)
+    _raises(r"accel: non-finite value nan at index 7", imu.corrupt, f, w, errors="mems", dt=0.01, kind="rates")
 
 
 def test_bad_inf_in_gyro_names_field_and_index():
     f, w = _zeros(10)
     w[2, 0] = np.inf
-    _raises(r"gyro: non-finite value inf at index 2", imu.corrupt, f, w, errors="mems", dt=0.01)
+    _raises(r"gyro: non-finite value inf at index 2", imu.corrupt, f, w, errors="mems", dt=0.01, kind="rates")
 
 
 def test_bad_stream_shape():
-    _raises(r"accel: expected shape \(N, 3\), got \(10, 2\)", imu.corrupt, np.zeros((10, 2)), np.zeros((10, 3)), errors="mems", dt=0.01)
+    _raises(r"accel: expected shape \(N, 3\), got \(10, 2\)", imu.corrupt, np.zeros((10, 2)), np.zeros((10, 3)), errors="mems", dt=0.01, kind="rates")
 
 
 def test_bad_stream_lengths_differ():
-    _raises(r"gyro: expected 10 rows like accel, got 9", imu.corrupt, np.zeros((10, 3)), np.zeros((9, 3)), errors="mems", dt=0.01)
+    _raises(r"gyro: expected 10 rows like accel, got 9", imu.corrupt, np.zeros((10, 3)), np.zeros((9, 3)), errors="mems", dt=0.01, kind="rates")
 
 
 def test_bad_gyro_missing():
-    _raises(r"gyro: required", imu.corrupt, np.zeros((10, 3)), errors="mems", dt=0.01)
+    _raises(r"gyro: required", imu.corrupt, np.zeros((10, 3)), errors="mems", dt=0.01, kind="rates")
 
 
 def test_bad_dataframe_columns():
@@ -490,11 +490,11 @@ def test_bad_conversion_nonpositive_tau():
 
 def test_bad_chunk_leaves_the_simulator_state_unchanged():
     f, w = np.ones((20, 3)), np.ones((20, 3))
-    sim = imu.ImuSimulator(_full(), 0.01, seed=5)
+    sim = imu.ImuSimulator(_full(), 0.01, "rates", seed=5)
     bad = f.copy()
     bad[4, 2] = np.nan
     _raises(r"accel: non-finite value nan at index 4", sim.corrupt, bad, w)
-    pd.testing.assert_frame_equal(sim.corrupt(f, w), imu.corrupt(f, w, errors=_full(), dt=0.01, seed=5))
+    pd.testing.assert_frame_equal(sim.corrupt(f, w), imu.corrupt(f, w, errors=_full(), dt=0.01, kind="rates", seed=5))
 
 
 def test_corrupts_a_trajectory_imu_table_and_feeds_the_strapdown():

@@ -35,7 +35,7 @@ short = trajectory.stationary(1.0, rate)
 init = short.initial_state()
 row = short.ideal_imu("increments").to_numpy()[0]  # time, dtheta (rad), dv (m/s) of one 1/rate interval
 dt = row[0] - init["t0"]
-sd = Strapdown(**init, vertical="damped")
+sd = Strapdown(**init, kind="increments", vertical="damped")
 block = np.empty((chunk, 7))
 block[:, 1:] = row[1:]
 h_ref = np.full(chunk, init["lla"][2])

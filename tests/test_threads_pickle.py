@@ -170,7 +170,7 @@ def test_a_state_of_another_class_is_an_input_error():
 @pytest.mark.parametrize("repeat", range(REPEATS))
 def test_strapdown_run_while_threads_read_its_state(record, repeat):
     traj, _, meas = record
-    sd = an.strapdown.Strapdown(**traj.initial_state())
+    sd = an.strapdown.Strapdown(**traj.initial_state(), kind="increments")
     seen = []
 
     def call(k):

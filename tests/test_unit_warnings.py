@@ -143,7 +143,7 @@ def test_corrupt_with_accelerations_in_g_warns(sinusoidal, kind):
 def test_corrupt_arrays_in_g_at_rest_warn():
     f = np.tile([0.0, 0.0, -1.0], (200, 1))  # 1 g up, in g
     w = np.zeros((200, 3))
-    _warns(lambda: an.imu.corrupt(f, w, errors="navigation", dt=0.01), "accel", "g", G0)
+    _warns(lambda: an.imu.corrupt(f, w, errors="navigation", dt=0.01, kind="rates"), "accel", "g", G0)
 
 
 # ---- gyro rates in °/s ---------------------------------------------------------------
@@ -160,13 +160,13 @@ def test_corrupt_static_gyro_in_degrees_per_second_warns(at_rest):
     ideal = traj.ideal_imu("rates")
     f = ideal[["accel_x_mps2", "accel_y_mps2", "accel_z_mps2"]].to_numpy()
     w_deg = np.rad2deg(ideal[["gyro_x_rad_s", "gyro_y_rad_s", "gyro_z_rad_s"]].to_numpy())
-    _warns(lambda: an.imu.corrupt(f, w_deg, errors="navigation", dt=0.01), "gyro", "deg/s", DEG)
+    _warns(lambda: an.imu.corrupt(f, w_deg, errors="navigation", dt=0.01, kind="rates"), "gyro", "deg/s", DEG)
 
 
 def test_rate_beyond_35_rad_s_warns():
     f = np.tile([0.0, 0.0, -G0], (100, 1))
     w_deg = np.tile([0.0, 0.0, 57.29577951308232], (100, 1))  # a turntable at 1 rad/s, in °/s
-    _warns(lambda: an.imu.corrupt(f, w_deg, errors="navigation", dt=0.01), "gyro", "deg/s", DEG)
+    _warns(lambda: an.imu.corrupt(f, w_deg, errors="navigation", dt=0.01, kind="rates"), "gyro", "deg/s", DEG)
 
 
 def test_fast_turn_in_degrees_per_second_is_flagged_by_the_phase_predictor():

@@ -74,7 +74,7 @@ def test_cai_aided_ins_initial_latitude_in_degrees_names_lla0():
     shots, phase = 0.1 + 0.05 * np.arange(3), np.zeros((3, len(sensor.channels)))
     with pytest.raises(InputError, match="latitude") as e:
         an.cai.cai_aided_ins(0.0, (np.degrees(LAT), LON, H), (0, 0, 0), (1, 0, 0, 0), sensor, shots, phase=phase,
-                             noise=phase)
+                             noise=phase, kind="rates")
     assert e.value.parameter == "lla0"
 
 
@@ -82,7 +82,7 @@ def test_cai_aided_ins_initial_longitude_in_degrees_warns_naming_lla0():
     sensor = an.cai.seed003_sensor()
     shots, phase = 0.1 + 0.05 * np.arange(3), np.zeros((3, len(sensor.channels)))
     with pytest.warns(UnitWarning) as record:
-        an.cai.cai_aided_ins(0.0, (LAT, 37.6, H), (0, 0, 0), (1, 0, 0, 0), sensor, shots, phase=phase, noise=phase)
+        an.cai.cai_aided_ins(0.0, (LAT, 37.6, H), (0, 0, 0), (1, 0, 0, 0), sensor, shots, phase=phase, noise=phase, kind="rates")
     (w,) = _unit_warnings(record)
     assert (w.parameter, w.unit) == ("lla0", "deg")
     assert w.factor == pytest.approx(DEG, rel=1e-15)

@@ -75,9 +75,9 @@ def test_reordered_columns_with_extras_give_the_identical_result(traj, meas, cle
 
 def test_plain_array_is_read_in_the_documented_column_order(traj, meas, clean):
     cols = an.trajectory.IMU_COLUMNS["increments"]
-    pd.testing.assert_frame_equal(an.strapdown.integrate(meas[cols].to_numpy(), **traj.initial_state()), clean, check_exact=True)
+    pd.testing.assert_frame_equal(an.strapdown.integrate(meas[cols].to_numpy(), **traj.initial_state(), kind="increments"), clean, check_exact=True)
     with pytest.raises(InputError, match=r"imu: expected shape \(N, 7\) with the columns"):
-        an.strapdown.integrate(meas.to_numpy(), **traj.initial_state())
+        an.strapdown.integrate(meas.to_numpy(), **traj.initial_state(), kind="increments")
 
 
 # ---- nullable dtypes and strings --------------------------------------------------------

@@ -48,6 +48,7 @@ import pandas as pd
 from . import _core, plausibility, units
 from ._stateful import Stateful, serialized
 from ._validate import as_floats, choice, input_error, instance, locate, renamed, rows, scalar, seconds, table, vector
+from .trajectory import imu_kind
 
 KINDS = tuple(_core.OPTIONS["ImuKind"])
 _AXES = ("x", "y", "z")
@@ -225,25 +226,29 @@ class ImuSimulator(Stateful):
     calls continue the random processes, so chunks give the numbers of one batch call.
 
     ``kind``, ``dt`` and ``errors`` are fixed at construction (read-only: build a new
-    simulator for another kind). One simulator may be shared by threads (calls run one
-    after another) and pickled or deep-copied mid-record: the copy continues the same
-    random streams bit for bit."""
+    simulator for another kind); ``kind=None`` (default) takes the kind of the column
+    names of the first DataFrame :meth:`corrupt` reads (:func:`atomnav.trajectory.imu_kind`)
+    and fixes it then (:attr:`kind` is None until then); arrays need ``kind`` given here.
+    One simulator may be shared by threads (calls run one after another) and pickled or
+    deep-copied mid-record: the copy continues the same random streams bit for bit."""
 
-    def __init__(self, errors: ImuErrors | str, dt: float, kind: str = "rates", seed: int = 0):
+    def __init__(self, errors: ImuErrors | str, dt: float, kind: str | None = None, seed: int = 0):
         if isinstance(errors, str):
             with renamed(preset="errors"):
                 errors = ImuErrors.preset(errors)
         instance(errors, ImuErrors, "errors")
         self._dt = scalar(dt, "dt")
         self._errors = copy.deepcopy(errors)
-        self._sim = _core.ImuErrorSimulator(*errors._to_core(), self._dt, kind, seed)
+        self._seed = seed  # to draw the same streams for the kind of the first table when none is given
+        self._sim = _core.ImuErrorSimulator(*errors._to_core(), self._dt, "rates" if kind is None else kind, seed)
         self._kind = kind
         plausibility.sample_interval(self._dt, "dt")
         self._k = 0
 
     @property
-    def kind(self) -> str:
-        """Output kind, ``"rates"`` or ``"increments"`` (read-only)."""
+    def kind(self) -> str | None:
+        """Output kind, ``"rates"`` or ``"increments"`` (read-only; None until the first
+        table when not given)."""
         return self._kind
 
     @property
@@ -261,12 +266,18 @@ class ImuSimulator(Stateful):
         """Corrupt the next chunk. ``accel``, ``gyro``: (N, 3) true specific force (m/s²)
         and angular rate (rad/s), or Δv (m/s) and Δθ (rad) for increments; or one DataFrame
         in ``accel`` with the stream columns of this kind (module docstring), read by name
-        (extra columns ignored); its errors name ``accel`` and the column. Returns a
+        (extra columns ignored; with ``kind=None`` the first one fixes the kind); its errors
+        name ``accel`` and the column. Returns a
         DataFrame indexed by the running sample number with the measured columns (same
         names) and the bias truth columns; a ``time_s`` column is carried through as given
         (datetime64 included). No other column is carried: a time column under another
         name (``time``) is ignored like any extra column, and the output then has none."""
-        fcols, wcols = COLUMNS[self.kind]
+        sim, kind = self._sim, self._kind
+        if kind is None:  # the first table fixes the kind; no sample was drawn yet
+            kind = imu_kind(None, accel, "accel")
+            if kind != "rates":
+                sim = _core.ImuErrorSimulator(*self._errors._to_core(), self._dt, kind, self._seed)
+        fcols, wcols = COLUMNS[kind]
         gyro_name = "accel" if gyro is None else "gyro"  # a DataFrame in accel holds the gyro too
         t = None
         if isinstance(accel, pd.DataFrame):
@@ -283,8 +294,9 @@ class ImuSimulator(Stateful):
         f, w = rows(accel, 3, "accel"), rows(gyro, 3, "gyro")
         if len(w) != len(f):
             raise input_error("gyro", f"expected {len(f)} rows like accel, got {len(w)}")
-        plausibility.imu(t, w, f, self.kind, "accel", gyro_name=gyro_name, dt=self.dt)
-        fm, wm, fb, wb = self._sim.corrupt(f, w)
+        plausibility.imu(t, w, f, kind, "accel", gyro_name=gyro_name, dt=self.dt)
+        fm, wm, fb, wb = sim.corrupt(f, w)
+        self._sim, self._kind = sim, kind
         index = pd.RangeIndex(self._k, self._k + len(f), name="sample")
         self._k += len(f)
         df = pd.DataFrame(np.hstack([fm, wm, fb, wb]), columns=fcols + wcols + BIAS_COLUMNS[0] + BIAS_COLUMNS[1], index=index)
@@ -293,9 +305,11 @@ class ImuSimulator(Stateful):
         return df
 
 
-def corrupt(accel, gyro=None, *, errors: ImuErrors | str, dt: float, kind: str = "rates", seed: int = 0) -> pd.DataFrame:
-    """One-shot :class:`ImuSimulator` ``(errors, dt, kind, seed).corrupt(accel, gyro)``."""
-    return ImuSimulator(errors, dt, kind, seed).corrupt(accel, gyro)
+def corrupt(accel, gyro=None, *, errors: ImuErrors | str, dt: float, kind: str | None = None, seed: int = 0) -> pd.DataFrame:
+    """One-shot :class:`ImuSimulator` ``(errors, dt, kind, seed).corrupt(accel, gyro)``;
+    ``kind=None`` (default) is the kind of the column names of the DataFrame ``accel``
+    (:func:`atomnav.trajectory.imu_kind`), and arrays need ``kind``."""
+    return ImuSimulator(errors, dt, imu_kind(kind, accel, "accel"), seed).corrupt(accel, gyro)
 
 
 def white_sigma(density: float, dt: float, kind: str = "rates") -> float:

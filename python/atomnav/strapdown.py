@@ -22,7 +22,7 @@ import pandas as pd
 from . import _core, plausibility
 from ._stateful import Stateful, serialized
 from ._validate import as_floats, flag, input_error, renamed, rows, scalar, seconds, table, timestamp, vector
-from .trajectory import COLUMNS, IMU_COLUMNS
+from .trajectory import COLUMNS, IMU_COLUMNS, imu_kind
 
 #: Rows per call into Rust: the progress bar's granularity for long runs.
 CHUNK = 500_000
@@ -119,10 +119,13 @@ class Strapdown(Stateful):
 
     Parameters
     ----------
-    kind : str
+    kind : str, optional
         ``"rates"`` (rad/s, m/s²) or ``"increments"`` (rad, m/s). With rates, the first
         sample must be at ``t0`` (it primes the integrator). With increments, each row
-        covers (t_{k−1}, t_k] and is stamped t_k > t0.
+        covers (t_{k−1}, t_k] and is stamped t_k > t0. None (default): the kind of the
+        column names of the first table :meth:`run` reads
+        (:func:`atomnav.trajectory.imu_kind`), fixed from then on; :attr:`kind` is None
+        until then. A plain array needs ``kind`` given here.
     ellipsoid : str
         Earth model, one of ``_core.OPTIONS["Ellipsoid"]``.
     vertical : str
@@ -143,23 +146,26 @@ class Strapdown(Stateful):
     or deep-copied mid-record: the copy continues bit for bit like the original.
     """
 
-    def __init__(self, t0, lla, vel_ned, q_nb, *, kind: str = "increments", ellipsoid: str = "WGS84",
+    def __init__(self, t0, lla, vel_ned, q_nb, *, kind: str | None = None, ellipsoid: str = "WGS84",
                  vertical: str = "free", zeta: float | None = None, omega: float | None = None, epoch=None):
         #: The datetime of time 0 (``epoch``, or ``t0`` given as a datetime), else None.
         self.epoch = _epoch(t0, epoch)
         t0 = scalar(t0, "t0") if timestamp(t0) is None else seconds(pd.Series([t0]), "t0", "t0", self.epoch, "epoch")[0]
-        self._core = _core.Strapdown(t0, vector(lla, 3, "lla"), vector(vel_ned, 3, "vel_ned"),
-                                     vector(q_nb, 4, "q_nb"), kind=kind, ellipsoid=ellipsoid, vertical=vertical,
-                                     zeta=None if zeta is None else scalar(zeta, "zeta"),
-                                     omega=None if omega is None else scalar(omega, "omega"))
+        # the state and options, to build the core anew for the kind of the first table when none is given
+        self._start = (t0, vector(lla, 3, "lla"), vector(vel_ned, 3, "vel_ned"), vector(q_nb, 4, "q_nb"))
+        self._options = dict(ellipsoid=ellipsoid, vertical=vertical, zeta=None if zeta is None else scalar(zeta, "zeta"),
+                             omega=None if omega is None else scalar(omega, "omega"))
+        self._core = _core.Strapdown(*self._start, kind="increments" if kind is None else kind, **self._options)
+        self._fixed = kind is not None
         plausibility.lla(lla, "lla")
         self._rows = 0
 
     @property
     @serialized
-    def kind(self) -> str:
-        """The IMU kind, ``"rates"`` or ``"increments"``."""
-        return self._core.kind
+    def kind(self) -> str | None:
+        """The IMU kind, ``"rates"`` or ``"increments"`` (None until the first table when
+        not given)."""
+        return self._core.kind if self._fixed else None
 
     @serialized
     def run(self, imu, h_ref=None) -> pd.DataFrame:
@@ -193,16 +199,20 @@ class Strapdown(Stateful):
             this method would return them), ``.row`` and ``.time_s`` (s) name the sample
             at which it diverged. Restart with :meth:`reset`.
         """
-        t, g, a = _imu_arrays(imu, self.kind, self.epoch)
-        plausibility.imu(t, g, a, self.kind)
+        core = self._core
+        if not self._fixed:  # the first table fixes the kind
+            kind = imu_kind(None, imu, "imu")
+            core = core if kind == core.kind else _core.Strapdown(*self._start, kind=kind, **self._options)
+        t, g, a = _imu_arrays(imu, core.kind, self.epoch)
+        plausibility.imu(t, g, a, core.kind)
         first = self._rows
         try:
-            with _imu_errors(self.kind, g, a, first):
-                table = self._core.run(t, g, a, _h_ref(h_ref, len(t)), first)
+            with _imu_errors(core.kind, g, a, first):
+                table = core.run(t, g, a, _h_ref(h_ref, len(t)), first)
         except _core.NumericalError as err:
-            self._rows = first + err.rows + 1
+            self._core, self._fixed, self._rows = core, True, first + err.rows + 1
             raise _diverged(err, err.table, err.rows, first, t) from None
-        self._rows = first + len(t)
+        self._core, self._fixed, self._rows = core, True, first + len(t)
         return _table(table, first)
 
     @serialized
@@ -242,13 +252,15 @@ class Strapdown(Stateful):
         else:
             raise TypeError(f"state: expected a one-row DataFrame or a dict, got {type(state).__name__}")
         t0, lla, vel, q = fields
+        start = (scalar(t0, "state"), vector(lla, 3, "state"), vector(vel, 3, "state"), vector(q, 4, "state"))
         with renamed(t0="state", lla="state", vel_ned="state", q_nb="state"):
-            self._core.reset(scalar(t0, "state"), vector(lla, 3, "state"), vector(vel, 3, "state"), vector(q, 4, "state"))
+            self._core.reset(*start)
+        self._start = start
         plausibility.lla(lla, "state")
         self._rows = 0
 
 
-def integrate(imu, t0, lla, vel_ned, q_nb, *, kind: str = "increments", ellipsoid: str = "WGS84",
+def integrate(imu, t0, lla, vel_ned, q_nb, *, kind: str | None = None, ellipsoid: str = "WGS84",
               vertical: str = "free", h_ref=None, zeta: float | None = None, omega: float | None = None,
               progress: bool | None = None, epoch=None) -> pd.DataFrame:
     """Integrate a whole IMU record from the initial state.
@@ -262,7 +274,10 @@ def integrate(imu, t0, lla, vel_ned, q_nb, *, kind: str = "increments", ellipsoi
     t0, lla, vel_ned, q_nb
         Initial state: time (s, or a datetime, see :class:`Strapdown`); lat (rad), lon
         (rad), h (m); NED velocity (m/s); q_nb.
-    kind, ellipsoid, vertical, zeta, omega, epoch
+    kind : str, optional
+        ``"rates"`` or ``"increments"``; None (default): the kind of the table's column
+        names (:func:`atomnav.trajectory.imu_kind`); required for a plain array.
+    ellipsoid, vertical, zeta, omega, epoch
         As for :class:`Strapdown` (``epoch``: time 0 of a datetime64 ``time_s``).
     h_ref : array (N,), optional
         Reference altitude (m) per IMU row for a damped vertical channel.
@@ -281,7 +296,7 @@ def integrate(imu, t0, lla, vel_ned, q_nb, *, kind: str = "increments", ellipsoi
         If the solution diverges: ``.partial`` holds every row computed before it,
         ``.row`` and ``.time_s`` (s) name the sample at which it diverged.
     """
-    sd = Strapdown(t0, lla, vel_ned, q_nb, kind=kind, ellipsoid=ellipsoid, vertical=vertical, zeta=zeta, omega=omega, epoch=epoch)
+    sd = Strapdown(t0, lla, vel_ned, q_nb, kind=imu_kind(kind, imu, "imu"), ellipsoid=ellipsoid, vertical=vertical, zeta=zeta, omega=omega, epoch=epoch)
     t, g, a = _imu_arrays(imu, sd.kind, sd.epoch)
     plausibility.imu(t, g, a, sd.kind)
     h = _h_ref(h_ref, len(t))

@@ -25,6 +25,28 @@ IMU_COLUMNS = {
     "rates": ["time_s", "gyro_x_rad_s", "gyro_y_rad_s", "gyro_z_rad_s", "accel_x_mps2", "accel_y_mps2", "accel_z_mps2"],
     "increments": ["time_s", "dtheta_x_rad", "dtheta_y_rad", "dtheta_z_rad", "dv_x_mps", "dv_y_mps", "dv_z_mps"],
 }
+
+
+def imu_kind(kind, imu, name: str = "imu") -> str:
+    """The IMU output kind of a call, by the one rule of every function taking ``kind``:
+    ``kind`` when given (``"rates"`` or ``"increments"``, checked by the core); with
+    ``kind=None``, the kind whose gyro or accel columns of :data:`IMU_COLUMNS` the
+    DataFrame ``imu`` (argument ``name``) has. A table with columns of both kinds or of
+    neither is an :class:`atomnav.InputError` naming ``name`` and listing both sets; a
+    plain array, which has no column names, needs ``kind`` (an
+    :class:`atomnav.InputError` naming ``kind``)."""
+    if kind is not None:
+        return kind
+    if not isinstance(imu, pd.DataFrame):
+        raise input_error("kind", 'a plain array needs kind="rates" or "increments" (kind=None reads it from a table\'s column names)')
+    found = [k for k, columns in IMU_COLUMNS.items() if any(c in imu.columns for c in columns[1:])]
+    if len(found) != 1:
+        raise input_error(name, f"has {'columns of both IMU kinds' if found else 'no IMU columns'}, so kind=None cannot tell its kind: "
+                                f"give kind=, or the columns of one kind, rates {IMU_COLUMNS['rates']} or increments "
+                                f"{IMU_COLUMNS['increments']}")
+    return found[0]
+
+
 #: Default site: Moscow, 55.75°N 37.6°E, 200 m.
 MOSCOW = (np.deg2rad(55.75), np.deg2rad(37.6), 200.0)
 #: Most samples of a generated trajectory (a table of 14 float columns: 11 GB).

@@ -164,7 +164,7 @@ def expected_phase_exceedance(sensor: CaiSensor, dt: float, q_accel: float, q_gy
 
 
 def cai_aided_ins(t0: float, lla0, vel0, q0, sensor: CaiSensor, shots, *, phase=None, noise=None, population=None, laser_phase=None,
-                  kind: str = "rates", setup: FilterSetup | None = None, p0=None, ba0=(0, 0, 0), bg0=(0, 0, 0), extra0=None,
+                  kind: str | None = None, setup: FilterSetup | None = None, p0=None, ba0=(0, 0, 0), bg0=(0, 0, 0), extra0=None,
                   method: str = "van_loan", mode: str = "closed", sequential: bool = False, gate: float | None = None,
                   ellipsoid: str = "WGS84"):
     """A CAI-aided INS on the generic engine (:class:`atomnav.filter.AidedIns`; run it with
@@ -175,7 +175,8 @@ def cai_aided_ins(t0: float, lla0, vel0, q0, sensor: CaiSensor, shots, *, phase=
     ``laser_phase`` (rad) the instrument applied. ``setup``: filter noise (default the
     tuning of Tennstedt et al. 2023, :func:`atomnav.cai.seed003_filter`); ``p0`` overrides
     ``setup.p0``; the initial state and the remaining options are those of
-    :func:`atomnav.filter.position_aided_ins`."""
+    :func:`atomnav.filter.position_aided_ins`; ``kind`` ("rates" or "increments") is
+    required, as the IMU record comes as plain arrays."""
     from ..filter.aided import AidedIns, InsSetup
     from ..filter.engine import BiasModel
     from .scenarios import seed003_filter

@@ -19,6 +19,7 @@ import pandas as pd
 from .. import _core, plausibility
 from .._validate import as_floats, finite_scalar, flag, input_error, instance, integer, positive, renamed, rows
 from ..strapdown import _table
+from ..trajectory import imu_kind
 from .engine import BiasModel, Config, _floats
 from .riccati import _mat
 
@@ -85,6 +86,7 @@ class InsSetup(Config):
     baro_bias_sigma0: float | None = None
 
     def __post_init__(self):
+        imu_kind(self.kind, None)  # the IMU record comes as plain arrays (AidedIns.run): kind=None is an InputError
         for name, n in (("lla0", 3), ("vel0", 3), ("q0", 4), ("ba0", 3), ("bg0", 3)):
             v = as_floats(getattr(self, name), name)
             if v.shape != (n,):
