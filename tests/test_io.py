@@ -488,3 +488,27 @@ def test_a_plain_array_in_the_documented_order_equals_the_table(traj, rates):
     init = traj.initial_state()
     pd.testing.assert_frame_equal(an.strapdown.integrate(rates[IMU_COLUMNS["rates"]].to_numpy(), **init, kind="rates"),
                                   an.strapdown.integrate(rates, **init), check_exact=True)
+
+
+@pytest.mark.parametrize("kind", ["rates", "increments"])
+def test_a_plain_array_in_the_stream_order_time_accel_gyro_does_not_pass_silently(traj, kind):
+    """imu.COLUMNS lists the accelerometer first; an (N, 7) array built in that order would
+    integrate to a height error of kilometres. Its gyro block has the mean magnitude of
+    gravity (checked here against 9.80665 m/s² itself), so it is refused."""
+    ideal = traj.ideal_imu(kind)
+    accel, gyro = an.imu.COLUMNS[kind]
+    scale = 1.0 if kind == "rates" else 1.0 / 0.01
+    assert np.linalg.norm(ideal[accel].to_numpy() * scale, axis=1).mean() == pytest.approx(G0, rel=0.01)
+    with pytest.raises(InputError, match="columns 1-3 look like the accelerometer") as e:
+        an.strapdown.integrate(ideal[["time_s", *accel, *gyro]].to_numpy(), **traj.initial_state(), kind=kind)
+    assert e.value.parameter == "imu"
+
+
+def test_the_order_check_passes_free_fall_and_fast_rotation(traj):
+    """No false alarm where the gyro block is not near gravity or the accel block is: a
+    satellite-like record (|f| ≈ 0, slow rotation) and a fast but Earth-bound one."""
+    t = np.arange(200) * 0.01
+    still = np.column_stack([t, np.full((200, 3), 1e-3), np.full((200, 3), 1e-6)])
+    spin = np.column_stack([t, np.tile([0.0, 0.0, 8.0], (200, 1)), np.tile([0.0, 0.0, -9.8], (200, 1))])
+    for arr in (still, spin):
+        assert an.plausibility.swapped_blocks(arr[:, 0], arr[:, 1:4], arr[:, 4:7], "rates") is None

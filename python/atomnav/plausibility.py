@@ -207,15 +207,44 @@ def _near(value: float, target: float, tolerance: float) -> bool:
     return abs(value - target) <= tolerance * target
 
 
+def _mean_norm(v: np.ndarray, scale: float) -> float:
+    """Mean magnitude of the rows of ``v`` (N, 3) times ``scale`` (NaN if empty)."""
+    x, y, z = _columns(v)
+    if not len(x):
+        return np.nan
+    with np.errstate(all="ignore"):
+        return float(np.sqrt(x * x + y * y + z * z).mean()) * _value(scale)
+
+
+def _rate_scale(kind, step: float) -> float:
+    """The factor from an IMU record of ``kind`` to rates: 1 for rates, 1/``step`` for
+    increments (NaN without a usable median step, s)."""
+    if isinstance(kind, str) and kind == "rates":
+        return 1.0
+    return 1.0 / step if np.isfinite(step) and step > 0 else np.nan
+
+
+def swapped_blocks(time, gyro, accel, kind: str) -> str | None:
+    """Evidence that the gyro and accel blocks of a plain IMU array were given in the other
+    order (time, accel, gyro: the stream order of :data:`atomnav.imu.COLUMNS`), else None.
+    ``time`` (N,) s, ``gyro`` and ``accel`` (N, 3) as read, of ``kind``. Read that
+    way, the "gyro" block is a specific force: its mean magnitude is gravity,
+    :data:`ACCEL_G_BAND` in m/s² (a sustained 450 to 700 °/s as a rate, which no navigation
+    record has on average), while the "accel" block is an angular rate, below the band's
+    lower end, where an Earth-bound specific force never is. Both at once is the swap."""
+    low, high = ACCEL_G_BAND[0] * units.G0, ACCEL_G_BAND[1] * units.G0
+    scale = _rate_scale(kind, _median_step(time))
+    rate, force = _mean_norm(gyro, scale), _mean_norm(accel, scale)
+    if low <= rate <= high and force < low:
+        return f"mean |gyro| = {rate:.3g} rad/s, Earth's gravity in m/s²; mean |accel| = {force:.3g} m/s², a rate"
+    return None
+
+
 def specific_force(f: np.ndarray, name: str, scale: float = 1.0) -> None:
     """Warn if the specific force ``f`` (N, 3) times ``scale`` (1 for m/s², 1/Δt for Δv
     in m/s) has a mean magnitude in :data:`ACCEL_G_BAND`: the record is in g. An ``f``
     that is not numbers (strings included) is a ``TypeError`` naming ``f``."""
-    x, y, z = _columns(as_floats(f, "f"))
-    if not len(x):
-        return
-    with np.errstate(all="ignore"):
-        mean = float(np.sqrt(x * x + y * y + z * z).mean()) * _value(scale)
+    mean = _mean_norm(as_floats(f, "f"), scale)
     if ACCEL_G_BAND[0] <= mean <= ACCEL_G_BAND[1]:
         _warn(name, "specific force", "g", "m/s²", f"mean |f| = {mean:.3g}, Earth's gravity is 9.8 m/s²", units.G0)
 
@@ -315,12 +344,9 @@ def imu(time, gyro, accel, kind: str, name: str = "imu", *, gyro_name: str | Non
         step = dt
     else:
         _step(step, time_name)
-    if isinstance(kind, str) and kind == "rates":
-        scale = 1.0
-    else:
-        if not (np.isfinite(step) and step > 0):
-            return  # no interval to turn increments into rates
-        scale = 1.0 / step
+    scale = _rate_scale(kind, step)
+    if not np.isfinite(scale):
+        return  # no interval to turn increments into rates
     specific_force(accel, name, scale)
     angular_rate(gyro, gyro_name, scale, static=True)
 

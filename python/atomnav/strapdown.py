@@ -49,6 +49,11 @@ def _imu_arrays(imu, kind: str, epoch=None):
         if a.ndim != 2 or a.shape[1] != 7:
             raise input_error("imu", f"expected shape (N, 7) with the columns {IMU_COLUMNS[kind]} in this order, got {a.shape}")
         a = np.asfortranarray(a)
+        evidence = plausibility.swapped_blocks(a[:, 0], a[:, 1:4], a[:, 4:7], kind)
+        if evidence is not None:
+            raise input_error("imu", f"a plain array is read as {IMU_COLUMNS[kind]} in this order, but its columns 1-3 look like "
+                                     f"the accelerometer and 4-6 like the gyro ({evidence}): reorder them, or pass a DataFrame "
+                                     "whose columns are read by name")
     return a[:, 0], a[:, 1:4], a[:, 4:7]
 
 
