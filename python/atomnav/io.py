@@ -293,6 +293,10 @@ def _fields(columns, fields: tuple, also: tuple = ()) -> dict:
         raise input_error("columns", f"no column given for {missing}; atomnav's names are {list(fields)}")
     seen = {}
     for f in fields:
+        try:
+            hash(columns[f])
+        except TypeError:
+            raise TypeError(f"columns: {f!r}: expected a column name, got {type(columns[f]).__name__}") from None
         if columns[f] in seen:
             raise input_error("columns", f"{seen[columns[f]]!r} and {f!r} both name the column {columns[f]!r}")
         seen[columns[f]] = f
@@ -392,7 +396,10 @@ def _time(values: pd.Series, column, time_unit: str, epoch):
     if not pd.api.types.is_datetime64_any_dtype(dtype):
         if pd.api.types.is_numeric_dtype(dtype) and not pd.api.types.is_bool_dtype(dtype):
             raise TypeError(f"source: column {column!r} holds numbers, not datetimes: give time_unit as one of {list(TIME_UNITS[:-1])}")
-        parsed = pd.to_datetime(values, errors="coerce", format="ISO8601")
+        try:
+            parsed = pd.to_datetime(values, errors="coerce", format="ISO8601")
+        except (ValueError, TypeError) as e:  # e.g. time zones that differ between rows
+            raise input_error("source", f"column {column!r}: not one series of ISO 8601 dates and times ({e})") from None
         bad = np.flatnonzero(parsed.isna().to_numpy() & values.notna().to_numpy())
         if bad.size:
             k = bad[0]

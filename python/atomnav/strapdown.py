@@ -183,7 +183,10 @@ class Strapdown(Stateful):
             object's kind (time s, gyro, accel). A DataFrame is read by column name (any
             order, extra columns ignored; ``time_s`` may be datetime64 when ``t0`` is a
             datetime, or timedelta64). A plain array is accepted only with exactly these
-            seven columns in exactly this order: time, gyro x/y/z, accel x/y/z.
+            seven columns in exactly this order: time, gyro x/y/z, accel x/y/z (one whose
+            columns 1-3 have the mean magnitude of gravity and 4-6 that of a rate, the
+            order time, accel, gyro, is an :class:`InputError`:
+            :func:`atomnav.plausibility.swapped_blocks`).
         h_ref : array (N,), optional
             Reference altitude (m) per row, required with ``vertical="damped"``.
 
