@@ -268,7 +268,7 @@ def read_trajectory(source, *, columns: Mapping, units: Mapping, time_unit: str 
     outside = np.flatnonzero((h < low) | (h > high))
     if outside.size:
         k = outside[0]
-        raise input_error("source", f"column {wanted['h']!r} (h): height {h[k]} m at data row {k} is outside "
+        raise input_error("source", f"column {wanted['h']!r} (h): height {h[k]} m at {_row(k)} is outside "
                                     f"[{low:g}, {high:g}] m", k)
     table = pd.DataFrame(np.column_stack([t, values]), columns=list(fields.values()))
     with renamed(df="source"):
@@ -276,6 +276,11 @@ def read_trajectory(source, *, columns: Mapping, units: Mapping, time_unit: str 
 
 
 # ---- arguments ----------------------------------------------------------------------------
+
+def _row(k: int) -> str:
+    """Row ``k`` as error messages name it."""
+    return f"data row {k} (0-based, the header line not counted)"
+
 
 def _fields(columns, fields: tuple, also: tuple = ()) -> dict:
     """``columns`` (atomnav's name → the source's column) checked against ``fields``, all
@@ -403,7 +408,7 @@ def _time(values: pd.Series, column, time_unit: str, epoch):
         bad = np.flatnonzero(parsed.isna().to_numpy() & values.notna().to_numpy())
         if bad.size:
             k = bad[0]
-            raise input_error("source", f"column {column!r}: {values.iloc[k]!r} at data row {k} is not an ISO 8601 date and time", k)
+            raise input_error("source", f"column {column!r}: {values.iloc[k]!r} at {_row(k)} is not an ISO 8601 date and time", k)
         values = parsed
     first = values.dropna()
     epoch = timestamp(epoch) if epoch is not None else (first.iloc[0] if len(first) else None)
@@ -429,7 +434,7 @@ def _finite(values: np.ndarray, names: list) -> None:
         k = rows[0]
         j = int(np.flatnonzero(bad[k])[0])
         what = "a missing value (NaN)" if np.isnan(values[k, j]) else f"an infinite value ({values[k, j]})"
-        raise input_error("source", f"column {names[j]!r}: {what} at data row {k}; no row is dropped silently: clean the log "
+        raise input_error("source", f"column {names[j]!r}: {what} at {_row(k)}; no row is dropped silently: clean the log "
                                     "or pass only the rows to read", k)
 
 
@@ -439,7 +444,7 @@ def _increasing(t: np.ndarray, column) -> None:
     if bad.size:
         k = bad[0] + 1
         how = "repeats the stamp before it" if t[k] == t[k - 1] else f"goes back from {t[k - 1]!r} s"
-        raise input_error("source", f"time column {column!r} is not strictly increasing: data row {k} ({t[k]!r} s) {how}; "
+        raise input_error("source", f"time column {column!r} is not strictly increasing: {_row(k)} ({t[k]!r} s) {how}; "
                                     "rows are never reordered or dropped silently", k)
 
 
@@ -459,7 +464,7 @@ def _sampling(t: np.ndarray, column, max_gap, on_gap: str) -> SamplingReport:
                          "missing_samples": np.rint(dt[after - 1] / median).astype(np.int64) - 1})
     if stated is not None and on_gap == "raise" and after.size:
         k = after[0]
-        raise input_error("source", f"time column {column!r}: a gap of {dt[k - 1]:.6g} s before data row {k} ({t[k - 1]:.6g} to "
+        raise input_error("source", f"time column {column!r}: a gap of {dt[k - 1]:.6g} s before {_row(k)} ({t[k - 1]:.6g} to "
                                     f"{t[k]:.6g} s) exceeds max_gap = {stated:g} s ({after.size} such gap(s)); "
                                     "on_gap='report' lists them in the report instead", k)
     return SamplingReport(len(t), float(t[0]), float(t[-1]), median, 1.0 / median, limit, gaps)
