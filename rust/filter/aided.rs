@@ -73,6 +73,11 @@ pub trait Aiding: Send {
     }
     /// Measurement times (s), strictly increasing.
     fn times(&self) -> &[f64];
+    /// Check [`Self::times`] when the engine is built: finite and strictly increasing
+    /// (a composite of several sources allows equal times from different sources).
+    fn check_times(&self) -> Result<()> {
+        check_times(self.name(), self.times())
+    }
     /// After every strapdown step: the bias-compensated IMU sample (rates or increments as
     /// the record), its interval `dt` (s; 0 for a rate sample at the initial time, which
     /// only primes the integrator) and the new navigation solution.
@@ -96,6 +101,9 @@ impl Aiding for Box<dyn Aiding> {
     }
     fn times(&self) -> &[f64] {
         (**self).times()
+    }
+    fn check_times(&self) -> Result<()> {
+        (**self).check_times()
     }
     fn observe(&mut self, t: f64, dt: f64, gyro: &Vec3, accel: &Vec3, nav: &NavState) {
         (**self).observe(t, dt, gyro, accel, nav)
@@ -324,17 +332,7 @@ impl<A: Aiding> AidedIns<A> {
         for (field, v) in [("accel_bias0", &accel_bias0), ("gyro_bias0", &gyro_bias0)] {
             crate::error::check_finite(field, v.as_slice(), 1)?;
         }
-        let times = aiding.times();
-        let mut prev = None;
-        for (i, &tm) in times.iter().enumerate() {
-            if !tm.is_finite() {
-                return Err(invalid(aiding.name(), format!("non-finite time {tm} at index {i}")));
-            }
-            if prev.is_some_and(|p| tm <= p) {
-                return Err(invalid(aiding.name(), format!("time not strictly increasing at index {i}")));
-            }
-            prev = Some(tm);
-        }
+        aiding.check_times()?;
         let kf = Kf::new(p0, cfg.mode)?;
         let sd = Strapdown::new(initial, kind, ell, Vertical::Free)?;
         Ok(AidedIns {
@@ -566,6 +564,21 @@ impl<A: Aiding> AidedIns<A> {
     }
 }
 
+/// Measurement times of sensor `name`: finite and strictly increasing.
+pub fn check_times(name: &str, times: &[f64]) -> Result<()> {
+    let mut prev = None;
+    for (i, &tm) in times.iter().enumerate() {
+        if !tm.is_finite() {
+            return Err(invalid(name, format!("non-finite time {tm} at index {i}")));
+        }
+        if prev.is_some_and(|p| tm <= p) {
+            return Err(invalid(name, format!("time not strictly increasing at index {i}")));
+        }
+        prev = Some(tm);
+    }
+    Ok(())
+}
+
 /// Name the measurement in an invalid-input error of the update (NaN z, bad R, ...).
 fn at_measurement(e: NavError, name: &str, j: usize) -> NavError {
     match e {
@@ -606,30 +619,21 @@ pub struct PositionAiding {
 }
 
 impl PositionFix {
-    /// Fixes from columns: times (s), (lat, lon, h) and NED covariances (3 × 3, m²); a
-    /// latitude outside ±π/2 is an error naming `fix_lla` and its row.
-    pub fn table(t: &[f64], lla: &[Vec3], cov: &[DMatrix<f64>]) -> Result<Vec<PositionFix>> {
-        if lla.len() != t.len() || cov.len() != t.len() {
-            return Err(invalid("fixes", format!("fix_t has {} entries but fix_lla {} and fix_cov {}", t.len(), lla.len(), cov.len())));
-        }
-        if let Some((i, c)) = cov.iter().enumerate().find(|(_, c)| c.nrows() != 3 || c.ncols() != 3) {
-            return Err(invalid("fix_cov", format!("expected (M, 3, 3), entry {i} is {}x{}", c.nrows(), c.ncols())));
-        }
+    /// Fixes from columns: times (s), (lat, lon, h) and NED covariances (3 × 3, m²);
+    /// `names` are the caller's arguments (times, positions, covariances), errors name
+    /// them: a latitude outside ±π/2 names the positions and its row.
+    pub fn table(names: [&str; 3], t: &[f64], lla: &[Vec3], cov: &[DMatrix<f64>]) -> Result<Vec<PositionFix>> {
+        let cov = super::sources::fix_covariances(names, t.len(), lla.len(), cov)?;
         // a latitude beyond ±π/2 (one in degrees) would pull the filter off the Earth
-        crate::earth::check_latitudes("fix_lla", lla)?;
-        // each covariance is 3 × 3 (checked above): its 9 column-major values
-        Ok(t.iter().zip(lla).zip(cov).map(|((&t, &lla), c)| PositionFix { t, lla, cov_ned: Mat3::from_iterator(c.iter().copied()) }).collect())
+        let [_, positions, _] = names;
+        crate::earth::check_latitudes(positions, lla)?;
+        Ok(t.iter().zip(lla).zip(cov).map(|((&t, &lla), cov_ned)| PositionFix { t, lla, cov_ned }).collect())
     }
 }
 
 impl PositionAiding {
     pub fn new(fixes: Vec<PositionFix>) -> Result<Self> {
-        for (i, f) in fixes.iter().enumerate() {
-            if !f.lla.iter().all(|x| x.is_finite()) {
-                return Err(invalid("fixes", format!("non-finite position at index {i}")));
-            }
-            super::matrix::check_covariance(&format!("fixes[{i}] covariance"), &DMatrix::from_column_slice(3, 3, f.cov_ned.as_slice()), Some(3), true)?;
-        }
+        super::sources::check_fix_rows("fixes", "position", fixes.iter().map(|f| (&f.lla, &f.cov_ned)))?;
         Ok(PositionAiding { times: fixes.iter().map(|f| f.t).collect(), fixes })
     }
 }
@@ -731,7 +735,7 @@ mod tests {
     fn fix_latitude_beyond_half_pi_names_fix_lla_and_its_row() {
         let lla = [Vec3::new(0.8, 0.2, 100.0), Vec3::new(45.8, 0.2, 100.0)];
         let cov = vec![DMatrix::<f64>::identity(3, 3); 2];
-        match PositionFix::table(&[0.5, 1.0], &lla, &cov) {
+        match PositionFix::table(["fix_t", "fix_lla", "fix_cov"], &[0.5, 1.0], &lla, &cov) {
             Err(NavError::InvalidInput { field, index, .. }) => assert_eq!((field.as_str(), index), ("fix_lla", Some(1))),
             other => panic!("expected an invalid fix_lla, got {:?}", other.map(|f| f.len())),
         }

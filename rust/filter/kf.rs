@@ -377,16 +377,50 @@ fn check_steps(steps: &[StoredStep]) -> Result<usize> {
 
 /// [`rts`] with the algebra chosen by the caller (benches and tests).
 pub fn rts_using(steps: &[StoredStep], algebra: Algebra) -> Result<Vec<(DVector<f64>, DMatrix<f64>)>> {
+    rts_chunk_using(steps, None, 0, algebra)
+}
+
+/// The RTS smoother over one chunk of consecutive stored steps, for a record smoothed
+/// chunk by chunk from its end (memory-bounded): `after` is the step that follows the
+/// chunk (its Φ, x⁻ and P⁻ are read) with its smoothed (x^s, P^s), the carry from the
+/// chunk after this one; None for the last chunk of the record, which starts from its
+/// last posterior. `first` is the index of `steps[0]` in the whole record (named by
+/// errors). Smoothing a record in chunks this way equals [`rts`] on the whole record.
+pub fn rts_chunk(steps: &[StoredStep], after: Option<(&StoredStep, DVector<f64>, DMatrix<f64>)>, first: usize) -> Result<Vec<(DVector<f64>, DMatrix<f64>)>> {
+    let n = steps.first().map_or(0, |s| s.p_post.nrows());
+    rts_chunk_using(steps, after, first, Algebra::by_size(n, RTS_FAER_MIN))
+}
+
+/// [`rts_chunk`] with the algebra chosen by the caller.
+fn rts_chunk_using(steps: &[StoredStep], after: Option<(&StoredStep, DVector<f64>, DMatrix<f64>)>, first: usize, algebra: Algebra) -> Result<Vec<(DVector<f64>, DMatrix<f64>)>> {
     let n = check_steps(steps)?;
-    let Some(last) = steps.last() else { return Ok(vec![]) };
+    if steps.is_empty() {
+        return Ok(vec![]);
+    }
+    let mut rest = steps.iter().enumerate().rev();
     let mut out = Vec::with_capacity(steps.len());
-    let (mut xs, mut ps) = (last.x_post.clone(), last.p_post.clone());
+    // the step after the current one and its smoothed moments
+    let (mut next, mut xs, mut ps) = match after {
+        Some((s, x, p)) => {
+            if check_steps(std::slice::from_ref(s))? != n || x.len() != n || p.shape() != (n, n) {
+                return Err(invalid("after", format!("expected the following step and its smoothed moments over the {n} states of the chunk")));
+            }
+            (s, x, p)
+        }
+        None => match rest.next() {
+            Some((_, last)) => {
+                out.push((last.x_post.clone(), last.p_post.clone()));
+                (last, last.x_post.clone(), last.p_post.clone())
+            }
+            None => return Ok(vec![]),
+        },
+    };
     let (mut ct, mut u) = match algebra {
         Algebra::Faer => (DMatrix::zeros(n, n), DMatrix::zeros(n, n)),
         Algebra::Kernels => (DMatrix::zeros(0, 0), DMatrix::zeros(0, 0)),
     };
-    for (k, pair) in steps.windows(2).enumerate().rev() {
-        let [cur, next] = pair else { continue };
+    for (k, cur) in rest {
+        let k = first + k;
         let not_pd = || NavError::Numerical(format!("smoother: prior covariance not positive definite at step {}", k + 1));
         // C = P⁺Φᵀ(P⁻)⁻¹  ⇔  P⁻ Cᵀ = Φ P⁺.
         let (x, mut p) = match algebra {
@@ -413,9 +447,9 @@ pub fn rts_using(steps: &[StoredStep], algebra: Algebra) -> Result<Vec<(DVector<
         if !x.iter().chain(p.iter()).all(|v| v.is_finite()) {
             return Err(NavError::Numerical(format!("smoother: the smoothed estimate of step {k} overflows the floating-point range")));
         }
-        out.push((std::mem::replace(&mut xs, x), std::mem::replace(&mut ps, p)));
+        out.push((x.clone(), p.clone()));
+        (next, xs, ps) = (cur, x, p);
     }
-    out.push((xs, ps));
     out.reverse();
     Ok(out)
 }
@@ -524,6 +558,27 @@ mod tests {
         assert_eq!(algebra(15), Algebra::Kernels);
         assert_eq!(algebra(21), Algebra::Kernels);
         assert_eq!(algebra(22), Algebra::Faer);
+    }
+
+    /// Smoothing a record chunk by chunk from its end, carrying the smoothed moments of
+    /// each chunk's first step, equals smoothing it whole, on both algebras.
+    #[test]
+    fn chunks_equal_whole() {
+        for (n, algebra) in [(5, Algebra::Kernels), (RTS_FAER_MIN + 3, Algebra::Faer)] {
+            let (steps, _) = run(n, 12, algebra);
+            let whole = rts_using(&steps, algebra).unwrap();
+            for size in [1, 5, 12] {
+                let mut got: Vec<(DVector<f64>, DMatrix<f64>)> = vec![];
+                for lo in (0..12).step_by(size).rev() {
+                    let hi = (lo + size).min(12);
+                    let after = steps.get(hi).map(|s| (s, got[0].0.clone(), got[0].1.clone()));
+                    let mut part = rts_chunk_using(&steps[lo..hi], after, lo, algebra).unwrap();
+                    part.extend(got);
+                    got = part;
+                }
+                assert_eq!(got, whole, "n = {n}, chunks of {size}");
+            }
+        }
     }
 
     /// Bad input to the core is an error, never a panic: an empty P₀, mismatched stored

@@ -11,4 +11,5 @@ pub mod kf;
 pub mod ins;
 pub mod analysis;
 pub mod aided;
+pub mod sources;
 pub mod initial_error;

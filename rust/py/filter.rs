@@ -5,18 +5,19 @@ use super::convert::{count, index_count, register_choices, Wrap, mat, quat_rows,
 use crate::earth::Ellipsoid;
 use crate::error::{check_finite, invalid, NavError};
 use pyo3::exceptions::PyTypeError;
-use crate::filter::aided::{AidedConfig, AidedIns, AidedOutput, Aiding, DampedVertical, InsSetup, PositionAiding, PositionFix};
+use crate::filter::aided::{AidedConfig, AidedIns, AidedOutput, Aiding, DampedVertical, ForwardPass, InsSetup, PositionAiding, PositionFix, NOMINAL_WIDTH};
 use crate::strapdown::Vertical;
 use crate::filter::discretize::Discretization;
 use crate::filter::initial_error::perturbed_start;
 use crate::filter::ins::{error_dynamics_along, BaroModel, BiasKind, BiasModel, InsNoise};
-use crate::filter::kf::LoopMode;
+use crate::filter::kf::{stored_steps, LoopMode, StoredStep};
+use super::kalman::{rows_mat, vecs_to_py};
 use crate::filter::layout::{Layout, INS15, STANDARD_BLOCKS};
 use crate::imu::ImuKind;
 use crate::strapdown::NavState;
 use nalgebra::{DMatrix, DVector};
 use numpy::ndarray::Array3;
-use numpy::{IntoPyArray, PyArray1, PyArray3, PyReadonlyArray1, PyReadonlyArray2, PyReadonlyArray3, PyUntypedArrayMethods};
+use numpy::{IntoPyArray, PyArray1, PyArray2, PyArray3, PyReadonlyArray1, PyReadonlyArray2, PyReadonlyArray3, PyUntypedArrayMethods};
 use pyo3::prelude::*;
 
 // invariant: callers pass n × n matrices (the core's state size), k < ms.len().
@@ -96,7 +97,10 @@ fn ins_error_dynamics<'py>(
 /// a sensor's factory function (`position_aided_ins`, ...). `process` and `finish` return
 /// (nav (14, E) column table, accel_bias (E, 3), gyro_bias (E, 3), extra (E, n_extra),
 /// sigma (E, n), meas_time (M,), meas_rows (M,), innovation (ΣM rows,), nis (M,),
-/// rejected (M,)) for the epochs and measurements of that call.
+/// rejected (M,), forward) for the epochs and measurements of that call; `forward` is the
+/// stored forward pass of those epochs (empty unless `store_forward_pass` was called):
+/// (phi (E, n, n), qd (E, n, n), x_prior (E, n), p_prior (E, n, n), x_post (E, n),
+/// p_post (E, n, n), nominal (E, 17 + n_extra)).
 #[pyclass(name = "AidedIns", module = "atomnav._core")]
 pub struct PyAidedIns {
     inner: std::sync::Mutex<AidedIns<Box<dyn Aiding>>>,
@@ -200,6 +204,23 @@ impl PyAidedIns {
             o.innovation.into_pyarray(py).into_any(),
             o.nis.into_pyarray(py).into_any(),
             o.rejected.into_pyarray(py).into_any(),
+            Self::forward(py, o.forward, n, n_extra)?.into_any(),
+        ];
+        pyo3::types::PyTuple::new(py, items)
+    }
+
+    fn forward<'py>(py: Python<'py>, f: ForwardPass, n: usize, n_extra: usize) -> PyResult<OutputTuple<'py>> {
+        use super::convert::rows_to_py;
+        let e = f.steps.len();
+        let pick = |m: fn(&StoredStep) -> &DMatrix<f64>| f.steps.iter().map(m).cloned().collect::<Vec<_>>();
+        let items: Vec<Bound<'py, PyAny>> = vec![
+            stack_to_py(py, &pick(|s| &s.phi), n).into_any(),
+            stack_to_py(py, &f.qd, n).into_any(),
+            rows_to_py(py, e, n, f.steps.iter().flat_map(|s| s.x_prior.iter().copied())).into_any(),
+            stack_to_py(py, &pick(|s| &s.p_prior), n).into_any(),
+            rows_to_py(py, e, n, f.steps.iter().flat_map(|s| s.x_post.iter().copied())).into_any(),
+            stack_to_py(py, &pick(|s| &s.p_post), n).into_any(),
+            rows_to_py(py, e, NOMINAL_WIDTH + n_extra, f.nominal.iter().flat_map(|r| r.iter().copied())).into_any(),
         ];
         pyo3::types::PyTuple::new(py, items)
     }
@@ -249,6 +270,52 @@ impl PyAidedIns {
         self.call(py, |ins, out| ins.finish(out))
     }
 
+    /// Store the forward pass of every epoch from the first sample on (the last item of
+    /// what `process` and `finish` return), for `smooth_chunk`.
+    fn store_forward_pass(&self, py: Python<'_>) -> PyResult<()> {
+        Ok(super::shared::lock(py, &self.inner).store_forward_pass()?)
+    }
+
+    /// The RTS smoother over one chunk of the stored forward pass (filter/aided.rs,
+    /// `AidedIns::smooth_chunk`): the chunk's phi, x_prior, p_prior, x_post, p_post and
+    /// nominal as stored; `after` None for the last chunk of the record, else the step that
+    /// follows the chunk (phi, x_prior, p_prior, x_post, p_post) and its smoothed (x_s, p_s);
+    /// `first` the epoch index of the chunk's first step. Returns (the output tuple of the
+    /// smoothed epochs, x_s (E, n), p_s (E, n, n)).
+    #[pyo3(signature = (phi, x_prior, p_prior, x_post, p_post, nominal, after, first))]
+    #[allow(clippy::too_many_arguments, clippy::type_complexity)]
+    fn smooth_chunk<'py>(
+        &self,
+        py: Python<'py>,
+        phi: PyReadonlyArray3<'py, f64>,
+        x_prior: PyReadonlyArray2<'py, f64>,
+        p_prior: PyReadonlyArray3<'py, f64>,
+        x_post: PyReadonlyArray2<'py, f64>,
+        p_post: PyReadonlyArray3<'py, f64>,
+        nominal: PyReadonlyArray2<'py, f64>,
+        after: Option<(PyReadonlyArray2<'py, f64>, PyReadonlyArray1<'py, f64>, PyReadonlyArray2<'py, f64>, PyReadonlyArray1<'py, f64>, PyReadonlyArray2<'py, f64>, PyReadonlyArray1<'py, f64>, PyReadonlyArray2<'py, f64>)>,
+        first: &Bound<'py, PyAny>,
+    ) -> PyResult<(OutputTuple<'py>, Bound<'py, PyArray2<f64>>, Bound<'py, PyArray3<f64>>)> {
+        let steps = stored_steps(mats(&phi, "phi")?, rows_mat(&x_prior, "x_prior")?, mats(&p_prior, "p_prior")?, rows_mat(&x_post, "x_post")?, mats(&p_post, "p_post")?)?;
+        let chunk = ForwardPass { steps, qd: vec![], nominal: rows_mat(&nominal, "nominal")? };
+        let after = match after {
+            Some((phi, xp, pp, xq, pq, xs, ps)) => {
+                let dv = |a: &PyReadonlyArray1<'py, f64>, f: &str| vector(a, f).map(DVector::from_vec);
+                let step = StoredStep { phi: mat(&phi, "after")?, x_prior: dv(&xp, "after")?, p_prior: mat(&pp, "after")?, x_post: dv(&xq, "after")?, p_post: mat(&pq, "after")? };
+                Some((step, dv(&xs, "after")?, mat(&ps, "after")?))
+            }
+            None => None,
+        };
+        let first = index_count(first, "first", 0, usize::MAX)?;
+        let mut guard = super::shared::lock(py, &self.inner);
+        let (n, n_extra) = (guard.layout().size(), guard.n_extra());
+        // &mut: the engine is Send, not Sync (its sensor is a Box<dyn Aiding + Send>)
+        let engine: &mut AidedIns<Box<dyn Aiding>> = &mut guard;
+        let sm = py.detach(move || engine.smooth_chunk(&chunk, after.as_ref().map(|(s, x, p)| (s, x.clone(), p.clone())), first))?;
+        drop(guard);
+        Ok((Self::output(py, sm.out, n, n_extra)?, vecs_to_py(py, &sm.x, n), stack_to_py(py, &sm.p, n)))
+    }
+
     /// Labels of the state components, e.g. "velocity[2]".
     #[getter]
     fn labels(&self, py: Python<'_>) -> Vec<String> {
@@ -291,7 +358,7 @@ pub(crate) fn ins_noise(accel_psd: f64, gyro_psd: f64, accel_bias: &(String, f64
 /// covariance `fix_cov` (M, 3, 3) m².
 #[pyfunction]
 fn position_aided_ins(ins: PyRef<'_, AidedSetup>, fix_t: PyReadonlyArray1<'_, f64>, fix_lla: PyReadonlyArray2<'_, f64>, fix_cov: PyReadonlyArray3<'_, f64>) -> PyResult<PyAidedIns> {
-    let fixes = PositionFix::table(&vector(&fix_t, "fix_t")?, &vec3_rows(&fix_lla, "fix_lla")?, &mats(&fix_cov, "fix_cov")?)?;
+    let fixes = PositionFix::table(["fix_t", "fix_lla", "fix_cov"], &vector(&fix_t, "fix_t")?, &vec3_rows(&fix_lla, "fix_lla")?, &mats(&fix_cov, "fix_cov")?)?;
     PyAidedIns::from_aiding(&ins, DVector::zeros(0), Box::new(PositionAiding::new(fixes)?))
 }
 

@@ -61,14 +61,14 @@ fn kalman_recursion<'py>(
     Ok((PyArray1::from_vec(py, rec.prior).reshape(shape)?, PyArray1::from_vec(py, rec.post).reshape(shape)?))
 }
 
-fn rows_mat(a: &PyReadonlyArray2<'_, f64>, field: &str) -> Result<Vec<DVector<f64>>, NavError> {
+pub(crate) fn rows_mat(a: &PyReadonlyArray2<'_, f64>, field: &str) -> Result<Vec<DVector<f64>>, NavError> {
     let m = mat(a, field)?;
     Ok((0..m.nrows()).map(|k| m.row(k).transpose()).collect())
 }
 
 // invariant: callers pass vectors of n entries, k < v.len().
 #[allow(clippy::indexing_slicing)]
-fn vecs_to_py<'py>(py: Python<'py>, v: &[DVector<f64>], n: usize) -> Bound<'py, PyArray2<f64>> {
+pub(crate) fn vecs_to_py<'py>(py: Python<'py>, v: &[DVector<f64>], n: usize) -> Bound<'py, PyArray2<f64>> {
     Array2::from_shape_fn((v.len(), n), |(k, i)| v[k][i]).into_pyarray(py)
 }
 

@@ -13,6 +13,7 @@ mod kalman;
 mod noise;
 mod pickle;
 mod shared;
+mod sources;
 mod rotation;
 mod strapdown;
 mod trajectory;
@@ -63,5 +64,6 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     filter::register(m)?;
     kalman::register(m)?;
     gnss::register(m)?;
+    sources::register(m)?;
     Ok(())
 }

@@ -1,0 +1,102 @@
+//! Bindings of filter/sources.rs: measurement sources for one aided INS. A sensor's
+//! constructor (`position_fixes`, `velocity_fixes`, and those of other modules) returns an
+//! `AidingSource`; `aided_ins_from_sources` builds one `AidedIns` from a list of them.
+
+use super::convert::{vec3_rows, vector};
+use super::filter::{mats, AidedSetup, PyAidedIns};
+use crate::error::{invalid_at, Result};
+use crate::filter::aided::{Aiding, InsSetup, PositionAiding, PositionFix};
+use crate::filter::sources::{combine, Source, VelocityFix, VelocityFixes};
+use numpy::{PyReadonlyArray1, PyReadonlyArray2, PyReadonlyArray3};
+use pyo3::prelude::*;
+use std::sync::Mutex;
+
+/// What makes a source's sensor once the INS it feeds is known (a sensor may need the
+/// IMU kind of the setup).
+pub(crate) type Build = Box<dyn FnOnce(&InsSetup) -> Result<Source> + Send>;
+
+/// One measurement source for an aided INS (position fixes, velocity fixes, ...), made by
+/// its constructor function. It is consumed when an INS is built from it.
+#[pyclass(name = "AidingSource", module = "atomnav._core", frozen)]
+pub struct AidingSource {
+    name: String,
+    build: Mutex<Option<Build>>,
+}
+
+impl AidingSource {
+    /// A source of `aiding`, which has no extra state blocks.
+    pub(crate) fn new(aiding: Box<dyn Aiding>) -> Self {
+        Self::deferred(aiding.name().to_string(), Box::new(move |_| Ok(Source::plain(aiding))))
+    }
+
+    /// A source whose sensor is made by `build` from the setup of the INS it feeds.
+    pub(crate) fn deferred(name: String, build: Build) -> Self {
+        AidingSource { name, build: Mutex::new(Some(build)) }
+    }
+}
+
+#[pymethods]
+impl AidingSource {
+    /// The sensor's name (e.g. "fixes").
+    #[getter]
+    fn name(&self) -> &str {
+        &self.name
+    }
+
+    /// Whether an INS was built from this source already.
+    #[getter]
+    fn consumed(&self, py: Python<'_>) -> bool {
+        super::shared::lock(py, &self.build).is_none()
+    }
+}
+
+/// Position fixes: times (M,) s, (lat, lon, h) (M, 3) rad, rad, m and NED covariances
+/// (M, 3, 3) m².
+#[pyfunction]
+fn position_fixes(time: PyReadonlyArray1<'_, f64>, lla: PyReadonlyArray2<'_, f64>, cov: PyReadonlyArray3<'_, f64>) -> PyResult<AidingSource> {
+    let (t, lla, cov) = (vector(&time, "time")?, vec3_rows(&lla, "lla")?, mats(&cov, "cov")?);
+    let fixes = PositionFix::table(["time", "lla", "cov"], &t, &lla, &cov)?;
+    Ok(AidingSource::new(Box::new(PositionAiding::new(fixes)?)))
+}
+
+/// NED velocity fixes: times (M,) s, velocities (M, 3) m/s and covariances (M, 3, 3)
+/// m²/s².
+#[pyfunction]
+fn velocity_fixes(time: PyReadonlyArray1<'_, f64>, vel_ned: PyReadonlyArray2<'_, f64>, cov: PyReadonlyArray3<'_, f64>) -> PyResult<AidingSource> {
+    let (t, vel, cov) = (vector(&time, "time")?, vec3_rows(&vel_ned, "vel_ned")?, mats(&cov, "cov")?);
+    let fixes = VelocityFix::table(["time", "vel_ned", "cov"], &t, &vel, &cov)?;
+    Ok(AidingSource::new(Box::new(VelocityFixes::new(fixes)?)))
+}
+
+/// The aided INS of `setup` fed by every source of `sources` (a list of `AidingSource`,
+/// each consumed). A source used before, or given twice, is an `InputError` naming
+/// `sources` and its place in the list.
+#[pyfunction]
+fn aided_ins_from_sources(py: Python<'_>, setup: PyRef<'_, AidedSetup>, sources: Vec<Bound<'_, AidingSource>>) -> PyResult<PyAidedIns> {
+    for (i, s) in sources.iter().enumerate() {
+        if let Some(k) = sources.iter().take(i).position(|o| o.is(s)) {
+            return Err(invalid_at("sources", i, format!("source {i} is source {k} again (each source feeds one INS once)")).into());
+        }
+    }
+    let mut guards = Vec::with_capacity(sources.len());
+    for (i, s) in sources.iter().enumerate() {
+        let guard = super::shared::lock(py, &s.get().build);
+        if guard.is_none() {
+            return Err(invalid_at("sources", i, format!("source {i} ({}) was used to build an INS already: make it again", s.get().name)).into());
+        }
+        guards.push(guard);
+    }
+    let builds: Vec<Build> = guards.iter_mut().filter_map(|g| g.take()).collect();
+    drop(guards);
+    let parts = builds.into_iter().map(|b| b(&setup.setup)).collect::<Result<Vec<Source>>>()?;
+    let (sources, extra0, p0) = combine(&setup.setup, parts)?;
+    PyAidedIns::from_aiding_with(&setup, extra0, Some(p0), Box::new(sources))
+}
+
+pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_class::<AidingSource>()?;
+    m.add_function(wrap_pyfunction!(position_fixes, m)?)?;
+    m.add_function(wrap_pyfunction!(velocity_fixes, m)?)?;
+    m.add_function(wrap_pyfunction!(aided_ins_from_sources, m)?)?;
+    Ok(())
+}
