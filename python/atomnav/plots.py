@@ -72,9 +72,9 @@ def _no_inf(values: np.ndarray, names, parameter: str) -> None:
         raise input_error(parameter, f"column {names[col]!r}: infinite value at index {row} (NaN marks a missing value)", row)
 
 
-def _missing(count: int, what: str = "rows") -> str:
-    """Legend suffix for ``count`` missing (NaN) values left out."""
-    return f" ({count} {what} with NaN left out)" if count else ""
+def _missing(count: int, what: str = "row") -> str:
+    """Legend suffix for ``count`` missing (NaN) rows or values left out."""
+    return f" ({count} {what}{'' if count == 1 else 's'} with NaN left out)" if count else ""
 
 
 def _pyplot():
@@ -249,7 +249,7 @@ def imu_errors(result, truth=None):
         for c, axis in enumerate(_XYZ):
             ax = axes[r, c]
             ax.plot(t, est[:, c], "-", color="C0", lw=1, label="estimate" + _missing(int(np.isnan(est[:, c]).sum())))
-            _envelope(ax, t, est[:, c], sig[:, c], "estimate ± 3σ" + _missing(int(np.isnan(sig[:, c]).sum())))
+            _envelope(ax, t, est[:, c], sig[:, c], "±3σ" + _missing(int(np.isnan(sig[:, c]).sum())))
             if truth is not None:
                 ax.plot(tt, b[:, 3 * r + c] / factor, "-", color="k", lw=1, label="true")
             ax.set_ylabel(f"{axis} {sensor} ({unit})")
@@ -274,7 +274,7 @@ def _band_panel(ax, t: np.ndarray, x: np.ndarray, dof: np.ndarray, p: float, nam
     present = ~np.isnan(x)
     inside = int(np.count_nonzero((x[present] >= lo[present]) & (x[present] <= hi[present])))
     used = int(np.count_nonzero(present))
-    ax.plot(t, x, ".", ms=3, color="C0", label=name + _missing(len(x) - used, "values"))
+    ax.plot(t, x, ".", ms=3, color="C0", label=name + _missing(len(x) - used, "value"))
     values = ", ".join(f"χ²({k}) [{a:.3g}, {b:.3g}]" for k, (a, b) in bands.items())
     share = f"{100.0 * inside / used:.1f} % of {used} inside" if used else "no value"
     ax.plot(t, lo, "-", color="C1", lw=0.8, label=f"{100 * p:g} % band {values}: {share}")
