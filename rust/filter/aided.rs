@@ -19,7 +19,7 @@
 use super::discretize::{discretize, Discretization};
 use super::ins::{baro_loop_dynamics, error_dynamics, BaroModel, InsNoise};
 use super::initial_error::add_nav_error;
-use super::kf::{Kf, LoopMode};
+use super::kf::{rts_chunk, Kf, LoopMode, StoredStep};
 use super::layout::{ins_size, Layout};
 use crate::earth::Ellipsoid;
 use crate::error::{invalid, NavError, Result};
@@ -155,6 +155,56 @@ pub struct AidedOutput {
     pub innovation: Vec<f64>,
     pub nis: Vec<f64>,
     pub rejected: Vec<usize>,
+    /// The forward pass of these epochs, stored for the smoother (empty unless
+    /// [`AidedIns::store_forward_pass`] was called).
+    pub forward: ForwardPass,
+}
+
+/// The forward pass of an aided-INS run stored for the Rauch–Tung–Striebel smoother, per
+/// prediction epoch: the filter step (Φ from the previous epoch, prior and posterior
+/// error-state mean and covariance; the posterior before a closed loop's feedback), Q_d of
+/// the step, and the nominal solution after the epoch (the corrected solution in closed
+/// loop, the free INS in open loop) as a row of [`NOMINAL_WIDTH`] + n_extra values: t (s),
+/// lat, lon (rad), h (m), v_NED (m/s), q_nb (4), accel bias (m/s²), gyro bias (rad/s), then
+/// the extra blocks. 8 (5n² + 2n + 17 + n_extra) bytes per epoch for n states.
+#[derive(Debug, Clone, Default)]
+pub struct ForwardPass {
+    pub steps: Vec<StoredStep>,
+    pub qd: Vec<DMatrix<f64>>,
+    pub nominal: Vec<DVector<f64>>,
+}
+
+/// Values of a nominal row before the extra blocks (t, lla, v_NED, q_nb, accel and gyro
+/// bias).
+pub const NOMINAL_WIDTH: usize = 17;
+
+/// The nominal row of a solution (layout of [`ForwardPass::nominal`]).
+fn nominal_row(nav: &NavState, ba: &Vec3, bg: &Vec3, extra: &DVector<f64>) -> DVector<f64> {
+    let q = &nav.q_nb;
+    let head = [nav.t, nav.lla.x, nav.lla.y, nav.lla.z, nav.vel.x, nav.vel.y, nav.vel.z, q.w, q.i, q.j, q.k, ba.x, ba.y, ba.z, bg.x, bg.y, bg.z];
+    DVector::from_iterator(NOMINAL_WIDTH + extra.len(), head.into_iter().chain(extra.iter().copied()))
+}
+
+/// A nominal row back as (solution, accel bias, gyro bias, extra blocks); `None` when
+/// the row is shorter than [`NOMINAL_WIDTH`].
+fn from_nominal_row(row: &DVector<f64>) -> Option<(NavState, Vec3, Vec3, DVector<f64>)> {
+    let (&[t, lat, lon, h, vn, ve, vd, qw, qx, qy, qz, bax, bay, baz, bgx, bgy, bgz], extra) = row.as_slice().split_first_chunk::<NOMINAL_WIDTH>()?;
+    let nav = NavState { t, lla: Vec3::new(lat, lon, h), vel: Vec3::new(vn, ve, vd), q_nb: crate::math::quat(qw, qx, qy, qz) };
+    Some((nav, Vec3::new(bax, bay, baz), Vec3::new(bgx, bgy, bgz), DVector::from_column_slice(extra)))
+}
+
+/// The smoothed solution of one chunk of a stored forward pass
+/// ([`AidedIns::smooth_chunk`]).
+#[derive(Debug, Clone, Default)]
+pub struct SmoothedChunk {
+    /// Smoothed navigation solution, IMU bias and extra-block estimates and σ of every
+    /// state, per epoch (the measurement fields are empty: a smoothed NIS does not exist).
+    pub out: AidedOutput,
+    /// Smoothed error state x^s and covariance P^s per epoch, relative to the nominal
+    /// before the epoch's feedback (the prior nominal in closed loop, the free INS in
+    /// open loop): the carry into the chunk before this one.
+    pub x: Vec<DVector<f64>>,
+    pub p: Vec<DMatrix<f64>>,
 }
 
 /// NED position difference (m) of `a` relative to `b` (small-difference form).
@@ -301,6 +351,8 @@ pub struct AidedIns<A: Aiding> {
     baro: BaroModel,
     /// Where the INS blocks sit in the layout.
     ix: InsIndex,
+    /// Store the forward pass for the smoother ([`AidedOutput::forward`]).
+    store: bool,
 }
 
 impl<A: Aiding> AidedIns<A> {
@@ -352,6 +404,7 @@ impl<A: Aiding> AidedIns<A> {
             samples: 0,
             baro: BaroModel { noise_psd: 0.0, bias: None },
             ix,
+            store: false,
         })
     }
 
@@ -416,6 +469,77 @@ impl<A: Aiding> AidedIns<A> {
     /// Measurements not applied yet (their time is after the last processed sample).
     pub fn pending(&self) -> usize {
         self.aiding.times().len() - self.next_meas
+    }
+
+    /// Store the forward pass of every epoch from now on in [`AidedOutput::forward`], for
+    /// the smoother ([`Self::smooth_chunk`]). Only before the first sample (a fixed-interval
+    /// smoother needs the whole record).
+    pub fn store_forward_pass(&mut self) -> Result<()> {
+        if self.samples > 0 {
+            return Err(invalid("smooth", "the forward pass must be stored from the first sample: request smoothing before processing the record"));
+        }
+        self.store = true;
+        Ok(())
+    }
+
+    /// The Rauch–Tung–Striebel smoother (Rauch, Tung & Striebel 1965) over one chunk of
+    /// the stored forward pass ([`ForwardPass`]); a record is smoothed chunk by chunk from
+    /// its end, `after` carrying the step that follows the chunk and its smoothed moments
+    /// (`x`, `p` of the first epoch of the next chunk's [`SmoothedChunk`]); `first` is the
+    /// epoch index of the chunk's first step in the record (named by errors). The
+    /// backward pass is [`rts_chunk`], on the filter's error states.
+    ///
+    /// Which nominal the smoothed error refers to. Let X̄⁻ₖ be the solution at epoch k
+    /// before its update (the prior nominal) and δxₖ = X̄⁻ₖ ⊖ X_true its error.
+    ///
+    /// Open loop: the nominal is the free INS, X̄⁻ₖ₊₁ = f(X̄⁻ₖ), δxₖ₊₁ = Φₖ₊₁δxₖ + wₖ; the
+    /// filter's x⁻, x⁺ are the prior and posterior means of δxₖ and the smoother is the
+    /// textbook one: x^s_k = x⁺ₖ + Cₖ(x^s_{k+1} − x⁻ₖ₊₁), Cₖ = P⁺ₖΦᵀₖ₊₁(P⁻ₖ₊₁)⁻¹, and the
+    /// smoothed solution is X̄⁻ₖ ⊖ x^s_k.
+    ///
+    /// Closed loop: after the update the estimate δx̂ₖ = x⁺ₖ is fed back, the corrected
+    /// nominal X̄⁺ₖ = X̄⁻ₖ ⊖ δx̂ₖ has the error δxₖ − δx̂ₖ, and the next prior nominal is its
+    /// propagation, X̄⁻ₖ₊₁ = f(X̄⁺ₖ), so δxₖ₊₁ = Φₖ₊₁(δxₖ − δx̂ₖ) + wₖ: the same linear-Gaussian
+    /// model as open loop with the known input −Φₖ₊₁δx̂ₖ, whose prior mean is x⁻ₖ₊₁ =
+    /// Φₖ₊₁x⁺ₖ − Φₖ₊₁δx̂ₖ = 0, as the filter has it after the reset. A known input leaves the
+    /// RTS recursion unchanged in the stored x⁻ (= 0) and x⁺ (= δx̂ₖ): x^s_k = δx̂ₖ + Cₖx^s_{k+1}
+    /// is the smoothed δxₖ relative to the prior nominal, and relative to the corrected
+    /// nominal (the filter's output, stored) the smoothed error is x^s_k − δx̂ₖ = Cₖx^s_{k+1};
+    /// the smoothed solution is X̄⁺ₖ ⊖ Cₖx^s_{k+1}, and at the last epoch X̄⁺ₖ itself. The
+    /// covariances are those of open loop (a known input does not change them).
+    ///
+    /// Biases and extra blocks follow the same rule with their (additive) nominal values.
+    pub fn smooth_chunk(&self, chunk: &ForwardPass, after: Option<(&StoredStep, DVector<f64>, DMatrix<f64>)>, first: usize) -> Result<SmoothedChunk> {
+        let (n, n_extra) = (self.layout.size(), self.extra.len());
+        let epochs = chunk.steps.len();
+        if chunk.nominal.len() != epochs {
+            return Err(invalid("nominal", format!("expected {epochs} rows like phi, got {}", chunk.nominal.len())));
+        }
+        if let Some(m) = chunk.steps.first().map(|s| s.p_post.nrows()).filter(|&m| m != n) {
+            return Err(invalid("p_post", format!("expected the {n} states of the filter, got {m}")));
+        }
+        let smoothed = rts_chunk(&chunk.steps, after, first)?;
+        let mut sm = SmoothedChunk::default();
+        for (k, ((step, row), (x, p))) in chunk.steps.iter().zip(&chunk.nominal).zip(smoothed).enumerate() {
+            let (nav, ba, bg, extra) = from_nominal_row(row)
+                .filter(|r| r.3.len() == n_extra)
+                .ok_or_else(|| crate::error::invalid_at("nominal", first + k, format!("row {} has {} values, expected {}", first + k, row.len(), NOMINAL_WIDTH + n_extra)))?;
+            let dx = match self.cfg.mode {
+                LoopMode::Closed => &x - &step.x_post,
+                LoopMode::Open => x.clone(),
+            };
+            let ix = self.ix;
+            let out = &mut sm.out;
+            out.time.push(nav.t);
+            out.nav.push(ix.remove_error(&self.ell, &nav, &dx));
+            out.accel_bias.push(ba - block(&dx, ix.accel_bias));
+            out.gyro_bias.push(bg - block(&dx, ix.gyro_bias));
+            out.extra.extend((extra - dx.rows(ix.n, n - ix.n)).iter());
+            out.sigma.extend(p.diagonal().iter().map(|d| d.sqrt()));
+            sm.x.push(x);
+            sm.p.push(p);
+        }
+        Ok(sm)
     }
 
     /// Feed one chunk of the IMU record (`t`, `gyro`, `accel` as for `Strapdown::run`);
@@ -503,6 +627,7 @@ impl<A: Aiding> AidedIns<A> {
         let dt = tk - self.t_last_predict;
         let (phi, qd) = discretize(&f, &qc, dt, self.cfg.method);
         self.kf.predict_unchecked(&phi, &qd)?;
+        let prior = self.store.then(|| (self.kf.x.clone(), self.kf.p.clone()));
         self.t_last_predict = tk;
         // nominal values of the extra blocks follow their dynamics too (δx = nominal − true)
         self.aiding.propagate_extra(&self.layout, dt, self.extra.as_mut_slice());
@@ -532,6 +657,7 @@ impl<A: Aiding> AidedIns<A> {
             out.nis.push(rep.nis.iter().sum());
             out.rejected.push(rep.rejected.len());
         }
+        let post = self.store.then(|| (self.kf.x.clone(), self.kf.p.clone()));
         if self.cfg.mode == LoopMode::Closed {
             let dx = self.kf.take_correction();
             let ix = self.ix;
@@ -539,6 +665,11 @@ impl<A: Aiding> AidedIns<A> {
             self.accel_bias -= block(&dx, ix.accel_bias);
             self.gyro_bias -= block(&dx, ix.gyro_bias);
             self.extra -= dx.rows(ix.n, dx.len() - ix.n);
+        }
+        if let (Some((x_prior, p_prior)), Some((x_post, p_post))) = (prior, post) {
+            out.forward.steps.push(StoredStep { phi, x_prior, p_prior, x_post, p_post });
+            out.forward.qd.push(qd);
+            out.forward.nominal.push(nominal_row(&self.sd.state, &self.accel_bias, &self.gyro_bias, &self.extra));
         }
         self.record(out);
         Ok(())
@@ -728,6 +859,45 @@ mod tests {
         assert_eq!(want.nis, got.nis);
         assert_eq!(want.innovation, got.innovation);
         assert_eq!((want.meas_time.len(), got.meas_time.len()), (measurements, measurements));
+    }
+
+    /// The smoother over the stored forward pass: chunk by chunk from the end equals one
+    /// chunk, its σ is at most the filter's, and closed and open loop (two linearisations
+    /// of one problem, whose smoothed error states refer to different nominals) give the
+    /// same smoothed solution to well within σ.
+    #[test]
+    fn smoother_chunks_and_loop_modes_agree() {
+        let (_, t, g, a, _) = record();
+        let mut smoothed = vec![];
+        for mode in [LoopMode::Closed, LoopMode::Open] {
+            let mut ins = engine(mode);
+            ins.store_forward_pass().unwrap();
+            let (out, ins) = run_aided(ins, &t, &g, &a).unwrap();
+            let f = &out.forward;
+            assert_eq!((f.steps.len(), f.nominal.len(), f.qd.len()), (out.time.len(), out.time.len(), out.time.len()));
+            let whole = ins.smooth_chunk(f, None, 0).unwrap();
+            let (e, size) = (f.steps.len(), 4);
+            let mut parts: Vec<SmoothedChunk> = vec![];
+            for lo in (0..e).step_by(size).rev() {
+                let hi = (lo + size).min(e);
+                let part = ForwardPass { steps: f.steps[lo..hi].to_vec(), qd: vec![], nominal: f.nominal[lo..hi].to_vec() };
+                let after = parts.last().and_then(|p| Some((f.steps.get(hi)?, p.x[0].clone(), p.p[0].clone())));
+                parts.push(ins.smooth_chunk(&part, after, lo).unwrap());
+            }
+            let nav: Vec<NavState> = parts.iter().rev().flat_map(|p| p.out.nav.clone()).collect();
+            let sigma: Vec<f64> = parts.iter().rev().flat_map(|p| p.out.sigma.clone()).collect();
+            assert_eq!((&nav, &sigma), (&whole.out.nav, &whole.out.sigma), "{mode:?}");
+            assert!(whole.out.sigma.iter().zip(&out.sigma).all(|(s, f)| *s <= f * (1.0 + 1e-12)), "{mode:?}");
+            smoothed.push(whole.out);
+        }
+        let (c, o) = (&smoothed[0], &smoothed[1]);
+        for k in 0..c.time.len() {
+            let dv = (c.nav[k].vel - o.nav[k].vel).norm();
+            let dba = (c.accel_bias[k] - o.accel_bias[k]).norm();
+            // σ of velocity and accel bias (states 3 and 9 of 15)
+            let (sv, sba) = (c.sigma[k * 15 + 3], c.sigma[k * 15 + 9]);
+            assert!(dv < 0.01 * sv && dba < 0.01 * sba, "epoch {k}: closed - open {dv} m/s (σ {sv}), {dba} m/s² (σ {sba})");
+        }
     }
 
     /// A fix latitude in degrees (45.8 "rad") is an error naming `fix_lla` and its row.
