@@ -55,7 +55,7 @@ def _increments_log(ideal: pd.DataFrame) -> pd.DataFrame:
     """The ideal increments as a user's log: integer ns, deg, m/s."""
     c = INCREMENTS_COLUMNS
     out = pd.DataFrame({c["time"]: np.rint(ideal["time_s"].to_numpy() * 1e9).astype(np.int64)})
-    for i, axis in enumerate("xyz"):
+    for axis in "xyz":
         out[c[f"gyro_{axis}"]] = ideal[f"dtheta_{axis}_rad"] / DEG
         out[c[f"accel_{axis}"]] = ideal[f"dv_{axis}_mps"]
     return out
@@ -406,7 +406,7 @@ def _bad_trajectory(traj, column, row, value):
 
 def test_latitude_beyond_90_degrees_names_the_row(traj):
     e = _bad_trajectory(traj, "Lat", 17, 90.5)
-    assert (e.parameter, e.index) == ("source", 17) and "lat" in str(e)
+    assert (e.parameter, e.index) == ("source", 17) and "column 'Lat' (lat_rad)" in str(e) and "data row 17" in str(e)
 
 
 @pytest.mark.parametrize("h", [-1.0e4 - 1.0, 1.0e6 + 1.0])

@@ -30,7 +30,8 @@ import numpy as np
 import pandas as pd
 
 from . import earth, plausibility, units as _units
-from ._validate import check_numbers, choice, input_error, instance, locate, path as checked_path, positive, renamed, seconds, timestamp
+from ._core import InputError
+from ._validate import check_numbers, choice, input_error, instance, locate, path as checked_path, positive, seconds, timestamp
 from .trajectory import IMU_COLUMNS, Trajectory
 
 #: atomnav's names of an IMU log's fields, in the order of ``IMU_COLUMNS[kind]`` (``gyro``
@@ -271,8 +272,17 @@ def read_trajectory(source, *, columns: Mapping, units: Mapping, time_unit: str 
         raise input_error("source", f"column {wanted['h']!r} (h): height {h[k]} m at {_row(k)} is outside "
                                     f"[{low:g}, {high:g}] m", k)
     table = pd.DataFrame(np.column_stack([t, values]), columns=list(fields.values()))
-    with renamed(df="source"):
+    try:
         return Trajectory.from_dataframe(table, ellipsoid, epoch=epoch)
+    except InputError as e:  # the core's checks of the table (latitudes, quaternions): in the source's names
+        if getattr(e, "parameter", None) != "df":
+            raise
+        reason = str(e)[len("df: "):]
+        for f, name in fields.items():
+            reason = reason.replace(repr(name), f"{wanted[f]!r} ({name})")
+        if e.index is not None:
+            reason = reason.replace(f"at index {e.index}", f"at {_row(e.index)}")
+        raise input_error("source", reason, e.index) from None
 
 
 # ---- arguments ----------------------------------------------------------------------------
