@@ -7,7 +7,13 @@ whole IMU record in chunks with a progress bar, :meth:`AidedIns.process` /
 damped by a reference (barometric) altitude per IMU sample (``vertical="damped"``, the
 third-order baro loop, docs/departures.md#baro-damped-vertical-channel), which :meth:`AidedIns.run` then takes as
 ``h_ref``. The INS part of every factory is one frozen configuration, :class:`InsSetup`,
-checked by the core when it is built and convertible to and from dict and JSON."""
+checked by the core when it is built and convertible to and from dict and JSON.
+
+Smoothing: built with ``smooth=True`` (a field of :class:`InsSetup`, so an option of
+every factory), the engine stores its forward pass and :meth:`AidedIns.smooth` runs the
+Rauch–Tung–Striebel fixed-interval smoother (Rauch, Tung & Striebel 1965) backwards over
+it in the Rust core; :meth:`AidedIns.run` then returns the smoothed solution with the
+filtered one (:attr:`AidedResult.smoothed`)."""
 
 from __future__ import annotations
 
@@ -17,7 +23,8 @@ import numpy as np
 import pandas as pd
 
 from .. import _core, plausibility
-from .._validate import as_floats, finite_scalar, flag, input_error, instance, integer, positive, renamed, rows
+from .._validate import as_floats, finite_scalar, flag, input_error, instance, integer, path, positive, renamed, rows
+from ._forward import ForwardStore, epoch_bytes
 from ..strapdown import _table
 from ..trajectory import imu_kind
 from .engine import BiasModel, Config, _floats
@@ -52,6 +59,15 @@ class InsSetup(Config):
     ``baro_bias`` (m, after the sensor's extra states) with initial σ
     ``baro_bias_sigma0`` (m); without it the filter assumes b = 0.
 
+    Smoother (Rauch, Tung & Striebel 1965): ``smooth`` True stores the forward pass for
+    :meth:`AidedIns.smooth` (and makes :meth:`AidedIns.run` return the smoothed solution),
+    8 (5n² + 2n + 17 + n_extra) bytes per prediction epoch for n states (15 INS states:
+    9 376 bytes; a 1-hour record with an epoch every 0.1 s: 338 MB), in chunks of
+    ``smooth_chunk`` epochs (the unit of the backward pass) held in memory up to
+    ``smooth_memory`` bytes, beyond that written to a temporary directory under
+    ``smooth_dir`` (the system's temporary directory when None) and deleted with the
+    engine.
+
     >>> s = InsSetup(t0=0.0, lla0=(0.8, 0.2, 100.0), vel0=(0, 0, 0), q0=(1, 0, 0, 0),
     ...              kind="rates", p0=np.eye(15), accel_psd=1e-8, gyro_psd=1e-12)  # doctest: +SKIP
     >>> InsSetup.from_json(s.to_json()) == s                                      # doctest: +SKIP
@@ -84,8 +100,20 @@ class InsSetup(Config):
     baro_psd: float = 0.0
     baro_bias: BiasModel | None = None
     baro_bias_sigma0: float | None = None
+    smooth: bool = False
+    smooth_chunk: int = 1000
+    smooth_memory: int = 1 << 30
+    smooth_dir: str | None = None
 
     def __post_init__(self):
+        flag(self.smooth, "smooth")
+        integer(self.smooth_chunk, "smooth_chunk", 1)
+        integer(self.smooth_memory, "smooth_memory", 0)
+        if self.smooth_dir is not None:
+            d = path(self.smooth_dir, "smooth_dir")
+            if not d.is_dir():
+                raise input_error("smooth_dir", f"{str(d)!r} is not a directory")
+            object.__setattr__(self, "smooth_dir", str(d))
         imu_kind(self.kind, None)  # the IMU record comes as plain arrays (AidedIns.run): kind=None is an InputError
         for name, n in (("lla0", 3), ("vel0", 3), ("q0", 4), ("ba0", 3), ("bg0", 3)):
             v = as_floats(getattr(self, name), name)
@@ -129,11 +157,31 @@ class AidedResult:
     state). ``measurements``: one row per applied measurement — its time, row count, NIS
     (summed over rows) and the number of rows the χ² gate rejected. ``innovation``: the
     innovations of all measurements, concatenated in order (``measurements.rows`` each).
+    ``smoothed``: the smoothed solution when the engine was built with ``smooth=True``
+    (:meth:`AidedIns.run`), else None.
     """
 
     nav: pd.DataFrame
     measurements: pd.DataFrame
     innovation: np.ndarray
+    smoothed: SmoothedResult | None = None
+
+
+@dataclass
+class SmoothedResult:
+    """Output of the Rauch–Tung–Striebel smoother (Rauch, Tung & Striebel 1965) over an
+    aided-INS run (:meth:`AidedIns.smooth`).
+
+    ``nav``: one row per prediction epoch, in the columns of :attr:`AidedResult.nav`: the
+    smoothed navigation solution, IMU bias and extra-block estimates and the smoothed σ of
+    every state (``sigma_<label>``, SI units of the state). There is no smoothed NIS: the
+    filtered ``measurements`` stay the record of the innovations. ``covariance``: the
+    smoothed error-state covariance (E, n, n) in the order of :attr:`AidedIns.labels`
+    when asked for, else None.
+    """
+
+    nav: pd.DataFrame
+    covariance: np.ndarray | None = None
 
 
 class AidedIns:
@@ -149,6 +197,29 @@ class AidedIns:
         self.kind = setup.kind
         #: Labels of the state components in filter order, e.g. ``velocity[2]``.
         self.labels: list[str] = list(core.labels)
+        self._store = None
+        if setup.smooth:
+            core.store_forward_pass()
+            self._store = ForwardStore(setup.smooth_chunk, setup.smooth_memory, setup.smooth_dir)
+
+    @property
+    def forward_pass(self) -> ForwardStore | None:
+        """The stored forward pass (``smooth=True``), else None: its ``chunks()`` give, per
+        chunk, the index of its first epoch and the arrays ``phi`` (E, n, n) (Φ from the
+        previous epoch, the first one from the start), ``qd`` (E, n, n), ``x_prior``,
+        ``x_post`` (E, n) and ``p_prior``, ``p_post`` (E, n, n) (the filter's error-state
+        moments before and after the epoch's update, before a closed loop's feedback), and
+        ``nominal`` (E, 17 + n_extra) (t s, lat, lon rad, h m, v_NED m/s, q_nb, accel bias
+        m/s², gyro bias rad/s, extra blocks: the solution after the epoch, the free INS in
+        open loop)."""
+        return self._store
+
+    @property
+    def epoch_bytes(self) -> int:
+        """Bytes of the forward pass stored per prediction epoch: 8 (5n² + 2n + 17 +
+        n_extra) for n states."""
+        n = len(self.labels)
+        return epoch_bytes(n, n - 15)
 
     @property
     def pending(self) -> int:
@@ -156,7 +227,12 @@ class AidedIns:
         return self._core.pending
 
     def _result(self, out) -> AidedResult:
-        nav, ba, bg, extra, sigma, mt, mrows, innov, nis, rejected = out
+        *solution, mt, mrows, innov, nis, rejected, _forward = out
+        meas = pd.DataFrame({"time_s": mt, "rows": mrows, "nis": nis, "rejected_rows": rejected})
+        return AidedResult(self._nav(*solution), meas, innov)
+
+    def _nav(self, nav, ba, bg, extra, sigma) -> pd.DataFrame:
+        """The table of :attr:`AidedResult.nav` from the core's columns."""
         table = _table(nav).copy()
         for name, block, unit in (("accel_bias", ba, "mps2"), ("gyro_bias", bg, "rad_s")):
             for i, a in enumerate(_AXES):
@@ -165,8 +241,7 @@ class AidedIns:
             table[f"extra_{lab}"] = extra[:, i]
         for i, lab in enumerate(self.labels):
             table[f"sigma_{lab}"] = sigma[:, i]
-        meas = pd.DataFrame({"time_s": mt, "rows": mrows, "nis": nis, "rejected_rows": rejected})
-        return AidedResult(table, meas, innov)
+        return table
 
     def process(self, time, gyro, accel, h_ref=None) -> AidedResult:
         """Feed one chunk of the IMU record: ``time`` (N,) s, ``gyro``/``accel`` (N, 3) as
@@ -191,12 +266,65 @@ class AidedIns:
         plausibility.imu(t, g, a, self.kind, "accel", gyro_name="gyro", time_name="time")
 
     def _call(self, fn, *args) -> AidedResult:
+        if self._store is None:
+            return self._outcome(fn, args)
+        with self._store.lock:  # the engine call and the append of its forward pass, as one
+            return self._outcome(fn, args)
+
+    def _outcome(self, fn, args) -> AidedResult:
         try:
-            return self._result(fn(*args))
+            out = fn(*args)
         except (ValueError, _core.NumericalError) as e:
             if isinstance(getattr(e, "partial", None), tuple):
+                self._keep(e.partial)  # the engine has moved past these epochs
                 e.partial = self._result(e.partial)
             raise
+        self._keep(out)
+        return self._result(out)
+
+    def _keep(self, out) -> None:
+        if self._store is not None:
+            self._store.append(out[-1])
+
+    def smooth(self, covariance: bool = False, progress: bool = False) -> SmoothedResult:
+        """The Rauch–Tung–Striebel fixed-interval smoother (Rauch, Tung & Striebel 1965)
+        over the epochs processed so far (call it after :meth:`finish`): the backward pass
+        runs in the Rust core, chunk by chunk from the end of the stored forward pass
+        (``smooth_chunk`` epochs at a time, those on disk memory-mapped), carrying the
+        smoothed mean and covariance across chunk boundaries; the result does not depend on
+        the chunk size. Memory: one chunk of the forward pass and its smoothed
+        covariances, 8 (6n² + 2n + 17 + n_extra) bytes per epoch of the chunk, plus the
+        smoothed table; ``covariance`` True also keeps every smoothed covariance, 8n²
+        bytes per epoch (:attr:`SmoothedResult.covariance`). ``progress`` shows a bar over
+        the chunks.
+
+        In closed loop the smoothed error is referred to the corrected (output) solution
+        of each epoch; the derivation is in the core (``AidedIns::smooth_chunk``,
+        rust/filter/aided.rs). An engine built without ``smooth=True`` raises
+        :class:`atomnav.InputError` naming ``smooth``."""
+        covariance = flag(covariance, "covariance")
+        progress = flag(progress, "progress")
+        if self._store is None:
+            raise input_error("smooth", "the forward pass was not stored: build the aided INS with smooth=True "
+                                        "(an option of every factory, a field of InsSetup)")
+        from tqdm.auto import tqdm  # imported here: tqdm.auto pulls in asyncio, which slows `import atomnav`
+
+        with self._store.lock:
+            chunks = self._store.chunks()
+            navs, covs, after = [], [], None
+            for first, c in tqdm(chunks[::-1], desc="smoother", unit="chunk", disable=not progress or len(chunks) < 2):
+                out, xs, ps = self._core.smooth_chunk(c["phi"], c["x_prior"], c["p_prior"], c["x_post"], c["p_post"],
+                                                      c["nominal"], after, first)
+                after = (c["phi"][0], c["x_prior"][0], c["p_prior"][0], c["x_post"][0], c["p_post"][0], xs[0], ps[0])
+                navs.append(self._nav(*out[:5]))
+                if covariance:
+                    covs.append(ps)
+        if not navs:  # nothing processed yet: the empty table of the core's empty output
+            out, _, ps = self._core.smooth_chunk(*[np.zeros((0, 0, 0)), np.zeros((0, 0))] * 2, np.zeros((0, 0, 0)),
+                                                 np.zeros((0, 0)), None, 0)
+            navs, covs = [self._nav(*out[:5])], [ps]
+        nav = pd.concat(navs[::-1], ignore_index=True)
+        return SmoothedResult(nav, np.concatenate(covs[::-1]) if covariance else None)
 
     def finish(self) -> AidedResult:
         """End of the record: a last epoch at the last sample if steps are left over."""
@@ -238,7 +366,10 @@ class AidedIns:
             if isinstance(getattr(e, "partial", None), AidedResult):
                 e.partial = _concat(parts + [e.partial])
             raise
-        return _concat(parts)
+        result = _concat(parts)
+        if self._store is not None:
+            result.smoothed = self.smooth(progress=progress)
+        return result
 
 
 def _imu(time, gyro, accel, h_ref):
