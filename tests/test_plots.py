@@ -24,7 +24,8 @@ from atomnav import plots  # noqa: E402
 DEG = np.pi / 180.0
 DEG_PER_HOUR = DEG / 3600.0
 MICRO_G = 9.80665e-6
-WGS84_A, WGS84_F = 6378137.0, 1.0 / 298.257223563
+WGS84 = (6378137.0, 1.0 / 298.257223563)
+PZ90 = (6378136.0, 1.0 / 298.25784)
 NAV_BLOCKS = ("position", "velocity", "attitude")
 
 
@@ -45,13 +46,14 @@ def legend_texts(ax) -> list[str]:
     return [t.get_text() for t in ax.get_legend().get_texts()]
 
 
-def ned_numpy(lla: np.ndarray, origin: np.ndarray) -> np.ndarray:
-    """NED (m) of geodetic points from an origin on WGS-84, closed form in numpy."""
-    e2 = WGS84_F * (2 - WGS84_F)
+def ned_numpy(lla: np.ndarray, origin: np.ndarray, ellipsoid=WGS84) -> np.ndarray:
+    """NED (m) of geodetic points from an origin on an ellipsoid (a, f), closed form."""
+    a, f = ellipsoid
+    e2 = f * (2 - f)
 
     def ecef(p):
         lat, lon, h = p[..., 0], p[..., 1], p[..., 2]
-        n = WGS84_A / np.sqrt(1 - e2 * np.sin(lat) ** 2)
+        n = a / np.sqrt(1 - e2 * np.sin(lat) ** 2)
         return np.stack([(n + h) * np.cos(lat) * np.cos(lon), (n + h) * np.cos(lat) * np.sin(lon),
                          (n * (1 - e2) + h) * np.sin(lat)], axis=-1)
 
@@ -118,6 +120,18 @@ def test_trajectory_of_spp_columns_leaves_out_and_counts_epochs_without_a_soluti
     kept = np.delete(lla, [0, 3], axis=0)
     np.testing.assert_allclose(line(ax, "solution").get_xydata(), ned_numpy(kept, kept[0])[:, [1, 0]], rtol=0, atol=1e-6)
     assert "solution (2 rows with NaN left out)" in legend_texts(ax)
+
+
+def test_trajectory_uses_the_ellipsoid_of_a_trajectory_object():
+    traj = an.trajectory.sinusoidal(10.0, rate_hz=10.0, amp_ned=(2000.0, 1500.0, 20.0), ellipsoid="PZ90.11")
+    want = {"PZ90.11": ned_numpy(traj.lla, traj.lla[0], PZ90), "WGS84": ned_numpy(traj.lla, traj.lla[0], WGS84)}
+    assert np.abs(want["PZ90.11"] - want["WGS84"]).max() > 1e-4  # the test can tell them apart
+    for fig, name in ((plots.trajectory(traj), "PZ90.11"), (plots.trajectory(traj.df), "WGS84"),
+                      (plots.trajectory(traj.df, ellipsoid="PZ90.11"), "PZ90.11")):
+        np.testing.assert_allclose(line(fig.axes[0], "solution").get_xydata(), want[name][:, [1, 0]], rtol=0, atol=1e-6)
+    with pytest.raises(an.InputError) as e:
+        plots.trajectory(traj, ellipsoid="WGS-84")
+    assert e.value.parameter == "ellipsoid"
 
 
 # ---- errors -------------------------------------------------------------------------

@@ -99,13 +99,14 @@ def _positions(x, parameter: str) -> tuple[np.ndarray, int]:
 
 
 def _ned(lla: np.ndarray, origin: np.ndarray, ellipsoid: str, parameter: str) -> np.ndarray:
-    """NED (m) of ``lla`` from ``origin``: :func:`atomnav.earth.lla_to_ned` with the
-    caller's argument named in errors."""
+    """NED (m) of ``lla`` from ``origin``, as :func:`atomnav.earth.lla_to_ned` computes
+    it but naming the caller's argument in errors (its unit check, which would name
+    ``lla``, is :func:`_positions`'s)."""
     with renamed(lla=parameter, origin_lla=parameter):
         return _core.ecef_to_ned_rows(_core.lla_to_ecef_rows(lla, ellipsoid), origin, ellipsoid)
 
 
-def trajectory(nav, reference=None, *, ellipsoid: str = "WGS84"):
+def trajectory(nav, reference=None, *, ellipsoid: str | None = None):
     """Map view of a navigation solution: north against east, in m from its first point.
 
     Parameters
@@ -117,8 +118,9 @@ def trajectory(nav, reference=None, *, ellipsoid: str = "WGS84"):
         (an epoch without a solution) are left out and counted in the legend.
     reference : pandas.DataFrame or atomnav.trajectory.Trajectory, optional
         A reference trajectory (same columns), drawn from the same origin.
-    ellipsoid : str
-        Ellipsoid of the positions, ``"WGS84"`` or ``"PZ90.11"``.
+    ellipsoid : str, optional
+        Ellipsoid of the positions, ``"WGS84"`` or ``"PZ90.11"``; by default that of
+        ``nav`` when it is a :class:`Trajectory`, else ``"WGS84"``.
 
     Returns
     -------
@@ -128,6 +130,8 @@ def trajectory(nav, reference=None, *, ellipsoid: str = "WGS84"):
     """
     lla, missing = _positions(nav, "nav")
     origin = lla[0]
+    if ellipsoid is None:
+        ellipsoid = nav.ellipsoid if isinstance(nav, Trajectory) else "WGS84"
     plt = _pyplot()
     fig, ax = plt.subplots(figsize=(6, 6))
     ned = _ned(lla, origin, ellipsoid, "nav")

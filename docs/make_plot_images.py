@@ -1,0 +1,59 @@
+"""Draw the images of docs/plots.md (docs/img/plots_*.png) from a short simulated run:
+two minutes of sinusoidal motion, a tactical-grade IMU, 1 Hz position fixes, and an
+hour of a simulated gyro log. Run from the repository root:
+
+    .venv/bin/python docs/make_plot_images.py
+"""
+
+from pathlib import Path
+
+import matplotlib
+
+matplotlib.use("Agg")
+
+import numpy as np  # noqa: E402
+import pandas as pd  # noqa: E402
+
+import atomnav as an  # noqa: E402
+
+OUT = Path(__file__).parent / "img"
+
+
+def main() -> None:
+    OUT.mkdir(exist_ok=True)
+    traj = an.trajectory.sinusoidal(120.0, rate_hz=100.0)
+    meas = an.imu.corrupt(traj.ideal_imu("increments"), errors="tactical", dt=0.01, kind="increments", seed=7)
+    st = traj.initial_state()
+    fix_t = np.arange(1.0, 120.0, 1.0)
+    rng = np.random.default_rng(3)
+    fix_lla = traj.lla[np.searchsorted(traj.time, fix_t)]
+    m_rad, n_rad = an.earth.radii(fix_lla[0, 0])
+    noise = rng.standard_normal((len(fix_t), 3))  # 1 m per axis, NED
+    fix_lla = fix_lla + noise * [1.0 / (m_rad + fix_lla[0, 2]), 1.0 / ((n_rad + fix_lla[0, 2]) * np.cos(fix_lla[0, 0])), -1.0]
+    p0 = np.diag(np.r_[[1.0] * 3, [0.01] * 3, [1e-6] * 3, [1e-4] * 3, [1e-10] * 3])
+    ins = an.filter.position_aided_ins(st["t0"], st["lla"], st["vel_ned"], st["q_nb"], "increments", fix_t, fix_lla,
+                                       np.tile(np.eye(3), (len(fix_t), 1, 1)), p0=p0, accel_psd=1e-6, gyro_psd=1e-10,
+                                       predict_every=10)
+    res = ins.run(meas["time_s"].to_numpy(), meas[["dtheta_x_rad", "dtheta_y_rad", "dtheta_z_rad"]].to_numpy(),
+                  meas[["dv_x_mps", "dv_y_mps", "dv_z_mps"]].to_numpy(), progress=False)
+    err = traj.errors(res.nav)
+    # NEES over the nine navigation states from the reported σ (cross-correlations ignored)
+    sig = res.nav[[f"sigma_{b}[{i}]" for b in ("position", "velocity", "attitude") for i in range(3)]].to_numpy()
+    nees = pd.DataFrame({"time_s": err["time_s"], "nees": ((err.iloc[:, 1:10].to_numpy() / sig) ** 2).sum(axis=1)})
+    # an hour of a gyro at 10 Hz in °/h: ARW 0.1 °/√h and a 2 °/h bias
+    w = 2.0 + 0.1 * 60.0 / np.sqrt(0.1) * rng.standard_normal(36000)
+    table = an.noise.allan.allan_variance(w, 0.1)
+    fit = an.noise.allan.fit_allan(w, 0.1, terms=("arw", "bias_instability"))
+    figures = {
+        "trajectory": an.plots.trajectory(an.strapdown.integrate(meas, **st), traj),
+        "errors": an.plots.errors(err, res),
+        "imu_errors": an.plots.imu_errors(res, truth=meas),
+        "consistency": an.plots.consistency(nis=res, nees=nees, dof=9),
+        "allan": an.plots.allan(table, fit, unit=an.units.DEG_PER_HOUR),
+    }
+    for name, fig in figures.items():
+        fig.savefig(OUT / f"plots_{name}.png", dpi=60)
+
+
+if __name__ == "__main__":
+    main()
