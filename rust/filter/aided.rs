@@ -166,7 +166,7 @@ pub struct AidedOutput {
 /// the step, and the nominal solution after the epoch (the corrected solution in closed
 /// loop, the free INS in open loop) as a row of [`NOMINAL_WIDTH`] + n_extra values: t (s),
 /// lat, lon (rad), h (m), v_NED (m/s), q_nb (4), accel bias (m/s²), gyro bias (rad/s), then
-/// the extra blocks. 8 (5n² + 2n + 17 + n_extra) bytes per epoch for n states.
+/// the extra blocks. 8 (4n² + 2n + 17 + n_extra) bytes per epoch for n states.
 #[derive(Debug, Clone, Default)]
 pub struct ForwardPass {
     pub steps: Vec<StoredStep>,
@@ -754,7 +754,7 @@ impl PositionFix {
     /// `names` are the caller's arguments (times, positions, covariances), errors name
     /// them: a latitude outside ±π/2 names the positions and its row.
     pub fn table(names: [&str; 3], t: &[f64], lla: &[Vec3], cov: &[DMatrix<f64>]) -> Result<Vec<PositionFix>> {
-        let cov = super::sources::fix_covariances(names, t.len(), lla.len(), cov)?;
+        let cov = super::sources::fix_table(names, "position", t, lla, cov)?;
         // a latitude beyond ±π/2 (one in degrees) would pull the filter off the Earth
         let [_, positions, _] = names;
         crate::earth::check_latitudes(positions, lla)?;
@@ -764,7 +764,7 @@ impl PositionFix {
 
 impl PositionAiding {
     pub fn new(fixes: Vec<PositionFix>) -> Result<Self> {
-        super::sources::check_fix_rows("fixes", "position", fixes.iter().map(|f| (&f.lla, &f.cov_ned)))?;
+        super::sources::check_fix_rows(["fixes", "fixes"], "position", fixes.iter().map(|f| (&f.lla, &f.cov_ned)))?;
         Ok(PositionAiding { times: fixes.iter().map(|f| f.t).collect(), fixes })
     }
 }

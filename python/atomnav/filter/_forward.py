@@ -20,8 +20,8 @@ FIELDS = ("phi", "qd", "x_prior", "p_prior", "x_post", "p_post", "nominal")
 
 def epoch_bytes(n: int, n_extra: int) -> int:
     """Bytes stored per prediction epoch for ``n`` states of which ``n_extra`` in the
-    sensor's extra blocks: 8 (5n² + 2n + 17 + n_extra)."""
-    return 8 * (5 * n * n + 2 * n + 17 + n_extra)
+    sensor's extra blocks: 8 (4n² + 2n + 17 + n_extra)."""
+    return 8 * (4 * n * n + 2 * n + 17 + n_extra)
 
 
 class ForwardStore:

@@ -61,8 +61,8 @@ class InsSetup(Config):
 
     Smoother (Rauch, Tung & Striebel 1965): ``smooth`` True stores the forward pass for
     :meth:`AidedIns.smooth` (and makes :meth:`AidedIns.run` return the smoothed solution),
-    8 (5n² + 2n + 17 + n_extra) bytes per prediction epoch for n states (15 INS states:
-    9 376 bytes; a 1-hour record with an epoch every 0.1 s: 338 MB), in chunks of
+    8 (4n² + 2n + 17 + n_extra) bytes per prediction epoch for n states (15 INS states:
+    7 576 bytes; a 1-hour record with an epoch every 0.1 s: 273 MB), in chunks of
     ``smooth_chunk`` epochs (the unit of the backward pass) held in memory up to
     ``smooth_memory`` bytes, beyond that written to a temporary directory under
     ``smooth_dir`` (the system's temporary directory when None) and deleted with the
@@ -216,7 +216,7 @@ class AidedIns:
 
     @property
     def epoch_bytes(self) -> int:
-        """Bytes of the forward pass stored per prediction epoch: 8 (5n² + 2n + 17 +
+        """Bytes of the forward pass stored per prediction epoch: 8 (4n² + 2n + 17 +
         n_extra) for n states."""
         n = len(self.labels)
         return epoch_bytes(n, n - 15)
@@ -293,7 +293,7 @@ class AidedIns:
         (``smooth_chunk`` epochs at a time, those on disk memory-mapped), carrying the
         smoothed mean and covariance across chunk boundaries; the result does not depend on
         the chunk size. Memory: one chunk of the forward pass and its smoothed
-        covariances, 8 (6n² + 2n + 17 + n_extra) bytes per epoch of the chunk, plus the
+        covariances, 8 (5n² + 3n + 17 + n_extra) bytes per epoch of the chunk, plus the
         smoothed table; ``covariance`` True also keeps every smoothed covariance, 8n²
         bytes per epoch (:attr:`SmoothedResult.covariance`). ``progress`` shows a bar over
         the chunks.
