@@ -196,6 +196,10 @@ SINE_UNITS = (Unit("t", "imu_time"), Unit("f", "accel"), Unit("w", "gyro"), Unit
 OBS = "epoch, camera = np.array([0, 0, 0, 1, 1, 1]), np.zeros(6, dtype=np.int64)\ns_cf = g = np.vstack([np.eye(3)] * 2)"
 RHO = "rho, epochs = np.tile([0.0, 4e-5, 6e-5], (400, 1)) * 0.005, np.array([0.1, 0.9, 1.7])"
 KF = "phi, q, h, r = kf_phi, kf_q, kf_h, kf_r"
+PLOTS = ("import matplotlib.pyplot as plt\n"
+         "drawn = lambda fig: ([(a.get_title(), ln.get_label(), ln.get_xydata()) for a in fig.axes for ln in a.lines], "
+         "plt.close(fig))[0]")
+PLOTS_AIDED = PLOTS + "\n" + AIDED + "\nres = ins.run(time, gyro, accel, progress=False)"
 
 CATALOGUE: tuple[Clean, ...] = (
     # strapdown
@@ -357,6 +361,22 @@ CATALOGUE: tuple[Clean, ...] = (
        (Unit("time", "time"), Unit("gyro", "gyro"))),
     _c("atomnav.plausibility.specific_force", 'an.plausibility.specific_force(f, "f")', "f = imu_accel", (),
        (Unit("f", "accel"),)),
+    # plots: compared by what they draw (every line's axes title, label and data)
+    _c("atomnav.plots.trajectory", "drawn(an.plots.trajectory(nav, reference))",
+       PLOTS + '\nnav, reference = nav[["lat_rad", "lon_rad", "h_m"]], truth[["lat_rad", "lon_rad", "h_m"]]',
+       ["nav", "reference"]),
+    _c("atomnav.plots.errors", "drawn(an.plots.errors(err, sigma))", PLOTS_AIDED + "\nerr = traj.errors(res.nav)\n"
+       'sigma = res.nav[["time_s", *[f"sigma_{b}[{i}]" for b in ("position", "velocity", "attitude") for i in range(3)]]]',
+       ["err", "sigma"]),
+    _c("atomnav.plots.imu_errors", "drawn(an.plots.imu_errors(result, truth))",
+       PLOTS_AIDED + '\nresult = res.nav[["time_s", *[c for c in res.nav.columns if "bias" in c]]]\ntruth = meas[["time_s", *an.imu.BIAS_COLUMNS[0], *an.imu.BIAS_COLUMNS[1]]]',
+       ["result", "truth"]),
+    _c("atomnav.plots.consistency", "drawn(an.plots.consistency(nis=nis, nees=nees, dof=3))",
+       PLOTS_AIDED + '\nnis, err = res.measurements, traj.errors(res.nav)\n'
+       'nees = pd.DataFrame({"time_s": err["time_s"], "nees": (err[["dpos_n_m", "dpos_e_m", "dpos_d_m"]] ** 2).sum(axis=1)})',
+       ["nis", "nees"]),
+    _c("atomnav.plots.allan", "drawn(an.plots.allan(table, fit, unit=an.units.DEG_PER_HOUR))",
+       PLOTS + "\ntable, fit = allan, an.noise.allan.fit_allan(omega, 1.0)", ["table"]),
 )
 
 
@@ -545,7 +565,7 @@ def table_mutations(var: str, df, time_origin: str = "", epoch: str = "") -> lis
                          f"{var} = {var}.astype({{c: 'Float64' for c in {numeric!r}}})\n"
                          f"{var}.loc[{var}.index[{row}], {col!r}] = pd.NA",
                          f"{var} = {var}.copy()\n{var}.loc[{var}.index[{row}], {col!r}] = np.nan"),
-                Mutation("strings", f"numbers as strings in {col!r}", f"{var} = {var}.assign({col}={var}[{col!r}].astype(str))"),
+                Mutation("strings", f"numbers as strings in {col!r}", f"{var} = {var}.assign(**{{{col!r}: {var}[{col!r}].astype(str)}})"),
                 Mutation("strings", "all numbers as strings", f"{var} = {var}.astype(str)")]
     return out
 

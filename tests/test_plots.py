@@ -428,3 +428,16 @@ def test_import_atomnav_plots_does_not_load_matplotlib_or_scipy_stats():
             "print('matplotlib' in sys.modules, 'scipy.stats' in sys.modules)")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout.split()
     assert out == ["False", "False"]
+
+
+def test_time_as_timedelta_is_its_seconds_and_datetime_is_a_type_error(run):
+    err = run["err"]
+    as_td = err.assign(time_s=pd.to_timedelta(err["time_s"], unit="s"))
+    xy = line(plots.errors(as_td).axes[0], "error").get_xydata()
+    np.testing.assert_allclose(xy[:, 0], err["time_s"], rtol=1e-12)
+    as_date = err.assign(time_s=pd.Timestamp("2024-01-01") + pd.to_timedelta(err["time_s"], unit="s"))
+    with pytest.raises(TypeError, match="^err: column 'time_s' holds datetimes"):
+        plots.errors(as_date)
+    meas = run["res"].measurements
+    with pytest.raises(TypeError, match="^nis: column 'time_s' holds datetimes"):
+        plots.consistency(nis=meas.assign(time_s=pd.Timestamp("2024-01-01") + pd.to_timedelta(meas["time_s"], unit="s")))

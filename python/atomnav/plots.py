@@ -17,7 +17,8 @@ imported inside the functions: ``import atomnav`` does not load them.
   terms (IEEE Std 952-1997, Annex C).
 
 Tables are read by column name (extra columns are ignored; a missing one is an
-:class:`atomnav.InputError` naming the argument and the column). NaN marks a missing
+:class:`atomnav.InputError` naming the argument and the column); time is ``time_s`` in
+seconds (or timedelta64; a datetime64 column is a ``TypeError``). NaN marks a missing
 value: it is left out of the plot and the number of rows left out is given in the
 legend; ±inf is an :class:`atomnav.InputError` naming the argument, the column and the
 row.
@@ -29,7 +30,7 @@ import numpy as np
 import pandas as pd
 
 from . import _core, plausibility, units
-from ._validate import flag, input_error, instance, integer, positive, probability, renamed, table as read_table
+from ._validate import flag, input_error, instance, integer, locate, positive, probability, renamed, table as read_table
 from .filter.aided import AidedResult
 from .filter.analysis import chi2_band
 from .imu import BIAS_COLUMNS
@@ -54,13 +55,16 @@ def _sigma_columns(block: str, size: int = 3) -> list[str]:
 
 
 def _read(df, names, parameter: str) -> tuple[np.ndarray, np.ndarray]:
-    """Columns ``time_s`` and ``names`` of table ``df``: the time (finite) and the values
-    (N, len(names)), NaN where missing; ±inf is an :class:`InputError` naming the column
-    and its row."""
-    t = read_table(df, ["time_s"], parameter).ravel()
+    """Columns ``time_s`` and ``names`` of table ``df``: the time (s, finite; timedelta64
+    as its seconds, datetime64 a ``TypeError``: the series of one figure share a time axis
+    in seconds, which a date in one table cannot join) and the values (N, len(names)), NaN
+    where missing; ±inf is an :class:`InputError` naming the column and its row."""
     values = read_table(df, names, parameter, finite=False)
     _no_inf(values, names, parameter)
-    return t, values
+    if pd.api.types.is_datetime64_any_dtype(df.dtypes.iloc[locate(df, ["time_s"], parameter)[0]]):
+        raise TypeError(f"{parameter}: column 'time_s' holds datetimes; give the time in seconds (or as timedelta64), "
+                        "e.g. (t - t.iloc[0]).dt.total_seconds(), the same way for every table of the figure")
+    return read_table(df, ["time_s"], parameter).ravel(), values
 
 
 def _no_inf(values: np.ndarray, names, parameter: str) -> None:
@@ -194,7 +198,7 @@ def errors(err, sigma=None):
         instance(sig_table, pd.DataFrame, "sigma")
         ts, s = _read(sig_table, [c for b in _ERROR_BLOCKS for c in _sigma_columns(b)], "sigma")
     plt = _pyplot()
-    fig, axes = plt.subplots(3, 3, figsize=(12, 8), sharex=True)
+    fig, axes = plt.subplots(3, 3, figsize=(12, 8), sharex=True, layout="constrained")
     for r, (quantity, unit, factor) in enumerate(_ERROR_ROWS):
         for c, axis in enumerate(_NED):
             j = 3 * r + c
@@ -209,7 +213,6 @@ def errors(err, sigma=None):
     for ax in axes[-1]:
         ax.set_xlabel("time (s)")
     fig.suptitle("Navigation errors (estimate − reference)" + (" with ±3σ" if sigma is not None else ""))
-    fig.tight_layout()
     return fig
 
 
@@ -247,7 +250,7 @@ def imu_errors(result, truth=None):
         instance(truth, pd.DataFrame, "truth")
         tt, b = _read(truth, [c for _, est, _, _, _ in _BIAS_ROWS for c in est], "truth")
     plt = _pyplot()
-    fig, axes = plt.subplots(2, 3, figsize=(12, 6), sharex=True)
+    fig, axes = plt.subplots(2, 3, figsize=(12, 6), sharex=True, layout="constrained")
     for r, (sensor, _, _, unit, factor) in enumerate(_BIAS_ROWS):
         est, sig = v[:, 6 * r:6 * r + 3] / factor, v[:, 6 * r + 3:6 * r + 6] / factor
         for c, axis in enumerate(_XYZ):
@@ -263,7 +266,6 @@ def imu_errors(result, truth=None):
     for ax in axes[-1]:
         ax.set_xlabel("time (s)")
     fig.suptitle("IMU error estimates with ±3σ")
-    fig.tight_layout()
     return fig
 
 
@@ -342,11 +344,10 @@ def consistency(nis=None, nees=None, dof=None, *, p: float = 0.95):
         t, v = _read(nees, ["nees"], "nees")
         panels.append((t, v[:, 0], np.full(len(t), k, dtype=np.int64), "NEES"))
     plt = _pyplot()
-    fig, axes = plt.subplots(len(panels), 1, figsize=(9, 3.5 * len(panels)), squeeze=False)
+    fig, axes = plt.subplots(len(panels), 1, figsize=(9, 3.5 * len(panels)), squeeze=False, layout="constrained")
     for ax, (t, x, k, name) in zip(axes[:, 0], panels):
         _band_panel(ax, t, x, k, p, name)
         ax.set_title(f"{name} with its two-sided {100 * p:g} % χ² band")
-    fig.tight_layout()
     return fig
 
 
