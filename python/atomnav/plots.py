@@ -411,8 +411,7 @@ def allan(table, fit=None, *, unit: float = 1.0, angular: bool = True):
     tau, dev, lo, hi = (d[keep] * [1.0, *[scale / rate_factor] * 3]).T
     plt = _pyplot()
     fig, ax = plt.subplots(figsize=(7, 5))
-    ax.errorbar(tau, dev, yerr=[dev - lo, hi - dev], fmt="o", ms=4, color="k", capsize=2,
-                label="Allan deviation" + _missing(int(np.count_nonzero(~keep))))
+    _allan_points(ax, tau, dev, lo, hi, color="k", capsize=2, label="Allan deviation" + _missing(int(np.count_nonzero(~keep))))
     if fit is not None and tau.size:
         grid = np.geomspace(tau.min(), tau.max(), 100)
         for k, (name, (label, term_unit, term_factor)) in enumerate(zip(TERMS, terms)):
@@ -421,13 +420,29 @@ def allan(table, fit=None, *, unit: float = 1.0, angular: bool = True):
                 value = getattr(fit, name) * scale / term_factor
                 ax.plot(grid, np.sqrt(a * grid ** (k - 2)) * scale / rate_factor, ":", lw=1,
                         label=f"{label} {value:.3g} {term_unit}")
-        ax.plot(grid, np.sqrt(np.maximum(fit.curve(grid), 0.0)) * scale / rate_factor, "-", color="C3", lw=1.2,
-                label="five-term fit")
+        _allan_fit(ax, fit, grid, scale / rate_factor, color="C3", lw=1.2, label="five-term fit")
+    _allan_axes(ax, rate_unit)
+    ax.set_title(f"Allan deviation of the {'gyro' if angular else 'accelerometer'} log")
+    return fig
+
+
+def _allan_points(ax, tau, dev, lo, hi, **style) -> None:
+    """Allan deviation points ``dev`` at ``tau`` with their confidence interval [lo, hi]
+    as error bars (also drawn by :func:`atomnav.noise.report.plot_allan`)."""
+    ax.errorbar(tau, dev, yerr=[dev - lo, hi - dev], fmt="o", ms=4, **style)
+
+
+def _allan_fit(ax, fit, tau, scale: float, **style) -> None:
+    """The deviation √σ²(τ) of a five-term fit at ``tau`` times ``scale`` (a negative sum
+    drawn as 0)."""
+    ax.plot(tau, np.sqrt(np.maximum(fit.curve(tau), 0.0)) * scale, "-", **style)
+
+
+def _allan_axes(ax, unit: str) -> None:
+    """Log–log axes of an Allan plot, τ in s and the deviation in ``unit``, with a legend."""
     ax.set_xscale("log")
     ax.set_yscale("log")
     ax.set_xlabel("averaging time τ (s)")
-    ax.set_ylabel(f"Allan deviation ({rate_unit})")
-    ax.set_title(f"Allan deviation of the {'gyro' if angular else 'accelerometer'} log")
+    ax.set_ylabel(f"Allan deviation ({unit})")
     ax.grid(True, which="both", alpha=0.3)
     ax.legend(fontsize=8)
-    return fig

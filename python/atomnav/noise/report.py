@@ -114,20 +114,16 @@ def plot_allan(cmp: Comparison, methods=("raw", "fixed KF", "adaptive KF (differ
     instance(cmp, Comparison, "cmp")
     import matplotlib.pyplot as plt
 
+    from ..plots import _allan_axes, _allan_fit, _allan_points
+
     fig, ax = plt.subplots(figsize=(7, 5))
     for i, name in enumerate(methods):
         f = cmp.allan_fits[name]
-        tb = f.table
+        tau, dev, lo, hi = f.table[["tau_s", "dev", "dev_lo", "dev_hi"]].to_numpy().T
         color = f"C{i}"
-        ax.errorbar(tb["tau_s"], tb["dev"], yerr=[tb["dev"] - tb["dev_lo"], tb["dev_hi"] - tb["dev"]], fmt="o", ms=4, color=color, label=name)
-        t = np.geomspace(tb["tau_s"].iloc[0], tb["tau_s"].iloc[-1], 100)
-        ax.plot(t, np.sqrt(np.maximum(f.curve(t), 0.0)), "-", color=color, lw=1)
-    ax.set_xscale("log")
-    ax.set_yscale("log")
-    ax.set_xlabel("τ (s)")
-    ax.set_ylabel("Allan deviation (°/h)")
-    ax.grid(True, which="both", alpha=0.3)
-    ax.legend(fontsize=8)
+        _allan_points(ax, tau, dev, lo, hi, color=color, label=name)
+        _allan_fit(ax, f, np.geomspace(tau[0], tau[-1], 100), 1.0, color=color, lw=1)
+    _allan_axes(ax, "°/h")
     return fig
 
 
