@@ -13,3 +13,4 @@ pub mod analysis;
 pub mod aided;
 pub mod sources;
 pub mod initial_error;
+pub mod alignment;
