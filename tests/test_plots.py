@@ -403,6 +403,14 @@ def test_bad_values_are_input_errors(run):
         plots.consistency()
     assert e.value.parameter == "nis"
     with pytest.raises(an.InputError) as e:
+        plots.consistency(nis=res, dof=3)  # the NIS's degrees of freedom are its rows
+    assert e.value.parameter == "dof"
+    meas = meas.astype({"rows": float})
+    meas.loc[2, "rows"] = 1e30
+    with pytest.raises(an.InputError, match="rows.*index 2") as e:
+        plots.consistency(nis=meas)
+    assert (e.value.parameter, e.value.index) == ("nis", 2)
+    with pytest.raises(an.InputError) as e:
         plots.consistency(nis=res, p=1.0)
     assert e.value.parameter == "p"
     with pytest.raises(an.InputError) as e:

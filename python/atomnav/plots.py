@@ -293,6 +293,10 @@ def _band_panel(ax, t: np.ndarray, x: np.ndarray, dof: np.ndarray, p: float, nam
     ax.legend(fontsize=8)
 
 
+#: Largest degrees of freedom of a χ² band (that of :func:`atomnav.filter.analysis.chi2_band`).
+_MAX_DOF = 2**32
+
+
 def consistency(nis=None, nees=None, dof=None, *, p: float = 0.95):
     """NIS per measurement and/or NEES against their two-sided χ² bands.
 
@@ -311,7 +315,7 @@ def consistency(nis=None, nees=None, dof=None, *, p: float = 0.95):
         :meth:`atomnav.trajectory.Trajectory.errors` and the σ of an aided INS.
     dof : int
         Degrees of freedom of the NEES (the number of states in it); required with
-        ``nees``.
+        ``nees``, refused without it.
     p : float
         Probability of the band, in (0, 1).
 
@@ -325,6 +329,8 @@ def consistency(nis=None, nees=None, dof=None, *, p: float = 0.95):
     """
     if nis is None and nees is None:
         raise input_error("nis", "give nis, nees or both")
+    if nees is None and dof is not None:
+        raise input_error("dof", "is the NEES's degrees of freedom, and no nees was given (the NIS's are its rows column)")
     p = probability(p, "p")
     panels = []
     if nis is not None:
@@ -332,15 +338,15 @@ def consistency(nis=None, nees=None, dof=None, *, p: float = 0.95):
         instance(meas, pd.DataFrame, "nis")
         t, v = _read(meas, ["nis", "rows"], "nis")
         rows = v[:, 1]
-        bad = np.flatnonzero(~(rows >= 1) | (rows != np.round(rows)))
+        bad = np.flatnonzero(~((rows >= 1) & (rows <= _MAX_DOF) & (rows == np.round(rows))))
         if bad.size:
-            raise input_error("nis", f"column 'rows': {rows[bad[0]]} at index {bad[0]} is not a row count >= 1", bad[0])
+            raise input_error("nis", f"column 'rows': {rows[bad[0]]} at index {bad[0]} is not a row count in [1, {_MAX_DOF}]", bad[0])
         panels.append((t, v[:, 0], rows.astype(np.int64), "NIS"))
     if nees is not None:
         instance(nees, pd.DataFrame, "nees")
         if dof is None:
             raise input_error("dof", "the NEES needs its degrees of freedom (the number of states in it)")
-        k = integer(dof, "dof", 1)
+        k = integer(dof, "dof", 1, _MAX_DOF)
         t, v = _read(nees, ["nees"], "nees")
         panels.append((t, v[:, 0], np.full(len(t), k, dtype=np.int64), "NEES"))
     plt = _pyplot()
