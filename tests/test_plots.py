@@ -449,3 +449,18 @@ def test_time_as_timedelta_is_its_seconds_and_datetime_is_a_type_error(run):
     meas = run["res"].measurements
     with pytest.raises(TypeError, match="^nis: column 'time_s' holds datetimes"):
         plots.consistency(nis=meas.assign(time_s=pd.Timestamp("2024-01-01") + pd.to_timedelta(meas["time_s"], unit="s")))
+
+
+def test_the_docs_images_script_runs_and_keeps_each_image_small(tmp_path, monkeypatch):
+    import importlib.util
+    from pathlib import Path
+
+    path = Path(__file__).parent.parent / "docs" / "make_plot_images.py"
+    spec = importlib.util.spec_from_file_location("make_plot_images", path)
+    script = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(script)
+    monkeypatch.setattr(script, "OUT", tmp_path)
+    script.main()
+    images = sorted(p.name for p in tmp_path.iterdir())
+    assert images == [f"plots_{n}.png" for n in ("allan", "consistency", "errors", "imu_errors", "trajectory")]
+    assert max(p.stat().st_size for p in tmp_path.iterdir()) < 100_000
