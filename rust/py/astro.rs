@@ -1,6 +1,6 @@
 //! Bindings of astro/: gyro increments, star attitudes, mount calibration, scenario runs.
 
-use super::convert::{index_count, mat_to_py, mats, mats_to_py, quat_to_py, register_choices, seed, vec3_rows, vec3_to_py, vector, Wrap};
+use super::convert::{index_count, mat_to_py, mats, mats_to_py, quat_to_py, real, register_choices, seed, vec3_rows, vec3_to_py, vector, Wrap};
 use crate::astro::calibration::{self, Calibration, DiffForm, Init, Observability, Options, ResidualForm, Solver, Start, Verdict};
 use crate::astro::increments::{self, GyroErrorMode, GyroErrorModel, ImuRecord, TaylorVariant};
 use crate::astro::scenario::{self, Run, Scenario};
@@ -95,8 +95,8 @@ type IncrementArrays<'py> = (Bound<'py, PyArray2<f64>>, Bound<'py, PyArray3<f64>
 #[allow(clippy::too_many_arguments)]
 fn astro_increments<'py>(
     py: Python<'py>,
-    t_start: f64,
-    period: f64,
+    #[pyo3(from_py_with = real)] t_start: f64,
+    #[pyo3(from_py_with = real)] period: f64,
     rho: PyReadonlyArray2<'py, f64>,
     epochs: PyReadonlyArray1<'py, f64>,
     sigmas: (f64, f64, f64, f64),
@@ -118,8 +118,8 @@ fn astro_increments<'py>(
 #[pyfunction]
 fn astro_dead_reckoning_cov<'py>(
     py: Python<'py>,
-    t_start: f64,
-    period: f64,
+    #[pyo3(from_py_with = real)] t_start: f64,
+    #[pyo3(from_py_with = real)] period: f64,
     rho: PyReadonlyArray2<'py, f64>,
     epochs: PyReadonlyArray1<'py, f64>,
     sigmas: (f64, f64, f64, f64),
@@ -174,7 +174,7 @@ fn astro_calibrate<'py>(
     c0: Option<PyReadonlyArray2<'py, f64>>,
     solver: Wrap<Solver>,
     max_iter: Option<Bound<'py, PyAny>>,
-    tol: f64,
+    #[pyo3(from_py_with = real)] tol: f64,
     residual_form: Wrap<ResidualForm>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let (a, b) = (mats::<3, 3>(&ds_imu, "ds_imu")?, mats::<3, 3>(&ds_avu, "ds_avu")?);
@@ -219,9 +219,9 @@ fn astro_star_attitudes<'py>(
     n_epochs: &Bound<'py, PyAny>,
     cameras: PyReadonlyArray3<'py, f64>,
     p_alpha: PyReadonlyArray3<'py, f64>,
-    sigma_s: f64,
+    #[pyo3(from_py_with = real)] sigma_s: f64,
     up_gcrs: Option<PyReadonlyArray2<'py, f64>>,
-    n_refr: f64,
+    #[pyo3(from_py_with = real)] n_refr: f64,
     p_avu: Option<PyReadonlyArray3<'py, f64>>,
 ) -> PyResult<(Arr3<'py>, Arr3<'py>, Bound<'py, PyArray1<i64>>)> {
     let obs = Observations { epoch: indices(&epoch, "epoch")?, camera: indices(&camera, "camera")?, s_cf: vec3_rows(&s_cf, "star_directions")?, g: vec3_rows(&g, "catalog_directions")? };
@@ -294,19 +294,19 @@ fn astro_aberration<'py>(py: Python<'py>, directions: PyReadonlyArray2<'py, f64>
 type CatalogArrays<'py> = (Bound<'py, PyArray2<f64>>, Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<u64>>);
 
 #[pyfunction]
-fn astro_synthetic_catalog<'py>(py: Python<'py>, m_lim: f64, seed: &Bound<'py, PyAny>) -> PyResult<CatalogArrays<'py>> {
+fn astro_synthetic_catalog<'py>(py: Python<'py>, #[pyo3(from_py_with = real)] m_lim: f64, seed: &Bound<'py, PyAny>) -> PyResult<CatalogArrays<'py>> {
     let c = Catalog::synthetic(m_lim, super::convert::seed(seed, "seed")?)?;
     Ok((vec3_to_py(py, &c.dirs), c.mags.into_pyarray(py), c.ids.into_pyarray(py)))
 }
 
 #[pyfunction]
-fn astro_refraction<'py>(py: Python<'py>, s: PyReadonlyArray2<'py, f64>, u: PyReadonlyArray2<'py, f64>, n_refr: f64, apply: bool) -> PyResult<Bound<'py, PyArray2<f64>>> {
+fn astro_refraction<'py>(py: Python<'py>, s: PyReadonlyArray2<'py, f64>, u: PyReadonlyArray2<'py, f64>, #[pyo3(from_py_with = real)] n_refr: f64, apply: bool) -> PyResult<Bound<'py, PyArray2<f64>>> {
     let (s, u) = (vec3_rows(&s, "directions")?, vec3_rows(&u, "up")?);
     Ok(vec3_to_py(py, &stars::refraction_rows(&s, &u, n_refr, apply)?))
 }
 
 #[pyfunction]
-fn astro_refractive_index(height: f64) -> PyResult<f64> {
+fn astro_refractive_index(#[pyo3(from_py_with = real)] height: f64) -> PyResult<f64> {
     Ok(stars::refractive_index(height)?)
 }
 
@@ -320,10 +320,10 @@ fn astro_simulate_observations<'py>(
     s_gcrs_vf: PyReadonlyArray3<'py, f64>,
     up_gcrs: PyReadonlyArray2<'py, f64>,
     cameras: PyReadonlyArray3<'py, f64>,
-    fov_half: f64,
-    m_lim: f64,
-    sigma_s: f64,
-    n_refr: f64,
+    #[pyo3(from_py_with = real)] fov_half: f64,
+    #[pyo3(from_py_with = real)] m_lim: f64,
+    #[pyo3(from_py_with = real)] sigma_s: f64,
+    #[pyo3(from_py_with = real)] n_refr: f64,
     seed: &Bound<'py, PyAny>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let dirs = vec3_rows(&catalog_dirs, "catalog_directions")?;

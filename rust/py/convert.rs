@@ -10,7 +10,7 @@ use numpy::{IntoPyArray, PyArray1, PyArray2, PyReadonlyArray1, PyReadonlyArray2,
 use pyo3::exceptions::{PyMemoryError, PyTypeError};
 use pyo3::prelude::*;
 use pyo3::pybacked::PyBackedStr;
-use pyo3::types::{PyBool, PyDict, PyInt};
+use pyo3::types::{PyBool, PyBytes, PyDict, PyInt, PyString};
 
 impl From<NavError> for PyErr {
     fn from(e: NavError) -> PyErr {
@@ -44,6 +44,31 @@ impl<'a, 'py, T: Choice> FromPyObject<'a, 'py> for Wrap<T> {
             .extract()
             .map_err(|_| PyTypeError::new_err(format!("expected a str, one of {}", T::names().join(", "))))?;
         Ok(Wrap(T::parse(&name)?))
+    }
+}
+
+/// A scalar float argument (`#[pyo3(from_py_with = real)]`): a Python or numpy number.
+/// Text is never read as a number: a `str`, `bytes`, or a numpy string scalar or array
+/// (whose `float()` would parse the text, or raise `ValueError`) is a `TypeError` (pyo3
+/// prefixes the argument name), as is any other non-number.
+pub fn real(obj: &Bound<'_, PyAny>) -> PyResult<f64> {
+    let text_dtype = obj
+        .getattr(pyo3::intern!(obj.py(), "dtype"))
+        .and_then(|d| d.getattr(pyo3::intern!(obj.py(), "kind")))
+        .and_then(|k| k.extract::<PyBackedStr>())
+        .is_ok_and(|k| matches!(&*k, "U" | "S" | "O" | "V" | "M" | "m"));
+    if text_dtype || obj.is_instance_of::<PyString>() || obj.is_instance_of::<PyBytes>() {
+        return Err(PyTypeError::new_err(format!("expected a number, got {}", type_name(obj))));
+    }
+    obj.extract()
+}
+
+/// [`real`] for an optional argument: `None` is `None`.
+pub fn real_opt(obj: &Bound<'_, PyAny>) -> PyResult<Option<f64>> {
+    if obj.is_none() {
+        Ok(None)
+    } else {
+        real(obj).map(Some)
     }
 }
 

@@ -1,6 +1,6 @@
 //! Bindings of earth.rs, vectorised over rows; every function takes an ellipsoid name.
 
-use super::convert::{mat_to_py, rows, set_floats, to_py_rows, vec3, vec3_rows, vec3_to_py, Wrap};
+use super::convert::{mat_to_py, real, rows, set_floats, to_py_rows, vec3, vec3_rows, vec3_to_py, Wrap};
 use crate::earth::{check_latitude, check_latitudes, dcm_ned_to_ecef, Ellipsoid};
 use crate::math::Vec3;
 use numpy::{PyArray2, PyReadonlyArray1, PyReadonlyArray2};
@@ -76,7 +76,7 @@ fn check_latitudes_rows(lla: PyReadonlyArray2<'_, f64>, field: &str) -> PyResult
 
 /// C_n^e for one (lat, lon) as a (3, 3) array.
 #[pyfunction]
-fn dcm_ned_to_ecef_py<'py>(py: Python<'py>, lat: f64, lon: f64) -> PyResult<Bound<'py, PyArray2<f64>>> {
+fn dcm_ned_to_ecef_py<'py>(py: Python<'py>, #[pyo3(from_py_with = real)] lat: f64, #[pyo3(from_py_with = real)] lon: f64) -> PyResult<Bound<'py, PyArray2<f64>>> {
     check_latitude("lat", lat, 0)?;
     Ok(mat_to_py(py, &dcm_ned_to_ecef(lat, lon)))
 }

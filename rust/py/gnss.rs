@@ -2,7 +2,7 @@
 //! simulation, single-point positioning and the tightly coupled aided INS, over numpy
 //! arrays, with one options object ([`PyGnssOptions`]) for all of them.
 
-use super::convert::{register_choices, rows, seed as seed_arg, to_py_rows, vec3, vec3_rows, vector, Wrap};
+use super::convert::{real, real_opt, register_choices, rows, seed as seed_arg, to_py_rows, vec3, vec3_rows, vector, Wrap};
 use super::filter::{floats, AidedSetup, PyAidedIns};
 use crate::earth::Helmert;
 use crate::error::invalid;
@@ -39,7 +39,7 @@ fn sat_id(name: &str) -> PyResult<SatId> {
 impl PyEphemerides {
     #[new]
     #[pyo3(signature = (gps, glonass, n_leap=18.0, datum=Wrap(Helmert::IDENTITY)))]
-    fn new(gps: PyReadonlyArray2<'_, f64>, glonass: PyReadonlyArray2<'_, f64>, n_leap: f64, datum: Wrap<Helmert>) -> PyResult<Self> {
+    fn new(gps: PyReadonlyArray2<'_, f64>, glonass: PyReadonlyArray2<'_, f64>, #[pyo3(from_py_with = real)] n_leap: f64, datum: Wrap<Helmert>) -> PyResult<Self> {
         let g = rows::<22>(&gps, "gps")?.iter().map(GpsEphemeris::from_row).collect();
         let r = rows::<14>(&glonass, "glonass")?.iter().enumerate().map(|(i, x)| GloEphemeris::from_row(x, i)).collect::<crate::Result<Vec<_>>>()?;
         Ok(PyEphemerides { inner: Ephemerides::new(g, r, TimeScales { n_leap }, datum.0)? })
@@ -49,7 +49,7 @@ impl PyEphemerides {
     #[staticmethod]
     #[pyo3(signature = (t_start, t_end, gps=true, glonass=true, tau_gps=0.0, n_leap=18.0, clocks=true, seed=None))]
     #[allow(clippy::too_many_arguments)]
-    fn nominal(t_start: f64, t_end: f64, gps: bool, glonass: bool, tau_gps: f64, n_leap: f64, clocks: bool, seed: Option<&Bound<'_, PyAny>>) -> PyResult<Self> {
+    fn nominal(#[pyo3(from_py_with = real)] t_start: f64, #[pyo3(from_py_with = real)] t_end: f64, gps: bool, glonass: bool, #[pyo3(from_py_with = real)] tau_gps: f64, #[pyo3(from_py_with = real)] n_leap: f64, clocks: bool, seed: Option<&Bound<'_, PyAny>>) -> PyResult<Self> {
         let seed = seed.map(|s| seed_arg(s, "seed")).transpose()?.unwrap_or_default();
         let cfg = ConstellationConfig { gps, glonass, t_start, t_end, tau_gps, time: TimeScales { n_leap }, clocks, seed };
         Ok(PyEphemerides { inner: nominal(&cfg)? })
@@ -78,7 +78,7 @@ impl PyEphemerides {
     /// (N, 8) rows [x, y, z, vx, vy, vz (WGS-84 ECEF), clock s, clock rate] of `sat` at GPS
     /// times `t` (GLONASS evaluated at t − ΔT_leap − tau_gps).
     #[pyo3(signature = (sat, t, tau_gps=0.0))]
-    fn state<'py>(&self, py: Python<'py>, sat: String, t: PyReadonlyArray1<'py, f64>, tau_gps: f64) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    fn state<'py>(&self, py: Python<'py>, sat: String, t: PyReadonlyArray1<'py, f64>, #[pyo3(from_py_with = real)] tau_gps: f64) -> PyResult<Bound<'py, PyArray2<f64>>> {
         Ok(to_py_rows(py, &self.inner.state_rows(sat_id(&sat)?, &vector(&t, "t")?, tau_gps)?))
     }
 
@@ -91,7 +91,7 @@ impl PyEphemerides {
 /// GLONASS RK4 propagation of (pos, vel) with constant acceleration `acc` over `dt` s
 /// (GLONASS ICD 2008, A.3.1.2), step ≤ `step` s, J₂ = `j2`; returns [x, y, z, vx, vy, vz].
 #[pyfunction]
-fn glonass_propagate<'py>(py: Python<'py>, pos: PyReadonlyArray1<'py, f64>, vel: PyReadonlyArray1<'py, f64>, acc: PyReadonlyArray1<'py, f64>, dt: f64, step: f64, j2: f64) -> PyResult<Bound<'py, PyArray1<f64>>> {
+fn glonass_propagate<'py>(py: Python<'py>, pos: PyReadonlyArray1<'py, f64>, vel: PyReadonlyArray1<'py, f64>, acc: PyReadonlyArray1<'py, f64>, #[pyo3(from_py_with = real)] dt: f64, #[pyo3(from_py_with = real)] step: f64, #[pyo3(from_py_with = real)] j2: f64) -> PyResult<Bound<'py, PyArray1<f64>>> {
     let (p, v) = propagate_checked(vec3(&pos, "pos")?, vec3(&vel, "vel")?, &vec3(&acc, "acc")?, dt, step, j2)?;
     Ok(PyArray1::from_vec(py, vec![p.x, p.y, p.z, v.x, v.y, v.z]))
 }
@@ -110,9 +110,9 @@ impl PyGnssOptions {
     #[pyo3(signature = (*, sigma_code, sigma_code_glonass, sigma_rate, iono, tropo, use_tau, elevation_weight, formulation, lever_arm, use_rate, tau0, sigma_tau0, tau_psd, clock0, sigma_clock0, clock_h0, clock_hm2))]
     #[allow(clippy::too_many_arguments)]
     fn new(
-        sigma_code: f64, sigma_code_glonass: Option<f64>, sigma_rate: f64, iono: bool, tropo: bool, use_tau: bool, elevation_weight: bool,
-        formulation: Wrap<Formulation>, lever_arm: &Bound<'_, PyAny>, use_rate: bool, tau0: f64, sigma_tau0: f64, tau_psd: f64,
-        clock0: &Bound<'_, PyAny>, sigma_clock0: &Bound<'_, PyAny>, clock_h0: f64, clock_hm2: f64,
+        #[pyo3(from_py_with = real)] sigma_code: f64, #[pyo3(from_py_with = real_opt)] sigma_code_glonass: Option<f64>, #[pyo3(from_py_with = real)] sigma_rate: f64, iono: bool, tropo: bool, use_tau: bool, elevation_weight: bool,
+        formulation: Wrap<Formulation>, lever_arm: &Bound<'_, PyAny>, use_rate: bool, #[pyo3(from_py_with = real)] tau0: f64, #[pyo3(from_py_with = real)] sigma_tau0: f64, #[pyo3(from_py_with = real)] tau_psd: f64,
+        clock0: &Bound<'_, PyAny>, sigma_clock0: &Bound<'_, PyAny>, #[pyo3(from_py_with = real)] clock_h0: f64, #[pyo3(from_py_with = real)] clock_hm2: f64,
     ) -> PyResult<Self> {
         let (lever_arm, clock0) = (floats::<3>(lever_arm, "lever_arm")?, floats::<2>(clock0, "clock0")?);
         let sigma_clock0 = floats::<2>(sigma_clock0, "sigma_clock0")?;
@@ -149,7 +149,7 @@ impl PyGnssOptions {
 #[allow(clippy::too_many_arguments)]
 fn gnss_simulate<'py>(
     py: Python<'py>, eph: &PyEphemerides, t: PyReadonlyArray1<'py, f64>, lla: PyReadonlyArray2<'py, f64>, vel_ned: PyReadonlyArray2<'py, f64>,
-    options: &PyGnssOptions, tau_gps: f64, clock_bias: f64, clock_drift: f64, mask: f64, only: Option<Vec<String>>,
+    options: &PyGnssOptions, #[pyo3(from_py_with = real)] tau_gps: f64, #[pyo3(from_py_with = real)] clock_bias: f64, #[pyo3(from_py_with = real)] clock_drift: f64, #[pyo3(from_py_with = real)] mask: f64, only: Option<Vec<String>>,
     outages: Option<PyReadonlyArray2<'py, f64>>, sat_outages: Vec<(String, f64, f64)>, seed: Option<&Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let seed = seed.map(|s| seed_arg(s, "seed")).transpose()?.unwrap_or_default();

@@ -1,7 +1,7 @@
 //! Bindings of imu::{errors, noise, presets}: the error-model parameters travel as one dict
 //! per triad (keys of `TRIAD_KEYS`), the IMU stream as whole (N, 3) arrays.
 
-use super::convert::{each_item, vec3_rows, vec3_to_py, Wrap};
+use super::convert::{each_item, real, vec3_rows, vec3_to_py, Wrap};
 use crate::error::invalid;
 use crate::imu::errors::{FlickerSpec, GaussMarkovSpec, ImuErrorModel, ImuSimulator, TriadErrors};
 use crate::imu::noise;
@@ -97,7 +97,7 @@ super::pickle::picklable!(ImuErrorSimulator, sim, "ImuErrorSimulator");
 #[pymethods]
 impl ImuErrorSimulator {
     #[new]
-    fn new(accel: &Bound<'_, PyDict>, gyro: &Bound<'_, PyDict>, dt: f64, kind: Wrap<ImuKind>, seed: &Bound<'_, PyAny>) -> PyResult<Self> {
+    fn new(accel: &Bound<'_, PyDict>, gyro: &Bound<'_, PyDict>, #[pyo3(from_py_with = real)] dt: f64, kind: Wrap<ImuKind>, seed: &Bound<'_, PyAny>) -> PyResult<Self> {
         let model = ImuErrorModel { accel: triad_from_dict(accel, "accel")?, gyro: triad_from_dict(gyro, "gyro")? };
         Ok(Self { sim: ImuSimulator::new(&model, dt, kind.0, super::convert::seed(seed, "seed")?)? })
     }
@@ -118,47 +118,47 @@ impl ImuErrorSimulator {
 }
 
 #[pyfunction]
-fn imu_white_sigma(density: f64, dt: f64, kind: Wrap<ImuKind>) -> PyResult<f64> {
+fn imu_white_sigma(#[pyo3(from_py_with = real)] density: f64, #[pyo3(from_py_with = real)] dt: f64, kind: Wrap<ImuKind>) -> PyResult<f64> {
     Ok(noise::white_sigma(density, dt, kind.0)?)
 }
 
 #[pyfunction]
-fn imu_white_density(sigma: f64, dt: f64, kind: Wrap<ImuKind>) -> PyResult<f64> {
+fn imu_white_density(#[pyo3(from_py_with = real)] sigma: f64, #[pyo3(from_py_with = real)] dt: f64, kind: Wrap<ImuKind>) -> PyResult<f64> {
     Ok(noise::white_density(sigma, dt, kind.0)?)
 }
 
 #[pyfunction]
-fn imu_random_walk_step_sigma(density: f64, dt: f64) -> PyResult<f64> {
+fn imu_random_walk_step_sigma(#[pyo3(from_py_with = real)] density: f64, #[pyo3(from_py_with = real)] dt: f64) -> PyResult<f64> {
     Ok(noise::random_walk_step_sigma(density, dt)?)
 }
 
 #[pyfunction]
-fn imu_random_walk_density(step_sigma: f64, dt: f64) -> PyResult<f64> {
+fn imu_random_walk_density(#[pyo3(from_py_with = real)] step_sigma: f64, #[pyo3(from_py_with = real)] dt: f64) -> PyResult<f64> {
     Ok(noise::random_walk_density(step_sigma, dt)?)
 }
 
 #[pyfunction]
-fn imu_gauss_markov_driving_sigma(sigma: f64, tau: f64, dt: f64) -> PyResult<f64> {
+fn imu_gauss_markov_driving_sigma(#[pyo3(from_py_with = real)] sigma: f64, #[pyo3(from_py_with = real)] tau: f64, #[pyo3(from_py_with = real)] dt: f64) -> PyResult<f64> {
     Ok(noise::gauss_markov_driving_sigma(sigma, tau, dt)?)
 }
 
 #[pyfunction]
-fn imu_gauss_markov_sigma(driving_sigma: f64, tau: f64, dt: f64) -> PyResult<f64> {
+fn imu_gauss_markov_sigma(#[pyo3(from_py_with = real)] driving_sigma: f64, #[pyo3(from_py_with = real)] tau: f64, #[pyo3(from_py_with = real)] dt: f64) -> PyResult<f64> {
     Ok(noise::gauss_markov_sigma(driving_sigma, tau, dt)?)
 }
 
 #[pyfunction]
-fn imu_gauss_markov_low_freq_asd(sigma: f64, tau: f64) -> PyResult<f64> {
+fn imu_gauss_markov_low_freq_asd(#[pyo3(from_py_with = real)] sigma: f64, #[pyo3(from_py_with = real)] tau: f64) -> PyResult<f64> {
     Ok(noise::gauss_markov_low_freq_asd(sigma, tau)?)
 }
 
 #[pyfunction]
-fn imu_flicker_psd(b: f64, f: f64) -> PyResult<f64> {
+fn imu_flicker_psd(#[pyo3(from_py_with = real)] b: f64, #[pyo3(from_py_with = real)] f: f64) -> PyResult<f64> {
     Ok(noise::flicker_psd(b, f)?)
 }
 
 #[pyfunction]
-fn imu_flicker_allan_floor(b: f64) -> PyResult<f64> {
+fn imu_flicker_allan_floor(#[pyo3(from_py_with = real)] b: f64) -> PyResult<f64> {
     Ok(noise::flicker_allan_floor(b)?)
 }
 

@@ -1,7 +1,7 @@
 //! Bindings of noise/: Allan family (batch, streaming, EDF, five-term fit), NNLS, ARIMA
 //! state space and the Kalman filters (batch, streaming, steady state).
 
-use super::convert::{counts, flags, index_count, flat_to_py, mat, mat_to_py, register_choices, set_floats, vec_to_py, vector, Wrap};
+use super::convert::{counts, flags, flat_to_py, index_count, mat, mat_to_py, real, real_opt, register_choices, set_floats, vec_to_py, vector, Wrap};
 use crate::error::invalid;
 use crate::noise::allan::{self, AllanResult, AllanStream, DataType, Kind, NoiseType, TauGrid, TauSet};
 use crate::noise::arma_filter::{self, Adaptive, ArimaStateSpace, ArmaFilterConfig, FilterOutput, Kalman, NoiseForm, X0, MAX_DIM};
@@ -25,7 +25,7 @@ fn result_to_py<'py>(py: Python<'py>, r: AllanResult) -> AllanArrays<'py> {
 fn allan_var<'py>(
     py: Python<'py>,
     data: PyReadonlyArray1<'py, f64>,
-    tau0: f64,
+    #[pyo3(from_py_with = real)] tau0: f64,
     data_type: Wrap<DataType>,
     kind: Wrap<Kind>,
     set: Wrap<TauGrid>,
@@ -58,8 +58,8 @@ fn allan_fit<'py>(
     var: PyReadonlyArray1<'py, f64>,
     n_samples: &Bound<'py, PyAny>,
     terms: &Bound<'py, PyAny>,
-    tau_min: f64,
-    tau_max: f64,
+    #[pyo3(from_py_with = real)] tau_min: f64,
+    #[pyo3(from_py_with = real)] tau_max: f64,
 ) -> PyResult<Bound<'py, PyDict>> {
     let m = counts(m, "m", 1, usize::MAX)?;
     let n = vec![0; m.len()];
@@ -92,7 +92,7 @@ super::pickle::picklable!(PyAllanStream, 0, "AllanStream");
 impl PyAllanStream {
     #[new]
     #[pyo3(signature = (m, tau0, data_type=Wrap(DataType::Rate)))]
-    fn new(m: &Bound<'_, PyAny>, tau0: f64, data_type: Wrap<DataType>) -> PyResult<Self> {
+    fn new(m: &Bound<'_, PyAny>, #[pyo3(from_py_with = real)] tau0: f64, data_type: Wrap<DataType>) -> PyResult<Self> {
         Ok(PyAllanStream(AllanStream::new(&counts(m, "m", 1, usize::MAX)?, tau0, data_type.0)?))
     }
 
@@ -115,7 +115,7 @@ fn order(d: Option<Bound<'_, PyAny>>) -> PyResult<usize> {
 /// Φ, B, Q and BQBᵀ of an ARIMA(p,d,q) state-space model.
 #[pyfunction]
 #[pyo3(signature = (ar, ma, sigma2, d=None, noise_form=Wrap(NoiseForm::Paper)))]
-fn arima_state_space<'py>(py: Python<'py>, ar: Vec<f64>, ma: Vec<f64>, sigma2: f64, d: Option<Bound<'py, PyAny>>, noise_form: Wrap<NoiseForm>) -> PyResult<Bound<'py, PyDict>> {
+fn arima_state_space<'py>(py: Python<'py>, ar: Vec<f64>, ma: Vec<f64>, #[pyo3(from_py_with = real)] sigma2: f64, d: Option<Bound<'py, PyAny>>, noise_form: Wrap<NoiseForm>) -> PyResult<Bound<'py, PyDict>> {
     let s = ArimaStateSpace::from_arma(&ar, &ma, sigma2, order(d)?, noise_form.0)?;
     let out = PyDict::new(py);
     out.set_item("phi", mat_to_py(py, &s.phi))?;
@@ -139,16 +139,16 @@ impl PyArmaFilterConfig {
     fn new(
         ar: Vec<f64>,
         ma: Vec<f64>,
-        sigma2: f64,
+        #[pyo3(from_py_with = real)] sigma2: f64,
         d: Option<Bound<'_, PyAny>>,
         noise_form: Wrap<NoiseForm>,
-        r0: Option<f64>,
+        #[pyo3(from_py_with = real_opt)] r0: Option<f64>,
         adaptive: Wrap<Adaptive>,
-        b: f64,
+        #[pyo3(from_py_with = real)] b: f64,
         adapt_q: bool,
         fading: bool,
         x0: Wrap<X0>,
-        p0: f64,
+        #[pyo3(from_py_with = real)] p0: f64,
     ) -> PyResult<Self> {
         let d = order(d)?;
         let c = ArmaFilterConfig { ar, ma, sigma2, d, noise_form: noise_form.0, r0, adaptive: adaptive.0, b, adapt_q, fading, x0: x0.0, p0 };
@@ -201,7 +201,7 @@ impl PyKalmanStream {
 #[pyfunction]
 #[pyo3(signature = (ar, ma, sigma2, r, d=None, noise_form=Wrap(NoiseForm::Paper)))]
 #[allow(clippy::type_complexity)]
-fn steady_state_gain<'py>(py: Python<'py>, ar: Vec<f64>, ma: Vec<f64>, sigma2: f64, r: f64, d: Option<Bound<'py, PyAny>>, noise_form: Wrap<NoiseForm>) -> PyResult<(Arr<'py>, Bound<'py, PyArray2<f64>>, Bound<'py, PyArray2<f64>>)> {
+fn steady_state_gain<'py>(py: Python<'py>, ar: Vec<f64>, ma: Vec<f64>, #[pyo3(from_py_with = real)] sigma2: f64, #[pyo3(from_py_with = real)] r: f64, d: Option<Bound<'py, PyAny>>, noise_form: Wrap<NoiseForm>) -> PyResult<(Arr<'py>, Bound<'py, PyArray2<f64>>, Bound<'py, PyArray2<f64>>)> {
     let s = ArimaStateSpace::from_arma(&ar, &ma, sigma2, order(d)?, noise_form.0)?;
     let (k, pm, pp) = arma_filter::steady_state(&s, r)?;
     Ok((vec_to_py(py, k), mat_to_py(py, &pm), mat_to_py(py, &pp)))

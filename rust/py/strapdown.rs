@@ -1,6 +1,6 @@
 //! Bindings of strapdown/: a streaming mechanization object and attitude integration.
 
-use super::convert::{count, flat_to_py, quat_rows, quat_to_py, register_choices, vec3, vec3_rows, vector, Wrap};
+use super::convert::{count, flat_to_py, quat_rows, quat_to_py, real, real_opt, register_choices, vec3, vec3_rows, vector, Wrap};
 use crate::earth::Ellipsoid;
 use crate::error::{invalid, NavError};
 use crate::math::{quat, Vec3};
@@ -109,15 +109,15 @@ impl Strapdown {
     #[pyo3(signature = (t0, lla, vel_ned, q_nb, *, kind=Wrap(ImuKind::Increments), ellipsoid=Wrap(crate::earth::WGS84), vertical=Wrap(Vertical::Free), zeta=None, omega=None))]
     #[allow(clippy::too_many_arguments)]
     fn new(
-        t0: f64,
+        #[pyo3(from_py_with = real)] t0: f64,
         lla: PyReadonlyArray1<'_, f64>,
         vel_ned: PyReadonlyArray1<'_, f64>,
         q_nb: PyReadonlyArray1<'_, f64>,
         kind: Wrap<ImuKind>,
         ellipsoid: Wrap<Ellipsoid>,
         vertical: Wrap<Vertical>,
-        zeta: Option<f64>,
-        omega: Option<f64>,
+        #[pyo3(from_py_with = real_opt)] zeta: Option<f64>,
+        #[pyo3(from_py_with = real_opt)] omega: Option<f64>,
     ) -> PyResult<Self> {
         let init = nav_state(t0, &lla, &vel_ned, &q_nb)?;
         Ok(Strapdown { inner: Core::new(init, kind.0, ellipsoid.0, vertical.0.tuned(zeta, omega))? })
@@ -131,7 +131,7 @@ impl Strapdown {
 
     /// Restart from the state (t0, lla, vel_ned, q_nb) as a new object with the same
     /// options would; the state is checked (unit q_nb within 1e-6, latitude, height).
-    fn reset(&mut self, t0: f64, lla: PyReadonlyArray1<'_, f64>, vel_ned: PyReadonlyArray1<'_, f64>, q_nb: PyReadonlyArray1<'_, f64>) -> PyResult<()> {
+    fn reset(&mut self, #[pyo3(from_py_with = real)] t0: f64, lla: PyReadonlyArray1<'_, f64>, vel_ned: PyReadonlyArray1<'_, f64>, q_nb: PyReadonlyArray1<'_, f64>) -> PyResult<()> {
         let state = nav_state(t0, &lla, &vel_ned, &q_nb)?;
         Ok(self.inner.reset(state)?)
     }

@@ -1,6 +1,6 @@
 //! Bindings of trajectory/ (motion models and generators) and imu::ideal.
 
-use super::convert::{Wrap, quat_rows, quat_to_py, to_py_rows, vec3, vec3_rows, vec3_to_py, vec_to_py, vector};
+use super::convert::{quat_rows, quat_to_py, real, to_py_rows, vec3, vec3_rows, vec3_to_py, vec_to_py, vector, Wrap};
 use crate::earth::{check_latitude, Ellipsoid};
 use crate::imu::ideal::{ideal_increments, ideal_rates};
 use crate::imu::ImuKind;
@@ -44,7 +44,7 @@ impl Motion {
     }
 
     #[staticmethod]
-    fn stationary(origin: PyReadonlyArray1<'_, f64>, duration: f64, euler: PyReadonlyArray1<'_, f64>) -> PyResult<Motion> {
+    fn stationary(origin: PyReadonlyArray1<'_, f64>, #[pyo3(from_py_with = real)] duration: f64, euler: PyReadonlyArray1<'_, f64>) -> PyResult<Motion> {
         crate::error::check_positive("duration", duration)?;
         Ok(wrap(CoreMotion::stationary("stationary", checked_origin(&origin)?, duration, vec3(&euler, "euler")?)))
     }
@@ -53,12 +53,12 @@ impl Motion {
     #[allow(clippy::too_many_arguments)]
     fn sinusoidal(
         origin: PyReadonlyArray1<'_, f64>,
-        duration: f64,
+        #[pyo3(from_py_with = real)] duration: f64,
         amp_ned: PyReadonlyArray1<'_, f64>,
         period_ned: PyReadonlyArray1<'_, f64>,
         amp_euler: PyReadonlyArray1<'_, f64>,
         period_euler: PyReadonlyArray1<'_, f64>,
-        heading: f64,
+        #[pyo3(from_py_with = real)] heading: f64,
     ) -> PyResult<Motion> {
         crate::error::check_positive("duration", duration)?;
         Ok(wrap(generators::sinusoidal(
@@ -73,24 +73,24 @@ impl Motion {
     }
 
     #[staticmethod]
-    fn hexapod(origin: PyReadonlyArray1<'_, f64>, max_tilt: f64, pitch_delay: f64, heading: f64) -> PyResult<Motion> {
+    fn hexapod(origin: PyReadonlyArray1<'_, f64>, #[pyo3(from_py_with = real)] max_tilt: f64, #[pyo3(from_py_with = real)] pitch_delay: f64, #[pyo3(from_py_with = real)] heading: f64) -> PyResult<Motion> {
         Ok(wrap(generators::hexapod(checked_origin(&origin)?, max_tilt, pitch_delay, heading)?))
     }
 
     #[staticmethod]
-    fn drive_with_yaw(origin: PyReadonlyArray1<'_, f64>, speed: f64, yaw_rate_amp: f64, period: f64, duration: f64, heading: f64) -> PyResult<Motion> {
+    fn drive_with_yaw(origin: PyReadonlyArray1<'_, f64>, #[pyo3(from_py_with = real)] speed: f64, #[pyo3(from_py_with = real)] yaw_rate_amp: f64, #[pyo3(from_py_with = real)] period: f64, #[pyo3(from_py_with = real)] duration: f64, #[pyo3(from_py_with = real)] heading: f64) -> PyResult<Motion> {
         crate::error::check_positive("duration", duration)?;
         Ok(wrap(generators::drive_with_yaw(checked_origin(&origin)?, speed, yaw_rate_amp, period, duration, heading)?))
     }
 
     #[staticmethod]
-    fn slalom(origin: PyReadonlyArray1<'_, f64>, speed: f64, amp: f64, period: f64, duration: f64) -> PyResult<Motion> {
+    fn slalom(origin: PyReadonlyArray1<'_, f64>, #[pyo3(from_py_with = real)] speed: f64, #[pyo3(from_py_with = real)] amp: f64, #[pyo3(from_py_with = real)] period: f64, #[pyo3(from_py_with = real)] duration: f64) -> PyResult<Motion> {
         crate::error::check_positive("duration", duration)?;
         Ok(wrap(generators::slalom(checked_origin(&origin)?, speed, amp, period, duration)?))
     }
 
     #[staticmethod]
-    fn car(origin: PyReadonlyArray1<'_, f64>, heading: f64, vibration: bool) -> PyResult<Motion> {
+    fn car(origin: PyReadonlyArray1<'_, f64>, #[pyo3(from_py_with = real)] heading: f64, vibration: bool) -> PyResult<Motion> {
         Ok(wrap(generators::car(checked_origin(&origin)?, heading, vibration)))
     }
 
@@ -99,8 +99,8 @@ impl Motion {
         origin: PyReadonlyArray1<'_, f64>,
         states: PyReadonlyArray2<'_, f64>,
         move_starts: PyReadonlyArray1<'_, f64>,
-        move_duration: f64,
-        duration: f64,
+        #[pyo3(from_py_with = real)] move_duration: f64,
+        #[pyo3(from_py_with = real)] duration: f64,
     ) -> PyResult<Motion> {
         let st: Vec<(f64, f64)> = super::convert::rows::<2>(&states, "states")?.into_iter().map(|r| (r[0], r[1])).collect();
         let ms = vector(&move_starts, "move_starts")?;
