@@ -19,7 +19,7 @@
 //!
 //! **Fine alignment** runs the aided INS of `aided.rs` on the static record with
 //! zero-velocity ([`ZeroVelocity`]) and zero-angular-rate ([`ZeroRate`]) updates
-//! (Groves 2013, §15.3.1 and §15.3.3), from the coarse attitude and the initial
+//! (Groves 2013, §15.3.1 and §15.3.3; two sources of `sources.rs`), from the coarse attitude and the initial
 //! covariance of [`fine_p0`], which keeps the correlation between the coarse attitude
 //! error and the sensor biases that caused it.
 
@@ -280,17 +280,6 @@ pub fn fine_p0(layout: &Layout, q_nb: &Quat, lat: f64, gravity: f64, omega: f64,
     Ok(p)
 }
 
-/// Measurement times every `interval` s from `t0 + interval` up to `t1`.
-pub fn update_times(t0: f64, t1: f64, interval: f64) -> Result<Vec<f64>> {
-    crate::error::check_positive("interval", interval)?;
-    let count = ((t1 - t0) / interval + 1e-9).floor();
-    if !count.is_finite() || count < 1.0 {
-        return Err(invalid("interval", format!("{interval} s leaves no update inside the record [{t0}, {t1}] s")));
-    }
-    let count = crate::error::check_count("interval", count as usize, 1, 100_000_000)?;
-    Ok((1..=count).map(|k| (t0 + k as f64 * interval).min(t1)).collect())
-}
-
 /// Zero-velocity update (ZUPT; Groves 2013, §15.3.1): the vehicle is at rest, so
 /// z = v̂ − 0 (predicted − measured), H = [0 I 0 …] on the velocity block, R = σ²I.
 #[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
@@ -302,8 +291,8 @@ pub struct ZeroVelocity {
 impl ZeroVelocity {
     /// Updates at `times` (s) with velocity noise σ `sigma` (m/s, > 0).
     pub fn new(times: Vec<f64>, sigma: f64) -> Result<Self> {
-        crate::error::check_positive("zupt_sigma", sigma)?;
-        check_finite("zupt_times", &times, 1)?;
+        crate::error::check_positive("sigma", sigma)?;
+        check_finite("zero_velocity", &times, 1)?;
         Ok(ZeroVelocity { times, sigma })
     }
 
@@ -317,7 +306,7 @@ impl ZeroVelocity {
 #[typetag::serde]
 impl Aiding for ZeroVelocity {
     fn name(&self) -> &str {
-        "zupt_times"
+        "zero_velocity"
     }
     fn times(&self) -> &[f64] {
         &self.times
@@ -356,14 +345,14 @@ impl ZeroRate {
     /// Updates at `times` (s) on a record of `kind`, gyro white-noise PSD `gyro_psd`
     /// (rad²/s, ≥ 0) and motion allowance `sigma` (rad/s, ≥ 0; not both zero).
     pub fn new(times: Vec<f64>, kind: ImuKind, gyro_psd: f64, sigma: f64) -> Result<Self> {
-        check_finite("zaru_times", &times, 1)?;
-        for (field, x) in [("gyro_psd", gyro_psd), ("zaru_sigma", sigma)] {
+        check_finite("zero_rate", &times, 1)?;
+        for (field, x) in [("gyro_psd", gyro_psd), ("sigma", sigma)] {
             if !(x.is_finite() && x >= 0.0) {
                 return Err(invalid(field, format!("must be finite and >= 0, got {x}")));
             }
         }
         if gyro_psd == 0.0 && sigma == 0.0 {
-            return Err(invalid("zaru_sigma", "must be > 0 when the gyro has no white noise (the update would have R = 0)"));
+            return Err(invalid("sigma", "must be > 0 when the gyro has no white noise (the update would have R = 0)"));
         }
         Ok(ZeroRate { times, kind, gyro_psd, sigma, sum: Vec3::zeros(), span: 0.0 })
     }
@@ -391,7 +380,7 @@ impl ZeroRate {
 #[typetag::serde]
 impl Aiding for ZeroRate {
     fn name(&self) -> &str {
-        "zaru_times"
+        "zero_rate"
     }
     fn times(&self) -> &[f64] {
         &self.times
@@ -405,56 +394,6 @@ impl Aiding for ZeroRate {
     }
     fn measure(&mut self, _j: usize, ctx: &AidingContext) -> Result<Option<Measurement>> {
         self.model(ctx)
-    }
-}
-
-/// Zero-velocity and, optionally, zero-angular-rate updates at the same epochs as one
-/// sensor (rows stacked: velocity, then rate), the measurement model of a fine alignment.
-#[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
-pub struct ZeroMotion {
-    velocity: ZeroVelocity,
-    rate: Option<ZeroRate>,
-}
-
-impl ZeroMotion {
-    /// ZUPT at `velocity`'s times, and the ZARU `rate` at the same times when given.
-    pub fn new(velocity: ZeroVelocity, rate: Option<ZeroRate>) -> Result<Self> {
-        if rate.as_ref().is_some_and(|r| r.times != velocity.times) {
-            return Err(invalid("zaru_times", "must equal zupt_times in a combined zero-motion update"));
-        }
-        Ok(ZeroMotion { velocity, rate })
-    }
-}
-
-#[typetag::serde]
-impl Aiding for ZeroMotion {
-    fn name(&self) -> &str {
-        "zupt_times"
-    }
-    fn times(&self) -> &[f64] {
-        &self.velocity.times
-    }
-    fn observe(&mut self, t: f64, dt: f64, gyro: &Vec3, accel: &Vec3, nav: &NavState) {
-        if let Some(r) = self.rate.as_mut() {
-            r.observe(t, dt, gyro, accel, nav);
-        }
-    }
-    fn measure(&mut self, _j: usize, ctx: &AidingContext) -> Result<Option<Measurement>> {
-        let v = self.velocity.model(ctx)?;
-        let Some(w) = (match self.rate.as_mut() {
-            Some(r) => r.model(ctx)?,
-            None => None,
-        }) else {
-            return Ok(Some(v));
-        };
-        let n = ctx.layout.size();
-        let mut h = DMatrix::<f64>::zeros(6, n);
-        h.view_mut((0, 0), (3, n)).copy_from(&v.h);
-        h.view_mut((3, 0), (3, n)).copy_from(&w.h);
-        let mut r = DMatrix::<f64>::zeros(6, 6);
-        r.view_mut((0, 0), (3, 3)).copy_from(&v.r);
-        r.view_mut((3, 3), (3, 3)).copy_from(&w.r);
-        Ok(Some(Measurement { z: v.z.into_iter().chain(w.z).collect(), h, r }))
     }
 }
 
@@ -542,8 +481,9 @@ mod tests {
         let bg = TriadBudget { white_psd: 1e-14, walk_psd: 0.0, bias_var: Vec3::repeat(1e-16), drift_var: 0.0 };
         let gamma = ell.local(lla.x, lla.z).gravity;
         let p0 = fine_p0(&layout, &start, lla.x, gamma, ell.omega, &(Mat3::identity() * 1e-4), &ba, &bg, 1.0, 0.01).unwrap();
-        let times = update_times(0.0, 120.0, 1.0).unwrap();
-        let aid = ZeroMotion::new(ZeroVelocity::new(times.clone(), 1e-3).unwrap(), Some(ZeroRate::new(times, ImuKind::Rates, 1e-14, 0.0).unwrap())).unwrap();
+        let times: Vec<f64> = (1..=120).map(f64::from).collect();
+        let zv: Box<dyn Aiding> = Box::new(ZeroVelocity::new(times.clone(), 1e-3).unwrap());
+        let aid = crate::filter::sources::Sources::new(vec![zv, Box::new(ZeroRate::new(times, ImuKind::Rates, 1e-14, 0.0).unwrap())]).unwrap();
         let s0 = NavState { t: 0.0, lla, vel: Vec3::zeros(), q_nb: start };
         let ins = AidedIns::new(s0, ImuKind::Rates, ell, Vec3::zeros(), Vec3::zeros(), nalgebra::DVector::zeros(0), p0, cfg, aid).unwrap();
         let (out, _) = run_aided(ins, &t, &g, &a).unwrap();

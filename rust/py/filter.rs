@@ -333,6 +333,14 @@ impl PyAidedIns {
     fn pending(&self, py: Python<'_>) -> usize {
         super::shared::lock(py, &self.inner).pending()
     }
+
+    /// The current error-state covariance P (n, n) in the order of `labels` (after the
+    /// last epoch processed), e.g. for the NEES against a known truth.
+    #[getter]
+    fn covariance<'py>(&self, py: Python<'py>) -> Bound<'py, numpy::PyArray2<f64>> {
+        let p = super::shared::lock(py, &self.inner).covariance().clone();
+        super::convert::mat_to_py(py, &p)
+    }
 }
 
 /// The rows of an (N, 3) array, shape-checked only: the aided engine checks finiteness

@@ -2,6 +2,7 @@
 
 use pyo3::prelude::*;
 
+mod alignment;
 mod astro;
 mod cai;
 mod convert;
@@ -65,5 +66,6 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     kalman::register(m)?;
     gnss::register(m)?;
     sources::register(m)?;
+    alignment::register(m)?;
     Ok(())
 }

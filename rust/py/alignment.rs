@@ -1,0 +1,117 @@
+//! Bindings of filter/alignment.rs: the coarse alignment of a static record, the initial
+//! covariance of a fine alignment, and the zero-velocity / zero-angular-rate updates as
+//! measurement sources (`AidingSource`) of an aided INS.
+
+use super::convert::{mat, mat_to_py, vec3, vec3_rows, vector, Wrap};
+use super::imu::triad_from_dict;
+use super::sources::AidingSource;
+use crate::earth::Ellipsoid;
+use crate::filter::alignment::{coarse, fine_p0, TriadBudget, ZeroRate, ZeroVelocity};
+use crate::filter::layout::Layout;
+use crate::filter::sources::Source;
+use crate::imu::errors::ImuErrorModel;
+use crate::imu::ImuKind;
+use crate::math::{quat, Mat3};
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+
+/// Coarse alignment of a static record: time (N,) s, gyro and accel (N, 3) of `kind`, the
+/// site `lla` (3,) and the sensor error model as the two triad dicts of `atomnav.imu`.
+/// Returns a dict of the core's `CoarseAlignment` fields (arrays, floats).
+#[pyfunction]
+#[pyo3(signature = (time, gyro, accel, kind, lla, accel_errors, gyro_errors, ellipsoid=Wrap(crate::earth::WGS84)))]
+#[allow(clippy::too_many_arguments)]
+fn coarse_alignment<'py>(
+    py: Python<'py>,
+    time: numpy::PyReadonlyArray1<'py, f64>,
+    gyro: numpy::PyReadonlyArray2<'py, f64>,
+    accel: numpy::PyReadonlyArray2<'py, f64>,
+    kind: Wrap<ImuKind>,
+    lla: numpy::PyReadonlyArray1<'py, f64>,
+    accel_errors: &Bound<'py, PyDict>,
+    gyro_errors: &Bound<'py, PyDict>,
+    ellipsoid: Wrap<Ellipsoid>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let model = ImuErrorModel { accel: triad_from_dict(accel_errors, "accel")?, gyro: triad_from_dict(gyro_errors, "gyro")? };
+    let (t, g, a, lla) = (vector(&time, "time")?, vec3_rows(&gyro, "gyro")?, vec3_rows(&accel, "accel")?, vec3(&lla, "lla")?);
+    let c = py.detach(|| coarse(&t, &g, &a, kind.0, &lla, &ellipsoid.0, &model))?;
+    let d = PyDict::new(py);
+    d.set_item("t0", c.t0)?;
+    d.set_item("t1", c.t1)?;
+    d.set_item("samples", c.samples)?;
+    d.set_item("q_nb", vec![c.q_nb.w, c.q_nb.i, c.q_nb.j, c.q_nb.k])?;
+    d.set_item("euler", c.euler.as_slice().to_vec())?;
+    d.set_item("euler_sigma", c.euler_sigma.as_slice().to_vec())?;
+    d.set_item("mean_f", c.mean_f.as_slice().to_vec())?;
+    d.set_item("mean_w", c.mean_w.as_slice().to_vec())?;
+    d.set_item("gravity", c.gravity)?;
+    d.set_item("earth_rate_h", c.earth_rate_h)?;
+    d.set_item("psi_cov", mat_to_py(py, &c.psi_cov))?;
+    d.set_item("psi_cov_noise", mat_to_py(py, &c.psi_cov_noise))?;
+    d.set_item("spread", c.spread)?;
+    Ok(d)
+}
+
+/// The initial covariance (15, 15) of a fine alignment from a coarse one (`q_nb` (4,),
+/// `psi_cov_noise` (3, 3), static means `mean_f`, `mean_w`, `gravity`) at `lla` over a
+/// record of `horizon` s, with the error model's triad dicts, position σ `pos_sigma` (m)
+/// and velocity σ `vel_sigma` (m/s); and the filter's noise model: (accel white PSD,
+/// accel bias random-walk PSD, gyro white PSD, gyro bias random-walk PSD).
+#[pyfunction]
+#[pyo3(signature = (lla, q_nb, psi_cov_noise, mean_f, mean_w, gravity, horizon, accel_errors, gyro_errors, pos_sigma, vel_sigma, ellipsoid=Wrap(crate::earth::WGS84)))]
+#[allow(clippy::too_many_arguments, clippy::type_complexity)]
+fn fine_alignment_p0<'py>(
+    py: Python<'py>,
+    lla: numpy::PyReadonlyArray1<'py, f64>,
+    q_nb: numpy::PyReadonlyArray1<'py, f64>,
+    psi_cov_noise: numpy::PyReadonlyArray2<'py, f64>,
+    mean_f: numpy::PyReadonlyArray1<'py, f64>,
+    mean_w: numpy::PyReadonlyArray1<'py, f64>,
+    gravity: f64,
+    horizon: f64,
+    accel_errors: &Bound<'py, PyDict>,
+    gyro_errors: &Bound<'py, PyDict>,
+    pos_sigma: f64,
+    vel_sigma: f64,
+    ellipsoid: Wrap<Ellipsoid>,
+) -> PyResult<(Bound<'py, numpy::PyArray2<f64>>, (f64, f64, f64, f64))> {
+    let model = ImuErrorModel { accel: triad_from_dict(accel_errors, "accel")?, gyro: triad_from_dict(gyro_errors, "gyro")? };
+    model.validate()?;
+    let (lla, q) = (vec3(&lla, "lla")?, vector(&q_nb, "q_nb")?);
+    let [w, x, y, z] = <[f64; 4]>::try_from(q).map_err(|q| crate::error::invalid("q_nb", format!("expected 4 values, got {}", q.len())))?;
+    let noise = mat(&psi_cov_noise, "psi_cov_noise")?;
+    if noise.shape() != (3, 3) {
+        return Err(crate::error::invalid("psi_cov_noise", format!("expected (3, 3), got {:?}", noise.shape())).into());
+    }
+    let noise = Mat3::from_iterator(noise.iter().copied());
+    crate::error::check_positive("horizon", horizon)?;
+    let ba = TriadBudget::of(&model.accel, &vec3(&mean_f, "mean_f")?, horizon);
+    let bg = TriadBudget::of(&model.gyro, &vec3(&mean_w, "mean_w")?, horizon);
+    let layout = Layout::ins_with(&[])?;
+    let p0 = fine_p0(&layout, &quat(w, x, y, z), lla.x, gravity, ellipsoid.0.omega, &noise, &ba, &bg, pos_sigma, vel_sigma)?;
+    Ok((mat_to_py(py, &p0), (ba.white_psd, ba.walk_psd, bg.white_psd, bg.walk_psd)))
+}
+
+/// Zero-velocity updates at `time` (M,) s with velocity noise σ `sigma` (m/s).
+#[pyfunction]
+fn zero_velocity(time: numpy::PyReadonlyArray1<'_, f64>, sigma: f64) -> PyResult<AidingSource> {
+    Ok(AidingSource::new(Box::new(ZeroVelocity::new(vector(&time, "time")?, sigma)?)))
+}
+
+/// Zero-angular-rate updates at `time` (M,) s: gyro white-noise PSD `gyro_psd` (rad²/s)
+/// and a motion allowance σ `sigma` (rad/s); the IMU kind is the INS's.
+#[pyfunction]
+fn zero_rate(time: numpy::PyReadonlyArray1<'_, f64>, gyro_psd: f64, sigma: f64) -> PyResult<AidingSource> {
+    let t = vector(&time, "time")?;
+    // checked now, with the setup's IMU kind when the INS is built
+    ZeroRate::new(t.clone(), ImuKind::Rates, gyro_psd, sigma)?;
+    Ok(AidingSource::deferred("zero_rate".to_string(), Box::new(move |setup| Ok(Source::plain(Box::new(ZeroRate::new(t, setup.kind, gyro_psd, sigma)?))))))
+}
+
+pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_function(wrap_pyfunction!(coarse_alignment, m)?)?;
+    m.add_function(wrap_pyfunction!(fine_alignment_p0, m)?)?;
+    m.add_function(wrap_pyfunction!(zero_velocity, m)?)?;
+    m.add_function(wrap_pyfunction!(zero_rate, m)?)?;
+    Ok(())
+}
