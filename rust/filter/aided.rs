@@ -188,9 +188,9 @@ fn nominal_row(nav: &NavState, ba: &Vec3, bg: &Vec3, extra: &DVector<f64>) -> DV
 /// A nominal row back as (solution, accel bias, gyro bias, extra blocks); `None` when
 /// the row is shorter than [`NOMINAL_WIDTH`].
 fn from_nominal_row(row: &DVector<f64>) -> Option<(NavState, Vec3, Vec3, DVector<f64>)> {
-    let (&[t, lat, lon, h, vn, ve, vd, qw, qx, qy, qz, bax, bay, baz, bgx, bgy, bgz], extra) = row.as_slice().split_first_chunk::<NOMINAL_WIDTH>()?;
+    let (&[t, lat, lon, h, vn, ve, vd, qw, qx, qy, qz, ba_x, ba_y, ba_z, bg_x, bg_y, bg_z], extra) = row.as_slice().split_first_chunk::<NOMINAL_WIDTH>()?;
     let nav = NavState { t, lla: Vec3::new(lat, lon, h), vel: Vec3::new(vn, ve, vd), q_nb: crate::math::quat(qw, qx, qy, qz) };
-    Some((nav, Vec3::new(bax, bay, baz), Vec3::new(bgx, bgy, bgz), DVector::from_column_slice(extra)))
+    Some((nav, Vec3::new(ba_x, ba_y, ba_z), Vec3::new(bg_x, bg_y, bg_z), DVector::from_column_slice(extra)))
 }
 
 /// The smoothed solution of one chunk of a stored forward pass

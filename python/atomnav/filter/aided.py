@@ -170,14 +170,19 @@ class AidedResult:
 @dataclass
 class SmoothedResult:
     """Output of the Rauch–Tung–Striebel smoother (Rauch, Tung & Striebel 1965) over an
-    aided-INS run (:meth:`AidedIns.smooth`).
+    aided-INS run (:meth:`AidedIns.smooth`). There is no smoothed NIS: the filtered
+    ``measurements`` stay the record of the innovations.
 
-    ``nav``: one row per prediction epoch, in the columns of :attr:`AidedResult.nav`: the
-    smoothed navigation solution, IMU bias and extra-block estimates and the smoothed σ of
-    every state (``sigma_<label>``, SI units of the state). There is no smoothed NIS: the
-    filtered ``measurements`` stay the record of the innovations. ``covariance``: the
-    smoothed error-state covariance (E, n, n) in the order of :attr:`AidedIns.labels`
-    when asked for, else None.
+    Attributes
+    ----------
+    nav : pandas.DataFrame
+        One row per prediction epoch in the columns of :attr:`AidedResult.nav`: the
+        smoothed navigation solution (rad, m, m/s, q_nb, rad), IMU bias estimates (m/s²,
+        rad/s), extra-block estimates and the smoothed σ of every state
+        (``sigma_<label>``, SI units of the state).
+    covariance : numpy.ndarray or None
+        The smoothed error-state covariance (E, n, n) in the order of
+        :attr:`AidedIns.labels` (SI units of the states) when asked for, else None.
     """
 
     nav: pd.DataFrame
@@ -288,20 +293,39 @@ class AidedIns:
 
     def smooth(self, covariance: bool = False, progress: bool = False) -> SmoothedResult:
         """The Rauch–Tung–Striebel fixed-interval smoother (Rauch, Tung & Striebel 1965)
-        over the epochs processed so far (call it after :meth:`finish`): the backward pass
-        runs in the Rust core, chunk by chunk from the end of the stored forward pass
-        (``smooth_chunk`` epochs at a time, those on disk memory-mapped), carrying the
-        smoothed mean and covariance across chunk boundaries; the result does not depend on
-        the chunk size. Memory: one chunk of the forward pass and its smoothed
-        covariances, 8 (5n² + 3n + 17 + n_extra) bytes per epoch of the chunk, plus the
-        smoothed table; ``covariance`` True also keeps every smoothed covariance, 8n²
-        bytes per epoch (:attr:`SmoothedResult.covariance`). ``progress`` shows a bar over
-        the chunks.
+        over the epochs processed so far (call it after :meth:`finish`).
 
-        In closed loop the smoothed error is referred to the corrected (output) solution
-        of each epoch; the derivation is in the core (``AidedIns::smooth_chunk``,
-        rust/filter/aided.rs). An engine built without ``smooth=True`` raises
-        :class:`atomnav.InputError` naming ``smooth``."""
+        The backward pass runs in the Rust core, chunk by chunk from the end of the stored
+        forward pass (``smooth_chunk`` epochs at a time, chunks on disk memory-mapped),
+        carrying the smoothed mean and covariance across chunk boundaries, so the result
+        does not depend on the chunk size. In closed loop the smoothed error is referred to
+        each epoch's corrected (output) solution; the derivation is in the core
+        (``AidedIns::smooth_chunk``, ``rust/filter/aided.rs``).
+
+        Parameters
+        ----------
+        covariance : bool
+            Also return every smoothed error-state covariance (8n² bytes per epoch).
+        progress : bool
+            Show a progress bar over the chunks.
+
+        Returns
+        -------
+        SmoothedResult
+            The smoothed table (the columns of :attr:`AidedResult.nav`) and, with
+            ``covariance``, the covariances (E, n, n) in SI units of the states. Before any
+            epoch: an empty table.
+
+        Raises
+        ------
+        atomnav.InputError
+            Naming ``smooth`` when the engine was built without ``smooth=True``.
+
+        Notes
+        -----
+        Memory: one chunk of the forward pass and its smoothed moments, 8 (5n² + 3n + 17 +
+        n_extra) bytes per epoch of the chunk, plus the smoothed table.
+        """
         covariance = flag(covariance, "covariance")
         progress = flag(progress, "progress")
         if self._store is None:
@@ -319,9 +343,9 @@ class AidedIns:
                 navs.append(self._nav(*out[:5]))
                 if covariance:
                     covs.append(ps)
-        if not navs:  # nothing processed yet: the empty table of the core's empty output
-            out, _, ps = self._core.smooth_chunk(*[np.zeros((0, 0, 0)), np.zeros((0, 0))] * 2, np.zeros((0, 0, 0)),
-                                                 np.zeros((0, 0)), None, 0)
+        if not navs:  # nothing processed yet: the table of the core's output for no epochs
+            m, v = np.zeros((0, 0, 0)), np.zeros((0, 0))
+            out, _, ps = self._core.smooth_chunk(m, v, m, v, m, v, None, 0)
             navs, covs = [self._nav(*out[:5])], [ps]
         nav = pd.concat(navs[::-1], ignore_index=True)
         return SmoothedResult(nav, np.concatenate(covs[::-1]) if covariance else None)
