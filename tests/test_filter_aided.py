@@ -94,14 +94,14 @@ def test_bad_p0_size():
 def test_bad_fix_covariance():
     kw, _ = _args()
     kw["fix_cov"] = -np.eye(3)[None]
-    with pytest.raises(ValueError, match=r"fixes\[0\] covariance: not positive definite"):
+    with pytest.raises(ValueError, match=r"fix_cov: entry 0: not positive definite"):
         position_aided_ins(**kw)
 
 
 def test_bad_unsorted_fixes():
     kw, _ = _args()
     kw.update(fix_time=[0.5, 0.4], fix_lla=[[LAT, LON, H]] * 2, fix_cov=np.tile(np.eye(3), (2, 1, 1)))
-    with pytest.raises(ValueError, match="fixes: time not strictly increasing at index 1"):
+    with pytest.raises(ValueError, match="fix_t: time not strictly increasing: decreasing stamp 0.4 at index 1"):
         position_aided_ins(**kw)
 
 

@@ -9,46 +9,51 @@
 use super::aided::{Aiding, AidingContext, InsSetup, Measurement};
 use super::layout::{ins_size, Layout};
 use super::matrix::check_covariance;
-use crate::error::{invalid, invalid_at, NavError, Result};
+use crate::error::{check_increasing, invalid, invalid_at, NavError, Result};
 use crate::math::{Mat3, Vec3};
 use crate::strapdown::NavState;
 use nalgebra::{DMatrix, DVector};
 
-/// The covariances of a table of 3-vector fixes as 3 × 3 matrices. `names` are the
-/// caller's arguments (times, values, covariances): as many values and covariances as
-/// times, each covariance 3 × 3 (M, 3, 3).
-pub fn fix_covariances(names: [&str; 3], times: usize, values: usize, cov: &[DMatrix<f64>]) -> Result<Vec<Mat3>> {
-    let [t, v, c] = names;
-    if values != times {
-        return Err(invalid(v, format!("{t} has {times} entries but {v} {values}")));
+/// A table of 3-vector fixes (position, velocity) checked: times finite and strictly
+/// increasing, as many values and covariances as times, each covariance 3 × 3, and every
+/// row as [`check_fix_rows`] checks it. `names` are the caller's arguments (times, values,
+/// covariances): errors name them and the first offending row. Returns the covariances.
+pub fn fix_table(names: [&str; 3], what: &str, t: &[f64], values: &[Vec3], cov: &[DMatrix<f64>]) -> Result<Vec<Mat3>> {
+    let [time, v, c] = names;
+    check_increasing(time, t)?;
+    if values.len() != t.len() {
+        return Err(invalid(v, format!("{time} has {} entries but {v} {}", t.len(), values.len())));
     }
-    if cov.len() != times {
-        return Err(invalid(c, format!("{t} has {times} entries but {c} {}", cov.len())));
+    if cov.len() != t.len() {
+        return Err(invalid(c, format!("{time} has {} entries but {c} {}", t.len(), cov.len())));
     }
     if let Some((i, m)) = cov.iter().enumerate().find(|(_, m)| m.nrows() != 3 || m.ncols() != 3) {
         return Err(invalid_at(c, i, format!("expected (M, 3, 3), entry {i} is {}x{}", m.nrows(), m.ncols())));
     }
     // each is 3 × 3 (checked above): its 9 column-major values
-    Ok(cov.iter().map(|m| Mat3::from_iterator(m.iter().copied())).collect())
+    let cov: Vec<Mat3> = cov.iter().map(|m| Mat3::from_iterator(m.iter().copied())).collect();
+    check_fix_rows([v, c], what, values.iter().zip(&cov))?;
+    Ok(cov)
 }
 
-/// The checks every table of 3-vector fixes (position, velocity) shares, row by row: a
-/// finite `what` and a symmetric positive-definite covariance. Errors name `field` and
-/// the row.
-pub fn check_fix_rows<'a>(field: &str, what: &str, rows: impl IntoIterator<Item = (&'a Vec3, &'a Mat3)>) -> Result<()> {
-    for (i, (v, c)) in rows.into_iter().enumerate() {
-        if !v.iter().all(|x| x.is_finite()) {
-            return Err(invalid_at(field, i, format!("non-finite {what} at index {i}")));
+/// The checks of every row of a table of 3-vector fixes: a finite value (a `what`) and a
+/// symmetric positive-definite covariance. `names` (values, covariances) are named in the
+/// errors, with the row.
+pub fn check_fix_rows<'a>(names: [&str; 2], what: &str, rows: impl IntoIterator<Item = (&'a Vec3, &'a Mat3)>) -> Result<()> {
+    let [v, c] = names;
+    for (i, (value, m)) in rows.into_iter().enumerate() {
+        if !value.iter().all(|x| x.is_finite()) {
+            return Err(invalid_at(v, i, format!("non-finite {what} at index {i}")));
         }
-        check_covariance(&format!("{field}[{i}] covariance"), &DMatrix::from_column_slice(3, 3, c.as_slice()), Some(3), true).map_err(|e| at_row(e, i))?;
+        check_covariance(c, &DMatrix::from_column_slice(3, 3, m.as_slice()), Some(3), true).map_err(|e| at_row(e, i))?;
     }
     Ok(())
 }
 
-/// An invalid-input error with its row set.
+/// An invalid-input error about entry `i` of an array: its row set, named in the reason.
 fn at_row(e: NavError, i: usize) -> NavError {
     match e {
-        NavError::InvalidInput { field, reason, .. } => NavError::InvalidInput { field, reason, index: Some(i) },
+        NavError::InvalidInput { field, reason, .. } => NavError::InvalidInput { field, reason: format!("entry {i}: {reason}"), index: Some(i) },
         other => other,
     }
 }
@@ -61,15 +66,6 @@ pub struct VelocityFix {
     pub cov: Mat3,
 }
 
-impl VelocityFix {
-    /// Fixes from columns: times (s), NED velocities (m/s) and their covariances (3 × 3,
-    /// m²/s²); `names` are the caller's arguments, errors name them.
-    pub fn table(names: [&str; 3], t: &[f64], vel: &[Vec3], cov: &[DMatrix<f64>]) -> Result<Vec<VelocityFix>> {
-        let cov = fix_covariances(names, t.len(), vel.len(), cov)?;
-        Ok(t.iter().zip(vel).zip(cov).map(|((&t, &vel_ned), cov)| VelocityFix { t, vel_ned, cov }).collect())
-    }
-}
-
 /// NED velocity fixes as an aiding sensor: z = v̂ − v_fix, H = [0 I 0 ...] on the velocity
 /// block (δv = estimate − true), R the fix's covariance.
 #[derive(serde::Serialize, serde::Deserialize)]
@@ -79,9 +75,12 @@ pub struct VelocityFixes {
 }
 
 impl VelocityFixes {
-    pub fn new(fixes: Vec<VelocityFix>) -> Result<Self> {
-        check_fix_rows("velocity_fixes", "velocity", fixes.iter().map(|f| (&f.vel_ned, &f.cov)))?;
-        Ok(VelocityFixes { times: fixes.iter().map(|f| f.t).collect(), fixes })
+    /// Fixes from columns: times (s), NED velocities (m/s) and their covariances (3 × 3,
+    /// m²/s²), checked by [`fix_table`]; `names` are the caller's arguments.
+    pub fn table(names: [&str; 3], t: &[f64], vel: &[Vec3], cov: &[DMatrix<f64>]) -> Result<Self> {
+        let cov = fix_table(names, "velocity", t, vel, cov)?;
+        let fixes = t.iter().zip(vel).zip(cov).map(|((&t, &vel_ned), cov)| VelocityFix { t, vel_ned, cov }).collect();
+        Ok(VelocityFixes { times: t.to_vec(), fixes })
     }
 }
 
@@ -268,7 +267,8 @@ mod tests {
     }
 
     fn velocity(times: impl Iterator<Item = f64>) -> VelocityFixes {
-        VelocityFixes::new(times.map(|t| VelocityFix { t, vel_ned: Vec3::zeros(), cov: Mat3::identity() * 1e-4 }).collect()).unwrap()
+        let t: Vec<f64> = times.collect();
+        VelocityFixes::table(["time", "vel_ned", "cov"], &t, &vec![Vec3::zeros(); t.len()], &vec![DMatrix::identity(3, 3) * 1e-4; t.len()]).unwrap()
     }
 
     fn run(setup: &InsSetup, parts: Vec<Source>, t: &[f64], g: &[Vec3], a: &[Vec3]) -> AidedOutput {

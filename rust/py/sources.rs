@@ -6,7 +6,7 @@ use super::convert::{vec3_rows, vector};
 use super::filter::{mats, AidedSetup, PyAidedIns};
 use crate::error::{invalid_at, Result};
 use crate::filter::aided::{Aiding, InsSetup, PositionAiding, PositionFix};
-use crate::filter::sources::{combine, Source, VelocityFix, VelocityFixes};
+use crate::filter::sources::{combine, Source, VelocityFixes};
 use numpy::{PyReadonlyArray1, PyReadonlyArray2, PyReadonlyArray3};
 use pyo3::prelude::*;
 use std::sync::Mutex;
@@ -64,31 +64,23 @@ fn position_fixes(time: PyReadonlyArray1<'_, f64>, lla: PyReadonlyArray2<'_, f64
 #[pyfunction]
 fn velocity_fixes(time: PyReadonlyArray1<'_, f64>, vel_ned: PyReadonlyArray2<'_, f64>, cov: PyReadonlyArray3<'_, f64>) -> PyResult<AidingSource> {
     let (t, vel, cov) = (vector(&time, "time")?, vec3_rows(&vel_ned, "vel_ned")?, mats(&cov, "cov")?);
-    let fixes = VelocityFix::table(["time", "vel_ned", "cov"], &t, &vel, &cov)?;
-    Ok(AidingSource::new(Box::new(VelocityFixes::new(fixes)?)))
+    Ok(AidingSource::new(Box::new(VelocityFixes::table(["time", "vel_ned", "cov"], &t, &vel, &cov)?)))
 }
 
 /// The aided INS of `setup` fed by every source of `sources` (a list of `AidingSource`,
 /// each consumed). A source used before, or given twice, is an `InputError` naming
-/// `sources` and its place in the list.
+/// `sources` and its place in the list; then no source is consumed.
 #[pyfunction]
 fn aided_ins_from_sources(py: Python<'_>, setup: PyRef<'_, AidedSetup>, sources: Vec<Bound<'_, AidingSource>>) -> PyResult<PyAidedIns> {
-    for (i, s) in sources.iter().enumerate() {
-        if let Some(k) = sources.iter().take(i).position(|o| o.is(s)) {
-            return Err(invalid_at("sources", i, format!("source {i} is source {k} again (each source feeds one INS once)")).into());
-        }
+    let slot = |s: &Bound<'_, AidingSource>| super::shared::lock(py, &s.get().build).take();
+    let taken: Vec<Option<Build>> = sources.iter().map(slot).collect();
+    if let Some(i) = taken.iter().position(Option::is_none) {
+        // give back what was taken: a failed call consumes nothing
+        sources.iter().zip(taken).filter_map(|(s, b)| Some((s, b?))).for_each(|(s, b)| *super::shared::lock(py, &s.get().build) = Some(b));
+        let name = sources.get(i).map_or_else(String::new, |s| s.get().name.clone());
+        return Err(invalid_at("sources", i, format!("source {i} ({name}) was used to build an INS already, or is given twice: make it again")).into());
     }
-    let mut guards = Vec::with_capacity(sources.len());
-    for (i, s) in sources.iter().enumerate() {
-        let guard = super::shared::lock(py, &s.get().build);
-        if guard.is_none() {
-            return Err(invalid_at("sources", i, format!("source {i} ({}) was used to build an INS already: make it again", s.get().name)).into());
-        }
-        guards.push(guard);
-    }
-    let builds: Vec<Build> = guards.iter_mut().filter_map(|g| g.take()).collect();
-    drop(guards);
-    let parts = builds.into_iter().map(|b| b(&setup.setup)).collect::<Result<Vec<Source>>>()?;
+    let parts = taken.into_iter().flatten().map(|b| b(&setup.setup)).collect::<Result<Vec<Source>>>()?;
     let (sources, extra0, p0) = combine(&setup.setup, parts)?;
     PyAidedIns::from_aiding_with(&setup, extra0, Some(p0), Box::new(sources))
 }

@@ -1,0 +1,185 @@
+"""Measurement sources for one aided INS (Rust core, ``rust/filter/sources.rs``).
+
+Each aiding sensor is a source — :class:`PositionFixes`, :class:`VelocityFixes`, and the
+sources other modules make (zero-velocity updates, CAI shots, GNSS) — and
+:func:`aided_ins` builds one :class:`~atomnav.filter.AidedIns` fed by all of them. The
+measurements of all sources are applied in time order (equal times in the order the
+sources are given), each at the first IMU epoch at or after its time; the sources' extra
+states (clock, lever arm, ...) follow the 15 INS states in source order.
+
+>>> setup = InsSetup(t0=0.0, lla0=lla0, vel0=vel0, q0=q0, kind="rates", p0=p0,
+...                  accel_psd=1e-8, gyro_psd=1e-12)                        # doctest: +SKIP
+>>> ins = aided_ins(setup, [PositionFixes(fixes_df), VelocityFixes(t, v, cov)])  # doctest: +SKIP
+>>> result = ins.run(time, gyro, accel)                                       # doctest: +SKIP
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+
+from .. import _core, plausibility
+from .._validate import as_floats, input_error, instance, rows, table, vector
+from .aided import AidedIns, InsSetup
+
+
+class Source:
+    """A measurement source for :func:`aided_ins`. The same source may feed any number of
+    aided INS (each gets its own copy of the measurements)."""
+
+    #: Columns of a table (DataFrame) of this source: time, then the 3-vector.
+    COLUMNS: tuple[str, ...] = ()
+    #: Optional columns of a table with the σ of each component (diagonal covariance).
+    SIGMA_COLUMNS: tuple[str, ...] = ()
+    #: Name of the 3-vector argument.
+    VALUE = ""
+
+    def __init__(self, time, value=None, cov=None, *, epoch=None):
+        if isinstance(time, pd.DataFrame):
+            if value is not None:
+                raise input_error(self.VALUE, f"given together with a table: the table's columns {list(self.COLUMNS[1:])} are the {self.VALUE}")
+            t, value, sigma = self._read(time, cov is None, epoch)
+            cov = np.apply_along_axis(np.diag, 1, sigma**2) if cov is None else cov
+        else:
+            if value is None:
+                raise input_error(self.VALUE, f"required (or give a DataFrame with the columns {list(self.COLUMNS)})")
+            if cov is None:
+                raise input_error("cov", "required: the (M, 3, 3) covariances, or one (3, 3) for every fix")
+            t = vector(time, None, "time")
+        value = rows(value, 3, self.VALUE)
+        self.time: np.ndarray = t
+        #: The fixes (M, 3) in SI units.
+        self.value: np.ndarray = self._plausible(value)
+        #: Their covariances (M, 3, 3), SI units squared.
+        self.cov: np.ndarray = _covariances(cov, len(t))
+        self._native()  # the core checks every fix now, naming this call's arguments
+
+    def _read(self, df: pd.DataFrame, with_sigma: bool, epoch):
+        """Time (s), values (M, 3) and, when ``with_sigma``, σ (M, 3) from a table."""
+        names = self.COLUMNS + (self.SIGMA_COLUMNS if with_sigma else ())
+        if with_sigma and not set(self.SIGMA_COLUMNS) <= set(df.columns):
+            raise input_error("cov", f"required unless the table has the columns {list(self.SIGMA_COLUMNS)}")
+        data = table(df, names, "time", epoch=epoch, epoch_name="epoch")
+        return np.ascontiguousarray(data[:, 0]), data[:, 1:4], data[:, 4:7]
+
+    def _plausible(self, value: np.ndarray) -> np.ndarray:
+        return value
+
+    def _native(self) -> _core.AidingSource:
+        raise NotImplementedError
+
+    def __len__(self) -> int:
+        return len(self.time)
+
+    def __repr__(self) -> str:
+        span = f", {self.time[0]:g} to {self.time[-1]:g} s" if len(self) else ""
+        return f"{type(self).__name__}({len(self)} fixes{span})"
+
+
+class PositionFixes(Source):
+    """Position fixes: ``time`` (M,) s, ``lla`` (M, 3) (lat rad, lon rad, h m) and their NED
+    covariances ``cov`` (M, 3, 3) m² (or one (3, 3) for every fix), z = NED(INS − fix).
+
+    ``time`` may instead be a DataFrame with the columns ``time_s, lat_rad, lon_rad, h_m``
+    and, unless ``cov`` is given, ``sigma_n_m, sigma_e_m, sigma_d_m`` (σ of the north,
+    east and down errors, m; uncorrelated). A ``time_s`` column of datetimes counts seconds
+    from ``epoch`` (the epoch of the IMU record's time); timedelta64 is its seconds.
+    Every fix is checked here: time finite and strictly increasing, positions finite
+    with latitudes within ±π/2, covariances symmetric positive definite; a bad one raises
+    :class:`atomnav.InputError` naming ``time``, ``lla`` or ``cov`` and its row.
+    Longitudes in degrees warn (:class:`atomnav.UnitWarning`).
+    """
+
+    COLUMNS = ("time_s", "lat_rad", "lon_rad", "h_m")
+    SIGMA_COLUMNS = ("sigma_n_m", "sigma_e_m", "sigma_d_m")
+    VALUE = "lla"
+
+    def __init__(self, time, lla=None, cov=None, *, epoch=None):
+        super().__init__(time, lla, cov, epoch=epoch)
+
+    def _plausible(self, value):
+        return plausibility.lla(value, "lla")
+
+    def _native(self) -> _core.AidingSource:
+        return _core.position_fixes(self.time, self.value, self.cov)
+
+
+class VelocityFixes(Source):
+    """NED velocity fixes: ``time`` (M,) s, ``vel_ned`` (M, 3) m/s and their covariances
+    ``cov`` (M, 3, 3) m²/s² (or one (3, 3) for every fix), z = v̂ − v_fix on the velocity
+    error states.
+
+    ``time`` may instead be a DataFrame with the columns ``time_s, vn_mps, ve_mps,
+    vd_mps`` and, unless ``cov`` is given, ``sigma_vn_mps, sigma_ve_mps, sigma_vd_mps``
+    (σ of each component, m/s; uncorrelated); time as for :class:`PositionFixes`. Every
+    fix is checked here (time finite and strictly increasing, velocities finite,
+    covariances symmetric positive definite); a bad one raises :class:`atomnav.InputError`
+    naming ``time``, ``vel_ned`` or ``cov`` and its row.
+    """
+
+    COLUMNS = ("time_s", "vn_mps", "ve_mps", "vd_mps")
+    SIGMA_COLUMNS = ("sigma_vn_mps", "sigma_ve_mps", "sigma_vd_mps")
+    VALUE = "vel_ned"
+
+    def __init__(self, time, vel_ned=None, cov=None, *, epoch=None):
+        super().__init__(time, vel_ned, cov, epoch=epoch)
+
+    def _native(self) -> _core.AidingSource:
+        return _core.velocity_fixes(self.time, self.value, self.cov)
+
+
+def _covariances(cov, m: int) -> np.ndarray:
+    """``cov`` as a C-contiguous (m, 3, 3) stack; one (3, 3) matrix serves every fix."""
+    c = as_floats(cov, "cov")
+    if c.shape == (3, 3):
+        c = np.broadcast_to(c, (m, 3, 3))
+    if c.ndim != 3 or c.shape[1:] != (3, 3):
+        raise input_error("cov", f"expected shape (M, 3, 3) or (3, 3), got {c.shape}")
+    return np.ascontiguousarray(c)
+
+
+def aided_ins(setup: InsSetup, sources) -> AidedIns:
+    """One aided INS fed by several measurement sources.
+
+    Parameters
+    ----------
+    setup : InsSetup
+        The INS: initial state, IMU kind, noise, filter options. Its ``p0`` is either the
+        (15, 15) covariance of the INS states — then sources with extra states (GNSS
+        clock, CAI lever arm, ...) add their own initial covariance after it — or the
+        covariance of the whole state (INS states, then every source's extra states in
+        source order), which replaces the sources' own.
+    sources : source or sequence of sources
+        :class:`PositionFixes`, :class:`VelocityFixes` and the sources other modules make.
+        Each source's measurements must lie inside the IMU record. Equal times of
+        different sources are applied at the same epoch in the order given.
+
+    Returns
+    -------
+    AidedIns
+        Run it with ``.run(time, gyro, accel)``; ``labels`` lists the states.
+
+    Raises
+    ------
+    atomnav.InputError
+        Naming ``sources`` (and the source's place in ``.index``) for two sources with a
+        state of the same name, a core source given twice or used before, or a source with
+        extra states but no initial covariance when ``setup.p0`` is (15, 15).
+    TypeError
+        For a ``setup`` that is no :class:`InsSetup` or a source that is no source.
+    """
+    instance(setup, InsSetup, "setup")
+    if isinstance(sources, (Source, _core.AidingSource)):
+        sources = [sources]
+    if isinstance(sources, (str, bytes, pd.DataFrame)) or not hasattr(sources, "__iter__"):
+        raise TypeError(f"sources: expected a measurement source or a sequence of them, got {type(sources).__name__}")
+    native = []
+    for i, s in enumerate(sources):
+        if isinstance(s, Source):
+            native.append(s._native())
+        elif isinstance(s, _core.AidingSource):
+            native.append(s)
+        else:
+            raise TypeError(f"sources: item {i} is a {type(s).__name__}, not a measurement source "
+                            "(PositionFixes, VelocityFixes, ...)")
+    return AidedIns(_core.aided_ins_from_sources(setup.native, native), setup)
