@@ -114,4 +114,4 @@ def test_reproduce_section_quick(tmp_path):
     t = reproduce.run(tmp_path, only=["noise_niu2025"], quick=True)
     assert (t["verdict"] != "FAIL").all()
     assert (tmp_path / "noise_niu2025_allan.png").exists() and (tmp_path / "noise_niu2025_psd.png").exists()
-    assert t["verdict"].str.contains("NOT reproduced").any()
+    assert (t["verdict"] == "not reproduced").any() and (t.loc[t["verdict"] == "not reproduced", "note"] != "").all()

@@ -8,7 +8,7 @@ from __future__ import annotations
 import numpy as np
 
 from .. import cai
-from . import section
+from . import NOT_REPRODUCED, REPORTED, section
 
 T = 0.025
 
@@ -34,8 +34,9 @@ def _oracle_error(report):
             p = cai.predict_phase(t, f, w, shots, T, ch, angular_acceleration=wd, omega_dot="given", interpolation=interp)
             err[interp].append(np.abs(p.total - oracle).max())
     e1k = err["cubic"][2]
-    report.row("predictor - oracle, 1 kHz, 0.05 rad/s, l = 0.3 m, vibration (cubic) [rad]", "< 1e-3", e1k, bool(e1k < 1e-3))
-    report.row("predictor - oracle, 1 kHz, linear inputs [rad]", "reported", err["linear"][2], "h^2 convergence")
+    report.row("predictor − inertial oracle, 1 kHz, 0.05 rad/s, l = 0.3 m, vibration (cubic) [rad], Tennstedt et al. 2023", "< 1e-3", e1k,
+               bool(e1k < 1e-3))
+    report.row("predictor − inertial oracle, 1 kHz, linear inputs [rad]", "—", err["linear"][2], REPORTED, "converges as h² (figure)")
     import matplotlib.pyplot as plt
 
     fig, ax = plt.subplots(figsize=(5.5, 3.8))
@@ -116,10 +117,11 @@ def _fig8(report):
     report.row("Fig. 8 |acceleration-term error| (per axis, constant in l) [rad]", 1.0066, np.abs(e_acc).mean(),
                bool(np.allclose(np.abs(e_acc), 1.0066, rtol=1e-3)))
     e_eul = max(np.abs(err[a]["eul"]).max() for a in range(3))
-    report.row("Fig. 8 Euler-term error from biases only [rad]", 0.0, e_eul, bool(e_eul < 1e-9))
+    report.row("Fig. 8 Euler-term error from biases only [rad] (exact: 0 for a constant gyro bias)", "grows with l", e_eul, bool(e_eul < 1e-9),
+               "the paper's Euler-term error cannot come from bias errors: docs/departures.md#lever-arm-error-of-fig-8")
     slope = max(abs(np.polyfit(ells, err[a]["cen"], 1)[0]) for a in range(3))
-    report.row("Fig. 8 centrifugal-term error slope [rad/m]", "≈ 0.6 (independent computation); paper: 0.4 m exceeds range", slope,
-               "not reproducible from bias errors (docs/departures.md#lever-arm-error-of-fig-8)")
+    report.row("Fig. 8 centrifugal-term error slope [rad/m]; the paper: 0.4 m exceeds the dynamic range", "0.4 m exceeds π", slope, NOT_REPRODUCED,
+               "bias errors give ≈ 0.6 rad/m (independent computation), far inside π at 0.4 m: docs/departures.md#lever-arm-error-of-fig-8")
     import matplotlib.pyplot as plt
 
     fig, axes = plt.subplots(1, 3, figsize=(12, 3.6), sharey=True)
@@ -174,9 +176,10 @@ def _noise_id(report):
     a_true, r_true = 0.025**2 + 0.02**2, 0.025**2 + (0.15 * 0.23) ** 2
     report.row("identifiable a = σ_p0² + σ_A²", a_true, nr.a.mean(), bool(abs(nr.a.mean() / a_true - 1) < 0.1))
     report.row("R at mid-fringe = a + b", r_true, nr.R_mid.mean(), bool(abs(nr.R_mid.mean() / r_true - 1) < 0.1))
-    report.row("iterations per batch, gradient ascent / Newton (mean)", "≈ 50 (paper, GA)",
+    report.row("iterations per batch, gradient ascent / Newton (mean; Newton fewer), Tennstedt et al. 2021 §3", "≈ 50 (gradient ascent)",
                f"{ga.iterations.mean():.1f} / {nr.iterations.mean():.1f}", bool(nr.iterations.mean() < ga.iterations.mean()))
-    report.row("full triple (σ_p0, σ_φ, σ_A)", "paper: all recovered", "unidentifiable (reported)", "docs/departures.md#identifiable-readout-noise")
+    report.row("full triple (σ_p0, σ_φ, σ_A), Tennstedt et al. 2021 §3", "all recovered", "a = σ_p0² + σ_A², b = A²σ_φ² − σ_A²", NOT_REPRODUCED,
+               "the readout variance is a + b sin²φ (Eq. 19), so only a and b are identifiable: docs/departures.md#identifiable-readout-noise")
     import matplotlib.pyplot as plt
 
     fig, axes = plt.subplots(1, 3, figsize=(12, 3.4))
