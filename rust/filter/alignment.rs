@@ -231,7 +231,7 @@ pub fn coarse(t: &[f64], gyro: &[Vec3], accel: &[Vec3], kind: ImuKind, lla: &Vec
 /// σ of (roll, pitch, yaw) from the covariance of ψ: a small rotation δθ of the
 /// navigation frame changes the Euler angles by δe with δθ = A δe,
 /// A = [R_z(yaw) R_y(pitch) x̂, R_z(yaw) ŷ, ẑ], and Ĉ = (I − [ψ×])C means δθ = −ψ.
-fn euler_sigma(euler: &Vec3, psi_cov: &Mat3) -> Vec3 {
+pub fn euler_sigma(euler: &Vec3, psi_cov: &Mat3) -> Vec3 {
     let (sp, cp) = euler.y.sin_cos();
     let (sy, cy) = euler.z.sin_cos();
     let a = Mat3::new(cy * cp, -sy, 0.0, sy * cp, cy, 0.0, -sp, 0.0, 1.0);

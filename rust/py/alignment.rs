@@ -6,7 +6,7 @@ use super::convert::{mat, mat_to_py, vec3, vec3_rows, vector, Wrap};
 use super::imu::triad_from_dict;
 use super::sources::AidingSource;
 use crate::earth::Ellipsoid;
-use crate::filter::alignment::{coarse, fine_p0, TriadBudget, ZeroRate, ZeroVelocity};
+use crate::filter::alignment::{coarse, euler_sigma, fine_p0, TriadBudget, ZeroRate, ZeroVelocity};
 use crate::filter::layout::Layout;
 use crate::filter::sources::Source;
 use crate::imu::errors::ImuErrorModel;
@@ -92,6 +92,18 @@ fn fine_alignment_p0<'py>(
     Ok((mat_to_py(py, &p0), (ba.white_psd, ba.walk_psd, bg.white_psd, bg.walk_psd)))
 }
 
+/// σ of (roll, pitch, yaw) (3,) rad from the Euler angles `euler` (3,) rad and the
+/// covariance `psi_cov` (3, 3) rad² of the attitude error ψ (NED).
+#[pyfunction]
+fn alignment_euler_sigma<'py>(py: Python<'py>, euler: numpy::PyReadonlyArray1<'py, f64>, psi_cov: numpy::PyReadonlyArray2<'py, f64>) -> PyResult<Bound<'py, numpy::PyArray1<f64>>> {
+    let p = mat(&psi_cov, "psi_cov")?;
+    if p.shape() != (3, 3) {
+        return Err(crate::error::invalid("psi_cov", format!("expected (3, 3), got {:?}", p.shape())).into());
+    }
+    let s = euler_sigma(&vec3(&euler, "euler")?, &Mat3::from_iterator(p.iter().copied()));
+    Ok(numpy::IntoPyArray::into_pyarray(s.as_slice().to_vec(), py))
+}
+
 /// Zero-velocity updates at `time` (M,) s with velocity noise σ `sigma` (m/s).
 #[pyfunction]
 fn zero_velocity(time: numpy::PyReadonlyArray1<'_, f64>, sigma: f64) -> PyResult<AidingSource> {
@@ -111,6 +123,7 @@ fn zero_rate(time: numpy::PyReadonlyArray1<'_, f64>, gyro_psd: f64, sigma: f64) 
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(coarse_alignment, m)?)?;
     m.add_function(wrap_pyfunction!(fine_alignment_p0, m)?)?;
+    m.add_function(wrap_pyfunction!(alignment_euler_sigma, m)?)?;
     m.add_function(wrap_pyfunction!(zero_velocity, m)?)?;
     m.add_function(wrap_pyfunction!(zero_rate, m)?)?;
     Ok(())
