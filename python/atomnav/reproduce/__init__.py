@@ -60,7 +60,9 @@ def section(name: str, title: str):
 
 @dataclass
 class Report:
-    """Collects the rows and figures of one section."""
+    """Collects the rows and figures of one section. A section runs at reduced size when
+    ``quick``, and passes ``progress`` to the ``progress=`` of its long runs (tqdm bars on
+    stderr)."""
 
     outdir: Path
     section: str
@@ -106,6 +108,7 @@ class Report:
 
 
 def discover() -> dict[str, tuple[str, Callable]]:
+    """Every registered section, by name: (title, function), sorted by name."""
     for mod in pkgutil.iter_modules(__path__):
         importlib.import_module(f"{__name__}.{mod.name}")
     return dict(sorted(_SECTIONS.items()))
