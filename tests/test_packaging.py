@@ -165,6 +165,14 @@ def test_heavy_libraries_are_imported_on_use(tmp_path):
     assert touched == "", f"the public submodules load {touched} at import"
 
 
+def test_static_imports_match_the_lazy_ones():
+    """What type checkers see (the TYPE_CHECKING block) is what __getattr__ serves."""
+    tree = ast.parse((PACKAGE / "__init__.py").read_text())
+    block = next(n for n in tree.body if isinstance(n, ast.If) and "TYPE_CHECKING" in ast.unparse(n.test))
+    names = {a.asname or a.name for imp in block.body for a in imp.names}
+    assert names == set(atomnav._SUBMODULES) | set(atomnav._NAMES)
+
+
 def test_lazy_names_are_the_real_objects():
     import importlib
 
