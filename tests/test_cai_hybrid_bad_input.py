@@ -38,13 +38,17 @@ def test_valid_record_runs(record):
 
 
 def test_shot_ending_after_the_record(record):
-    with pytest.raises(ValueError, match=r"outside the IMU span"):
-        _run(_ins(record, [0.5, 1.97]), record)
+    # 1.97 + 2T = 2.02 s, 0.02 s past the last sample at 200 Hz: 4 samples
+    with pytest.raises(InputError, match=r"shots: shot 1 \(start 1.97 s\) needs 4 IMU sample\(s\) after the record end") as e:
+        _run(_ins(record, [0.5, 1.97], incomplete_shots="error"), record)
+    assert (e.value.parameter, e.value.index) == ("shots", 1)
 
 
 def test_shot_starting_before_the_record(record):
-    with pytest.raises(ValueError, match=r"shots: shot 0 starts at -0.01"):
-        _run(_ins(record, [-0.01, 0.5]), record)
+    # 0.01 s before the first sample at 200 Hz: 2 samples
+    with pytest.raises(InputError, match=r"shots: shot 0 \(start -0.01 s\) needs 2 IMU sample\(s\) before the record start") as e:
+        _run(_ins(record, [-0.01, 0.5], incomplete_shots="error"), record)
+    assert (e.value.parameter, e.value.index) == ("shots", 0)
 
 
 def test_overlapping_shots(record):

@@ -25,7 +25,7 @@
 use super::in_shot;
 use super::predictor::{jacobian, predict, Channel, Imu, Interpolation, OmegaDot, PredictorConfig, MAX_SUBSTEPS};
 use super::readout::{population, slope, steer_mid_fringe};
-use crate::error::{check_finite, check_positive, invalid, Result};
+use crate::error::{check_finite, check_positive, invalid, invalid_at, Result};
 use crate::filter::aided::{Aiding, AidingContext, Measurement};
 use crate::filter::layout::Layout;
 use crate::imu::ImuKind;
@@ -130,6 +130,49 @@ impl ForceMode {
     }
 }
 
+/// What to do with a shot the IMU record cannot complete (option `incomplete_shots`): its
+/// interferometer window (pulses at t_s … t_s + 2T, the interpolation stencil and a whole
+/// Savitzky–Golay window) needs IMU samples before the record start or after its end.
+#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
+pub enum IncompleteShots {
+    /// Leave the shot out (no update; NaN in the shot log).
+    #[default]
+    Skip,
+    /// Refuse the record: an invalid-input error naming `shots` and the shot's index.
+    Error,
+}
+
+impl Choice for IncompleteShots {
+    const PARAMETER: &'static str = "incomplete_shots";
+    const CHOICES: &'static [(&'static str, Self)] = &[("skip", IncompleteShots::Skip), ("error", IncompleteShots::Error)];
+}
+
+/// IMU samples a shot lacks: `before` the record start and `after` its end (both 0 for a
+/// shot the record completes).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+pub struct ShotGap {
+    pub before: usize,
+    pub after: usize,
+}
+
+impl ShotGap {
+    pub fn is_complete(&self) -> bool {
+        self.before == 0 && self.after == 0
+    }
+
+    /// Why shot `j` starting at `ts` (s) cannot be predicted, for messages.
+    pub fn describe(&self, j: usize, ts: f64) -> String {
+        let mut parts = Vec::new();
+        if self.before > 0 {
+            parts.push(format!("{} IMU sample(s) before the record start", self.before));
+        }
+        if self.after > 0 {
+            parts.push(format!("{} IMU sample(s) after the record end", self.after));
+        }
+        format!("shot {j} (start {ts} s) needs {}", parts.join(" and "))
+    }
+}
+
 /// Configuration of the CAI aiding.
 #[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 pub struct CaiConfig {
@@ -161,11 +204,17 @@ pub struct CaiConfig {
     /// Kind of the IMU record the engine runs on (increments become interval-mean rates).
     #[serde(with = "crate::options::by_name")]
     pub kind: ImuKind,
+    /// A shot the record cannot complete: skipped (default) or an error.
+    #[serde(default)]
+    pub incomplete: IncompleteShots,
 }
 
 /// Per shot and channel, what the instrument and the filter saw.
 #[derive(Clone, Debug, Default, serde::Serialize, serde::Deserialize)]
 pub struct ShotLog {
+    /// Shots left out because the record cannot complete them: (index, start s, gap).
+    #[serde(default)]
+    pub skipped: Vec<(usize, f64, ShotGap)>,
     /// Predicted phase at the filter's best estimate (rad).
     pub predicted: Vec<f64>,
     /// True minus predicted phase (rad); NaN for recorded data.
@@ -232,6 +281,7 @@ impl CaiConfig {
             lever_arm: None,
             force: ForceMode::Bias,
             kind: ImuKind::Rates,
+            incomplete: IncompleteShots::Skip,
         }
     }
 
@@ -288,6 +338,42 @@ impl CaiConfig {
             omega_dot: self.omega_dot.clone(),
             interpolation: self.interpolation,
         }
+    }
+
+    /// The IMU samples the shot starting at `ts` (s) lacks in the record `t` (s, increasing,
+    /// at least 2 samples): before its start when the shot starts before the first sample
+    /// (counted at the record's mean spacing) or when fewer samples than a Savitzky–Golay
+    /// window (2m + 1) lie between the record start and the shot's end, where a shot in
+    /// mid-record has the window's samples before it; after its end when the last pulse
+    /// t_s + 2T comes after the last sample.
+    pub fn missing_samples(&self, t: &[f64], ts: f64) -> Result<ShotGap> {
+        let (&[first, .., last], n) = (t, t.len()) else {
+            return Err(invalid("time", format!("need at least 2 IMU samples to place a shot, got {}", t.len())));
+        };
+        let dt = (last - first) / (n - 1) as f64;
+        let eps = 1e-9 * self.t_sep;
+        let end = ts + 2.0 * self.t_sep;
+        let count = |gap: f64| if gap > eps && dt > 0.0 { (gap / dt - 1e-6).ceil().max(1.0) as usize } else { 0 };
+        let (before, after) = (count(first - ts), count(end - last));
+        let window = match self.omega_dot {
+            OmegaDot::Savgol { half_width } => 2 * half_width + 1,
+            _ => 0,
+        };
+        // the samples a shot's prediction sees: the pad before its start, then through the
+        // first sample at or after its end (as the aiding buffers them)
+        let start = t.partition_point(|&x| x < ts - eps);
+        let stop = t.partition_point(|&x| x < end - eps).saturating_add(1).min(n);
+        let seen = stop.saturating_sub(start) + start.min(self.omega_dot.pad());
+        let short = window.saturating_sub(seen + before + after);
+        Ok(ShotGap { before: before + short, after })
+    }
+
+    /// The shots the record `t` (s, increasing) cannot complete: index, start (s), the
+    /// samples it lacks ([`missing_samples`](Self::missing_samples)) and why, in words.
+    pub fn incomplete_shots(&self, t: &[f64]) -> Result<Vec<(usize, f64, ShotGap, String)>> {
+        crate::error::check_increasing("time", t)?;
+        let gaps = self.shots.iter().map(|&ts| self.missing_samples(t, ts)).collect::<Result<Vec<_>>>()?;
+        Ok(gaps.into_iter().zip(&self.shots).enumerate().filter(|(_, (g, _))| !g.is_complete()).map(|(j, (g, &ts))| (j, ts, g, g.describe(j, ts))).collect())
     }
 
     /// In-shot IMU noise of one shot on a regular record of spacing `dt` (s), samples from
@@ -434,17 +520,19 @@ impl CaiAiding {
     // shots × m values, so idx = j·m + ch is in range; predict and jacobian return one row per
     // channel, so ch < m indexes best and phi_nom.
     #[allow(clippy::indexing_slicing)]
-    fn shot_measurement(&mut self, j: usize, x: &DVector<f64>, extra: &DVector<f64>, layout: &Layout) -> Result<Measurement> {
+    fn shot_measurement(&mut self, j: usize, x: &DVector<f64>, extra: &DVector<f64>, layout: &Layout) -> Result<Option<Measurement>> {
         let ts = *self.cfg.shots.get(j).ok_or_else(|| invalid("shots", format!("no shot {j} (of {})", self.cfg.shots.len())))?;
-        let first = self.buf_t.iter().position(|&t| t >= ts - 1e-9 * self.cfg.t_sep);
-        match (self.buf_t.first(), first) {
-            (Some(&t0), Some(_)) if t0 <= ts + 1e-9 * self.cfg.t_sep => {}
-            _ => {
-                return Err(invalid(
-                    "shots",
-                    format!("shot {j} starts at {ts} s, before the first IMU sample available to it ({:?} s)", self.buf_t.first()),
-                ))
-            }
+        // mid-record the buffer holds the whole window before the shot, so a gap means the
+        // record started too late for it
+        let gap = self.cfg.missing_samples(&self.buf_t, ts)?;
+        if !gap.is_complete() {
+            return match self.cfg.incomplete {
+                IncompleteShots::Error => Err(invalid_at("shots", j, gap.describe(j, ts))),
+                IncompleteShots::Skip => {
+                    self.skip_shot(j, ts, gap);
+                    Ok(None)
+                }
+            };
         }
         let channels = self.current_channels(layout, extra);
         let imu = Imu { t: &self.buf_t, f: &self.buf_f, w: &self.buf_w };
@@ -477,7 +565,17 @@ impl CaiAiding {
         let h = &g * jac;
         let r = DMatrix::identity(m, m) * self.cfg.sigma_p.powi(2) + &g * self.in_shot_covariance(ts)? * &g;
         self.prune(self.cfg.shots.get(j + 1).copied());
-        Ok(Measurement { z, h, r })
+        Ok(Some(Measurement { z, h, r }))
+    }
+
+    /// Leave shot `j` out: logged as skipped, NaN for each channel in the shot log.
+    fn skip_shot(&mut self, j: usize, ts: f64, gap: ShotGap) {
+        self.log.skipped.push((j, ts, gap));
+        let m = self.cfg.channels.len();
+        for v in [&mut self.log.predicted, &mut self.log.phase_error, &mut self.log.laser_phase, &mut self.log.population] {
+            v.extend(std::iter::repeat_n(f64::NAN, m));
+        }
+        self.prune(self.cfg.shots.get(j + 1).copied());
     }
 }
 
@@ -522,7 +620,7 @@ impl Aiding for CaiAiding {
     }
 
     fn measure(&mut self, j: usize, ctx: &AidingContext) -> Result<Option<Measurement>> {
-        self.shot_measurement(j, ctx.x, ctx.extra, ctx.layout).map(Some)
+        self.shot_measurement(j, ctx.x, ctx.extra, ctx.layout)
     }
 
     // invariant: f and qc are n × n for this layout, whose blocks (and the velocity
@@ -611,7 +709,7 @@ mod tests {
             let (ba, bg) = (lay.range("accel_bias").unwrap().start, lay.range("gyro_bias").unwrap().start);
             feed(&mut a, &f, &w, Vec3::new(dx[ba], dx[ba + 1], dx[ba + 2]), Vec3::new(dx[bg], dx[bg + 1], dx[bg + 2]));
             let extra = DVector::from_iterator(n - 15, dx.iter().skip(15).copied());
-            let m = a.shot_measurement(0, &DVector::zeros(n), &extra, &lay).unwrap();
+            let m = a.shot_measurement(0, &DVector::zeros(n), &extra, &lay).unwrap().unwrap();
             (m.z, m.h)
         };
         let (_, h) = z_at(&DVector::zeros(n));
@@ -651,7 +749,7 @@ mod tests {
         let mut a = CaiAiding::new(cfg, CaiData::Emulated { phase, noise: noise.clone() }).unwrap();
         let lay = layout(&a);
         feed(&mut a, &|_| f0, &|_| w0, Vec3::zeros(), Vec3::zeros());
-        let m = a.shot_measurement(0, &DVector::zeros(lay.size()), &DVector::zeros(lay.size() - 15), &lay).unwrap();
+        let m = a.shot_measurement(0, &DVector::zeros(lay.size()), &DVector::zeros(lay.size() - 15), &lay).unwrap().unwrap();
         for c in 0..6 {
             let expect = 0.45 * (-truth[c]).sin() - noise[c];
             assert!((m.z[c] - expect).abs() < 1e-7, "channel {c}: {} vs {expect}", m.z[c]);
@@ -680,7 +778,7 @@ mod tests {
         let mut a = CaiAiding::new(cfg, CaiData::Emulated { phase: vec![0.0; 6], noise: vec![0.0; 6] }).unwrap();
         let lay = layout(&a);
         feed(&mut a, &|_| Vec3::zeros(), &|_| Vec3::zeros(), Vec3::zeros(), Vec3::zeros());
-        let m = a.shot_measurement(0, &DVector::zeros(lay.size()), &DVector::zeros(lay.size() - 15), &lay).unwrap();
+        let m = a.shot_measurement(0, &DVector::zeros(lay.size()), &DVector::zeros(lay.size() - 15), &lay).unwrap().unwrap();
         let (sa, sg) = (0.1838f64, 0.2994f64);
         let sampled = (2.0 * 30.0 + (5.0f64 - 1.0 / 3.0).powi(2) + 1.0 / 18.0) / (2.0 * 125.0 / 3.0);
         let diag = 1e-3 + 0.25 * sampled * (sa * sa + sg * sg);
@@ -698,13 +796,54 @@ mod tests {
         assert!(e.starts_with("shots:") && e.contains("shot 1") && e.contains("overlap"), "{e}");
         let e = CaiAiding::new(config(chs[..5].to_vec(), vec![0.0, 0.05]), ok).err().unwrap().to_string();
         assert!(e.starts_with("phase:") && e.contains("5 interferometers"), "{e}");
-        let mut a = CaiAiding::new(config(chs, vec![0.0]), CaiData::Emulated { phase: vec![0.0; 6], noise: vec![0.0; 6] }).unwrap();
-        let lay = layout(&a);
-        for i in 1..=12 {
-            a.observe(i as f64 * 0.005, 0.005, &Vec3::zeros(), &Vec3::zeros(), &nav());
+    }
+
+    /// A shot starting one sample before the record: skipped (logged, NaN phase error, no
+    /// update) by default, an error naming the shot and the sample it needs otherwise.
+    #[test]
+    fn shot_before_the_record_is_skipped_or_refused() {
+        let chs = cyclic(Vec3::zeros(), Mat3::identity());
+        for incomplete in [IncompleteShots::Skip, IncompleteShots::Error] {
+            let cfg = CaiConfig { incomplete, ..config(chs.clone(), vec![0.0]) };
+            let mut a = CaiAiding::new(cfg, CaiData::Emulated { phase: vec![0.0; 6], noise: vec![0.0; 6] }).unwrap();
+            let lay = layout(&a);
+            for i in 1..=12 {
+                a.observe(i as f64 * 0.005, 0.005, &Vec3::zeros(), &Vec3::zeros(), &nav());
+            }
+            let r = a.shot_measurement(0, &DVector::zeros(lay.size()), &DVector::zeros(lay.size() - 15), &lay);
+            match incomplete {
+                IncompleteShots::Skip => {
+                    assert!(r.unwrap().is_none());
+                    assert_eq!(a.log.skipped, vec![(0, 0.0, ShotGap { before: 1, after: 0 })]);
+                    assert!(a.log.phase_error.len() == 6 && a.log.phase_error.iter().all(|x| x.is_nan()));
+                }
+                IncompleteShots::Error => {
+                    let e = r.err().unwrap();
+                    assert!(matches!(&e, crate::NavError::InvalidInput { index: Some(0), .. }), "{e}");
+                    let e = e.to_string();
+                    assert!(e.starts_with("shots:") && e.contains("shot 0") && e.contains("1 IMU sample(s) before the record start"), "{e}");
+                }
+            }
         }
-        let e = a.shot_measurement(0, &DVector::zeros(lay.size()), &DVector::zeros(lay.size() - 15), &lay).err().unwrap().to_string();
-        assert!(e.starts_with("shots:") && e.contains("shot 0"), "{e}");
+    }
+
+    /// Samples a shot lacks, against counts by hand on a 200 Hz record from 0 to 1 s with
+    /// T = 25 ms: none inside; before the start at the spacing; the Savitzky–Golay window's
+    /// shortfall at the start (m = 8: 17 samples, 11 in the shot); after the end.
+    #[test]
+    fn missing_samples_counted_by_hand() {
+        let t: Vec<f64> = (0..=200).map(|i| i as f64 * 0.005).collect();
+        let cfg = config(cyclic(Vec3::zeros(), Mat3::identity()), vec![]);
+        let gap = |cfg: &CaiConfig, ts: f64| cfg.missing_samples(&t, ts).unwrap();
+        assert_eq!(gap(&cfg, 0.0), ShotGap::default());
+        assert_eq!(gap(&cfg, 0.5), ShotGap::default());
+        assert_eq!(gap(&cfg, -0.012), ShotGap { before: 3, after: 0 });
+        assert_eq!(gap(&cfg, 0.96), ShotGap { before: 0, after: 2 });
+        let sg = CaiConfig { omega_dot: OmegaDot::Savgol { half_width: 8 }, ..cfg.clone() };
+        assert_eq!(gap(&sg, 0.0), ShotGap { before: 6, after: 0 });
+        assert_eq!(gap(&sg, 0.01), ShotGap { before: 4, after: 0 });
+        assert_eq!(gap(&sg, 0.5), ShotGap::default());
+        assert!(cfg.missing_samples(&t[..1], 0.0).unwrap_err().to_string().starts_with("time:"));
     }
 
     #[test]

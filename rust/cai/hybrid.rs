@@ -8,20 +8,20 @@
 use super::aiding::{CaiAiding, CaiConfig, CaiData};
 use super::predictor::{predict, Imu, Interpolation, OmegaDot, PredictorConfig};
 use crate::earth::{Ellipsoid, KINEMATIC, WGS84};
-use crate::error::{check_count, check_positive, invalid, Result};
+use crate::error::{check_count, check_positive, invalid, invalid_at, Result};
 use crate::filter::aided::{AidedConfig, AidedIns, AidedOutput, Aiding};
 use crate::filter::discretize::Discretization;
 use crate::filter::ins::{BiasModel, InsNoise};
 use crate::filter::kf::LoopMode;
 use crate::filter::layout::ins_size;
 use crate::imu::errors::{ImuErrorModel, ImuSimulator};
-use crate::imu::ideal::ideal_rates;
+use crate::imu::ideal::{body_from_kinematics, ideal_rates};
 use crate::imu::ImuKind;
 use crate::filter::initial_error::draw_start;
-use crate::math::Vec3;
+use crate::math::{dcm_from_quat, quat_mul, rotation_quats, rotvec_from_quat, Quat, Vec3};
 use crate::options::Choice;
 use crate::strapdown::{NavState, Strapdown, Vertical};
-use crate::trajectory::{Motion, TruthState};
+use crate::trajectory::{Kinematics, Motion, TruthState};
 use nalgebra::{DMatrix, DVector};
 use rand::{RngCore, SeedableRng};
 use rand_chacha::ChaCha20Rng;
@@ -178,6 +178,63 @@ impl HybridScenario {
     /// [`HybridConfig::filter`]; `cai` carries the shots.
     pub fn new(motion: &Motion, cfg: &HybridConfig, imu_model: ImuErrorModel, reference: Option<ImuErrorModel>, cai: CaiConfig, p0: nalgebra::DMatrix<f64>) -> Result<Self> {
         let ell = cfg.gravity.ellipsoid();
+        let reference = Self::check(cfg, &imu_model, reference, &cai, &p0)?;
+        let (t, truth, f, w) = Self::imu_truth(motion, &ell, cfg.rate_hz)?;
+        let phase = match (reference, cfg.truth_rate_hz) {
+            (Some(model), _) => PhaseSource::Reference(model),
+            (None, Some(r)) if r == cfg.rate_hz => PhaseSource::Ideal(Self::ideal_phases(motion, &ell, &t, &truth, &f, &w, &cai)?),
+            (None, Some(r)) => {
+                let (tt, tr, tf, tw) = Self::imu_truth(motion, &ell, r)?;
+                PhaseSource::Ideal(Self::ideal_phases(motion, &ell, &tt, &tr, &tf, &tw, &cai)?)
+            }
+            (None, None) => return Err(invalid("truth_rate_hz", "required when phase_source = 'ideal'")),
+        };
+        Ok(HybridScenario { ell, t, truth, f, w, imu_model, cai, phase, filter: cfg.filter(), p0, aiding: cfg.aiding, draw_initial: cfg.draw_initial })
+    }
+
+    /// The scenario of a sampled trajectory (user data): sample times `t` (s, evenly spaced
+    /// at `cfg.rate_hz`), positions (lat rad, lon rad, h m), NED velocities (m/s) and
+    /// attitudes `q_nb`. The ideal IMU at the samples comes from the trajectory by finite
+    /// differences ([`table_imu`]); the truth is the strapdown integral of that ideal IMU
+    /// from the first sample, so an error-free IMU navigates exactly on it (it departs from
+    /// the table by the differences' error); a perfect CAI's phases are the sensor's own
+    /// predictor applied to the ideal IMU ("ideal"; there is no truth between the samples,
+    /// so `truth_rate_hz` must be None or the table's rate) or a reference IMU's.
+    #[allow(clippy::too_many_arguments)]
+    pub fn from_table(
+        t: Vec<f64>,
+        lla: &[Vec3],
+        vel: &[Vec3],
+        q_nb: &[Quat],
+        cfg: &HybridConfig,
+        imu_model: ImuErrorModel,
+        reference: Option<ImuErrorModel>,
+        cai: CaiConfig,
+        p0: DMatrix<f64>,
+    ) -> Result<Self> {
+        let ell = cfg.gravity.ellipsoid();
+        let reference = Self::check(cfg, &imu_model, reference, &cai, &p0)?;
+        check_count("trajectory", t.len(), 3, MAX_SAMPLES)?;
+        let q_nb = rotation_quats("trajectory", q_nb)?;
+        let (f, w, acc, w_nb) = table_imu(&ell, &t, lla, vel, &q_nb, cfg.rate_hz)?;
+        if let Some(r) = cfg.truth_rate_hz.filter(|&r| reference.is_none() && r != cfg.rate_hz) {
+            return Err(invalid("truth_rate_hz", format!("{r} Hz, but a sampled trajectory has no truth between its samples: give None (or its rate {} Hz)", cfg.rate_hz)));
+        }
+        let start = NavState { t: t.first().copied().unwrap_or(0.0), lla: lla.first().copied().unwrap_or_default(), vel: vel.first().copied().unwrap_or_default(), q_nb: q_nb.first().copied().unwrap_or_else(Quat::identity) };
+        let mut nav = Vec::with_capacity(t.len());
+        Strapdown::new(start, ImuKind::Rates, ell, Vertical::Free)?.run(&t, &w, &f, None, &mut nav)?;
+        let truth = nav.iter().zip(acc.iter().zip(&w_nb)).map(|(s, (&acc, &w_nb_b))| TruthState { t: s.t, lla: s.lla, vel: s.vel, acc, q_nb: s.q_nb, w_nb_b }).collect();
+        let phase = match reference {
+            Some(model) => PhaseSource::Reference(model),
+            None => PhaseSource::Ideal(predict(Imu { t: &t, f: &f, w: &w }, &cai.shots, &cai.channels, &cai.predictor())?.iter().map(|r| r[0]).collect()),
+        };
+        Ok(HybridScenario { ell, t, truth, f, w, imu_model, cai, phase, filter: cfg.filter(), p0, aiding: cfg.aiding, draw_initial: cfg.draw_initial })
+    }
+
+    /// The checks every scenario shares: the CAI, the IMU models, the filter settings, the
+    /// phase source against the reference model (returned when the source is "reference")
+    /// and the size of P0.
+    fn check(cfg: &HybridConfig, imu_model: &ImuErrorModel, reference: Option<ImuErrorModel>, cai: &CaiConfig, p0: &DMatrix<f64>) -> Result<Option<ImuErrorModel>> {
         cai.check()?;
         imu_model.validate()?;
         check_count("predict_every", cfg.predict_every, 1, MAX_SAMPLES)?;
@@ -186,26 +243,20 @@ impl HybridScenario {
                 return Err(invalid(name, format!("must be finite and >= 0, got {q}")));
             }
         }
-        let (t, truth, f, w) = Self::imu_truth(motion, &ell, cfg.rate_hz)?;
-        let phase = match (cfg.phase_source, reference, cfg.truth_rate_hz) {
-            (PhaseSourceKind::Reference, Some(model), _) => {
+        let reference = match (cfg.phase_source, reference) {
+            (PhaseSourceKind::Reference, Some(model)) => {
                 model.validate()?;
-                PhaseSource::Reference(model)
+                Some(model)
             }
-            (PhaseSourceKind::Reference, None, _) => return Err(invalid("reference", "required when phase_source = 'reference'")),
-            (PhaseSourceKind::Ideal, Some(_), _) => return Err(invalid("reference", "given, but phase_source = 'ideal' would ignore it")),
-            (PhaseSourceKind::Ideal, None, Some(r)) if r == cfg.rate_hz => PhaseSource::Ideal(Self::ideal_phases(motion, &ell, &t, &truth, &f, &w, &cai)?),
-            (PhaseSourceKind::Ideal, None, Some(r)) => {
-                let (tt, tr, tf, tw) = Self::imu_truth(motion, &ell, r)?;
-                PhaseSource::Ideal(Self::ideal_phases(motion, &ell, &tt, &tr, &tf, &tw, &cai)?)
-            }
-            (PhaseSourceKind::Ideal, None, None) => return Err(invalid("truth_rate_hz", "required when phase_source = 'ideal'")),
+            (PhaseSourceKind::Reference, None) => return Err(invalid("reference", "required when phase_source = 'reference'")),
+            (PhaseSourceKind::Ideal, Some(_)) => return Err(invalid("reference", "given, but phase_source = 'ideal' would ignore it")),
+            (PhaseSourceKind::Ideal, None) => None,
         };
-        let n = ins_size() + cai_extra_states(&cai);
+        let n = ins_size() + cai_extra_states(cai);
         if p0.nrows() != n || p0.ncols() != n {
             return Err(invalid("p0", format!("expected {n} × {n} ({} INS states and the CAI's extra states), got {} × {}", ins_size(), p0.nrows(), p0.ncols())));
         }
-        Ok(HybridScenario { ell, t, truth, f, w, imu_model, cai, phase, filter: cfg.filter(), p0, aiding: cfg.aiding, draw_initial: cfg.draw_initial })
+        Ok(reference)
     }
 
     /// Truth and ideal IMU of `motion` at `rate_hz` over its duration.
@@ -345,6 +396,48 @@ impl HybridScenario {
     }
 }
 
+/// Ideal IMU of a sampled trajectory: specific force f^b (m/s²) and angular rate ω_ib^b
+/// (rad/s) at each sample (the NED mechanization solved for them, [`body_from_kinematics`]),
+/// with the NED acceleration and ω_nb^b they come from. Both are second-order finite
+/// differences at the samples (central inside, one-sided three-point at the ends): of the
+/// velocity, and of the body-frame rotation vectors log(q_k⁻¹ ⊗ q_j) to the neighbours. The
+/// samples must be evenly spaced at `rate_hz` (the simulated IMU has one rate).
+// invariant: every series has n ≥ 3 entries (checked by the caller and here), and the
+// stencils use k − 1, k + 1 only inside (0 < k < n − 1) and 0..2, n − 3..n − 1 at the ends.
+#[allow(clippy::indexing_slicing)]
+pub fn table_imu(ell: &Ellipsoid, t: &[f64], lla: &[Vec3], vel: &[Vec3], q_nb: &[Quat], rate_hz: f64) -> Result<(Vec<Vec3>, Vec<Vec3>, Vec<Vec3>, Vec<Vec3>)> {
+    let n = t.len();
+    if n < 3 || lla.len() != n || vel.len() != n || q_nb.len() != n {
+        return Err(invalid("trajectory", format!("needs at least 3 samples with a position, velocity and attitude each, got {n} times, {} / {} / {}", lla.len(), vel.len(), q_nb.len())));
+    }
+    check_positive("rate_hz", rate_hz)?;
+    let dt = 1.0 / rate_hz;
+    if let Some(k) = (1..n).find(|&k| !((t[k] - t[k - 1] - dt).abs() <= 1e-6 * dt)) {
+        return Err(invalid_at("trajectory", k, format!("time step {} s before sample {k} is not 1/rate_hz = {dt} s: the simulated IMU samples at one rate", t[k] - t[k - 1])));
+    }
+    for (name, v) in [("trajectory", lla), ("trajectory", vel)] {
+        if let Some(k) = v.iter().position(|x| !x.iter().all(|c| c.is_finite())) {
+            return Err(invalid_at(name, k, "non-finite position or velocity"));
+        }
+    }
+    // d(k, j): the change from sample k to sample j, in sample k's frame
+    let derivative = |d: &dyn Fn(usize, usize) -> Vec3| -> Vec<Vec3> {
+        (0..n)
+            .map(|k| match k {
+                0 => (4.0 * d(0, 1) - d(0, 2)) / (2.0 * dt),
+                k if k == n - 1 => -(4.0 * d(k, k - 1) - d(k, k - 2)) / (2.0 * dt),
+                k => (d(k, k + 1) - d(k, k - 1)) / (2.0 * dt),
+            })
+            .collect()
+    };
+    let acc = derivative(&|k, j| vel[j] - vel[k]);
+    let w_nb = derivative(&|k, j| rotvec_from_quat(&quat_mul(&q_nb[k].conjugate(), &q_nb[j])));
+    let (f, w) = (0..n)
+        .map(|k| body_from_kinematics(ell, &Kinematics { vel: vel[k], acc: acc[k], c_nb: dcm_from_quat(&q_nb[k]), w_nb_b: w_nb[k] }, &lla[k]))
+        .unzip();
+    Ok((f, w, acc, w_nb))
+}
+
 /// Number of extra filter states the CAI adds (misalignment, lever arm, force blocks).
 fn cai_extra_states(cai: &CaiConfig) -> usize {
     3 * (usize::from(cai.misalignment.is_some()) + usize::from(cai.lever_arm.is_some()) + usize::from(cai.force != super::aiding::ForceMode::Bias))
@@ -424,6 +517,39 @@ mod tests {
         let mut bad = config(PhaseSourceKind::Ideal, Some(400.0));
         bad.gyro_psd = -1.0;
         assert!(err(bad, None, p0).starts_with("gyro_psd:"));
+    }
+
+    /// The ideal IMU of a sampled slalom (200 Hz, Earth gravity) against the motion's exact
+    /// rates: second-order differences err by h²/6 × the third derivative (≈ 1e-6 m/s²,
+    /// 1e-6 rad/s here); an uneven step is refused with its row; the table's scenario
+    /// truth starts at the table's first sample and stays within millimetres of it.
+    #[test]
+    fn table_imu_matches_the_exact_rates() {
+        let motion = crate::trajectory::generators::slalom(Vec3::new(0.9, 0.17, 60.0), 5.0, 2.0, 10.0, 20.0).unwrap();
+        let t: Vec<f64> = (0..=4000).map(|i| i as f64 / 200.0).collect();
+        let truth = motion.truth(&WGS84, &t).unwrap();
+        let (f_exact, w_exact, _) = ideal_rates(&motion, &WGS84, &truth);
+        let (lla, vel, q): (Vec<Vec3>, Vec<Vec3>, Vec<Quat>) = (truth.iter().map(|s| s.lla).collect(), truth.iter().map(|s| s.vel).collect(), truth.iter().map(|s| s.q_nb).collect());
+        let (f, w, _, _) = table_imu(&WGS84, &t, &lla, &vel, &q, 200.0).unwrap();
+        let worst = |a: &[Vec3], b: &[Vec3]| a.iter().zip(b).map(|(x, y)| (x - y).norm()).fold(0.0, f64::max);
+        assert!(worst(&f, &f_exact) < 2e-5, "{}", worst(&f, &f_exact));
+        assert!(worst(&w, &w_exact) < 2e-5, "{}", worst(&w, &w_exact));
+        let inner = |a: &[Vec3], b: &[Vec3]| worst(&a[1..a.len() - 1], &b[1..b.len() - 1]);
+        assert!(inner(&f, &f_exact) < 2e-6 && inner(&w, &w_exact) < 2e-6, "{} {}", inner(&f, &f_exact), inner(&w, &w_exact));
+        let mut uneven = t.clone();
+        uneven[7] += 1e-4;
+        let e = table_imu(&WGS84, &uneven, &lla, &vel, &q, 200.0).unwrap_err();
+        assert!(matches!(&e, crate::NavError::InvalidInput { index: Some(7), .. }), "{e}");
+        let mut cfg = config(PhaseSourceKind::Ideal, None);
+        cfg.gravity = GravityModel::Earth;
+        let s = HybridScenario::from_table(t.clone(), &lla, &vel, &q, &cfg, ImuErrorModel::default(), None, cai(vec![0.1, 0.2]), DMatrix::identity(15, 15)).unwrap();
+        assert_eq!(s.truth.len(), t.len());
+        let last = s.truth.len() - 1;
+        let err = nav_error(&WGS84, &state_at(&s.truth[last]), &truth[last]);
+        assert!(err[..3].iter().all(|e| e.abs() < 1e-2), "{err:?}");
+        cfg.truth_rate_hz = Some(2000.0);
+        let e = HybridScenario::from_table(t, &lla, &vel, &q, &cfg, ImuErrorModel::default(), None, cai(vec![0.1]), DMatrix::identity(15, 15)).err().unwrap();
+        assert!(e.to_string().starts_with("truth_rate_hz:"), "{e}");
     }
 
     #[test]

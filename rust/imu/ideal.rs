@@ -7,11 +7,15 @@
 
 use crate::earth::Ellipsoid;
 use crate::math::Vec3;
-use crate::trajectory::{Motion, TruthState};
+use crate::trajectory::{Kinematics, Motion, TruthState};
 
 /// Specific force (m/s²) and angular rate ω_ib^b (rad/s) at time t and position lla.
 pub fn body_measurements(motion: &Motion, ell: &Ellipsoid, t: f64, lla: &Vec3) -> (Vec3, Vec3) {
-    let k = motion.kinematics(t);
+    body_from_kinematics(ell, &motion.kinematics(t), lla)
+}
+
+/// Specific force (m/s²) and angular rate ω_ib^b (rad/s) of the kinematics `k` at position lla.
+pub fn body_from_kinematics(ell: &Ellipsoid, k: &Kinematics, lla: &Vec3) -> (Vec3, Vec3) {
     let w_ie = ell.earth_rate_ned(lla.x);
     let w_en = ell.transport_rate_ned(lla.x, lla.z, &k.vel);
     let f_n = k.acc - ell.gravity_ned(lla.x, lla.z) + (2.0 * w_ie + w_en).cross(&k.vel);

@@ -3,11 +3,11 @@
 //! sensor, the aided INS and the Monte-Carlo scenarios. Conversion only: every check and
 //! loop is in `crate::cai`.
 
-use super::convert::{count, counts, flags, register_choices, seed as seed_arg, rows, to_py_rows, vec3, vec3_rows, vec3_to_py, vec_to_py, vector, Wrap};
+use super::convert::{count, counts, flags, quat_rows, register_choices, seed as seed_arg, rows, to_py_rows, vec3, vec3_rows, vec3_to_py, vec_to_py, vector, Wrap};
 use super::filter::{mats, AidedSetup, PyAidedIns};
 use super::imu::triad_from_dict;
 use super::trajectory::Motion;
-use crate::cai::aiding::{shot_times, CaiAiding, CaiConfig, CaiData, DataKind, ForceKind, ForceMode};
+use crate::cai::aiding::{shot_times, CaiAiding, CaiConfig, CaiData, DataKind, ForceKind, ForceMode, IncompleteShots};
 use crate::cai::closed_form::{closed_form_phases, ClosedForm};
 use crate::cai::hybrid::{GravityModel, HybridConfig, HybridScenario, PhaseSourceKind};
 use crate::cai::noise_id::{fringe_track, ml_windows, FringeEkf, Method, MlConfig, MAX_ML_ITER};
@@ -405,6 +405,7 @@ impl CaiSensor {
             lever_arm,
             force: ForceMode::new(force.0, force_tau, force_sigma)?,
             kind: ImuKind::Rates,
+            incomplete: IncompleteShots::Skip,
         };
         cfg.check()?;
         Ok(CaiSensor(cfg))
@@ -432,6 +433,23 @@ fn cai_in_shot_noise<'py>(py: Python<'py>, sensor: &CaiSensor, dt: f64, q_a: f64
     Ok((super::convert::mat_to_py(py, &sigma), cube(py, flat, [cross.len(), n, m])?))
 }
 
+/// The shots of `sensor` at `shots` (s) that the record `time` (s) cannot complete: (index,
+/// start s, samples lacking before the record start, after its end, message)
+/// (`CaiConfig::incomplete_shots`).
+#[pyfunction]
+fn cai_incomplete_shots(sensor: &CaiSensor, shots: PyReadonlyArray1<'_, f64>, time: PyReadonlyArray1<'_, f64>) -> PyResult<Vec<(usize, f64, usize, usize, String)>> {
+    let found = sensor.with_shots(&shots)?.incomplete_shots(&vector(&time, "time")?)?;
+    Ok(found.into_iter().map(|(j, ts, g, text)| (j, ts, g.before, g.after, text)).collect())
+}
+
+/// The truth of a scenario: a motion model, or a sampled trajectory (time s, lla, NED
+/// velocity m/s, q_nb).
+#[derive(FromPyObject)]
+enum Truth<'py> {
+    Motion(PyRef<'py, Motion>),
+    Table(PyReadonlyArray1<'py, f64>, PyReadonlyArray2<'py, f64>, PyReadonlyArray2<'py, f64>, PyReadonlyArray2<'py, f64>),
+}
+
 /// A CAI-aided INS scenario (truth, IMU errors, CAI, filter), built once by the core
 /// (`HybridScenario::new`); `monte_carlo` runs seeded runs in parallel with the GIL released.
 #[pyclass(module = "atomnav._core", frozen)]
@@ -443,11 +461,11 @@ super::pickle::picklable!(CaiHybrid, 0, "CaiHybrid");
 impl CaiHybrid {
     #[new]
     #[allow(clippy::too_many_arguments)]
-    #[pyo3(signature = (motion, sensor, shots, imu_accel, imu_gyro, reference, p0, *, gravity, rate_hz, truth_rate_hz, phase_source,
+    #[pyo3(signature = (truth, sensor, shots, imu_accel, imu_gyro, reference, p0, *, gravity, rate_hz, truth_rate_hz, phase_source,
         accel_psd, gyro_psd, accel_bias_psd, gyro_bias_psd, predict_every, aiding, draw_initial))]
     fn new(
         py: Python<'_>,
-        motion: &Motion,
+        truth: Truth<'_>,
         sensor: &CaiSensor,
         shots: PyReadonlyArray1<'_, f64>,
         imu_accel: &Bound<'_, PyDict>,
@@ -483,8 +501,27 @@ impl CaiHybrid {
         let imu_model = error_model(imu_accel, imu_gyro, "imu")?;
         let reference = reference.map(|(a, g)| error_model(&a, &g, "reference")).transpose()?;
         let p0 = super::convert::mat(&p0, "p0")?;
-        let m = &motion.inner;
-        Ok(CaiHybrid(py.detach(|| HybridScenario::new(m, &cfg, imu_model, reference, cai, p0))?))
+        let scenario = match truth {
+            Truth::Motion(motion) => {
+                let m = &motion.inner;
+                py.detach(|| HybridScenario::new(m, &cfg, imu_model, reference, cai, p0))?
+            }
+            Truth::Table(t, lla, vel, q) => {
+                let (t, lla, vel, q) = (vector(&t, "trajectory")?, vec3_rows(&lla, "trajectory")?, vec3_rows(&vel, "trajectory")?, quat_rows(&q, "trajectory")?);
+                py.detach(|| HybridScenario::from_table(t, &lla, &vel, &q, &cfg, imu_model, reference, cai, p0))?
+            }
+        };
+        Ok(CaiHybrid(scenario))
+    }
+
+    /// The truth at the IMU times: position (N, 3) (lat rad, lon rad, h m), NED velocity
+    /// (N, 3) m/s and q_nb (N, 4).
+    fn truth<'py>(&self, py: Python<'py>) -> (Arr2<'py>, Arr2<'py>, Arr2<'py>) {
+        let tr = &self.0.truth;
+        let lla: Vec<Vec3> = tr.iter().map(|s| s.lla).collect();
+        let vel: Vec<Vec3> = tr.iter().map(|s| s.vel).collect();
+        let q: Vec<crate::math::Quat> = tr.iter().map(|s| s.q_nb).collect();
+        (vec3_to_py(py, &lla), vec3_to_py(py, &vel), super::convert::quat_to_py(py, &q))
     }
 
     /// Runs `runs` under `seed`: dict of arrays, each (runs, epochs, ...) except
@@ -525,7 +562,7 @@ impl CaiHybrid {
 /// either emulated (`phase` true phases + `noise` population noise, shots × channels, the
 /// laser phase steered inside the loop) or recorded (`population` + `laser_phase`).
 #[pyfunction]
-#[pyo3(signature = (ins, extra0, sensor, shots, data_kind, data_a, data_b))]
+#[pyo3(signature = (ins, extra0, sensor, shots, data_kind, data_a, data_b, incomplete_shots))]
 // invariant: a 2-D array's shape has 2 entries.
 #[allow(clippy::indexing_slicing)]
 fn cai_aided_ins(
@@ -536,9 +573,11 @@ fn cai_aided_ins(
     data_kind: Wrap<DataKind>,
     data_a: PyReadonlyArray2<'_, f64>,
     data_b: PyReadonlyArray2<'_, f64>,
+    incomplete_shots: Wrap<IncompleteShots>,
 ) -> PyResult<PyAidedIns> {
     let mut cfg = sensor.with_shots(&shots)?;
     cfg.kind = ins.setup.kind;
+    cfg.incomplete = incomplete_shots.0;
     // (shots, channels) tables, read row-major; the aiding checks their sizes
     let flat = |a: &PyReadonlyArray2<'_, f64>| a.as_array().iter().copied().collect::<Vec<f64>>();
     let widths = (data_a.shape()[1], data_b.shape()[1]);
@@ -559,6 +598,7 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     register_choices::<ForceKind>(m, "ForceMode")?;
     register_choices::<GravityModel>(m, "Gravity")?;
     register_choices::<PhaseSourceKind>(m, "PhaseSource")?;
+    register_choices::<IncompleteShots>(m, "IncompleteShots")?;
     m.add_class::<CaiChannels>()?;
     m.add_class::<CaiSetup>()?;
     m.add_class::<CaiGravity>()?;
@@ -567,6 +607,7 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<CaiSensor>()?;
     m.add_function(wrap_pyfunction!(cai_aided_ins, m)?)?;
     m.add_function(wrap_pyfunction!(cai_in_shot_noise, m)?)?;
+    m.add_function(wrap_pyfunction!(cai_incomplete_shots, m)?)?;
     m.add_function(wrap_pyfunction!(cai_phase_closed_form, m)?)?;
     m.add_function(wrap_pyfunction!(cai_sensitivity, m)?)?;
     m.add_function(wrap_pyfunction!(cai_convolution_phase, m)?)?;

@@ -11,13 +11,16 @@ Tennstedt et al. 2021, Eqs. 3–6, 33)."""
 
 from __future__ import annotations
 
+import warnings
 from dataclasses import KW_ONLY, dataclass
 
 import numpy as np
+import pandas as pd
 
 from .. import _core, plausibility
 from .._core import InputError
-from .._validate import as_floats, finite_scalar, flag, input_error, instance, integer, nonnegative, positive, scalar, vector
+from ..filter.aided import AidedIns
+from .._validate import as_floats, choice, finite_scalar, flag, input_error, instance, integer, nonnegative, positive, scalar, vector
 from ._config import ConfigMixin
 from .predictor import Channels
 
@@ -25,6 +28,7 @@ from .predictor import Channels
 OMEGA_DOT_OPTIONS = tuple(_core.OPTIONS["OmegaDot"])
 INTERPOLATION_OPTIONS = tuple(_core.OPTIONS["Interpolation"])
 FORCE_OPTIONS = tuple(_core.OPTIONS["ForceMode"])
+INCOMPLETE_SHOTS_OPTIONS = tuple(_core.OPTIONS["IncompleteShots"])
 
 
 @dataclass
@@ -164,26 +168,80 @@ def expected_phase_exceedance(sensor: CaiSensor, dt: float, q_accel: float, q_gy
 
 
 def cai_aided_ins(t0: float, lla0, vel0, q0, sensor: CaiSensor, shots, *, phase=None, noise=None, population=None, laser_phase=None,
-                  kind: str | None = None, setup: FilterSetup | None = None, p0=None, ba0=(0, 0, 0), bg0=(0, 0, 0), extra0=None,
+                  kind: str = "rates", setup: FilterSetup | None = None, p0=None, ba0=(0, 0, 0), bg0=(0, 0, 0), extra0=None,
                   method: str = "van_loan", mode: str = "closed", sequential: bool = False, gate: float | None = None,
-                  ellipsoid: str = "WGS84"):
-    """A CAI-aided INS on the generic engine (:class:`atomnav.filter.AidedIns`; run it with
-    ``.run(time, gyro, accel)``). Shots start at ``shots`` (S,) s (pulses at +0, +T, +2T,
-    update at +2T). Data, (S, C) arrays with one column per interferometer of ``sensor``:
-    either an emulated instrument — true ``phase`` (rad) and population ``noise`` — whose
-    laser phase the filter steers to mid-fringe inside the loop, or ``population`` with the
-    ``laser_phase`` (rad) the instrument applied. ``setup``: filter noise (default the
-    tuning of Tennstedt et al. 2023, :func:`atomnav.cai.seed003_filter`); ``p0`` overrides
-    ``setup.p0``; the initial state and the remaining options are those of
-    :func:`atomnav.filter.position_aided_ins`; ``kind`` ("rates" or "increments") is
-    required, as the IMU record comes as plain arrays."""
-    from ..filter.aided import AidedIns, InsSetup
+                  ellipsoid: str = "WGS84", incomplete_shots: str = "skip") -> "CaiAidedIns":
+    """A CAI-aided INS on the generic engine, for your own IMU record and CAI shots.
+
+    The filter is the error-state INS of :class:`atomnav.filter.AidedIns` with one stacked
+    update per shot: the raw populations of every interferometer of ``sensor`` against the
+    readout predicted from the bias-compensated IMU stream (Tennstedt et al. 2023, §2.8;
+    Tennstedt et al. 2021, Eqs. 3–6, 33). Run it with ``.run(time, gyro, accel)`` on the
+    whole record, or feed it chunk by chunk with ``.process``.
+
+    Parameters
+    ----------
+    t0 : float
+        Time of the initial state (s), the first IMU time stamp.
+    lla0 : array_like, shape (3,)
+        Initial position: latitude (rad), longitude (rad), height (m).
+    vel0 : array_like, shape (3,)
+        Initial NED velocity (m/s).
+    q0 : array_like, shape (4,)
+        Initial attitude q_nb, Hamilton, scalar first, unit norm.
+    sensor : CaiSensor
+        The interferometer: any channels (k directions, lever arms, C_sb, launch
+        velocities, see :class:`Channels`), pulse separation T (s), readout model.
+    shots : array_like, shape (S,)
+        Shot start times (s): pulses at +0, +T, +2T, the update at +2T. Any schedule of
+        non-overlapping shots (e.g. ``sensor.shots(t_first, t_last)``).
+    phase, noise : array_like, shape (S, C), optional
+        Emulated instrument: the true phase (rad) and the population noise of every shot
+        and channel; the filter steers the laser phase to mid-fringe inside the loop.
+    population, laser_phase : array_like, shape (S, C), optional
+        Recorded instrument: the measured population (0–1) and the laser phase (rad) the
+        instrument applied. Give either ``phase`` and ``noise`` or these two.
+    kind : {"rates", "increments"}
+        Kind of the IMU record (required: it comes as plain arrays).
+    setup : FilterSetup, optional
+        Filter noise and initial σ (default: the tuning of Tennstedt et al. 2023,
+        :func:`atomnav.cai.seed003_filter`).
+    p0 : array_like, shape (15 + E, 15 + E), optional
+        Initial covariance (SI units of the states); overrides ``setup.p0``.
+    ba0, bg0 : array_like, shape (3,)
+        Initial accelerometer (m/s²) and gyro (rad/s) bias estimates.
+    extra0 : array_like, shape (E,), optional
+        Initial values of the sensor's extra states (misalignment rad, lever arm m, force
+        error m/s²); zeros by default.
+    method, mode, sequential, gate, ellipsoid
+        As in :func:`atomnav.filter.position_aided_ins`.
+    incomplete_shots : {"skip", "error"}
+        A shot whose interferometer window needs IMU samples before the record start or
+        after its end — the pulses themselves, or a whole Savitzky–Golay ω̇ window of
+        2m + 1 samples (``sensor.omega_dot = "savgol"``) that a shot in mid-record has
+        before it — cannot be predicted. "skip" (the default) leaves it out with an
+        :class:`IncompleteShotWarning` naming the shot's index, its start time and the
+        samples it lacks; "error" refuses the record with an :class:`atomnav.InputError`
+        naming ``shots``, the same facts and the shot's index. :func:`incomplete_shots`
+        lists them beforehand. ``run`` checks the whole record before it starts;
+        ``process`` checks the record start on its first chunk (a shot past the end of a
+        streamed record is simply still pending).
+
+    Returns
+    -------
+    CaiAidedIns
+        The filter (an :class:`atomnav.filter.AidedIns`); its results have the bias
+        estimates (``accel_bias_*_mps2``, ``gyro_bias_*_rad_s``), σ of every state and the
+        NIS of every applied shot.
+    """
+    from ..filter.aided import InsSetup
     from ..filter.engine import BiasModel
     from .scenarios import seed003_filter
 
     instance(sensor, CaiSensor, "sensor")
     if setup is not None:
         instance(setup, FilterSetup, "setup")
+    choice(incomplete_shots, INCOMPLETE_SHOTS_OPTIONS, "incomplete_shots")
     emulated = phase is not None or noise is not None
     if emulated == (population is not None or laser_phase is not None):
         raise input_error("population" if emulated else "phase",
@@ -210,7 +268,94 @@ def cai_aided_ins(t0: float, lla0, vel0, q0, sensor: CaiSensor, shots, *, phase=
                    predict_every=setup.predict_every, method=method, mode=mode, sequential=sequential, gate=gate,
                    ellipsoid=ellipsoid)
     extra0 = vector(np.zeros(n_extra) if extra0 is None else extra0, n_extra, "extra0")
-    shots = vector(shots, None, "shots")
-    core = _core.cai_aided_ins(ins=ins.native, extra0=extra0, sensor=sensor._checked("sensor"), shots=shots,
-                               data_kind="emulated" if emulated else "recorded", data_a=tables[0], data_b=tables[1])
-    return AidedIns(core, ins)
+    build = dict(ins=ins.native, extra0=extra0, sensor=sensor._checked("sensor"), shots=vector(shots, None, "shots"),
+                 data_kind="emulated" if emulated else "recorded", data_a=tables[0], data_b=tables[1], incomplete_shots=incomplete_shots)
+    return CaiAidedIns(_core.cai_aided_ins(**build), ins, build)
+
+
+class IncompleteShotWarning(UserWarning):
+    """A CAI shot the IMU record cannot complete was left out (``incomplete_shots="skip"``).
+
+    Attributes
+    ----------
+    index : int
+        The shot's index in ``shots``.
+    time_s : float
+        Its start time (s).
+    before, after : int
+        IMU samples it lacks before the record start and after the record end.
+    """
+
+    def __init__(self, message: str, index: int, time_s: float, before: int, after: int):
+        super().__init__(message)
+        self.index, self.time_s, self.before, self.after = index, time_s, before, after
+
+
+def incomplete_shots(sensor: CaiSensor, shots, time) -> pd.DataFrame:
+    """The shots a record cannot complete (see ``incomplete_shots`` of :func:`cai_aided_ins`).
+
+    Parameters
+    ----------
+    sensor : CaiSensor
+        The interferometer (T, ω̇ source and its window).
+    shots : array_like, shape (S,)
+        Shot start times (s).
+    time : array_like, shape (N,)
+        The IMU time stamps (s), increasing.
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row per incomplete shot: ``shot`` (index), ``start_s``, ``samples_before``
+        and ``samples_after`` (IMU samples it lacks before the record start and after
+        its end, counted at the record's mean spacing) and ``reason``.
+    """
+    instance(sensor, CaiSensor, "sensor")
+    found = _core.cai_incomplete_shots(sensor._checked("sensor"), vector(shots, None, "shots"), vector(time, None, "time"))
+    return pd.DataFrame(found, columns=["shot", "start_s", "samples_before", "samples_after", "reason"])
+
+
+class CaiAidedIns(AidedIns):
+    """The CAI-aided INS of :func:`cai_aided_ins`: an :class:`atomnav.filter.AidedIns` that
+    handles the shots its IMU record cannot complete (``incomplete_shots``)."""
+
+    def __init__(self, core, setup, build: dict):
+        super().__init__(core, setup)
+        self._build = build
+        self._started = False
+
+    def _incomplete(self, time, start_only: bool) -> list:
+        """Report the shots ``time`` cannot complete (warn, or raise for "error"); returns
+        their indices."""
+        b = self._build
+        found = _core.cai_incomplete_shots(b["sensor"], b["shots"], time)
+        if start_only:
+            found = [f for f in found if f[2] > 0]
+        for index, ts, before, after, reason in found:
+            if b["incomplete_shots"] == "error":
+                raise input_error("shots", f"{reason} (incomplete_shots='error'; 'skip' leaves it out)", index)
+            warnings.warn(IncompleteShotWarning(f"{reason}: skipped (incomplete_shots='skip')", index, ts, before, after), stacklevel=3)
+        return [f[0] for f in found]
+
+    def process(self, time, gyro, accel, h_ref=None):
+        """See :meth:`atomnav.filter.AidedIns.process`; the first chunk is the record start,
+        whose incomplete shots are reported here."""
+        if not self._started:
+            t = as_floats(time, "time")
+            if t.ndim == 1 and len(t) >= 2:
+                self._incomplete(np.ascontiguousarray(t), start_only=True)
+        self._started = True
+        return super().process(time, gyro, accel, h_ref)
+
+    def run(self, time, gyro, accel, h_ref=None, chunk_s: float = 60.0, progress: bool = True):
+        """See :meth:`atomnav.filter.AidedIns.run`. Before it starts, the shots the whole
+        record cannot complete are reported and, with "skip", left out."""
+        t = as_floats(time, "time")
+        if not self._started and t.ndim == 1 and len(t) >= 2:
+            drop = self._incomplete(np.ascontiguousarray(t), start_only=False)
+            if drop:
+                keep = np.setdiff1d(np.arange(len(self._build["shots"])), drop)
+                b = {**self._build, **{k: self._build[k][keep] for k in ("shots", "data_a", "data_b")}}
+                self._core = _core.cai_aided_ins(**b)
+        self._started = True
+        return super().run(time, gyro, accel, h_ref, chunk_s, progress)
