@@ -282,6 +282,12 @@ def _series():
     return np.random.default_rng(1).standard_normal(3000)
 
 
+def _stored_forward_pass():
+    ins = _position_ins(smooth=True, smooth_chunk=50, smooth_memory=50 * 7576)
+    ins.run(*_static_record()[:3], progress=False)
+    return ins.forward_pass
+
+
 CASES = {
     "Channels": lambda: cai.Channels.cyclic(),
     "CaiSensor": lambda: cai.seed003_sensor(),
@@ -297,6 +303,9 @@ CASES = {
     "BiasModel": lambda: BiasModel("random_walk", psd=1e-8),
     "Layout": lambda: Layout(),
     "AidedResult": lambda: _position_ins().run(*_static_record()[:3], progress=False),
+    "SmoothedResult": lambda: _position_ins(smooth=True).run(*_static_record()[:3], progress=False).smoothed,
+    # a stored forward pass partly on disk (every chunk beyond the first)
+    "ForwardStore": lambda: _stored_forward_pass(),
     "MonteCarlo": lambda: monte_carlo(_filter_scenario(), runs=2, seed=1),
     "SteadyState": lambda: dare(np.eye(2) * 0.9, np.eye(2), np.eye(2), np.eye(2)),
     "GnssOptions": lambda: GnssOptions(formulation="clock_states", lever_arm=(0.1, 0.2, -0.3)),

@@ -29,7 +29,11 @@ class ForwardStore:
     most ``memory_bytes`` in all, the later ones written to a temporary directory made
     under ``directory`` (the system's default when None) and removed with the store. The
     epochs of the chunk being filled are held in memory too. ``lock`` serialises the
-    engine call and the append of its forward pass across threads."""
+    engine call and the append of its forward pass across threads. Two stores are equal
+    when they hold the same epochs in the same chunks with the same settings (wherever the
+    chunks are kept)."""
+
+    __slots__ = ("chunk_epochs", "memory_bytes", "directory", "_chunks", "_pending", "_held", "_tmp", "lock")
 
     def __init__(self, chunk_epochs: int, memory_bytes: int, directory: str | None):
         self.chunk_epochs = chunk_epochs
@@ -98,15 +102,29 @@ class ForwardStore:
             first += len(c["phi"])
         return out
 
+    def __eq__(self, other) -> bool:
+        if not isinstance(other, ForwardStore):
+            return NotImplemented
+        settings = ("chunk_epochs", "memory_bytes", "directory", "_held")
+        if any(getattr(self, k) != getattr(other, k) for k in settings) or len(self._chunks) != len(other._chunks):
+            return False
+        if [isinstance(c, str) for c in self._chunks] != [isinstance(c, str) for c in other._chunks]:
+            return False
+        same = [np.array_equal(a[f], b[f]) for (_, a), (_, b) in zip(self.chunks(), other.chunks()) for f in FIELDS]
+        return len(self.chunks()) == len(other.chunks()) and all(same)
+
+    __hash__ = None
+
     def __getstate__(self) -> dict:
         # a copy owns its chunks: those on disk travel as arrays and are written again
-        state = {k: v for k, v in self.__dict__.items() if k not in ("lock", "_tmp", "_chunks")}
+        state = {k: getattr(self, k) for k in ("chunk_epochs", "memory_bytes", "directory", "_pending", "_held")}
         state["_chunks"] = [(isinstance(c, str), {f: np.array(a) for f, a in self._load(c).items()}) for c in self._chunks]
         return state
 
     def __setstate__(self, state: dict) -> None:
         chunks = state.pop("_chunks")
-        self.__dict__.update(state)
+        for k, v in state.items():
+            setattr(self, k, v)
         self._chunks, self._tmp, self.lock = [], None, threading.Lock()
         for on_disk, c in chunks:
             self._chunks.append(self._write(c) if on_disk else c)
