@@ -360,7 +360,9 @@ class AidedIns:
         samples) with a progress bar. Every measurement must lie inside the record. The
         result is the same for any chunk length. Bad samples raise ``ValueError`` naming
         their index in the record (the Rust engine checks them chunk by chunk). On an
-        error the exception's ``partial`` attribute holds every epoch computed before it."""
+        error the exception's ``partial`` attribute holds every epoch computed before it.
+        With ``smooth=True`` the result's ``smoothed`` is :meth:`smooth` over the record
+        (the progress bar then also covers its chunks)."""
         t, g, a, h = _imu(time, gyro, accel, h_ref)
         self._plausible(t, g, a)  # once, on the whole record (a chunk may look static while the record moves)
         positive(chunk_s, "chunk_s")
