@@ -192,7 +192,8 @@ def test_streaming_and_a_copy_mid_record_smooth_like_run(short, tmp_path):
     _, want = _smoothed(short)
     ins = position_aided_ins(**kw, smooth=True, smooth_chunk=4, smooth_memory=0, smooth_dir=str(tmp_path))
     half = len(t) // 2
-    ins.process(t[:half], g[:half], a[:half])
+    for lo, hi in ((0, 3), (3, 140), (140, 141), (141, half)):  # uneven calls, some without an epoch
+        ins.process(t[lo:hi], g[lo:hi], a[lo:hi])
     twin = copy.deepcopy(ins)  # owns its chunks: the original's files are not shared
     assert twin.forward_pass.on_disk == ins.forward_pass.on_disk > 0
     for engine in (ins, twin):

@@ -33,7 +33,7 @@ class ForwardStore:
     when they hold the same epochs in the same chunks with the same settings (wherever the
     chunks are kept)."""
 
-    __slots__ = ("chunk_epochs", "memory_bytes", "directory", "_chunks", "_pending", "_held", "_tmp", "lock")
+    __slots__ = ("chunk_epochs", "memory_bytes", "directory", "_chunks", "_pending", "_pending_epochs", "_held", "_tmp", "lock")
 
     def __init__(self, chunk_epochs: int, memory_bytes: int, directory: str | None):
         self.chunk_epochs = chunk_epochs
@@ -41,6 +41,7 @@ class ForwardStore:
         self.directory = directory
         self._chunks: list = []  # a dict of arrays (in memory) or the path prefix of its files
         self._pending: list[dict] = []
+        self._pending_epochs = 0
         self._held = 0
         self._tmp: tempfile.TemporaryDirectory | None = None
         self.lock = threading.Lock()
@@ -48,7 +49,7 @@ class ForwardStore:
     @property
     def epochs(self) -> int:
         """Epochs stored so far."""
-        return sum(len(self._load(c)["phi"]) for c in self._chunks) + sum(len(p["phi"]) for p in self._pending)
+        return sum(len(self._load(c)["phi"]) for c in self._chunks) + self._pending_epochs
 
     @property
     def on_disk(self) -> int:
@@ -61,12 +62,14 @@ class ForwardStore:
         if not len(part["phi"]):
             return
         self._pending.append(part)
-        while sum(len(p["phi"]) for p in self._pending) >= self.chunk_epochs:
+        self._pending_epochs += len(part["phi"])
+        while self._pending_epochs >= self.chunk_epochs:
             whole = {f: np.concatenate([p[f] for p in self._pending]) for f in FIELDS}
             k = self.chunk_epochs
             self._keep({f: a[:k] for f, a in whole.items()})
             rest = {f: a[k:] for f, a in whole.items()}
-            self._pending = [rest] if len(rest["phi"]) else []
+            self._pending_epochs -= k
+            self._pending = [rest] if self._pending_epochs else []
 
     def _keep(self, chunk: dict) -> None:
         size = sum(a.nbytes for a in chunk.values())
@@ -117,7 +120,7 @@ class ForwardStore:
 
     def __getstate__(self) -> dict:
         # a copy owns its chunks: those on disk travel as arrays and are written again
-        state = {k: getattr(self, k) for k in ("chunk_epochs", "memory_bytes", "directory", "_pending", "_held")}
+        state = {k: getattr(self, k) for k in ("chunk_epochs", "memory_bytes", "directory", "_pending", "_pending_epochs", "_held")}
         state["_chunks"] = [(isinstance(c, str), {f: np.array(a) for f, a in self._load(c).items()}) for c in self._chunks]
         return state
 
