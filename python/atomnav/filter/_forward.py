@@ -113,8 +113,8 @@ class ForwardStore:
             return False
         if [isinstance(c, str) for c in self._chunks] != [isinstance(c, str) for c in other._chunks]:
             return False
-        same = [np.array_equal(a[f], b[f]) for (_, a), (_, b) in zip(self.chunks(), other.chunks()) for f in FIELDS]
-        return len(self.chunks()) == len(other.chunks()) and all(same)
+        mine, theirs = self.chunks(), other.chunks()
+        return len(mine) == len(theirs) and all(np.array_equal(a[f], b[f]) for (_, a), (_, b) in zip(mine, theirs) for f in FIELDS)
 
     __hash__ = None
 
