@@ -99,7 +99,7 @@ def test_denormal_step_is_rejected_not_a_nan(call, parameter):
     (lambda: cai.in_shot_noise({"a": 1}, 0.005, 1e-11, 1e-12), "sensor"),
     (lambda: cai.expected_phase_exceedance(np.zeros(3), 0.005, 1e-11, 1e-12), "sensor"),
     (lambda: cai.motion_imu(np.zeros(3), [0.0, 1.0]), "motion"),
-    (lambda: cai.run_campaign(np.zeros(3), None, None), "name"),
+    (lambda: cai.run_campaign(np.zeros(3), cai.ScenarioConfig(cai.seed003_sensor(), cai.seed003_filter())), "trajectory"),
     (lambda: cai.satellite_psd(None), "res"),
     (lambda: cai.satellite_steady_state("1.0"), "res"),
     (lambda: cai.readout([0.1], offset="x"), "offset"),

@@ -32,7 +32,7 @@ def _aided_ins_data_kind(kind):
 def _campaign(**kw):
     motion = _core.Motion.stationary(np.array(cai.HANNOVER), 1.0, np.zeros(3))
     config = cai.ScenarioConfig(cai.seed003_sensor(), cai.seed003_filter(), **kw)
-    cai.run_campaign("bad", motion, config, runs=1, progress=False)
+    cai.run_campaign(motion, config, runs=1, progress=False)
 
 
 BAD = {

@@ -10,6 +10,7 @@ import json
 import numpy as np
 
 from .._validate import instance, json_object
+from ..imu import ImuErrors, TriadErrors
 
 
 def _plain(value):
@@ -17,6 +18,8 @@ def _plain(value):
     tuples as (nested) lists, numpy scalars as Python numbers."""
     if hasattr(value, "to_dict"):
         return value.to_dict()
+    if isinstance(value, ImuErrors):
+        return dict(zip(("accel", "gyro"), value._to_core()))
     if isinstance(value, (np.ndarray, tuple, list)):
         return [_plain(v) for v in value]
     if isinstance(value, np.generic):
@@ -27,6 +30,17 @@ def _plain(value):
 def _tuples(value):
     """Lists read back from JSON as tuples (the dataclasses hold pairs and triples as tuples)."""
     return tuple(_tuples(v) for v in value) if isinstance(value, list) else value
+
+
+class _ImuModel:
+    """Reads back an IMU error model field of a configuration: a preset name as is, a dict
+    written by :meth:`ConfigMixin.to_dict` as an :class:`atomnav.imu.ImuErrors`."""
+
+    @staticmethod
+    def from_dict(value):
+        if isinstance(value, dict):
+            return ImuErrors(TriadErrors._from_core(value["accel"]), TriadErrors._from_core(value["gyro"]))
+        return value
 
 
 class ConfigMixin:

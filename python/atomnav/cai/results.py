@@ -28,7 +28,7 @@ class HybridResult:
     """Monte-Carlo result of one scenario. Arrays: ``time`` (E,) s; ``hybrid`` and ``free``
     (R, E, 9) errors (:data:`ERROR_COLUMNS`) of the CAI-aided and the IMU-only solutions;
     ``bias`` / ``bias_true`` (R, E, 6) estimated and true biases (:data:`BIAS_COLUMNS`);
-    ``sigma`` (R, E, n) filter σ of every state; ``accel_error`` (R, N, 3) accelerometer error
+    ``sigma`` (R, E, n) filter σ of every state (SI units); ``accel_error`` (R, N, 3) accelerometer error
     (measured − ideal, m/s²) of every IMU sample at ``imu_time`` (N,); ``phase_error`` (R, S, C) true − predicted phase (rad) per
     shot and channel; ``shots`` (S,) shot start times; ``nees`` (R, E) NEES of the 15 INS
     states (navigation errors and b̂ − b) under the filter's P."""
@@ -50,6 +50,8 @@ class HybridResult:
     channel_names: list = field(default_factory=list)
     #: The scenario configuration (``ScenarioConfig.to_dict()``) the runs were made with.
     config: dict = field(default_factory=dict)
+    #: False when the campaign stopped early (interrupt or error): the finished runs only.
+    complete: bool = True
 
     @property
     def runs(self) -> int:
@@ -109,6 +111,24 @@ class HybridResult:
             d[f"{c}_sigma"] = sig[:, :, i].mean(axis=0)
             d[f"{c}_in3sigma"] = (np.abs(err[:, :, i]) <= 3 * sig[:, :, i]).mean(axis=0)
         return pd.DataFrame(d)
+
+    def bias_table(self) -> pd.DataFrame:
+        """Long table of the bias estimates: ``run``, ``time_s`` and, per component of
+        :data:`BIAS_COLUMNS`, the estimate, the truth (``_true``) and the filter σ
+        (``_sigma``), in m/s² or rad/s."""
+        r, n = self.bias.shape[:2]
+        d = {"run": np.repeat(np.arange(r), n), "time_s": np.tile(self.time, r)}
+        for i, c in enumerate(BIAS_COLUMNS):
+            d[c] = self.bias[:, :, i].ravel()
+            d[f"{c}_true"] = self.bias_true[:, :, i].ravel()
+            d[f"{c}_sigma"] = self.sigma[:, :, 9 + i].ravel()
+        return pd.DataFrame(d)
+
+    def nees_table(self) -> pd.DataFrame:
+        """Long table ``run``, ``time_s``, ``nees`` (dimensionless, 15 INS states; χ²(15)
+        for a consistent filter)."""
+        r, n = self.nees.shape
+        return pd.DataFrame({"run": np.repeat(np.arange(r), n), "time_s": np.tile(self.time, r), "nees": self.nees.ravel()})
 
     def nees_inside(self, p: float = 0.95) -> float:
         """Share of (run, epoch) NEES values inside the two-sided p band of χ²(15)."""

@@ -13,7 +13,7 @@ import pandas as pd
 from .. import _core
 from .._validate import finite_result, flag, input_error, instance, positive, renamed, vector
 from ..imu import ImuErrors
-from ._config import ConfigMixin
+from ._config import ConfigMixin, _ImuModel
 from .campaign import run_campaign
 from .predictor import K_RB87, Channels, phase_jacobian
 from .results import HybridResult
@@ -29,26 +29,27 @@ PHASE_SOURCE_OPTIONS = tuple(_core.OPTIONS["PhaseSource"])
 MAX_SATELLITE_DAYS = 1000.0
 
 
-@dataclass
+@dataclass(frozen=True)
 class ScenarioConfig(ConfigMixin):
     """Everything of a Monte-Carlo scenario but its motion: the CAI ``sensor``, the filter
-    ``setup``, the navigation IMU (``imu``, an :meth:`atomnav.imu.ImuErrors.preset` name),
+    ``setup``, the navigation IMU (``imu``, an :meth:`atomnav.imu.ImuErrors.preset` name or
+    an :class:`atomnav.imu.ImuErrors`),
     ``gravity`` (:data:`GRAVITY_OPTIONS`: "kinematic" = no gravity or Earth rate, "earth" =
     WGS84), the IMU rate ``rate_hz`` (Hz), the source of the instrument's true phase
     ``phase_source`` (:data:`PHASE_SOURCE_OPTIONS`: "ideal" = a perfect CAI on the truth
     sampled at ``truth_rate_hz`` Hz; "reference" = a CAI emulated from the ``reference``
-    IMU preset), ``aiding`` (False: the same filter without CAI updates) and
+    IMU, a preset name or an :class:`atomnav.imu.ImuErrors`), ``aiding`` (False: the same filter without CAI updates) and
     ``draw_initial`` (draw the initial navigation error from P0 instead of starting at the
     truth). Checked by the core when the scenario is built; convertible to and from dict /
     JSON, and saved in :attr:`HybridResult.config`."""
 
-    _NESTED = {"sensor": CaiSensor, "setup": FilterSetup}
+    _NESTED = {"sensor": CaiSensor, "setup": FilterSetup, "imu": _ImuModel, "reference": _ImuModel}
 
     sensor: CaiSensor
     setup: FilterSetup
     _: KW_ONLY
-    imu: str = "navigation"
-    reference: str | None = None
+    imu: str | ImuErrors = "navigation"
+    reference: str | ImuErrors | None = None
     gravity: str = "kinematic"
     rate_hz: float = 200.0
     truth_rate_hz: float | None = 2000.0
@@ -109,7 +110,7 @@ def car_mc(runs: int = 100, seed: int = 2023, *, gravity: str = "kinematic", lev
     1.84 % to 5.83 %; the reproduce section reports both."""
     motion = _core.Motion.car(vector(HANNOVER, 3, "origin"), 0.0, bool(instance(vibration, (bool, np.bool_), "vibration")))
     config = ScenarioConfig(seed003_sensor(lever), seed003_filter(), gravity=gravity)
-    return run_campaign("car_mc", motion, config, runs=runs, seed=seed, progress=progress,
+    return run_campaign(motion, config, runs=runs, seed=seed, name="car_mc", progress=progress,
                         params={"gravity": gravity, "lever_m": tuple(lever), "vibration": vibration})
 
 
@@ -129,7 +130,7 @@ def slalom(runs: int = 100, seed: int = 2024, *, gravity: str = "kinematic", dur
     motion = _core.Motion.slalom(vector(HANNOVER, 3, "origin"), 5.0, 2.0, 10.0, positive(duration, "duration"))
     config = ScenarioConfig(seed003_sensor(lever) if sensor is None else sensor, seed003_filter() if setup is None else setup,
                             gravity=gravity, aiding=flag(aiding, "aiding"))
-    return run_campaign("slalom", motion, config, runs=runs, seed=seed, progress=progress,
+    return run_campaign(motion, config, runs=runs, seed=seed, name="slalom", progress=progress,
                         params={"gravity": gravity, "lever_m": tuple(lever), "duration_s": duration})
 
 
@@ -151,7 +152,7 @@ def satellite(days: float = 4.0, seed: int = 2021, *, drift: bool = True, progre
     setup = FilterSetup(1e-20, 1e-30, 1e-21, 0.0, 10, sigma0=(1e-6, 1e-9, 1e-9, 1e-9, 1e-12))
     config = ScenarioConfig(sensor, setup, imu="electrostatic_space_drift" if drift else "electrostatic_space", gravity="kinematic",
                             rate_hz=1.0, truth_rate_hz=1.0)
-    return run_campaign("satellite", motion, config, runs=1, seed=seed, progress=progress,
+    return run_campaign(motion, config, runs=1, seed=seed, name="satellite", progress=progress,
                         params={"days": days, "drift": drift, "T": sensor.T, "shot_period_s": 2 * sensor.T, "contrast": sensor.contrast,
                              "sigma_p": sensor.sigma_p, "q_rw": setup.accel_bias_psd})
 
@@ -171,7 +172,7 @@ def hexapod(runs: int = 100, seed: int = 2000, *, progress: bool = True) -> Hybr
                         mems.gyro.bias_rw**2 + nav.gyro.bias_rw**2, 10, sigma0=(1e-6, 1e-6, 1e-5, 3e-3, 1e-4))
     config = ScenarioConfig(sensor, setup, imu="mems", reference="navigation", gravity="earth", rate_hz=1000.0, truth_rate_hz=None,
                             phase_source="reference")
-    return run_campaign("hexapod", motion, config, runs=runs, seed=seed, progress=progress)
+    return run_campaign(motion, config, runs=runs, seed=seed, name="hexapod", progress=progress)
 
 
 def slalom_covariance(gravity: str = "earth", *, duration: float = 60.0, attitude_sigma: float | None = None,

@@ -49,8 +49,9 @@ class CaiSensor(ConfigMixin):
     "bias" = estimate biases (option b of Tennstedt et al. 2021, Eq. 11), "direct" =
     correct the specific force through a Gauss–Markov force-error block of correlation time
     ``force_tau`` (s) and σ ``force_sigma`` (m/s²) (option a); first_shot: start of the
-    first shot (s) in a simulated scenario (a Savitzky–Golay ω̇ window needs 2m + 1 samples
-    before the first shot ends). Checked by the core when handed to it
+    first shot (s) after the record start in a Monte-Carlo campaign
+    (:func:`atomnav.cai.run_campaign`; a shot whose Savitzky–Golay ω̇ window of 2m + 1
+    samples does not fit between the record start and its end is skipped). Checked by the core when handed to it
     (:meth:`_native`); convertible to and from dict / JSON."""
 
     _NESTED = {"channels": Channels}
