@@ -3,7 +3,7 @@
 
 use super::convert::{count, index_count, register_choices, Wrap, mat, quat_rows, vec3_rows, vector};
 use crate::earth::Ellipsoid;
-use crate::error::{check_finite, invalid, NavError};
+use crate::error::{check_finite, invalid, invalid_at, NavError};
 use pyo3::exceptions::PyTypeError;
 use crate::filter::aided::{AidedConfig, AidedIns, AidedOutput, Aiding, DampedVertical, ForwardPass, InsSetup, PositionAiding, PositionFix, NOMINAL_WIDTH};
 use crate::strapdown::Vertical;
@@ -33,7 +33,7 @@ pub(crate) fn mats(a: &PyReadonlyArray3<'_, f64>, field: &str) -> Result<Vec<DMa
     let s = a.shape();
     let v = a.as_array();
     if let Some(((k, i, j), x)) = v.indexed_iter().find(|(_, x)| !x.is_finite()) {
-        return Err(invalid(field, format!("non-finite value {x} at index ({k}, {i}, {j})")));
+        return Err(invalid_at(field, k, format!("non-finite value {x} at index ({k}, {i}, {j})")));
     }
     Ok((0..s[0]).map(|k| DMatrix::from_fn(s[1], s[2], |i, j| v[(k, i, j)])).collect())
 }

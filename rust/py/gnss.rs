@@ -17,7 +17,9 @@ use crate::gnss::spp::{solve_epochs, SPP_COLUMNS};
 use crate::gnss::tight::{Formulation, TightAiding};
 use crate::gnss::{SatId, TimeScales};
 use crate::math::Vec3;
-use nalgebra::DVector;
+use super::sources::AidingSource;
+use crate::filter::sources::Source;
+use nalgebra::{DMatrix, DVector};
 use numpy::{PyArray1, PyArray2, PyReadonlyArray1, PyReadonlyArray2};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
@@ -213,8 +215,31 @@ fn gnss_tight_ins<'py>(
     PyAidedIns::from_aiding_with(&ins, DVector::from_vec(x0), Some(p0), Box::new(aiding))
 }
 
+/// Tightly coupled GNSS as one measurement source of an aided INS
+/// (`aided_ins_from_sources`): observation table and options as for `gnss_tight_ins`; the
+/// initial values and σ of its extra states come from `options`. The sensor is made when
+/// the INS is built (it needs the IMU kind of the setup).
+#[pyfunction]
+#[allow(clippy::too_many_arguments)]
+fn gnss_source<'py>(
+    eph: &PyEphemerides, time: PyReadonlyArray1<'py, f64>, sat: Vec<String>, channel: PyReadonlyArray1<'py, i64>, code: PyReadonlyArray1<'py, f64>,
+    rate: PyReadonlyArray1<'py, f64>, options: &PyGnssOptions,
+) -> PyResult<AidingSource> {
+    let ep = epochs(&time, &sat, &channel, &code, &rate)?;
+    let (e, o) = (eph.inner.clone(), options.inner);
+    Ok(AidingSource::deferred(
+        "gnss".to_string(),
+        Box::new(move |setup| {
+            let (x0, var) = o.tight_initial();
+            let aiding = TightAiding::new(e, ep, o.tight(setup.kind))?;
+            Ok(Source { aiding: Box::new(aiding), extra0: x0, p0: Some(DMatrix::from_diagonal(&DVector::from_vec(var))) })
+        }),
+    ))
+}
+
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(gnss_tight_ins, m)?)?;
+    m.add_function(wrap_pyfunction!(gnss_source, m)?)?;
     m.add_class::<PyEphemerides>()?;
     m.add_class::<PyGnssOptions>()?;
     m.add_function(wrap_pyfunction!(glonass_propagate, m)?)?;

@@ -25,11 +25,20 @@ from .aided import AidedIns, InsSetup
 
 class Source:
     """A measurement source for :func:`aided_ins`. The same source may feed any number of
-    aided INS (each gets its own copy of the measurements)."""
+    aided INS: each gets its own copy of the measurements. A subclass makes the core's
+    source in :meth:`_native`."""
+
+    def _native(self) -> _core.AidingSource:
+        raise NotImplementedError
+
+
+class _Fixes(Source):
+    """Fixes of a 3-vector: times (M,) s, values (M, 3) and covariances (M, 3, 3), or a
+    table with :attr:`COLUMNS` and, without ``cov``, :attr:`SIGMA_COLUMNS`."""
 
     #: Columns of a table (DataFrame) of this source: time, then the 3-vector.
     COLUMNS: tuple[str, ...] = ()
-    #: Optional columns of a table with the σ of each component (diagonal covariance).
+    #: Columns with the σ of each component (a diagonal covariance), read when ``cov`` is None.
     SIGMA_COLUMNS: tuple[str, ...] = ()
     #: Name of the 3-vector argument.
     VALUE = ""
@@ -47,8 +56,9 @@ class Source:
                 raise input_error("cov", "required: the (M, 3, 3) covariances, or one (3, 3) for every fix")
             t = vector(time, None, "time")
         value = rows(value, 3, self.VALUE)
+        #: Times of the fixes (M,), s.
         self.time: np.ndarray = t
-        #: The fixes (M, 3) in SI units.
+        #: The fixes (M, 3), SI units.
         self.value: np.ndarray = self._plausible(value)
         #: Their covariances (M, 3, 3), SI units squared.
         self.cov: np.ndarray = _covariances(cov, len(t))
@@ -65,9 +75,6 @@ class Source:
     def _plausible(self, value: np.ndarray) -> np.ndarray:
         return value
 
-    def _native(self) -> _core.AidingSource:
-        raise NotImplementedError
-
     def __len__(self) -> int:
         return len(self.time)
 
@@ -76,7 +83,7 @@ class Source:
         return f"{type(self).__name__}({len(self)} fixes{span})"
 
 
-class PositionFixes(Source):
+class PositionFixes(_Fixes):
     """Position fixes: ``time`` (M,) s, ``lla`` (M, 3) (lat rad, lon rad, h m) and their NED
     covariances ``cov`` (M, 3, 3) m² (or one (3, 3) for every fix), z = NED(INS − fix).
 
@@ -104,7 +111,7 @@ class PositionFixes(Source):
         return _core.position_fixes(self.time, self.value, self.cov)
 
 
-class VelocityFixes(Source):
+class VelocityFixes(_Fixes):
     """NED velocity fixes: ``time`` (M,) s, ``vel_ned`` (M, 3) m/s and their covariances
     ``cov`` (M, 3, 3) m²/s² (or one (3, 3) for every fix), z = v̂ − v_fix on the velocity
     error states.
@@ -150,7 +157,9 @@ def aided_ins(setup: InsSetup, sources) -> AidedIns:
         covariance of the whole state (INS states, then every source's extra states in
         source order), which replaces the sources' own.
     sources : source or sequence of sources
-        :class:`PositionFixes`, :class:`VelocityFixes` and the sources other modules make.
+        :class:`PositionFixes`, :class:`VelocityFixes`,
+        :class:`atomnav.gnss.tight.GnssObservations`, the zero-velocity and zero-rate
+        updates of :mod:`atomnav.alignment` (those are used up by one INS).
         Each source's measurements must lie inside the IMU record. Equal times of
         different sources are applied at the same epoch in the order given.
 

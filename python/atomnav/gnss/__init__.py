@@ -6,7 +6,7 @@ from .ephemeris import GLONASS_COLUMNS, GPS_COLUMNS, Ephemerides, glonass_propag
 from .observations import OBS_COLUMNS, doppler_to_rate, simulate
 from .options import FORMULATIONS, GnssOptions
 from .spp import SPP_COLUMNS, solve
-from .tight import tight_ins
+from .tight import GnssObservations, tight_ins
 
 __all__ = ["Ephemerides", "GPS_COLUMNS", "GLONASS_COLUMNS", "glonass_propagate", "OBS_COLUMNS", "simulate",
-           "doppler_to_rate", "FORMULATIONS", "GnssOptions", "SPP_COLUMNS", "solve", "tight_ins"]
+           "doppler_to_rate", "FORMULATIONS", "GnssOptions", "SPP_COLUMNS", "solve", "tight_ins", "GnssObservations"]

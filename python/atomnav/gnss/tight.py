@@ -9,6 +9,7 @@ import pandas as pd
 
 from .. import _core
 from ..filter.aided import AidedIns, InsSetup
+from ..filter.sources import Source
 from .._validate import instance
 from .ephemeris import Ephemerides
 from .observations import obs_arrays
@@ -44,3 +45,29 @@ def tight_ins(eph: Ephemerides, obs: pd.DataFrame, options: GnssOptions | None =
     result = AidedIns(core, setup)
     result.options = opts
     return result
+
+
+class GnssObservations(Source):
+    """GNSS code and pseudorange-rate observations as one measurement source of
+    :func:`atomnav.filter.aided_ins`, the tightly coupled model of :func:`tight_ins`.
+
+    ``eph``: broadcast ephemerides; ``obs``: observation table as for :func:`tight_ins`;
+    ``options``: :class:`GnssOptions` (default ``GnssOptions()``), which also give the
+    initial values and σ of the extra states (``c_tau_gps``, and ``clock`` with
+    ``formulation="clock_states"``). The table is checked here; the sensor is made for
+    each INS built from it (it needs the IMU kind of the setup). Two GNSS sources in one
+    INS would share those state names: an :class:`atomnav.InputError` naming ``sources``.
+    """
+
+    def __init__(self, eph: Ephemerides, obs: pd.DataFrame, options: GnssOptions | None = None):
+        #: The ephemerides, the observation arrays and the options.
+        self.eph = instance(eph, Ephemerides, "eph")
+        self.options = GnssOptions() if options is None else instance(options, GnssOptions, "options")
+        self._obs = obs_arrays(obs)
+        self._native()  # the core checks the table now
+
+    def _native(self) -> _core.AidingSource:
+        return _core.gnss_source(self.eph._core, *self._obs, self.options.native)
+
+    def __repr__(self) -> str:
+        return f"GnssObservations({len(self._obs[0])} observations)"
