@@ -105,3 +105,9 @@ def test_verdicts_come_from_one_vocabulary(tmp_path):
     rep.row("a quantity", 1.0, 2.0, reproduce.NOT_REPRODUCED, "docs/departures.md")
     assert [r["verdict"] for r in rep.rows] == ["not reproduced"]
 
+
+
+def test_run_names_an_unknown_section_for_python_callers(tmp_path):
+    with pytest.raises(atomnav.InputError, match="nosuch") as e:
+        reproduce.run(tmp_path, only=["strapdown", "nosuch"])
+    assert e.value.parameter == "only" and "strapdown" in str(e.value)
