@@ -59,8 +59,10 @@ def _velocity_error(r, result):
     return err[VEL].to_numpy(), result.nav[[f"sigma_velocity[{i}]" for i in range(3)]].to_numpy()
 
 
-def test_velocity_fixes_keep_the_velocity_error_inside_its_3_sigma(run):
-    result = aided_ins(run["setup"], _velocity(run)).run(*run["imu"], progress=False)
+@pytest.mark.parametrize("mode", ["closed", "open"])
+def test_velocity_fixes_keep_the_velocity_error_inside_its_3_sigma(run, mode):
+    setup = InsSetup.from_dict({**run["setup"].to_dict(), "mode": mode})
+    result = aided_ins(setup, _velocity(run)).run(*run["imu"], progress=False)
     dv, sigma = _velocity_error(run, result)
     assert len(result.nav) == 3000 and len(result.measurements) == 300
     inside = (np.abs(dv) <= 3 * sigma).mean(axis=0)
