@@ -49,11 +49,15 @@ pub const MAX_LATITUDE: f64 = 89.0 * std::f64::consts::PI / 180.0;
 /// beyond this is no static record (accelerations in g, increments read as rates).
 pub const GRAVITY_TOLERANCE: f64 = 0.1;
 
+/// A bias process counts as white noise over a horizon this many times its correlation time.
+pub const WHITE_FRACTION: f64 = 10.0;
+
 /// The error budget of one sensor triad over a record of `horizon` s: each bias process
 /// (Gauss–Markov, and the Gauss–Markov poles that realise flicker, `imu::noise::Flicker`)
-/// counts as a bias random walk (PSD 2σ²/τ, initial variance σ²) when its correlation time
-/// is at least the horizon, and as white noise (PSD 2σ²τ, its low-frequency level) when it
-/// is shorter.
+/// counts as white noise (PSD 2σ²τ, its low-frequency level) only when its correlation
+/// time is short against the horizon (τ < horizon/[`WHITE_FRACTION`]), since only then
+/// does an estimate over the horizon average it down like white noise; otherwise it
+/// counts as a bias random walk (PSD 2σ²/τ, initial variance σ²).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct TriadBudget {
     /// White-noise PSD (density², units²·s): N² plus the fast processes.
@@ -78,7 +82,7 @@ impl TriadBudget {
         let (mut white_psd, mut walk_psd, mut slow, mut drift) = (e.white * e.white, e.bias_rw * e.bias_rw, 0.0, 0.0);
         for (s, tau) in processes {
             drift += s * s;
-            if tau >= horizon {
+            if tau * WHITE_FRACTION >= horizon {
                 slow += s * s;
                 walk_psd += 2.0 * s * s / tau;
             } else {
