@@ -396,6 +396,9 @@ impl HybridScenario {
     }
 }
 
+/// The ideal IMU of a table: specific force, angular rate ω_ib^b, NED acceleration, ω_nb^b.
+pub type TableImu = (Vec<Vec3>, Vec<Vec3>, Vec<Vec3>, Vec<Vec3>);
+
 /// Ideal IMU of a sampled trajectory: specific force f^b (m/s²) and angular rate ω_ib^b
 /// (rad/s) at each sample (the NED mechanization solved for them, [`body_from_kinematics`]),
 /// with the NED acceleration and ω_nb^b they come from. Both are second-order finite
@@ -405,14 +408,15 @@ impl HybridScenario {
 // invariant: every series has n ≥ 3 entries (checked by the caller and here), and the
 // stencils use k − 1, k + 1 only inside (0 < k < n − 1) and 0..2, n − 3..n − 1 at the ends.
 #[allow(clippy::indexing_slicing)]
-pub fn table_imu(ell: &Ellipsoid, t: &[f64], lla: &[Vec3], vel: &[Vec3], q_nb: &[Quat], rate_hz: f64) -> Result<(Vec<Vec3>, Vec<Vec3>, Vec<Vec3>, Vec<Vec3>)> {
+pub fn table_imu(ell: &Ellipsoid, t: &[f64], lla: &[Vec3], vel: &[Vec3], q_nb: &[Quat], rate_hz: f64) -> Result<TableImu> {
     let n = t.len();
     if n < 3 || lla.len() != n || vel.len() != n || q_nb.len() != n {
         return Err(invalid("trajectory", format!("needs at least 3 samples with a position, velocity and attitude each, got {n} times, {} / {} / {}", lla.len(), vel.len(), q_nb.len())));
     }
     check_positive("rate_hz", rate_hz)?;
     let dt = 1.0 / rate_hz;
-    if let Some(k) = (1..n).find(|&k| !((t[k] - t[k - 1] - dt).abs() <= 1e-6 * dt)) {
+    let even = |k: usize| (t[k] - t[k - 1] - dt).abs() <= 1e-6 * dt; // false for NaN
+    if let Some(k) = (1..n).find(|&k| !even(k)) {
         return Err(invalid_at("trajectory", k, format!("time step {} s before sample {k} is not 1/rate_hz = {dt} s: the simulated IMU samples at one rate", t[k] - t[k - 1])));
     }
     for (name, v) in [("trajectory", lla), ("trajectory", vel)] {

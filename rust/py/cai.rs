@@ -433,11 +433,14 @@ fn cai_in_shot_noise<'py>(py: Python<'py>, sensor: &CaiSensor, dt: f64, q_a: f64
     Ok((super::convert::mat_to_py(py, &sigma), cube(py, flat, [cross.len(), n, m])?))
 }
 
+/// One incomplete shot for Python: (index, start s, samples lacking before, after, message).
+type IncompleteShot = (usize, f64, usize, usize, String);
+
 /// The shots of `sensor` at `shots` (s) that the record `time` (s) cannot complete: (index,
 /// start s, samples lacking before the record start, after its end, message)
 /// (`CaiConfig::incomplete_shots`).
 #[pyfunction]
-fn cai_incomplete_shots(sensor: &CaiSensor, shots: PyReadonlyArray1<'_, f64>, time: PyReadonlyArray1<'_, f64>) -> PyResult<Vec<(usize, f64, usize, usize, String)>> {
+fn cai_incomplete_shots(sensor: &CaiSensor, shots: PyReadonlyArray1<'_, f64>, time: PyReadonlyArray1<'_, f64>) -> PyResult<Vec<IncompleteShot>> {
     let found = sensor.with_shots(&shots)?.incomplete_shots(&vector(&time, "time")?)?;
     Ok(found.into_iter().map(|(j, ts, g, text)| (j, ts, g.before, g.after, text)).collect())
 }
@@ -564,7 +567,7 @@ impl CaiHybrid {
 #[pyfunction]
 #[pyo3(signature = (ins, extra0, sensor, shots, data_kind, data_a, data_b, incomplete_shots))]
 // invariant: a 2-D array's shape has 2 entries.
-#[allow(clippy::indexing_slicing)]
+#[allow(clippy::indexing_slicing, clippy::too_many_arguments)]
 fn cai_aided_ins(
     ins: PyRef<'_, AidedSetup>,
     extra0: PyReadonlyArray1<'_, f64>,

@@ -141,8 +141,12 @@ class HybridResult:
         return float(np.mean((self.nees >= lo) & (self.nees <= hi)))
 
     def phase_exceedance(self, limit: float = np.pi / 2) -> float:
-        """Share of shot-channels with |true − predicted phase| > limit (rad)."""
-        return float(np.mean(np.abs(self.phase_error) > scalar(limit, "limit")))
+        """Share of shot-channels with |true − predicted phase| > limit (rad), over the
+        shots applied (a skipped shot's NaN phase error is left out)."""
+        e = np.abs(self.phase_error[np.isfinite(self.phase_error)])
+        if not e.size:
+            raise input_error("phase_error", "no shot was applied, so there is no share to take")
+        return float(np.mean(e > scalar(limit, "limit")))
 
     def phase_errors(self) -> pd.DataFrame:
         """Long table run, shot_start_s, channel, phase_error_rad."""

@@ -338,7 +338,7 @@ class CaiAidedIns(AidedIns):
             warnings.warn(IncompleteShotWarning(f"{reason}: skipped (incomplete_shots='skip')", index, ts, before, after), stacklevel=3)
         return [f[0] for f in found]
 
-    def process(self, time, gyro, accel, h_ref=None):
+    def process(self, time, gyro, accel, *args, **kwargs):
         """See :meth:`atomnav.filter.AidedIns.process`; the first chunk is the record start,
         whose incomplete shots are reported here."""
         if not self._started:
@@ -346,9 +346,9 @@ class CaiAidedIns(AidedIns):
             if t.ndim == 1 and len(t) >= 2:
                 self._incomplete(np.ascontiguousarray(t), start_only=True)
         self._started = True
-        return super().process(time, gyro, accel, h_ref)
+        return super().process(time, gyro, accel, *args, **kwargs)
 
-    def run(self, time, gyro, accel, h_ref=None, chunk_s: float = 60.0, progress: bool = True):
+    def run(self, time, gyro, accel, *args, **kwargs):
         """See :meth:`atomnav.filter.AidedIns.run`. Before it starts, the shots the whole
         record cannot complete are reported and, with "skip", left out."""
         t = as_floats(time, "time")
@@ -359,4 +359,4 @@ class CaiAidedIns(AidedIns):
                 b = {**self._build, **{k: self._build[k][keep] for k in ("shots", "data_a", "data_b")}}
                 self._core = _core.cai_aided_ins(**b)
         self._started = True
-        return super().run(time, gyro, accel, h_ref, chunk_s, progress)
+        return super().run(time, gyro, accel, *args, **kwargs)
