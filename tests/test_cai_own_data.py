@@ -181,6 +181,8 @@ def test_monte_carlo_skips_a_shot_at_the_start_with_a_warning(tmp_path):
     with pytest.warns(cai.IncompleteShotWarning, match=r"shot 0 \(start 0 s\) needs 6 IMU sample"):
         res = cai.run_campaign(traj, config, runs=2, progress=False)
     assert np.isnan(res.phase_error[:, 0, :]).all() and np.isfinite(res.phase_error[:, 1:, :]).all()
+    # the skipped shot is missing, not a shot inside the limit: every applied one exceeds 0 rad
+    assert res.phase_exceedance(0.0) == 1.0
 
 
 # ---- interrupted campaigns ------------------------------------------------------------------
