@@ -75,7 +75,7 @@ def _read(imu, kind: str):
     return np.ascontiguousarray(t), np.ascontiguousarray(g), np.ascontiguousarray(a)
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, kw_only=True)
 class CoarseAlignment:
     """The result of :func:`coarse`. Angles in rad; ``print`` it for a summary in degrees
     and arcminutes.
@@ -209,7 +209,7 @@ def coarse(imu, lla, *, errors, kind: str = "increments", ellipsoid: str = "WGS8
                            earth_rate_h=d["earth_rate_h"], spread=tuple(d["spread"]), errors=model, ellipsoid=ellipsoid, **arr)
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, kw_only=True)
 class FineAlignment:
     """The result of :func:`fine`. Angles in rad; ``print`` it for a summary.
 
@@ -345,9 +345,11 @@ def fine(imu, lla, coarse: CoarseAlignment, *, errors=None, interval: float = 1.
     times = t0 + interval * np.arange(1, int(np.floor(span / interval * (1 + 1e-12))) + 1)
     if not len(times):
         raise input_error("interval", f"{interval} s leaves no update inside the record of {span:g} s")
+    accel_errors, gyro_errors = model._to_core()
     p0, (accel_psd, accel_walk, gyro_psd, gyro_walk) = _core.fine_alignment_p0(
-        site, coarse.q_nb, coarse.psi_cov_noise, coarse.mean_f, coarse.mean_w, coarse.gravity, span, *model._to_core(),
-        positive(pos_sigma, "pos_sigma"), positive(vel_sigma, "vel_sigma"), ellipsoid=coarse.ellipsoid)
+        site, coarse.q_nb, psi_cov_noise=coarse.psi_cov_noise, mean_f=coarse.mean_f, mean_w=coarse.mean_w,
+        gravity=coarse.gravity, horizon=span, accel_errors=accel_errors, gyro_errors=gyro_errors,
+        pos_sigma=positive(pos_sigma, "pos_sigma"), vel_sigma=positive(vel_sigma, "vel_sigma"), ellipsoid=coarse.ellipsoid)
     setup = InsSetup(t0=t0, lla0=site, vel0=(0.0, 0.0, 0.0), q0=coarse.q_nb, kind=kind, p0=p0, accel_psd=accel_psd,
                      gyro_psd=gyro_psd, accel_bias=BiasModel(kind="random_walk", psd=accel_walk),
                      gyro_bias=BiasModel(kind="random_walk", psd=gyro_walk), predict_every=max(1, int(round(predict_s / step))),

@@ -52,13 +52,13 @@ fn coarse_alignment<'py>(
     Ok(d)
 }
 
-/// The initial covariance (15, 15) of a fine alignment from a coarse one (`q_nb` (4,),
-/// `psi_cov_noise` (3, 3), static means `mean_f`, `mean_w`, `gravity`) at `lla` over a
+/// The initial covariance (15, 15) of a fine alignment from a coarse one (`q_nb` (4,);
+/// keyword-only: `psi_cov_noise` (3, 3), static means `mean_f`, `mean_w`, `gravity`) at `lla` over a
 /// record of `horizon` s, with the error model's triad dicts, position σ `pos_sigma` (m)
 /// and velocity σ `vel_sigma` (m/s); and the filter's noise model: (accel white PSD,
 /// accel bias random-walk PSD, gyro white PSD, gyro bias random-walk PSD).
 #[pyfunction]
-#[pyo3(signature = (lla, q_nb, psi_cov_noise, mean_f, mean_w, gravity, horizon, accel_errors, gyro_errors, pos_sigma, vel_sigma, ellipsoid=Wrap(crate::earth::WGS84)))]
+#[pyo3(signature = (lla, q_nb, *, psi_cov_noise, mean_f, mean_w, gravity, horizon, accel_errors, gyro_errors, pos_sigma, vel_sigma, ellipsoid=Wrap(crate::earth::WGS84)))]
 #[allow(clippy::too_many_arguments, clippy::type_complexity)]
 fn fine_alignment_p0<'py>(
     py: Python<'py>,
