@@ -171,7 +171,7 @@ def expected_phase_exceedance(sensor: CaiSensor, dt: float, q_accel: float, q_gy
 def cai_aided_ins(t0: float, lla0, vel0, q0, sensor: CaiSensor, shots, *, phase=None, noise=None, population=None, laser_phase=None,
                   kind: str = "rates", setup: FilterSetup | None = None, p0=None, ba0=(0, 0, 0), bg0=(0, 0, 0), extra0=None,
                   method: str = "van_loan", mode: str = "closed", sequential: bool = False, gate: float | None = None,
-                  ellipsoid: str = "WGS84", incomplete_shots: str = "skip") -> "CaiAidedIns":
+                  ellipsoid: str = "WGS84", incomplete_shots: str = "skip", smooth: bool = False) -> "CaiAidedIns":
     """A CAI-aided INS on the generic engine, for your own IMU record and CAI shots.
 
     The filter is the error-state INS of :class:`atomnav.filter.AidedIns` with one stacked
@@ -227,6 +227,12 @@ def cai_aided_ins(t0: float, lla0, vel0, q0, sensor: CaiSensor, shots, *, phase=
         lists them beforehand. ``run`` checks the whole record before it starts;
         ``process`` checks the record start on its first chunk (a shot past the end of a
         streamed record is simply still pending).
+    smooth : bool
+        Store the forward pass for the Rauch–Tung–Striebel smoother (Rauch, Tung &
+        Striebel 1965): ``run`` then also returns the smoothed solution
+        (``result.smoothed``), and :meth:`atomnav.filter.AidedIns.smooth` smooths a
+        streamed record (memory and disk use as for ``smooth`` of
+        :class:`atomnav.filter.InsSetup`).
 
     Returns
     -------
@@ -267,7 +273,7 @@ def cai_aided_ins(t0: float, lla0, vel0, q0, sensor: CaiSensor, shots, *, phase=
                    accel_bias=BiasModel("random_walk", psd=setup.accel_bias_psd),
                    gyro_bias=BiasModel("random_walk", psd=setup.gyro_bias_psd), ba0=ba0, bg0=bg0,
                    predict_every=setup.predict_every, method=method, mode=mode, sequential=sequential, gate=gate,
-                   ellipsoid=ellipsoid)
+                   ellipsoid=ellipsoid, smooth=smooth)
     extra0 = vector(np.zeros(n_extra) if extra0 is None else extra0, n_extra, "extra0")
     build = dict(ins=ins.native, extra0=extra0, sensor=sensor._checked("sensor"), shots=vector(shots, None, "shots"),
                  data_kind="emulated" if emulated else "recorded", data_a=tables[0], data_b=tables[1], incomplete_shots=incomplete_shots)
