@@ -241,3 +241,66 @@ def test_fix_outside_the_imu_record_names_time(run):
     with pytest.raises(InputError, match="outside the IMU span") as e:
         aided_ins(run["setup"], [_velocity(run), late]).run(t, g, a, progress=False)
     assert e.value.parameter == "time"
+
+
+# ---- which source each measurement came from ----------------------------------------------
+
+def _first_epoch_at_or_after(imu_t, times):
+    """The IMU sample at or after each time: where the engine applies a measurement."""
+    return imu_t[np.searchsorted(imu_t, times, side="left")]
+
+
+def test_each_measurement_names_its_source(run):
+    """Position fixes every second (on the IMU grid) and velocity fixes every 2 s between
+    IMU samples: the source column counts the fixes of each, its times are each source's
+    fix times, its order is the merge of both by time, and the filter has an epoch at the
+    first IMU sample at or after every fix. Chunked runs give the same table."""
+    n = int(60 * RATE) + 1
+    t, g, a = (x[:n] for x in run["imu"])
+    t_pos = run["t"][run["t"] <= t[-1]]
+    t_vel = np.arange(0.0, 58.0, 2.0) + 1.005  # 1.005, 3.005, ...: between the 10 ms samples
+    k = np.searchsorted(run["truth"].time, t_vel)
+    pos = PositionFixes(t_pos, run["lla"][: len(t_pos)], np.eye(3) * SIGMA_POS**2)
+    vel = VelocityFixes(t_vel, run["truth"].vel_ned[k], np.eye(3) * SIGMA_VEL**2)
+    results = [aided_ins(run["setup"], [vel, pos]).run(t, g, a, chunk_s=c, progress=False) for c in (60.0, 7.3)]
+    meas = results[0].measurements
+    assert meas["source"].value_counts().to_dict() == {"position_fixes": len(t_pos), "velocity_fixes": len(t_vel)}
+    for name, times in (("position_fixes", t_pos), ("velocity_fixes", t_vel)):
+        assert np.array_equal(meas.loc[meas["source"] == name, "time_s"].to_numpy(), times), name
+    merged = np.r_[t_vel, t_pos]
+    order = np.argsort(merged, kind="stable")
+    labels = np.array(["velocity_fixes"] * len(t_vel) + ["position_fixes"] * len(t_pos))
+    assert meas["source"].tolist() == labels[order].tolist()
+    epochs = results[0].nav["time_s"].to_numpy()
+    assert np.isin(_first_epoch_at_or_after(t, merged), epochs).all()
+    assert not np.isin(t_vel, epochs).any()  # the fix times themselves are no IMU samples
+    pd.testing.assert_frame_equal(results[1].measurements, meas, check_exact=True)
+    # a sensor alone names itself
+    alone = aided_ins(run["setup"], pos).run(t, g, a, progress=False).measurements
+    assert (alone["source"] == "position_fixes").all() and len(alone) == len(t_pos)
+
+
+def test_a_skipped_gnss_epoch_leaves_no_row_and_others_keep_their_source():
+    """A GNSS epoch with one satellite left (first differences need two) is skipped by the
+    sensor: no row for it, while a velocity fix at the same time keeps its row."""
+    from atomnav.gnss import GnssObservations, tight_ins
+    from atomnav.gnss import scenarios as S
+
+    case = S.build(S.Scenario(duration_s=20.0))
+    obs = case["obs"]
+    lone = obs["time_s"] == 5.0
+    obs = obs[~lone | (obs["sat"] == obs.loc[lone, "sat"].iloc[0])].reset_index(drop=True)
+    factory = tight_ins(case["eph"], obs, **case["args"])
+    assert factory.options.formulation == "first_difference"
+    m = case["imu"]
+    imu = (m["time_s"].to_numpy(), m[["dtheta_x_rad", "dtheta_y_rad", "dtheta_z_rad"]].to_numpy(),
+           m[["dv_x_mps", "dv_y_mps", "dv_z_mps"]].to_numpy())
+    truth = case["trajectory"]
+    vel = VelocityFixes(np.array([5.0, 6.0]), truth.vel_ned[np.searchsorted(truth.time, [5.0, 6.0])], np.eye(3) * 0.01)
+    meas = aided_ins(factory.setup, [GnssObservations(case["eph"], obs, factory.options), vel]).run(
+        *imu, h_ref=case["h_ref"], progress=False).measurements
+    epochs = np.unique(obs["time_s"].to_numpy())
+    gnss = meas.loc[meas["source"] == "gnss", "time_s"].to_numpy()
+    assert np.array_equal(gnss, epochs[epochs != 5.0])
+    assert meas.loc[meas["source"] == "velocity_fixes", "time_s"].tolist() == [5.0, 6.0]
+    assert set(meas["source"]) == {"gnss", "velocity_fixes"}

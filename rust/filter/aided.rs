@@ -63,9 +63,15 @@ pub struct AidingContext<'a> {
 /// sensor included.
 #[typetag::serde]
 pub trait Aiding: Send {
-    /// Field name used in error messages about the measurements (e.g. "fixes").
+    /// The sensor's name: the field of error messages about its measurements and the
+    /// `source` of each of them in [`AidedOutput`] (e.g. "position_fixes").
     fn name(&self) -> &str {
         "measurements"
+    }
+    /// Name of the sensor that made measurement `j`: [`Self::name`], or for a composite
+    /// the name of its sensor of that measurement.
+    fn source_name(&self, _j: usize) -> &str {
+        self.name()
     }
     /// Extra state blocks after the 15 INS states: (name, size).
     fn extra_blocks(&self) -> Vec<(String, usize)> {
@@ -95,6 +101,9 @@ pub trait Aiding: Send {
 impl Aiding for Box<dyn Aiding> {
     fn name(&self) -> &str {
         (**self).name()
+    }
+    fn source_name(&self, j: usize) -> &str {
+        (**self).source_name(j)
     }
     fn extra_blocks(&self) -> Vec<(String, usize)> {
         (**self).extra_blocks()
@@ -149,12 +158,14 @@ pub struct AidedOutput {
     /// σ of every state, epochs × n.
     pub sigma: Vec<f64>,
     /// Per measurement: its time, number of rows, innovations (concatenated), NIS (summed
-    /// over rows) and the number of rows the χ² gate rejected.
+    /// over rows), the number of rows the χ² gate rejected and the name of the sensor that
+    /// made it ([`Aiding::source_name`]).
     pub meas_time: Vec<f64>,
     pub meas_rows: Vec<usize>,
     pub innovation: Vec<f64>,
     pub nis: Vec<f64>,
     pub rejected: Vec<usize>,
+    pub meas_source: Vec<String>,
     /// The forward pass of these epochs, stored for the smoother (empty unless
     /// [`AidedIns::store_forward_pass`] was called).
     pub forward: ForwardPass,
@@ -656,6 +667,7 @@ impl<A: Aiding> AidedIns<A> {
             out.innovation.extend_from_slice(&rep.innovation);
             out.nis.push(rep.nis.iter().sum());
             out.rejected.push(rep.rejected.len());
+            out.meas_source.push(self.aiding.source_name(j).to_string());
         }
         let post = self.store.then(|| (self.kf.x.clone(), self.kf.p.clone()));
         if self.cfg.mode == LoopMode::Closed {
@@ -772,13 +784,13 @@ impl PositionAiding {
 #[typetag::serde]
 impl Aiding for PositionAiding {
     fn name(&self) -> &str {
-        "fixes"
+        "position_fixes"
     }
     fn times(&self) -> &[f64] {
         &self.times
     }
     fn measure(&mut self, j: usize, ctx: &AidingContext) -> Result<Option<Measurement>> {
-        let fx = self.fixes.get(j).ok_or_else(|| invalid("fixes", format!("no fix {j} (of {})", self.fixes.len())))?;
+        let fx = self.fixes.get(j).ok_or_else(|| invalid("position_fixes", format!("no fix {j} (of {})", self.fixes.len())))?;
         let z = ned_diff(ctx.ell, &ctx.nav.lla, &fx.lla);
         let mut h = DMatrix::<f64>::zeros(3, ctx.layout.size());
         h.view_mut((0, ctx.layout.range("position")?.start), (3, 3)).fill_with_identity();

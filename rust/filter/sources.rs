@@ -150,6 +150,12 @@ impl Aiding for Sources {
     fn name(&self) -> &str {
         "sources"
     }
+    fn source_name(&self, j: usize) -> &str {
+        match self.order.get(j).and_then(|&(i, local)| Some((self.sources.get(i)?, local))) {
+            Some((s, local)) => s.source_name(local),
+            None => self.name(),
+        }
+    }
     fn extra_blocks(&self) -> Vec<(String, usize)> {
         self.sources.iter().flat_map(|s| s.extra_blocks()).collect()
     }
@@ -331,6 +337,39 @@ mod tests {
         assert!(speed(&both) < speed(&pos_only), "{} vs {}", speed(&both), speed(&pos_only));
     }
 
+    /// Each applied measurement names its sensor: fixes every second and velocity fixes
+    /// every other second, merged in time order (ties in sensor order); a sensor's skipped
+    /// measurements leave no entry; a sensor alone names itself.
+    #[test]
+    fn each_measurement_names_its_source() {
+        #[derive(serde::Serialize, serde::Deserialize)]
+        struct Skips(Vec<f64>);
+        #[typetag::serde]
+        impl Aiding for Skips {
+            fn name(&self) -> &str {
+                "skips"
+            }
+            fn times(&self) -> &[f64] {
+                &self.0
+            }
+            fn measure(&mut self, _j: usize, _ctx: &AidingContext) -> Result<Option<Measurement>> {
+                Ok(None)
+            }
+        }
+        let (setup, lla, t, g, a) = record(LoopMode::Closed);
+        let parts = vec![
+            Source::plain(Box::new(Skips(vec![0.5, 2.0, 9.5]))),
+            Source::plain(Box::new(fixes(lla, (1..10).map(f64::from)))),
+            Source::plain(Box::new(velocity((2..10).step_by(2).map(f64::from)))),
+        ];
+        let out = run(&setup, parts, &t, &g, &a);
+        let want: Vec<&str> = (1..10).flat_map(|s| if s % 2 == 0 { vec!["position_fixes", "velocity_fixes"] } else { vec!["position_fixes"] }).collect();
+        assert_eq!(out.meas_source, want);
+        assert_eq!(out.meas_time.len(), want.len());
+        let alone = run(&setup, vec![Source::plain(Box::new(velocity([3.0, 4.0].into_iter())))], &t, &g, &a);
+        assert_eq!(alone.meas_source, ["velocity_fixes"; 2]);
+    }
+
     /// Two sensors with the same state block name: an error naming `sources` and the second.
     #[test]
     fn duplicate_block_names_are_refused() {
@@ -360,8 +399,8 @@ mod tests {
         let (_, lla, _, _, _) = record(LoopMode::Closed);
         let bad = fixes(lla, [1.0, 1.0].into_iter());
         match Sources::new(vec![Box::new(bad)]) {
-            Err(NavError::InvalidInput { field, .. }) => assert_eq!(field, "fixes"),
-            other => panic!("expected an invalid fixes, got {:?}", other.map(|s| s.times.len())),
+            Err(NavError::InvalidInput { field, .. }) => assert_eq!(field, "position_fixes"),
+            other => panic!("expected an invalid position_fixes, got {:?}", other.map(|s| s.times.len())),
         }
     }
 }

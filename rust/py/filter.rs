@@ -97,8 +97,9 @@ fn ins_error_dynamics<'py>(
 /// a sensor's factory function (`position_aided_ins`, ...). `process` and `finish` return
 /// (nav (14, E) column table, accel_bias (E, 3), gyro_bias (E, 3), extra (E, n_extra),
 /// sigma (E, n), meas_time (M,), meas_rows (M,), innovation (ΣM rows,), nis (M,),
-/// rejected (M,), forward) for the epochs and measurements of that call; `forward` is the
-/// stored forward pass of those epochs (empty unless `store_forward_pass` was called):
+/// rejected (M,), source (list of M sensor names), forward) for the epochs and
+/// measurements of that call; `forward` is the stored forward pass of those epochs (empty
+/// unless `store_forward_pass` was called):
 /// (phi (E, n, n), qd (E, n, n), x_prior (E, n), p_prior (E, n, n), x_post (E, n),
 /// p_post (E, n, n), nominal (E, 17 + n_extra)).
 #[pyclass(name = "AidedIns", module = "atomnav._core")]
@@ -204,6 +205,7 @@ impl PyAidedIns {
             o.innovation.into_pyarray(py).into_any(),
             o.nis.into_pyarray(py).into_any(),
             o.rejected.into_pyarray(py).into_any(),
+            pyo3::types::PyList::new(py, o.meas_source)?.into_any(),
             Self::forward(py, o.forward, n, n_extra)?.into_any(),
         ];
         pyo3::types::PyTuple::new(py, items)

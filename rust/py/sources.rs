@@ -37,7 +37,7 @@ impl AidingSource {
 
 #[pymethods]
 impl AidingSource {
-    /// The sensor's name (e.g. "fixes").
+    /// The sensor's name (e.g. "position_fixes").
     #[getter]
     fn name(&self) -> &str {
         &self.name

@@ -155,7 +155,10 @@ class AidedResult:
     IMU bias estimates (``accel_bias_*_mps2``, ``gyro_bias_*_rad_s``), the extra blocks'
     estimates (``extra_<label>``) and σ of every state (``sigma_<label>``, SI units of the
     state). ``measurements``: one row per applied measurement — its time, row count, NIS
-    (summed over rows) and the number of rows the χ² gate rejected. ``innovation``: the
+    (summed over rows), the number of rows the χ² gate rejected and ``source``, the name
+    of the sensor that made it (str: "position_fixes", "velocity_fixes", "zero_velocity",
+    "zero_rate", "gnss", "cai"; a measurement the sensor skipped, e.g. a GNSS epoch
+    with too few satellites, has no row). ``innovation``: the
     innovations of all measurements, concatenated in order (``measurements.rows`` each).
     ``smoothed``: the smoothed solution when the engine was built with ``smooth=True``
     (:meth:`AidedIns.run`), else None.
@@ -232,8 +235,9 @@ class AidedIns:
         return self._core.pending
 
     def _result(self, out) -> AidedResult:
-        *solution, mt, mrows, innov, nis, rejected, _forward = out
-        meas = pd.DataFrame({"time_s": mt, "rows": mrows, "nis": nis, "rejected_rows": rejected})
+        *solution, mt, mrows, innov, nis, rejected, source, _forward = out
+        meas = pd.DataFrame({"time_s": mt, "rows": mrows, "nis": nis, "rejected_rows": rejected,
+                             "source": pd.Series(source, dtype="str")})
         return AidedResult(self._nav(*solution), meas, innov)
 
     def _nav(self, nav, ba, bg, extra, sigma) -> pd.DataFrame:
