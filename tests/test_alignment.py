@@ -237,3 +237,10 @@ def test_increment_records_align_like_rate_records(site):
     assert c.samples == len(inc) - 1
     tilt = np.linalg.norm((dcm(c.q_nb).T - TRUTH.T) @ np.array([0.0, 0.0, 1.0]))
     assert tilt < 5 * np.sqrt(c.psi_cov[0, 0] + c.psi_cov[1, 1])
+
+
+def test_an_unknown_preset_names_errors(site):
+    ideal, lla = site
+    with pytest.raises(an.InputError, match="hadamard") as e:
+        alignment.coarse(record(ideal, 0), lla, errors="hadamard", kind="rates")
+    assert e.value.parameter == "errors"

@@ -32,7 +32,7 @@ import numpy as np
 import pandas as pd
 
 from . import _core, plausibility
-from ._validate import choice, finite, flag, input_error, instance, nonnegative, positive, vector
+from ._validate import choice, finite, flag, input_error, instance, nonnegative, positive, renamed, vector
 from .filter.aided import AidedIns, AidedResult, InsSetup, _concat
 from .filter.engine import BiasModel
 from .imu import KINDS, ImuErrors
@@ -46,7 +46,8 @@ COVARIANCE_EPOCHS = 50
 def _errors(errors) -> ImuErrors:
     """The error model: an :class:`ImuErrors` or the name of a preset."""
     if isinstance(errors, str):
-        return ImuErrors.preset(errors)
+        with renamed(preset="errors"):
+            return ImuErrors.preset(errors)
     return instance(errors, ImuErrors, "errors")
 
 
