@@ -5,6 +5,7 @@
 
 use super::convert::{count, counts, flags, quat_rows, register_choices, seed as seed_arg, rows, to_py_rows, vec3, vec3_rows, vec3_to_py, vec_to_py, vector, Wrap};
 use super::filter::{mats, AidedSetup, PyAidedIns};
+use super::sources::AidingSource;
 use super::imu::triad_from_dict;
 use super::trajectory::Motion;
 use crate::cai::aiding::{shot_times, CaiAiding, CaiConfig, CaiData, DataKind, ForceKind, ForceMode, IncompleteShots};
@@ -19,10 +20,11 @@ use crate::cai::predictor::{
 use crate::cai::readout::{populations, steer_all};
 use crate::cai::sensitivity::{convolution_phase, ideal_transfers, sensitivity_samples, Pulses};
 use crate::error::invalid;
+use crate::filter::sources::Source;
 use crate::imu::errors::ImuErrorModel;
 use crate::imu::ImuKind;
 use crate::math::{Mat3, Vec3};
-use nalgebra::DVector;
+use nalgebra::{DMatrix, DVector};
 use numpy::{PyArray1, PyArray2, PyArray3, PyArrayMethods, PyReadonlyArray1, PyReadonlyArray2, PyReadonlyArray3, PyUntypedArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
@@ -561,13 +563,32 @@ impl CaiHybrid {
     }
 }
 
-/// CAI-aided INS on the generic engine (`atomnav.filter.AidedIns`): the shots' data are
-/// either emulated (`phase` true phases + `noise` population noise, shots × channels, the
-/// laser phase steered inside the loop) or recorded (`population` + `laser_phase`).
+/// The sensor `sensor` at `shots` (s) with the shots' data, `incomplete_shots` as chosen:
+/// either emulated (`data_a` true phases, `data_b` population noise, shots × channels, the
+/// laser phase steered inside the loop) or recorded (`data_a` populations, `data_b` laser
+/// phases). The tables are read row-major; the aiding checks their sizes.
+// invariant: a 2-D array's shape has 2 entries.
+#[allow(clippy::indexing_slicing)]
+fn cai_parts(
+    sensor: &CaiSensor,
+    shots: &PyReadonlyArray1<'_, f64>,
+    data_kind: DataKind,
+    data_a: &PyReadonlyArray2<'_, f64>,
+    data_b: &PyReadonlyArray2<'_, f64>,
+    incomplete_shots: IncompleteShots,
+) -> PyResult<(CaiConfig, CaiData)> {
+    let cfg = CaiConfig { incomplete: incomplete_shots, ..sensor.with_shots(shots)? };
+    let flat = |a: &PyReadonlyArray2<'_, f64>| a.as_array().iter().copied().collect::<Vec<f64>>();
+    let widths = (data_a.shape()[1], data_b.shape()[1]);
+    let data = CaiData::new(data_kind, flat(data_a), flat(data_b), widths, cfg.channels.len())?;
+    Ok((cfg, data))
+}
+
+/// CAI-aided INS on the generic engine (`atomnav.filter.AidedIns`): sensor, shots and
+/// data as for `cai_parts`; `extra0` the initial values of the sensor's extra states.
 #[pyfunction]
 #[pyo3(signature = (ins, extra0, sensor, shots, data_kind, data_a, data_b, incomplete_shots))]
-// invariant: a 2-D array's shape has 2 entries.
-#[allow(clippy::indexing_slicing, clippy::too_many_arguments)]
+#[allow(clippy::too_many_arguments)]
 fn cai_aided_ins(
     ins: PyRef<'_, AidedSetup>,
     extra0: PyReadonlyArray1<'_, f64>,
@@ -578,15 +599,40 @@ fn cai_aided_ins(
     data_b: PyReadonlyArray2<'_, f64>,
     incomplete_shots: Wrap<IncompleteShots>,
 ) -> PyResult<PyAidedIns> {
-    let mut cfg = sensor.with_shots(&shots)?;
-    cfg.kind = ins.setup.kind;
-    cfg.incomplete = incomplete_shots.0;
-    // (shots, channels) tables, read row-major; the aiding checks their sizes
-    let flat = |a: &PyReadonlyArray2<'_, f64>| a.as_array().iter().copied().collect::<Vec<f64>>();
-    let widths = (data_a.shape()[1], data_b.shape()[1]);
-    let data = CaiData::new(data_kind.0, flat(&data_a), flat(&data_b), widths, cfg.channels.len())?;
-    let aiding = CaiAiding::new(cfg, data)?;
+    let (cfg, data) = cai_parts(sensor, &shots, data_kind.0, &data_a, &data_b, incomplete_shots.0)?;
+    let aiding = CaiAiding::new(CaiConfig { kind: ins.setup.kind, ..cfg }, data)?;
     PyAidedIns::from_aiding(&ins, DVector::from_vec(vector(&extra0, "extra0")?), Box::new(aiding))
+}
+
+/// CAI shots as one measurement source of an aided INS (`aided_ins_from_sources`):
+/// sensor, shots and data as for `cai_parts`, `extra0` the initial values of the sensor's
+/// extra states and `extra_var` their initial variances (None: the setup's P₀ covers the
+/// whole layout). Checked now; the sensor is made when the INS is built (it needs the IMU
+/// kind of the setup).
+#[pyfunction]
+#[pyo3(signature = (extra0, extra_var, sensor, shots, data_kind, data_a, data_b, incomplete_shots))]
+#[allow(clippy::too_many_arguments)]
+fn cai_source(
+    extra0: PyReadonlyArray1<'_, f64>,
+    extra_var: Option<PyReadonlyArray1<'_, f64>>,
+    sensor: &CaiSensor,
+    shots: PyReadonlyArray1<'_, f64>,
+    data_kind: Wrap<DataKind>,
+    data_a: PyReadonlyArray2<'_, f64>,
+    data_b: PyReadonlyArray2<'_, f64>,
+    incomplete_shots: Wrap<IncompleteShots>,
+) -> PyResult<AidingSource> {
+    let (cfg, data) = cai_parts(sensor, &shots, data_kind.0, &data_a, &data_b, incomplete_shots.0)?;
+    CaiAiding::new(cfg.clone(), data.clone())?;
+    let extra0 = vector(&extra0, "extra0")?;
+    let p0 = extra_var.map(|v| vector(&v, "sigma0_extra")).transpose()?.map(|v| DMatrix::from_diagonal(&DVector::from_vec(v)));
+    Ok(AidingSource::deferred(
+        "cai".to_string(),
+        Box::new(move |setup| {
+            let aiding = CaiAiding::new(CaiConfig { kind: setup.kind, ..cfg }, data)?;
+            Ok(Source { aiding: Box::new(aiding), extra0, p0 })
+        }),
+    ))
 }
 
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
@@ -609,6 +655,7 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<CaiHybrid>()?;
     m.add_class::<CaiSensor>()?;
     m.add_function(wrap_pyfunction!(cai_aided_ins, m)?)?;
+    m.add_function(wrap_pyfunction!(cai_source, m)?)?;
     m.add_function(wrap_pyfunction!(cai_in_shot_noise, m)?)?;
     m.add_function(wrap_pyfunction!(cai_incomplete_shots, m)?)?;
     m.add_function(wrap_pyfunction!(cai_phase_closed_form, m)?)?;

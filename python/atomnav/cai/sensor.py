@@ -1,6 +1,7 @@
 """The CAI as the filter sees it (:class:`CaiSensor`), the filter tuning
-(:class:`FilterSetup`), the in-shot IMU noise of a shot, and the CAI-aided INS on the
-generic engine (:func:`cai_aided_ins`).
+(:class:`FilterSetup`), the in-shot IMU noise of a shot, the CAI shots as a measurement
+source of the generic aided INS (:class:`CaiShots`) and the CAI-aided INS built from them
+(:func:`cai_aided_ins`).
 
 The Rust core (``rust/cai/aiding.rs``) plugs the CAI into the generic aided-INS engine:
 every shot's six (or fewer) raw populations are stacked into one update, the predicted
@@ -11,6 +12,7 @@ Tennstedt et al. 2021, Eqs. 3–6, 33)."""
 
 from __future__ import annotations
 
+import copy
 import warnings
 from dataclasses import KW_ONLY, dataclass
 
@@ -20,6 +22,7 @@ import pandas as pd
 from .. import _core, plausibility
 from .._core import InputError
 from ..filter.aided import AidedIns
+from ..filter.sources import Source, native_ins
 from .._validate import as_floats, choice, finite_scalar, flag, input_error, instance, integer, nonnegative, positive, scalar, vector
 from ._config import ConfigMixin
 from .predictor import Channels
@@ -169,16 +172,20 @@ def expected_phase_exceedance(sensor: CaiSensor, dt: float, q_accel: float, q_gy
 
 
 def cai_aided_ins(t0: float, lla0, vel0, q0, sensor: CaiSensor, shots, *, phase=None, noise=None, population=None, laser_phase=None,
-                  kind: str = "rates", setup: FilterSetup | None = None, p0=None, ba0=(0, 0, 0), bg0=(0, 0, 0), extra0=None,
+                  kind: str | None = None, setup: FilterSetup | None = None, p0=None, ba0=(0, 0, 0), bg0=(0, 0, 0), extra0=None,
                   method: str = "van_loan", mode: str = "closed", sequential: bool = False, gate: float | None = None,
-                  ellipsoid: str = "WGS84", incomplete_shots: str = "skip", smooth: bool = False) -> "CaiAidedIns":
+                  ellipsoid: str = "WGS84", incomplete_shots: str = "skip", smooth: bool = False, smooth_chunk: int | None = None,
+                  smooth_memory: int | None = None, smooth_dir: str | None = None) -> "CaiAidedIns":
     """A CAI-aided INS on the generic engine, for your own IMU record and CAI shots.
 
     The filter is the error-state INS of :class:`atomnav.filter.AidedIns` with one stacked
     update per shot: the raw populations of every interferometer of ``sensor`` against the
     readout predicted from the bias-compensated IMU stream (Tennstedt et al. 2023, §2.8;
     Tennstedt et al. 2021, Eqs. 3–6, 33). Run it with ``.run(time, gyro, accel)`` on the
-    whole record, or feed it chunk by chunk with ``.process``.
+    whole record, or feed it chunk by chunk with ``.process``. It is
+    :func:`atomnav.filter.aided_ins` fed by one :class:`CaiShots` source, with the INS
+    set up from ``setup``; to add other sources (position fixes, ...), build those two
+    yourself.
 
     Parameters
     ----------
@@ -190,18 +197,8 @@ def cai_aided_ins(t0: float, lla0, vel0, q0, sensor: CaiSensor, shots, *, phase=
         Initial NED velocity (m/s).
     q0 : array_like, shape (4,)
         Initial attitude q_nb, Hamilton, scalar first, unit norm.
-    sensor : CaiSensor
-        The interferometer: any channels (k directions, lever arms, C_sb, launch
-        velocities, see :class:`Channels`), pulse separation T (s), readout model.
-    shots : array_like, shape (S,)
-        Shot start times (s): pulses at +0, +T, +2T, the update at +2T. Any schedule of
-        non-overlapping shots (e.g. ``sensor.shots(t_first, t_last)``).
-    phase, noise : array_like, shape (S, C), optional
-        Emulated instrument: the true phase (rad) and the population noise of every shot
-        and channel; the filter steers the laser phase to mid-fringe inside the loop.
-    population, laser_phase : array_like, shape (S, C), optional
-        Recorded instrument: the measured population (0–1) and the laser phase (rad) the
-        instrument applied. Give either ``phase`` and ``noise`` or these two.
+    sensor, shots, phase, noise, population, laser_phase, extra0, incomplete_shots
+        The interferometer, its shots and their data, as for :class:`CaiShots`.
     kind : {"rates", "increments"}
         Kind of the IMU record (required: it comes as plain arrays).
     setup : FilterSetup, optional
@@ -211,28 +208,17 @@ def cai_aided_ins(t0: float, lla0, vel0, q0, sensor: CaiSensor, shots, *, phase=
         Initial covariance (SI units of the states); overrides ``setup.p0``.
     ba0, bg0 : array_like, shape (3,)
         Initial accelerometer (m/s²) and gyro (rad/s) bias estimates.
-    extra0 : array_like, shape (E,), optional
-        Initial values of the sensor's extra states (misalignment rad, lever arm m, force
-        error m/s²); zeros by default.
     method, mode, sequential, gate, ellipsoid
         As in :func:`atomnav.filter.position_aided_ins`.
-    incomplete_shots : {"skip", "error"}
-        A shot whose interferometer window needs IMU samples before the record start or
-        after its end — the pulses themselves, or a whole Savitzky–Golay ω̇ window of
-        2m + 1 samples (``sensor.omega_dot = "savgol"``) that a shot in mid-record has
-        before it — cannot be predicted. "skip" (the default) leaves it out with an
-        :class:`IncompleteShotWarning` naming the shot's index, its start time and the
-        samples it lacks; "error" refuses the record with an :class:`atomnav.InputError`
-        naming ``shots``, the same facts and the shot's index. :func:`incomplete_shots`
-        lists them beforehand. ``run`` checks the whole record before it starts;
-        ``process`` checks the record start on its first chunk (a shot past the end of a
-        streamed record is simply still pending).
     smooth : bool
         Store the forward pass for the Rauch–Tung–Striebel smoother (Rauch, Tung &
         Striebel 1965): ``run`` then also returns the smoothed solution
         (``result.smoothed``), and :meth:`atomnav.filter.AidedIns.smooth` smooths a
-        streamed record (memory and disk use as for ``smooth`` of
-        :class:`atomnav.filter.InsSetup`).
+        streamed record.
+    smooth_chunk, smooth_memory, smooth_dir : optional
+        Epochs per chunk of the stored forward pass, bytes held in memory before chunks
+        go to disk, and the directory they go to, as in
+        :class:`atomnav.filter.InsSetup` (None: its defaults).
 
     Returns
     -------
@@ -245,39 +231,144 @@ def cai_aided_ins(t0: float, lla0, vel0, q0, sensor: CaiSensor, shots, *, phase=
     from ..filter.engine import BiasModel
     from .scenarios import seed003_filter
 
-    instance(sensor, CaiSensor, "sensor")
+    source = CaiShots(sensor, shots, phase=phase, noise=noise, population=population, laser_phase=laser_phase, extra0=extra0,
+                      incomplete_shots=incomplete_shots)
     if setup is not None:
         instance(setup, FilterSetup, "setup")
-    choice(incomplete_shots, INCOMPLETE_SHOTS_OPTIONS, "incomplete_shots")
-    emulated = phase is not None or noise is not None
-    if emulated == (population is not None or laser_phase is not None):
-        raise input_error("population" if emulated else "phase",
-                          "give either phase and noise (emulated instrument) or population and laser_phase (recorded)")
-    a, b = (phase, noise) if emulated else (population, laser_phase)
-    names = ("phase", "noise") if emulated else ("population", "laser_phase")
-    if a is None or b is None:
-        missing, given = (names[1], names[0]) if a is not None else (names[0], names[1])
-        raise input_error(missing, f"required together with {given}")
-    tables = []
-    for x, name in zip((a, b), names):
-        x = as_floats(x, name)
-        if x.ndim != 2:
-            raise input_error(name, f"expected a (shots, interferometers) array, got shape {x.shape}")
-        tables.append(np.ascontiguousarray(x))
-    if not emulated:
-        plausibility.population(tables[0], "population")
     setup = setup or seed003_filter()
-    n_extra = sensor.n_extra()
-    ins = InsSetup(t0=t0, lla0=lla0, vel0=vel0, q0=q0, kind=kind, p0=setup.p0(n_extra) if p0 is None else p0,
+    smoothing = {name: value for name, value in (("smooth_chunk", smooth_chunk), ("smooth_memory", smooth_memory),
+                                                  ("smooth_dir", smooth_dir)) if value is not None}
+    ins = InsSetup(t0=t0, lla0=lla0, vel0=vel0, q0=q0, kind=kind, p0=setup.p0(sensor.n_extra()) if p0 is None else p0,
                    accel_psd=setup.accel_psd, gyro_psd=setup.gyro_psd,
                    accel_bias=BiasModel("random_walk", psd=setup.accel_bias_psd),
                    gyro_bias=BiasModel("random_walk", psd=setup.gyro_bias_psd), ba0=ba0, bg0=bg0,
                    predict_every=setup.predict_every, method=method, mode=mode, sequential=sequential, gate=gate,
-                   ellipsoid=ellipsoid, smooth=smooth)
-    extra0 = vector(np.zeros(n_extra) if extra0 is None else extra0, n_extra, "extra0")
-    build = dict(ins=ins.native, extra0=extra0, sensor=sensor._checked("sensor"), shots=vector(shots, None, "shots"),
-                 data_kind="emulated" if emulated else "recorded", data_a=tables[0], data_b=tables[1], incomplete_shots=incomplete_shots)
-    return CaiAidedIns(_core.cai_aided_ins(**build), ins, build)
+                   ellipsoid=ellipsoid, smooth=smooth, **smoothing)
+    return CaiAidedIns(ins, source)
+
+
+class CaiShots(Source):
+    """CAI shots as one measurement source of :func:`atomnav.filter.aided_ins`: one stacked
+    update per shot, the raw populations of every interferometer of ``sensor`` against the
+    readout predicted from the bias-compensated IMU stream (Tennstedt et al. 2023, §2.8;
+    Tennstedt et al. 2021, Eqs. 3–6, 33).
+
+    >>> ins = aided_ins(setup, [CaiShots(sensor, shots, population=p, laser_phase=phi),
+    ...                         PositionFixes(fixes)])                        # doctest: +SKIP
+
+    Parameters
+    ----------
+    sensor : CaiSensor
+        The interferometer: any channels (k directions, lever arms, C_sb, launch
+        velocities, see :class:`Channels`), pulse separation T (s), readout model.
+    shots : array_like, shape (S,)
+        Shot start times (s): pulses at +0, +T, +2T, the update at +2T. Any schedule of
+        non-overlapping shots (e.g. ``sensor.shots(t_first, t_last)``).
+    phase, noise : array_like, shape (S, C), optional
+        Emulated instrument: the true phase (rad) and the population noise of every shot
+        and channel; the filter steers the laser phase to mid-fringe inside the loop.
+    population, laser_phase : array_like, shape (S, C), optional
+        Recorded instrument: the measured population (0–1) and the laser phase (rad) the
+        instrument applied. Give either ``phase`` and ``noise`` or these two.
+    extra0 : array_like, shape (E,), optional
+        Initial values of the sensor's extra states (misalignment rad, lever arm m, force
+        error m/s², :meth:`CaiSensor.n_extra` of them); zeros by default.
+    sigma0_extra : array_like, shape (E,), optional
+        Their initial σ (same units), uncorrelated. Needed when the sensor has extra
+        states and the setup's ``p0`` is the (15, 15) INS block; a ``p0`` over the whole
+        state replaces it.
+    incomplete_shots : {"skip", "error"}
+        A shot whose interferometer window needs IMU samples before the record start or
+        after its end — the pulses themselves, or a whole Savitzky–Golay ω̇ window of
+        2m + 1 samples (``sensor.omega_dot = "savgol"``) that a shot in mid-record has
+        before it — cannot be predicted. "skip" (the default) leaves it out, "error"
+        refuses it with an :class:`atomnav.InputError` naming ``shots`` and the shot's
+        index. :func:`cai_aided_ins` reports them before the record starts (with an
+        :class:`IncompleteShotWarning` for "skip"); in a composite of several sources the
+        engine skips or refuses such a shot when it reaches it, and :meth:`incomplete`
+        lists them beforehand.
+
+    Every argument is checked here; a bad one raises :class:`atomnav.InputError` naming
+    it (``sensor.T`` for a field of the sensor) and, for a table, its first bad row.
+    """
+
+    def __init__(self, sensor: CaiSensor, shots, *, phase=None, noise=None, population=None, laser_phase=None, extra0=None,
+                 sigma0_extra=None, incomplete_shots: str = "skip"):
+        #: The interferometer.
+        self.sensor = instance(sensor, CaiSensor, "sensor")
+        #: "skip" or "error" (see above).
+        self.incomplete_shots = choice(incomplete_shots, INCOMPLETE_SHOTS_OPTIONS, "incomplete_shots")
+        emulated = phase is not None or noise is not None
+        if emulated == (population is not None or laser_phase is not None):
+            raise input_error("population" if emulated else "phase",
+                              "give either phase and noise (emulated instrument) or population and laser_phase (recorded)")
+        a, b = (phase, noise) if emulated else (population, laser_phase)
+        names = ("phase", "noise") if emulated else ("population", "laser_phase")
+        if a is None or b is None:
+            missing, given = (names[1], names[0]) if a is not None else (names[0], names[1])
+            raise input_error(missing, f"required together with {given}")
+        tables = []
+        for x, name in zip((a, b), names):
+            x = as_floats(x, name)
+            if x.ndim != 2:
+                raise input_error(name, f"expected a (shots, interferometers) array, got shape {x.shape}")
+            tables.append(np.ascontiguousarray(x))
+        if not emulated:
+            plausibility.population(tables[0], "population")
+        n_extra = sensor.n_extra()
+        #: "emulated" (true phase and noise) or "recorded" (population and laser phase).
+        self.data_kind = "emulated" if emulated else "recorded"
+        #: Shot start times (S,), s.
+        self.shots = vector(shots, None, "shots")
+        #: The two (S, C) tables of the shots' data, in the order of the arguments.
+        self.data = tuple(tables)
+        #: Initial values of the extra states (E,).
+        self.extra0 = vector(np.zeros(n_extra) if extra0 is None else extra0, n_extra, "extra0")
+        #: Their initial σ (E,), or None.
+        self.sigma0_extra = None
+        if sigma0_extra is not None:
+            sigma = vector(sigma0_extra, n_extra, "sigma0_extra")
+            for i, v in enumerate(sigma):
+                if v < 0:
+                    raise input_error("sigma0_extra", f"must be >= 0, got {v} at index {i}", i)
+            self.sigma0_extra = sigma
+        self._sensor = sensor._checked("sensor")
+        self._native()  # the core checks the shots and their tables now
+
+    def _native(self) -> _core.AidingSource:
+        var = None if self.sigma0_extra is None else self.sigma0_extra**2
+        return _core.cai_source(self.extra0, var, self._sensor, self.shots, self.data_kind, *self.data, self.incomplete_shots)
+
+    def incomplete(self, time) -> pd.DataFrame:
+        """The shots the IMU record ``time`` (s, increasing) cannot complete, as
+        :func:`incomplete_shots` lists them."""
+        return incomplete_shots(self.sensor, self.shots, time)
+
+    def _report(self, time: np.ndarray, start_only: bool) -> list:
+        """Report the shots ``time`` cannot complete (at its start only, or anywhere):
+        warn, or raise for "error". Returns their indices."""
+        found = _core.cai_incomplete_shots(self._sensor, self.shots, time)
+        if start_only:
+            found = [f for f in found if f[2] > 0]
+        for index, ts, before, after, reason in found:
+            if self.incomplete_shots == "error":
+                raise input_error("shots", f"{reason} (incomplete_shots='error'; 'skip' leaves it out)", index)
+            warnings.warn(IncompleteShotWarning(f"{reason}: skipped (incomplete_shots='skip')", index, ts, before, after), stacklevel=3)
+        return [f[0] for f in found]
+
+    def _without(self, drop) -> "CaiShots":
+        """A copy without the shots of index ``drop``."""
+        keep = np.setdiff1d(np.arange(len(self.shots)), drop)
+        other = copy.copy(self)
+        other.shots, other.data = self.shots[keep], tuple(x[keep] for x in self.data)
+        return other
+
+    def __len__(self) -> int:
+        return len(self.shots)
+
+    def __repr__(self) -> str:
+        span = f", {self.shots[0]:g} to {self.shots[-1]:g} s" if len(self) else ""
+        return f"CaiShots({len(self)} shots, {self.data_kind}{span})"
 
 
 class IncompleteShotWarning(UserWarning):
@@ -323,26 +414,14 @@ def incomplete_shots(sensor: CaiSensor, shots, time) -> pd.DataFrame:
 
 
 class CaiAidedIns(AidedIns):
-    """The CAI-aided INS of :func:`cai_aided_ins`: an :class:`atomnav.filter.AidedIns` that
-    handles the shots its IMU record cannot complete (``incomplete_shots``)."""
+    """The CAI-aided INS of :func:`cai_aided_ins`: an :class:`atomnav.filter.AidedIns` fed
+    by one :class:`CaiShots` source that reports the shots its IMU record cannot complete
+    (``incomplete_shots``) before it starts."""
 
-    def __init__(self, core, setup, build: dict):
-        super().__init__(core, setup)
-        self._build = build
+    def __init__(self, setup, shots: CaiShots):
+        super().__init__(native_ins(setup, [shots]), setup)
+        self._shots = shots
         self._started = False
-
-    def _incomplete(self, time, start_only: bool) -> list:
-        """Report the shots ``time`` cannot complete (warn, or raise for "error"); returns
-        their indices."""
-        b = self._build
-        found = _core.cai_incomplete_shots(b["sensor"], b["shots"], time)
-        if start_only:
-            found = [f for f in found if f[2] > 0]
-        for index, ts, before, after, reason in found:
-            if b["incomplete_shots"] == "error":
-                raise input_error("shots", f"{reason} (incomplete_shots='error'; 'skip' leaves it out)", index)
-            warnings.warn(IncompleteShotWarning(f"{reason}: skipped (incomplete_shots='skip')", index, ts, before, after), stacklevel=3)
-        return [f[0] for f in found]
 
     def process(self, time, gyro, accel, *args, **kwargs):
         """See :meth:`atomnav.filter.AidedIns.process`; the first chunk is the record start,
@@ -350,7 +429,7 @@ class CaiAidedIns(AidedIns):
         if not self._started:
             t = as_floats(time, "time")
             if t.ndim == 1 and len(t) >= 2:
-                self._incomplete(np.ascontiguousarray(t), start_only=True)
+                self._shots._report(np.ascontiguousarray(t), start_only=True)
         self._started = True
         return super().process(time, gyro, accel, *args, **kwargs)
 
@@ -359,10 +438,10 @@ class CaiAidedIns(AidedIns):
         record cannot complete are reported and, with "skip", left out."""
         t = as_floats(time, "time")
         if not self._started and t.ndim == 1 and len(t) >= 2:
-            drop = self._incomplete(np.ascontiguousarray(t), start_only=False)
+            drop = self._shots._report(np.ascontiguousarray(t), start_only=False)
             if drop:
-                keep = np.setdiff1d(np.arange(len(self._build["shots"])), drop)
-                b = {**self._build, **{k: self._build[k][keep] for k in ("shots", "data_a", "data_b")}}
-                self._core = _core.cai_aided_ins(**b)
+                self._core = native_ins(self.setup, [self._shots._without(drop)])
+                if self._store is not None:
+                    self._core.store_forward_pass()
         self._started = True
         return super().run(time, gyro, accel, *args, **kwargs)

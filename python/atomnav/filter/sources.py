@@ -158,7 +158,7 @@ def aided_ins(setup: InsSetup, sources) -> AidedIns:
         source order), which replaces the sources' own.
     sources : source or sequence of sources
         :class:`PositionFixes`, :class:`VelocityFixes`,
-        :class:`atomnav.gnss.tight.GnssObservations`, the zero-velocity and zero-rate
+        :class:`atomnav.gnss.tight.GnssObservations`, :class:`atomnav.cai.CaiShots`, the zero-velocity and zero-rate
         updates of :mod:`atomnav.alignment` (those are used up by one INS).
         Each source's measurements must lie inside the IMU record. Equal times of
         different sources are applied at the same epoch in the order given.
@@ -177,6 +177,12 @@ def aided_ins(setup: InsSetup, sources) -> AidedIns:
     TypeError
         For a ``setup`` that is no :class:`InsSetup` or a source that is no source.
     """
+    return AidedIns(native_ins(setup, sources), setup)
+
+
+def native_ins(setup: InsSetup, sources) -> _core.AidedIns:
+    """The core aided INS of :func:`aided_ins` (arguments and errors as there), for a
+    subclass of :class:`AidedIns` that wraps it."""
     instance(setup, InsSetup, "setup")
     if isinstance(sources, (Source, _core.AidingSource)):
         sources = [sources]
@@ -191,4 +197,4 @@ def aided_ins(setup: InsSetup, sources) -> AidedIns:
         else:
             raise TypeError(f"sources: item {i} is a {type(s).__name__}, not a measurement source "
                             "(PositionFixes, VelocityFixes, ...)")
-    return AidedIns(_core.aided_ins_from_sources(setup.native, native), setup)
+    return _core.aided_ins_from_sources(setup.native, native)
