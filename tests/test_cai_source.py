@@ -189,19 +189,42 @@ def test_smoothing_survives_a_skipped_shot(record):
 # ---- incomplete shots in a composite ------------------------------------------------------------
 
 def test_incomplete_shots_in_a_composite(record):
-    """In aided_ins the engine skips a shot at the record start ("skip") or refuses it naming
-    shots and its index ("error"); CaiShots.incomplete lists it beforehand."""
+    """Next to position fixes, a shot at the record start is skipped with a warning
+    ("skip", the filter rebuilt without it) or refused naming shots and its index
+    ("error"), as cai_aided_ins does; CaiShots.incomplete lists it beforehand."""
     traj, imu, _, _, phase, noise = record
     sensor = cai.CaiSensor(cai.Channels.cyclic(), 0.025, omega_dot="savgol", savgol_half_width=8)
     shots = np.array([0.0, 0.5, 1.0])
     setup = _ins_setup(traj, _filter_setup().p0(0))
+    fixes = PositionFixes([2.0], traj.lla[[400]], np.eye(3))
     source = cai.CaiShots(sensor, shots, phase=phase[:3], noise=noise[:3])
     assert source.incomplete(imu["time_s"])[["shot", "samples_before"]].values.tolist() == [[0, 6]]
-    res = _run(aided_ins(setup, source), imu)
-    np.testing.assert_allclose(res.measurements["time_s"], shots[1:] + 2 * sensor.T, atol=1e-6)
+    with pytest.warns(cai.IncompleteShotWarning, match=r"shot 0 \(start 0 s\) needs 6 IMU sample") as caught:
+        res = _run(aided_ins(setup, [source, fixes]), imu)
+    assert [w.message.index for w in caught if isinstance(w.message, cai.IncompleteShotWarning)] == [0]
+    assert caught[0].filename == __file__
+    np.testing.assert_allclose(res.measurements["time_s"], [0.55, 1.05, 2.0], atol=1e-6)
+    # the filter without the skipped shot is the filter of the other two
+    without = _run(aided_ins(setup, [cai.CaiShots(sensor, shots[1:], phase=phase[1:3], noise=noise[1:3]), fixes]), imu)
+    _assert_same(without, res)
     with pytest.raises(InputError, match="needs 6 IMU sample") as e:
-        _run(aided_ins(setup, cai.CaiShots(sensor, shots, phase=phase[:3], noise=noise[:3], incomplete_shots="error")), imu)
+        _run(aided_ins(setup, [fixes, cai.CaiShots(sensor, shots, phase=phase[:3], noise=noise[:3], incomplete_shots="error")]), imu)
     assert (e.value.parameter, e.value.index) == ("shots", 0)
+
+
+def test_copies_of_a_composite_mid_record_continue_the_same(record):
+    traj, imu, sensor, shots, phase, noise = record
+    setup = _ins_setup(traj, _filter_setup().p0(0))
+    ins = aided_ins(setup, [cai.CaiShots(sensor, shots, phase=phase, noise=noise), PositionFixes([3.0], traj.lla[[600]], np.eye(3))])
+    t, g, a = imu["time_s"].to_numpy(), imu[GYRO].to_numpy(), imu[ACCEL].to_numpy()
+    ins.process(t[:500], g[:500], a[:500])
+    copies = [pickle.loads(pickle.dumps(ins)), copy.deepcopy(ins)]
+    want = [ins.process(t[500:], g[500:], a[500:]), ins.finish()]
+    for c in copies:
+        assert type(c) is type(ins)
+        for x, y in zip(want, [c.process(t[500:], g[500:], a[500:]), c.finish()]):
+            _assert_same(x, y)
+    assert len(want[0].measurements) > 50
 
 
 # ---- copies and bad input ------------------------------------------------------------------------

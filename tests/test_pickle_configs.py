@@ -344,9 +344,9 @@ def test_every_public_class_is_covered():
         # test_io.py
         "ImuLog", "SamplingReport",
         # test_cai_own_data.py (and its warning, an exception)
-        "CaiAidedIns", "IncompleteShotWarning",
-        # test_cai_source.py
-        "CaiShots",
+        "IncompleteShotWarning",
+        # test_cai_source.py (and the aided INS of aided_ins, with test_cai_own_data.py)
+        "CaiShots", "SourcedIns",
         # tests above
         "AidedIns", "AidedSetup", "CaiChannels", "CaiSetup", "CaiGravity", "CaiMotion", "CaiHybrid", "AstroScenario",
         "Vasilyuk2024", "Scenario", "Calibration", "Observations",

@@ -15,7 +15,7 @@ from .sensitivity import convolution_phase, ideal_transfer, response_area, sensi
 from .noise_id import fringe_track, identify_noise, readout_variance, residuals, simulate_fringe
 
 from .sensor import (
-    CaiAidedIns, CaiSensor, CaiShots, FilterSetup, IncompleteShotWarning, cai_aided_ins, expected_phase_exceedance, in_shot_noise, incomplete_shots,
+    CaiSensor, CaiShots, FilterSetup, IncompleteShotWarning, cai_aided_ins, expected_phase_exceedance, in_shot_noise, incomplete_shots,
 )
 from .results import BIAS_COLUMNS, ERROR_COLUMNS, HybridResult, satellite_psd, satellite_steady_state
 from .campaign import run_campaign

@@ -21,8 +21,7 @@ import pandas as pd
 
 from .. import _core, plausibility
 from .._core import InputError
-from ..filter.aided import AidedIns
-from ..filter.sources import Source, native_ins
+from ..filter.sources import Source, SourcedIns, aided_ins
 from .._validate import as_floats, choice, finite_scalar, flag, input_error, instance, integer, nonnegative, positive, scalar, vector
 from ._config import ConfigMixin
 from .predictor import Channels
@@ -175,7 +174,7 @@ def cai_aided_ins(t0: float, lla0, vel0, q0, sensor: CaiSensor, shots, *, phase=
                   kind: str | None = None, setup: FilterSetup | None = None, p0=None, ba0=(0, 0, 0), bg0=(0, 0, 0), extra0=None,
                   method: str = "van_loan", mode: str = "closed", sequential: bool = False, gate: float | None = None,
                   ellipsoid: str = "WGS84", incomplete_shots: str = "skip", smooth: bool = False, smooth_chunk: int | None = None,
-                  smooth_memory: int | None = None, smooth_dir: str | None = None) -> "CaiAidedIns":
+                  smooth_memory: int | None = None, smooth_dir: str | None = None) -> SourcedIns:
     """A CAI-aided INS on the generic engine, for your own IMU record and CAI shots.
 
     The filter is the error-state INS of :class:`atomnav.filter.AidedIns` with one stacked
@@ -184,8 +183,8 @@ def cai_aided_ins(t0: float, lla0, vel0, q0, sensor: CaiSensor, shots, *, phase=
     Tennstedt et al. 2021, Eqs. 3–6, 33). Run it with ``.run(time, gyro, accel)`` on the
     whole record, or feed it chunk by chunk with ``.process``. It is
     :func:`atomnav.filter.aided_ins` fed by one :class:`CaiShots` source, with the INS
-    set up from ``setup``; to add other sources (position fixes, ...), build those two
-    yourself.
+    set up from ``setup``; to add other sources (position fixes, ...), call that with
+    your :class:`atomnav.filter.InsSetup` and sources.
 
     Parameters
     ----------
@@ -222,7 +221,7 @@ def cai_aided_ins(t0: float, lla0, vel0, q0, sensor: CaiSensor, shots, *, phase=
 
     Returns
     -------
-    CaiAidedIns
+    atomnav.filter.sources.SourcedIns
         The filter (an :class:`atomnav.filter.AidedIns`); its results have the bias
         estimates (``accel_bias_*_mps2``, ``gyro_bias_*_rad_s``), σ of every state and the
         NIS of every applied shot.
@@ -244,7 +243,7 @@ def cai_aided_ins(t0: float, lla0, vel0, q0, sensor: CaiSensor, shots, *, phase=
                    gyro_bias=BiasModel("random_walk", psd=setup.gyro_bias_psd), ba0=ba0, bg0=bg0,
                    predict_every=setup.predict_every, method=method, mode=mode, sequential=sequential, gate=gate,
                    ellipsoid=ellipsoid, smooth=smooth, **smoothing)
-    return CaiAidedIns(ins, source)
+    return aided_ins(ins, [source])
 
 
 class CaiShots(Source):
@@ -281,12 +280,13 @@ class CaiShots(Source):
         A shot whose interferometer window needs IMU samples before the record start or
         after its end — the pulses themselves, or a whole Savitzky–Golay ω̇ window of
         2m + 1 samples (``sensor.omega_dot = "savgol"``) that a shot in mid-record has
-        before it — cannot be predicted. "skip" (the default) leaves it out, "error"
-        refuses it with an :class:`atomnav.InputError` naming ``shots`` and the shot's
-        index. :func:`cai_aided_ins` reports them before the record starts (with an
-        :class:`IncompleteShotWarning` for "skip"); in a composite of several sources the
-        engine skips or refuses such a shot when it reaches it, and :meth:`incomplete`
-        lists them beforehand.
+        before it — cannot be predicted. "skip" (the default) leaves it out with an
+        :class:`IncompleteShotWarning` naming the shot's index, its start time and the
+        samples it lacks; "error" refuses the record with an :class:`atomnav.InputError`
+        naming ``shots``, the same facts and the shot's index. :meth:`incomplete` lists
+        them beforehand. The INS's ``run`` checks the whole record before it starts;
+        ``process`` checks the record start on its first chunk (a shot past the end of a
+        streamed record is simply still pending).
 
     Every argument is checked here; a bad one raises :class:`atomnav.InputError` naming
     it (``sensor.T`` for a field of the sensor) and, for a table, its first bad row.
@@ -353,8 +353,14 @@ class CaiShots(Source):
         for index, ts, before, after, reason in found:
             if self.incomplete_shots == "error":
                 raise input_error("shots", f"{reason} (incomplete_shots='error'; 'skip' leaves it out)", index)
-            warnings.warn(IncompleteShotWarning(f"{reason}: skipped (incomplete_shots='skip')", index, ts, before, after), stacklevel=3)
+            warnings.warn(IncompleteShotWarning(f"{reason}: skipped (incomplete_shots='skip')", index, ts, before, after), stacklevel=5)
         return [f[0] for f in found]
+
+    def _check_record(self, time: np.ndarray, whole: bool) -> "CaiShots":
+        """Report the shots the record cannot complete (see ``incomplete_shots``); for the
+        whole record, with "skip", this source without them."""
+        drop = self._report(time, start_only=not whole)
+        return self._without(drop) if whole and drop else self
 
     def _without(self, drop) -> "CaiShots":
         """A copy without the shots of index ``drop``."""
@@ -411,37 +417,3 @@ def incomplete_shots(sensor: CaiSensor, shots, time) -> pd.DataFrame:
     instance(sensor, CaiSensor, "sensor")
     found = _core.cai_incomplete_shots(sensor._checked("sensor"), vector(shots, None, "shots"), vector(time, None, "time"))
     return pd.DataFrame(found, columns=["shot", "start_s", "samples_before", "samples_after", "reason"])
-
-
-class CaiAidedIns(AidedIns):
-    """The CAI-aided INS of :func:`cai_aided_ins`: an :class:`atomnav.filter.AidedIns` fed
-    by one :class:`CaiShots` source that reports the shots its IMU record cannot complete
-    (``incomplete_shots``) before it starts."""
-
-    def __init__(self, setup, shots: CaiShots):
-        super().__init__(native_ins(setup, [shots]), setup)
-        self._shots = shots
-        self._started = False
-
-    def process(self, time, gyro, accel, *args, **kwargs):
-        """See :meth:`atomnav.filter.AidedIns.process`; the first chunk is the record start,
-        whose incomplete shots are reported here."""
-        if not self._started:
-            t = as_floats(time, "time")
-            if t.ndim == 1 and len(t) >= 2:
-                self._shots._report(np.ascontiguousarray(t), start_only=True)
-        self._started = True
-        return super().process(time, gyro, accel, *args, **kwargs)
-
-    def run(self, time, gyro, accel, *args, **kwargs):
-        """See :meth:`atomnav.filter.AidedIns.run`. Before it starts, the shots the whole
-        record cannot complete are reported and, with "skip", left out."""
-        t = as_floats(time, "time")
-        if not self._started and t.ndim == 1 and len(t) >= 2:
-            drop = self._shots._report(np.ascontiguousarray(t), start_only=False)
-            if drop:
-                self._core = native_ins(self.setup, [self._shots._without(drop)])
-                if self._store is not None:
-                    self._core.store_forward_pass()
-        self._started = True
-        return super().run(time, gyro, accel, *args, **kwargs)

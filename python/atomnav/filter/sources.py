@@ -31,6 +31,12 @@ class Source:
     def _native(self) -> _core.AidingSource:
         raise NotImplementedError
 
+    def _check_record(self, time: np.ndarray, whole: bool) -> "Source":
+        """This source for the IMU record ``time`` (s, increasing; ``whole``: the whole
+        record, else its first chunk): itself, or a copy without the measurements the
+        record cannot take, which it reports."""
+        return self
+
 
 class _Fixes(Source):
     """Fixes of a 3-vector: times (M,) s, values (M, 3) and covariances (M, 3, 3), or a
@@ -145,7 +151,7 @@ def _covariances(cov, m: int) -> np.ndarray:
     return np.ascontiguousarray(c)
 
 
-def aided_ins(setup: InsSetup, sources) -> AidedIns:
+def aided_ins(setup: InsSetup, sources) -> "SourcedIns":
     """One aided INS fed by several measurement sources.
 
     Parameters
@@ -165,8 +171,9 @@ def aided_ins(setup: InsSetup, sources) -> AidedIns:
 
     Returns
     -------
-    AidedIns
-        Run it with ``.run(time, gyro, accel)``; ``labels`` lists the states.
+    SourcedIns
+        An :class:`AidedIns`: run it with ``.run(time, gyro, accel)``; ``labels`` lists
+        the states.
 
     Raises
     ------
@@ -177,24 +184,68 @@ def aided_ins(setup: InsSetup, sources) -> AidedIns:
     TypeError
         For a ``setup`` that is no :class:`InsSetup` or a source that is no source.
     """
-    return AidedIns(native_ins(setup, sources), setup)
-
-
-def native_ins(setup: InsSetup, sources) -> _core.AidedIns:
-    """The core aided INS of :func:`aided_ins` (arguments and errors as there), for a
-    subclass of :class:`AidedIns` that wraps it."""
     instance(setup, InsSetup, "setup")
+    sources = _listed(sources)
+    return SourcedIns(_native_ins(setup, sources), setup, sources)
+
+
+def _listed(sources) -> list:
+    """``sources`` (one source or a sequence of them) as a list; a ``TypeError`` naming
+    ``sources`` for anything else."""
     if isinstance(sources, (Source, _core.AidingSource)):
-        sources = [sources]
+        return [sources]
     if isinstance(sources, (str, bytes, pd.DataFrame)) or not hasattr(sources, "__iter__"):
         raise TypeError(f"sources: expected a measurement source or a sequence of them, got {type(sources).__name__}")
-    native = []
+    sources = list(sources)
     for i, s in enumerate(sources):
-        if isinstance(s, Source):
-            native.append(s._native())
-        elif isinstance(s, _core.AidingSource):
-            native.append(s)
-        else:
+        if not isinstance(s, (Source, _core.AidingSource)):
             raise TypeError(f"sources: item {i} is a {type(s).__name__}, not a measurement source "
                             "(PositionFixes, VelocityFixes, ...)")
+    return sources
+
+
+def _native_ins(setup: InsSetup, sources: list) -> _core.AidedIns:
+    """The core aided INS of ``setup`` fed by ``sources`` (a list of sources)."""
+    native = [s._native() if isinstance(s, Source) else s for s in sources]
     return _core.aided_ins_from_sources(setup.native, native)
+
+
+class SourcedIns(AidedIns):
+    """The aided INS of :func:`aided_ins`: an :class:`AidedIns` whose sources check the IMU
+    record before it starts — :class:`atomnav.cai.CaiShots` reports the shots the record
+    cannot complete. When a source leaves measurements out, ``run`` rebuilds the filter
+    without them (unless a core source, used up by the first build, is among the sources:
+    then the engine skips them when it reaches them)."""
+
+    def __init__(self, core: _core.AidedIns, setup: InsSetup, sources: list):
+        super().__init__(core, setup)
+        # the sources the filter can be rebuilt from (None for a core source)
+        self._sources = [s if isinstance(s, Source) else None for s in sources]
+        self._started = False
+
+    def _start(self, time, whole: bool) -> None:
+        """Let every source check the record ``time`` once, before its first sample
+        (``whole``: the whole record, from :meth:`run`)."""
+        t = as_floats(time, "time")
+        if self._started or t.ndim != 1 or len(t) < 2:  # the engine names a bad time
+            return
+        t = np.ascontiguousarray(t)
+        checked = []
+        for s in self._sources:  # a loop, not a comprehension: a source's warning points at the caller
+            checked.append(None if s is None else s._check_record(t, whole))
+        if None not in checked and any(c is not s for c, s in zip(checked, self._sources)):
+            self._core = _native_ins(self.setup, checked)
+            if self._store is not None:
+                self._core.store_forward_pass()
+        self._started = True
+
+    def process(self, time, gyro, accel, *args, **kwargs):
+        """See :meth:`AidedIns.process`; the first chunk is the record start, which the
+        sources check."""
+        self._start(time, whole=False)
+        return super().process(time, gyro, accel, *args, **kwargs)
+
+    def run(self, time, gyro, accel, *args, **kwargs):
+        """See :meth:`AidedIns.run`; the sources check the whole record before it starts."""
+        self._start(time, whole=True)
+        return super().run(time, gyro, accel, *args, **kwargs)
