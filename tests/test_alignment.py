@@ -149,8 +149,9 @@ def nees_fraction_in_band(site, seeds: int) -> float:
     return float(np.mean((nees >= lo) & (nees <= hi)))
 
 
-# Not met yet: the averaged attitude NEES rises from about 3.3 to 7.6 over the 240 s
-# (the upper bound is 4.2 for 20 seeds). Ruled out: the ZUPT model (the engine's velocity
+# Not met yet: the averaged attitude NEES rises from about 3.3 to 4.6 over the 240 s
+# (the upper bound is 4.2 for 20 seeds): 46 % of epochs in band with 20 seeds, 24 % with
+# 100. Ruled out: the ZUPT model (the engine's velocity
 # fixes give identical results), the ψ–bias correlation of P0, the IMU kind, the
 # prediction rate, a specific force with the bias-estimate error in F. Found: in the
 # engine's open-loop mode the tilts are consistent and the heading NEES grows with the

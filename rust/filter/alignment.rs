@@ -49,15 +49,14 @@ pub const MAX_LATITUDE: f64 = 89.0 * std::f64::consts::PI / 180.0;
 /// beyond this is no static record (accelerations in g, increments read as rates).
 pub const GRAVITY_TOLERANCE: f64 = 0.1;
 
-/// A bias process counts as white noise over a horizon this many times its correlation time.
-pub const WHITE_FRACTION: f64 = 10.0;
-
 /// The error budget of one sensor triad over a record of `horizon` s: each bias process
 /// (Gauss–Markov, and the Gauss–Markov poles that realise flicker, `imu::noise::Flicker`)
-/// counts as white noise (PSD 2σ²τ, its low-frequency level) only when its correlation
-/// time is short against the horizon (τ < horizon/[`WHITE_FRACTION`]), since only then
-/// does an estimate over the horizon average it down like white noise; otherwise it
-/// counts as a bias random walk (PSD 2σ²/τ, initial variance σ²).
+/// counts as white noise (PSD 2σ²τ, its low-frequency level) when its correlation time is
+/// shorter than the horizon T, and as a bias random walk (PSD 2σ²/τ, initial variance σ²)
+/// otherwise. For the mean over T, whose exact variance is
+/// 2σ²(τ/T)[1 − (τ/T)(1 − e^{−T/τ})], the white form 2σ²τ/T is exact as τ/T → 0 and
+/// at most 2.7 times too large at τ = T, where the constant form σ² takes over (1.36
+/// times too large there, exact as τ/T → ∞).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct TriadBudget {
     /// White-noise PSD (density², units²·s): N² plus the fast processes.
@@ -82,7 +81,7 @@ impl TriadBudget {
         let (mut white_psd, mut walk_psd, mut slow, mut drift) = (e.white * e.white, e.bias_rw * e.bias_rw, 0.0, 0.0);
         for (s, tau) in processes {
             drift += s * s;
-            if tau * WHITE_FRACTION >= horizon {
+            if tau >= horizon {
                 slow += s * s;
                 walk_psd += 2.0 * s * s / tau;
             } else {
