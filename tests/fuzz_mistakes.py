@@ -294,6 +294,8 @@ CATALOGUE: tuple[Clean, ...] = (
        'shots, phase, noise = cai_shots, cai_phase, cai_noise\n'
        'CAI_IMU = ["time_s", ["gyro_x_rad_s", "gyro_y_rad_s", "gyro_z_rad_s"], ["accel_x_mps2", "accel_y_mps2", "accel_z_mps2"]]',
        (), (Unit("shots", "time"),) + LLA),
+    _c("atomnav.cai.sensor.CaiShots", "an.cai.CaiShots(an.cai.seed003_sensor(), shots, phase=phase, noise=noise)",
+       "shots, phase, noise = cai_shots, cai_phase, cai_noise", (), (Unit("shots", "time"),)),
     # the atom-interferometer phase predictor (1 s of an analytic motion at 200 Hz)
     _c("atomnav.cai.predictor.predict_phase", "an.cai.predictor.predict_phase(t, f, w, shots, T, an.cai.Channels.cyclic())",
        SINE_IMU, (), SINE_UNITS),
