@@ -31,7 +31,7 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
-from . import _core, plausibility
+from . import _core, plausibility, units
 from ._validate import choice, finite, flag, input_error, instance, nonnegative, positive, renamed, vector
 from .filter.aided import AidedIns, AidedResult, InsSetup, _concat
 from .filter.engine import BiasModel
@@ -97,7 +97,9 @@ class CoarseAlignment:
         (roll, pitch, yaw) and their σ (rad); roll and yaw σ are inf at pitch ±90°.
     psi_cov, psi_cov_noise : ndarray (3, 3)
         Covariance (rad²) of the attitude error ψ (north, east, down; Ĉ = (I − [ψ×])C): the
-        whole, and its white-noise part alone (the rest is from the biases).
+        whole, and the part from noise alone — white noise and bias processes with a
+        correlation time shorter than the record, which average down over it (the rest is
+        from the biases).
     mean_f, mean_w : ndarray (3,)
         Mean specific force (m/s²) and angular rate (rad/s) in the body frame.
     gravity, earth_rate_h : float
@@ -144,11 +146,11 @@ class CoarseAlignment:
             f"Coarse alignment: {self.time_s - self.t0:.1f} s at rest, {self.samples} samples ({self.kind}), "
             f"at {lat:.4f}° {lon:.4f}°, {self.lla[2]:.1f} m",
             *_attitude_lines(self.euler, self.euler_sigma),
-            "  attainable accuracy (1σ), from the sensor biases | white noise:",
+            "  attainable accuracy (1σ), from the sensor biases | noise (white and faster than the record):",
             f"    levelling north/east  {_angle(bias[0])}, {_angle(bias[1])} | {_angle(noise[0])}, {_angle(noise[1])}"
             f"   (accel bias / g = {self.gravity:.4f} m/s²)",
             f"    heading               {_angle(bias[2])} | {_angle(noise[2])}"
-            f"   (gyro bias / Ω cos φ = {np.rad2deg(self.earth_rate_h) * 3600.0:.3f} °/h)",
+            f"   (gyro bias / Ω cos φ = {self.earth_rate_h / units.DEG_PER_HOUR:.3f} °/h)",
             f"  static test: spread {self.spread[0]:.2f} (specific force), {self.spread[1]:.2f} (angular rate); limit 5",
         ]
         return "\n".join(lines)
@@ -257,8 +259,8 @@ class FineAlignment:
         return "\n".join([
             f"Fine alignment: {len(self.result.measurements)} zero-motion measurements; attitude at {self.state['t0']:.3f} s",
             *_attitude_lines(self.euler, self.euler_sigma),
-            "  accel bias (µg)  " + ", ".join(f"{b / 9.80665e-6:.1f} ± {s / 9.80665e-6:.1f}" for b, s in zip(self.accel_bias, self.accel_bias_sigma)),
-            "  gyro bias (°/h)  " + ", ".join(f"{np.rad2deg(b) * 3600:.3f} ± {np.rad2deg(s) * 3600:.3f}" for b, s in zip(self.gyro_bias, self.gyro_bias_sigma)),
+            "  accel bias (µg)  " + ", ".join(f"{b / units.MICRO_G:.1f} ± {s / units.MICRO_G:.1f}" for b, s in zip(self.accel_bias, self.accel_bias_sigma)),
+            "  gyro bias (°/h)  " + ", ".join(f"{b / units.DEG_PER_HOUR:.3f} ± {s / units.DEG_PER_HOUR:.3f}" for b, s in zip(self.gyro_bias, self.gyro_bias_sigma)),
         ])
 
     def _repr_pretty_(self, p, cycle) -> None:
@@ -291,7 +293,7 @@ def fine(imu, lla, coarse: CoarseAlignment, *, errors=None, interval: float = 1.
     independent of the coarse attitude error, as the filter assumes. The filter's
     attitude error model is small-angle: with a heading error of several degrees (a
     tactical-grade gyro at mid latitudes leaves 5–15°) its stated heading σ is
-    optimistic, by up to a factor of two in our simulations.
+    optimistic (by up to a factor of two for a tactical-grade IMU simulated at 56°N).
 
     Parameters
     ----------

@@ -121,7 +121,8 @@ pub struct CoarseAlignment {
     /// Normal gravity γ (m/s²) and horizontal Earth rate Ω cos φ (rad/s) at the site.
     pub gravity: f64,
     pub earth_rate_h: f64,
-    /// Covariance of ψ (rad², NED): the whole, and its white-noise part alone.
+    /// Covariance of ψ (rad², NED): the whole, and the part from noise alone (white noise
+    /// and the bias processes faster than the record, [`TriadBudget`]).
     pub psi_cov: Mat3,
     pub psi_cov_noise: Mat3,
     /// σ of (roll, pitch, yaw) (rad); roll and yaw are +inf at pitch ±90°.
