@@ -234,8 +234,8 @@ def test_increment_records_align_like_rate_records(site):
     _, lla = site
     inc = an.imu.corrupt(an.trajectory.stationary(DURATION, rate_hz=RATE_HZ, euler=EULER).ideal_imu("increments"),
                          errors="tactical", dt=1.0 / RATE_HZ, kind="increments", seed=2)
-    c = alignment.coarse(inc, lla, errors="tactical", kind="increments")
-    assert c.samples == len(inc) - 1
+    c = alignment.coarse(inc, lla, errors="tactical")  # the kind read from the column names
+    assert c.kind == "increments" and c.samples == len(inc) - 1
     tilt = np.linalg.norm((dcm(c.q_nb).T - TRUTH.T) @ np.array([0.0, 0.0, 1.0]))
     assert tilt < 5 * np.sqrt(c.psi_cov[0, 0] + c.psi_cov[1, 1])
 

@@ -18,10 +18,10 @@ the correlation between the coarse attitude error and the biases that caused it.
 :func:`zero_velocity` and :func:`zero_rate` are these updates as measurement sources for
 any aided INS built with :func:`atomnav.filter.sources.aided_ins`.
 
->>> c = coarse(imu, lla, errors="tactical", kind="rates")    # doctest: +SKIP
+>>> c = coarse(imu, lla, errors="tactical")                  # doctest: +SKIP
 >>> print(c)                                                 # attitude and its accuracy
 >>> f = fine(later_imu, lla, c)                              # doctest: +SKIP
->>> nav = atomnav.strapdown.integrate(rest_of_imu, **f.state, kind="rates")  # doctest: +SKIP
+>>> nav = atomnav.strapdown.integrate(rest_of_imu, **f.state)  # doctest: +SKIP
 """
 
 from __future__ import annotations
@@ -37,6 +37,7 @@ from .filter.aided import AidedIns, AidedResult, InsSetup, _concat
 from .filter.engine import BiasModel
 from .imu import KINDS, ImuErrors
 from .strapdown import _imu_arrays, _imu_errors
+from .trajectory import imu_kind
 
 _ARCMIN = np.pi / (180.0 * 60.0)
 #: Most update epochs at which :func:`fine` keeps the filter covariance (spread evenly).
@@ -159,7 +160,7 @@ class CoarseAlignment:
         p.text(str(self))
 
 
-def coarse(imu, lla, *, errors, kind: str = "increments", ellipsoid: str = "WGS84") -> CoarseAlignment:
+def coarse(imu, lla, *, errors, kind: str | None = None, ellipsoid: str = "WGS84") -> CoarseAlignment:
     """Static coarse alignment: levelling and gyrocompassing from the record's means.
 
     Parameters
@@ -175,9 +176,10 @@ def coarse(imu, lla, *, errors, kind: str = "increments", ellipsoid: str = "WGS8
         The sensor error model (or a preset name, ``atomnav.imu.preset_names()``): its
         biases and noise give the attainable accuracy and the noise level of the static
         test.
-    kind : str
-        ``"rates"`` (rad/s, m/s²) or ``"increments"`` (rad, m/s), as for
-        :func:`atomnav.strapdown.integrate`.
+    kind : str, optional
+        ``"rates"`` (rad/s, m/s²) or ``"increments"`` (rad, m/s); None (default): the kind
+        of the table's column names (:func:`atomnav.trajectory.imu_kind`), required for a
+        plain array.
     ellipsoid : str
         Earth model, one of ``atomnav._core.OPTIONS["Ellipsoid"]``.
 
@@ -200,7 +202,7 @@ def coarse(imu, lla, *, errors, kind: str = "increments", ellipsoid: str = "WGS8
     TypeError
         For a column that does not hold numbers, or ``errors`` of another type.
     """
-    kind = choice(kind, KINDS, "kind")
+    kind = choice(imu_kind(kind, imu, "imu"), KINDS, "kind")
     model = _errors(errors)
     site = vector(lla, 3, "lla")
     plausibility.lla(site, "lla")
