@@ -166,3 +166,19 @@ def test_bias_stability_and_improvement_ratios():
     assert ir(3.56e-4, 3.48e-4) == pytest.approx(2.25, abs=0.01)
     assert ir(0.015, 0.012) == pytest.approx(20.00, abs=0.01) and ir(3.56e-4, 2.85e-4) == pytest.approx(19.94, abs=0.01)
     assert float(allan.improvement_ratio(0.0766, 0.7020)) == pytest.approx(-816.4, abs=0.1)
+
+
+def test_fit_of_exact_variances_with_zero_terms_converges():
+    """The five-term fit of noise-free Allan variances of white + flicker + random-walk
+    rate noise (IEEE Std 952-1997, Annex C closed forms: N²/τ + 2 ln2/π B² + K²τ/3) has
+    quantization and ramp coefficients exactly 0; rounding alone makes them candidates of
+    the NNLS active set, which used to cycle into "nnls: no convergence". The fit returns
+    the generating coefficients."""
+    tau = 2.0 ** np.arange(18)
+    arw, b, k = 1e-3, 1e-4, 1e-6
+    var = arw**2 / tau + 2 * np.log(2) / np.pi * b**2 + k**2 * tau / 3
+    fit = allan.fit_allan_table(pd.DataFrame({"m": tau, "tau_s": tau, "var": var}), 2**20)
+    assert fit.arw == pytest.approx(arw, rel=1e-9)
+    assert fit.bias_instability == pytest.approx(b, rel=1e-9)
+    assert fit.rrw == pytest.approx(k, rel=1e-9)
+    assert fit.quantization == 0.0 and fit.ramp == 0.0

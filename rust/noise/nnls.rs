@@ -14,13 +14,20 @@ pub fn nnls(a: &DMatrix<f64>, b: &DVector<f64>) -> Result<DVector<f64>> {
     let tol = 10.0 * f64::EPSILON * norm1 * (m.max(n) as f64);
     let mut x = DVector::zeros(n);
     let mut passive = vec![false; n];
+    // Candidates whose gradient was positive by rounding only: with them passive the
+    // least-squares solution puts them at ≤ 0 at once (a term whose true coefficient is
+    // exactly 0, e.g. an Allan fit of noise-free variances). Lawson & Hanson's own
+    // routine rejects such a candidate (its w is set to 0) until x next changes;
+    // without this the loop adds and drops it until it runs out of iterations.
+    let mut rounding_only = vec![false; n];
     let max_iter = 3 * n + 30;
-    for _ in 0..max_iter {
+    'outer: for _ in 0..max_iter {
         let w = a.transpose() * (b - a * &x);
         // Lawson–Hanson step 2: the most violating inactive variable.
-        let t = (0..n).filter(|&j| !passive[j] && w[j] > tol).max_by(|&i, &j| w[i].total_cmp(&w[j]));
+        let t = (0..n).filter(|&j| !passive[j] && !rounding_only[j] && w[j] > tol).max_by(|&i, &j| w[i].total_cmp(&w[j]));
         let Some(t) = t else { return Ok(x) };
         passive[t] = true;
+        let mut first = true;
         // Inner loop: least squares on the passive set, step back into the feasible region.
         loop {
             let idx: Vec<usize> = (0..n).filter(|&j| passive[j]).collect();
@@ -33,6 +40,12 @@ pub fn nnls(a: &DMatrix<f64>, b: &DVector<f64>) -> Result<DVector<f64>> {
             for (c, &j) in idx.iter().enumerate() {
                 z[j] = zp[c];
             }
+            if first && z[t] <= tol {
+                passive[t] = false;
+                rounding_only[t] = true;
+                continue 'outer;
+            }
+            first = false;
             if idx.iter().all(|&j| z[j] > tol) {
                 x = z;
                 break;
@@ -50,6 +63,7 @@ pub fn nnls(a: &DMatrix<f64>, b: &DVector<f64>) -> Result<DVector<f64>> {
                 }
             }
         }
+        rounding_only.fill(false);
     }
     Err(NavError::Numerical("nnls: no convergence".into()))
 }
