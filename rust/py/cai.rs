@@ -3,7 +3,7 @@
 //! sensor, the aided INS and the Monte-Carlo scenarios. Conversion only: every check and
 //! loop is in `crate::cai`.
 
-use super::convert::{count, counts, flags, quat_rows, register_choices, seed as seed_arg, rows, to_py_rows, vec3, vec3_rows, vec3_to_py, vec_to_py, vector, Wrap};
+use super::convert::{count, counts, flags, quat_rows, real, real_opt, register_choices, rows, seed as seed_arg, to_py_rows, vec3, vec3_rows, vec3_to_py, vec_to_py, vector, Wrap};
 use super::filter::{mats, AidedSetup, PyAidedIns};
 use super::sources::AidingSource;
 use super::imu::triad_from_dict;
@@ -111,7 +111,7 @@ impl CaiSetup {
         angular_rate: PyReadonlyArray2<'_, f64>,
         shots: PyReadonlyArray1<'_, f64>,
         channels: &CaiChannels,
-        T: f64,
+        #[pyo3(from_py_with = real)] T: f64,
         omega_dot: Wrap<OmegaDotKind>,
         angular_acceleration: Option<PyReadonlyArray2<'_, f64>>,
         savgol_half_width: &Bound<'_, PyAny>,
@@ -168,7 +168,7 @@ super::pickle::picklable!(CaiGravity, 0, "CaiGravity");
 #[pymethods]
 impl CaiGravity {
     #[new]
-    fn new(g0: PyReadonlyArray1<'_, f64>, gradient: Option<PyReadonlyArray2<'_, f64>>, t_ref: f64) -> PyResult<Self> {
+    fn new(g0: PyReadonlyArray1<'_, f64>, gradient: Option<PyReadonlyArray2<'_, f64>>, #[pyo3(from_py_with = real)] t_ref: f64) -> PyResult<Self> {
         Ok(CaiGravity(Gravity { g0: vec3(&g0, "g0")?, gradient: gradient_tensor(gradient)?, t_ref }))
     }
 }
@@ -197,7 +197,7 @@ impl CaiMotion {
 
     /// Forward speed (m/s), yaw-rate amplitude (rad/s), period (s) of the yaw rate sine.
     #[staticmethod]
-    fn yaw_drive(speed: f64, yaw_rate_amplitude: f64, period: f64) -> PyResult<Self> {
+    fn yaw_drive(#[pyo3(from_py_with = real)] speed: f64, #[pyo3(from_py_with = real)] yaw_rate_amplitude: f64, #[pyo3(from_py_with = real)] period: f64) -> PyResult<Self> {
         Ok(CaiMotion(AnalyticMotion::YawDrive(YawDrive::new(speed, yaw_rate_amplitude, period)?)))
     }
 
@@ -210,7 +210,7 @@ impl CaiMotion {
 
     /// Oracle phases (shots · channels).
     #[allow(non_snake_case)]
-    fn oracle<'py>(&self, py: Python<'py>, shots: PyReadonlyArray1<'py, f64>, T: f64, channels: &CaiChannels, gravity: &CaiGravity) -> PyResult<Arr1<'py>> {
+    fn oracle<'py>(&self, py: Python<'py>, shots: PyReadonlyArray1<'py, f64>, #[pyo3(from_py_with = real)] T: f64, channels: &CaiChannels, gravity: &CaiGravity) -> PyResult<Arr1<'py>> {
         let shots = vector(&shots, "shots")?;
         let out = py.detach(|| oracle_phase(&self.0, &shots, T, &channels.0, &gravity.0))?;
         Ok(vec_to_py(py, out))
@@ -230,7 +230,7 @@ fn cai_phase_closed_form<'py>(
     f: PyReadonlyArray1<'py, f64>,
     wd: PyReadonlyArray1<'py, f64>,
     gradient: Option<PyReadonlyArray2<'py, f64>>,
-    t: f64,
+    #[pyo3(from_py_with = real)] t: f64,
 ) -> PyResult<Arr1<'py>> {
     let (k, v0) = (vec3_rows(&k, "k")?, vec3_rows(&v0, "v0")?);
     let (w, f, wd, g) = (vec3(&w, "angular_rate")?, vec3(&f, "specific_force")?, vec3(&wd, "angular_acceleration")?, gradient_tensor(gradient)?.unwrap_or_else(Mat3::zeros));
@@ -239,7 +239,7 @@ fn cai_phase_closed_form<'py>(
 
 /// Sensitivity g(t) and response f(t) at times t (pulse centred at 0).
 #[pyfunction]
-fn cai_sensitivity<'py>(py: Python<'py>, t: PyReadonlyArray1<'py, f64>, t_dark: f64, tau: f64) -> PyResult<(Arr1<'py>, Arr1<'py>)> {
+fn cai_sensitivity<'py>(py: Python<'py>, t: PyReadonlyArray1<'py, f64>, #[pyo3(from_py_with = real)] t_dark: f64, #[pyo3(from_py_with = real)] tau: f64) -> PyResult<(Arr1<'py>, Arr1<'py>)> {
     let (g, f) = sensitivity_samples(&Pulses::new(t_dark, tau)?, &vector(&t, "t")?)?;
     Ok((vec_to_py(py, g), vec_to_py(py, f)))
 }
@@ -248,9 +248,9 @@ fn cai_sensitivity<'py>(py: Python<'py>, t: PyReadonlyArray1<'py, f64>, t_dark: 
 #[pyfunction]
 fn cai_convolution_phase<'py>(
     py: Python<'py>,
-    t_dark: f64,
-    tau: f64,
-    k: f64,
+    #[pyo3(from_py_with = real)] t_dark: f64,
+    #[pyo3(from_py_with = real)] tau: f64,
+    #[pyo3(from_py_with = real)] k: f64,
     t: PyReadonlyArray1<'py, f64>,
     a: PyReadonlyArray1<'py, f64>,
     centres: PyReadonlyArray1<'py, f64>,
@@ -264,20 +264,20 @@ fn cai_convolution_phase<'py>(
 
 /// Closed-form area ∫f of the response function.
 #[pyfunction]
-fn cai_response_area(t_dark: f64, tau: f64) -> PyResult<f64> {
+fn cai_response_area(#[pyo3(from_py_with = real)] t_dark: f64, #[pyo3(from_py_with = real)] tau: f64) -> PyResult<f64> {
     Ok(Pulses::new(t_dark, tau)?.area())
 }
 
 /// The ideal transfer 4 sin²(ωT/2)/ω² at angular frequencies ω (rad/s).
 #[pyfunction]
 #[allow(non_snake_case)]
-fn cai_ideal_transfer<'py>(py: Python<'py>, T: f64, omega: PyReadonlyArray1<'py, f64>) -> PyResult<Arr1<'py>> {
+fn cai_ideal_transfer<'py>(py: Python<'py>, #[pyo3(from_py_with = real)] T: f64, omega: PyReadonlyArray1<'py, f64>) -> PyResult<Arr1<'py>> {
     Ok(vec_to_py(py, ideal_transfers(T, &vector(&omega, "omega")?)?))
 }
 
 /// Populations o − (C/2) cos(φ) of total phases φ (rad) with contrasts C (same length).
 #[pyfunction]
-fn cai_readout<'py>(py: Python<'py>, offset: f64, contrast: PyReadonlyArray1<'py, f64>, phase: PyReadonlyArray1<'py, f64>) -> PyResult<Arr1<'py>> {
+fn cai_readout<'py>(py: Python<'py>, #[pyo3(from_py_with = real)] offset: f64, contrast: PyReadonlyArray1<'py, f64>, phase: PyReadonlyArray1<'py, f64>) -> PyResult<Arr1<'py>> {
     let (c, p) = (contrast.as_array().to_vec(), phase.as_array().to_vec());
     Ok(vec_to_py(py, populations(offset, &c, &p)?))
 }
@@ -291,7 +291,7 @@ fn cai_steer_mid_fringe<'py>(py: Python<'py>, phi_hat: PyReadonlyArray1<'py, f64
 /// Shot start times (s) from t0, one per `period` (≥ 2T), the last ending by t_end.
 #[pyfunction]
 #[allow(non_snake_case)]
-fn cai_shot_times<'py>(py: Python<'py>, t0: f64, t_end: f64, T: f64, shot_period: f64) -> PyResult<Arr1<'py>> {
+fn cai_shot_times<'py>(py: Python<'py>, #[pyo3(from_py_with = real)] t0: f64, #[pyo3(from_py_with = real)] t_end: f64, #[pyo3(from_py_with = real)] T: f64, #[pyo3(from_py_with = real)] shot_period: f64) -> PyResult<Arr1<'py>> {
     Ok(vec_to_py(py, shot_times(t0, t_end, T, shot_period)?))
 }
 
@@ -310,7 +310,7 @@ fn cai_fringe_track<'py>(
     zeta0: PyReadonlyArray1<'py, f64>,
     sigma0: PyReadonlyArray1<'py, f64>,
     q: PyReadonlyArray1<'py, f64>,
-    r: f64,
+    #[pyo3(from_py_with = real)] r: f64,
 ) -> PyResult<Arr2<'py>> {
     let (z, s, q) = (vec3(&zeta0, "zeta0")?, vec3(&sigma0, "sigma0")?, vec3(&q, "q")?);
     let cfg = FringeEkf { zeta0: [z.x, z.y, z.z], sigma0: [s.x, s.y, s.z], q: [q.x, q.y, q.z], r };
@@ -332,7 +332,7 @@ fn cai_ml_identify<'py>(
     free: &Bound<'py, PyAny>,
     theta0: PyReadonlyArray1<'py, f64>,
     max_iter: &Bound<'py, PyAny>,
-    tol: f64,
+    #[pyo3(from_py_with = real)] tol: f64,
     batch: &Bound<'py, PyAny>,
     sliding: bool,
 ) -> PyResult<Bound<'py, PyDict>> {
@@ -375,21 +375,21 @@ impl CaiSensor {
         jacobian_euler, misalignment, lever_arm, force, force_tau, force_sigma))]
     fn new(
         channels: &CaiChannels,
-        T: f64,
-        offset: f64,
-        contrast: f64,
-        sigma_p: f64,
+        #[pyo3(from_py_with = real)] T: f64,
+        #[pyo3(from_py_with = real)] offset: f64,
+        #[pyo3(from_py_with = real)] contrast: f64,
+        #[pyo3(from_py_with = real)] sigma_p: f64,
         inflation: Option<(f64, f64)>,
         omega_dot: Wrap<OmegaDotKind>,
         savgol_half_width: &Bound<'_, PyAny>,
         interpolation: Wrap<Interpolation>,
         substeps: &Bound<'_, PyAny>,
         jacobian_euler: bool,
-        misalignment: Option<f64>,
-        lever_arm: Option<f64>,
+        #[pyo3(from_py_with = real_opt)] misalignment: Option<f64>,
+        #[pyo3(from_py_with = real_opt)] lever_arm: Option<f64>,
         force: Wrap<ForceKind>,
-        force_tau: Option<f64>,
-        force_sigma: Option<f64>,
+        #[pyo3(from_py_with = real_opt)] force_tau: Option<f64>,
+        #[pyo3(from_py_with = real_opt)] force_sigma: Option<f64>,
     ) -> PyResult<Self> {
         let cfg = CaiConfig {
             channels: channels.0.clone(),
@@ -427,7 +427,7 @@ impl CaiSensor {
 #[pyfunction]
 // invariant: a 3-D array's shape has 3 entries.
 #[allow(clippy::indexing_slicing)]
-fn cai_in_shot_noise<'py>(py: Python<'py>, sensor: &CaiSensor, dt: f64, q_a: f64, q_g: f64, f: PyReadonlyArray3<'py, f64>) -> PyResult<(Arr2<'py>, Arr3<'py>)> {
+fn cai_in_shot_noise<'py>(py: Python<'py>, sensor: &CaiSensor, #[pyo3(from_py_with = real)] dt: f64, #[pyo3(from_py_with = real)] q_a: f64, #[pyo3(from_py_with = real)] q_g: f64, f: PyReadonlyArray3<'py, f64>) -> PyResult<(Arr2<'py>, Arr3<'py>)> {
     let fs = mats(&f, "f")?;
     let (sigma, cross) = py.detach(|| sensor.0.in_shot_noise(dt, q_a, q_g, &fs))?;
     let (n, m) = (f.shape()[1], sigma.nrows());
@@ -478,13 +478,13 @@ impl CaiHybrid {
         reference: Option<(Bound<'_, PyDict>, Bound<'_, PyDict>)>,
         p0: PyReadonlyArray2<'_, f64>,
         gravity: Wrap<GravityModel>,
-        rate_hz: f64,
-        truth_rate_hz: Option<f64>,
+        #[pyo3(from_py_with = real)] rate_hz: f64,
+        #[pyo3(from_py_with = real_opt)] truth_rate_hz: Option<f64>,
         phase_source: Wrap<PhaseSourceKind>,
-        accel_psd: f64,
-        gyro_psd: f64,
-        accel_bias_psd: f64,
-        gyro_bias_psd: f64,
+        #[pyo3(from_py_with = real)] accel_psd: f64,
+        #[pyo3(from_py_with = real)] gyro_psd: f64,
+        #[pyo3(from_py_with = real)] accel_bias_psd: f64,
+        #[pyo3(from_py_with = real)] gyro_bias_psd: f64,
         predict_every: &Bound<'_, PyAny>,
         aiding: bool,
         draw_initial: bool,

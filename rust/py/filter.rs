@@ -1,7 +1,7 @@
 //! Bindings of filter/: state layouts, the INS error model and the aided INS (the linear
 //! Kalman machinery is bound in kalman.rs).
 
-use super::convert::{count, index_count, register_choices, Wrap, mat, quat_rows, vec3_rows, vector};
+use super::convert::{count, index_count, mat, quat_rows, real, real_opt, register_choices, vec3_rows, vector, Wrap};
 use crate::earth::Ellipsoid;
 use crate::error::{check_finite, invalid, invalid_at, NavError};
 use pyo3::exceptions::PyTypeError;
@@ -76,8 +76,8 @@ fn ins_error_dynamics<'py>(
     vel_ned: PyReadonlyArray2<'py, f64>,
     q_nb: PyReadonlyArray2<'py, f64>,
     f_b: PyReadonlyArray2<'py, f64>,
-    accel_psd: f64,
-    gyro_psd: f64,
+    #[pyo3(from_py_with = real)] accel_psd: f64,
+    #[pyo3(from_py_with = real)] gyro_psd: f64,
     accel_bias: (String, f64, f64),
     gyro_bias: (String, f64, f64),
     ellipsoid: Wrap<Ellipsoid>,
@@ -132,14 +132,14 @@ impl AidedSetup {
     #[pyo3(signature = (*, t0, lla0, vel0, q0, kind, p0, accel_psd, gyro_psd, accel_bias, gyro_bias, ba0, bg0, predict_every, method, mode, sequential=false, gate=None, ellipsoid=Wrap(crate::earth::WGS84), vertical=Wrap(Vertical::Free), zeta=None, omega=None, baro_psd=0.0, baro_bias=None, baro_bias_sigma0=None))]
     #[allow(clippy::too_many_arguments)]
     fn new(
-        t0: f64,
+        #[pyo3(from_py_with = real)] t0: f64,
         lla0: &Bound<'_, PyAny>,
         vel0: &Bound<'_, PyAny>,
         q0: &Bound<'_, PyAny>,
         kind: Wrap<ImuKind>,
         p0: PyReadonlyArray2<'_, f64>,
-        accel_psd: f64,
-        gyro_psd: f64,
+        #[pyo3(from_py_with = real)] accel_psd: f64,
+        #[pyo3(from_py_with = real)] gyro_psd: f64,
         accel_bias: (String, f64, f64),
         gyro_bias: (String, f64, f64),
         ba0: &Bound<'_, PyAny>,
@@ -148,14 +148,14 @@ impl AidedSetup {
         method: &str,
         mode: &str,
         sequential: bool,
-        gate: Option<f64>,
+        #[pyo3(from_py_with = real_opt)] gate: Option<f64>,
         ellipsoid: Wrap<Ellipsoid>,
         vertical: Wrap<Vertical>,
-        zeta: Option<f64>,
-        omega: Option<f64>,
-        baro_psd: f64,
+        #[pyo3(from_py_with = real_opt)] zeta: Option<f64>,
+        #[pyo3(from_py_with = real_opt)] omega: Option<f64>,
+        #[pyo3(from_py_with = real)] baro_psd: f64,
         baro_bias: Option<(String, f64, f64)>,
-        baro_bias_sigma0: Option<f64>,
+        #[pyo3(from_py_with = real_opt)] baro_bias_sigma0: Option<f64>,
     ) -> PyResult<Self> {
         let (lla0, vel0, q0) = (floats::<3>(lla0, "lla0")?, floats::<3>(vel0, "vel0")?, floats::<4>(q0, "q0")?);
         let (ba0, bg0) = (floats::<3>(ba0, "ba0")?, floats::<3>(bg0, "bg0")?);

@@ -2,7 +2,7 @@
 //! discretisation, the streaming Kalman filter, the RTS smoother and the covariance
 //! analysis / Monte Carlo of a linearised scenario.
 
-use super::convert::{count, counts, mat, mat_to_py, register_choices, seed, vector, Wrap};
+use super::convert::{count, counts, mat, mat_to_py, real, real_opt, register_choices, seed, vector, Wrap};
 use super::filter::{mats, stack_to_py};
 use crate::error::NavError;
 use crate::filter::analysis::Scenario as CoreScenario;
@@ -33,7 +33,7 @@ fn dare<'py>(
 
 /// Scalar closed forms for Φ = 1 (Tennstedt et al. 2021, Eqs. 32–35): (P⁻, P⁺).
 #[pyfunction]
-fn riccati_scalar(q: f64, r: f64, h: f64) -> PyResult<(f64, f64)> {
+fn riccati_scalar(#[pyo3(from_py_with = real)] q: f64, #[pyo3(from_py_with = real)] r: f64, #[pyo3(from_py_with = real)] h: f64) -> PyResult<(f64, f64)> {
     Ok(riccati::scalar(q, r, h)?)
 }
 
@@ -80,7 +80,7 @@ fn discretize_model<'py>(
     py: Python<'py>,
     f: PyReadonlyArray2<'py, f64>,
     qc: PyReadonlyArray2<'py, f64>,
-    dt: f64,
+    #[pyo3(from_py_with = real)] dt: f64,
     method: Wrap<Discretization>,
 ) -> PyResult<(Bound<'py, PyArray2<f64>>, Bound<'py, PyArray2<f64>>)> {
     let (f, qc) = (mat(&f, "f")?, mat(&qc, "qc")?);
@@ -137,7 +137,7 @@ impl KalmanFilter {
         h: PyReadonlyArray2<'py, f64>,
         r: PyReadonlyArray2<'py, f64>,
         sequential: bool,
-        gate: Option<f64>,
+        #[pyo3(from_py_with = real_opt)] gate: Option<f64>,
     ) -> PyResult<(Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<f64>>, Vec<usize>, Vec<usize>)> {
         let z: Vec<f64> = z.as_array().iter().copied().collect();
         let rep = lock(py, &self.inner).update(&z, &with_missing(&h), &with_missing(&r), sequential, gate)?;
