@@ -162,6 +162,15 @@ def nees_fraction_in_band(site, seeds: int) -> float:
 # second-order term ψ_D·ψ_tilt of the small-angle model (0.1 rad × 1 mrad, the size of
 # the tilt signal itself), which changes as closed-loop feedback turns the heading; a
 # large-heading error model is the likely fix.
+# Further hypotheses, 20 seeds, band [2.02, 4.16], share of epochs in band (averaged NEES
+# at the start and at the end of the 240 s): as is 46 % (3.3 → 4.6). Unmodelled bias
+# wander is ruled out: with the preset's flicker switched off in the simulator and in the
+# filter's model (the only slow process of "tactical": no Gauss-Markov, bias_rw = 0) it is
+# 6 % (3.3 → 8.3), worse, so the random-walk bias noise the filter derives from the
+# flicker acts as inflation, not as a missing process. Zero-rate updates add to it but are
+# not the cause: zero-velocity updates only give 66 % (3.3 → 4.3); without flicker too, 16 %
+# (3.4 → 7.0). What is left grows as the filter's covariance shrinks, the signature of the
+# nonlinear (second-order heading × tilt) error above.
 NEES_NOT_MET = pytest.mark.xfail(strict=True, reason="fine-alignment attitude NEES above its 95 % band (see comment)")
 
 
