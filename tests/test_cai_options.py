@@ -25,8 +25,9 @@ def _aided_ins_data_kind(kind):
     ins = InsSetup(t0=0.0, lla0=(0.9, 0.1, 0.0), vel0=(0, 0, 0), q0=(1.0, 0, 0, 0), kind="rates", p0=cai.seed003_filter().p0(0),
                    accel_psd=1e-11, gyro_psd=1e-12, accel_bias=rw, gyro_bias=rw, predict_every=10).native
     table = np.zeros((1, 6))
-    _core.cai_aided_ins(ins=ins, extra0=np.zeros(0), sensor=cai.seed003_sensor()._native(), shots=np.array([0.1]), data_kind=kind,
-                        data_a=table, data_b=table, incomplete_shots="skip")
+    source = _core.cai_source(extra0=np.zeros(0), extra_var=None, sensor=cai.seed003_sensor()._native(), shots=np.array([0.1]),
+                              data_kind=kind, data_a=table, data_b=table, incomplete_shots="skip")
+    _core.aided_ins_from_sources(ins, [source])
 
 
 def _campaign(**kw):

@@ -73,7 +73,7 @@ def test_bad_fix_time_outside_imu_span():
 def test_bad_fix_before_streamed_record():
     kw, (t, g, a) = _args()
     kw.update(fix_time=[0.05], t0=0.1)
-    with pytest.raises(ValueError, match=r"fixes: time 0.05 s at index 0 is before the IMU record start 0.1 s"):
+    with pytest.raises(ValueError, match=r"sources: time 0.05 s at index 0 is before the IMU record start 0.1 s"):
         position_aided_ins(**kw).process(t[1:], g[1:], a[1:])
 
 
@@ -87,7 +87,7 @@ def test_bad_nan_fix():
 def test_bad_p0_size():
     kw, _ = _args()
     kw["p0"] = np.eye(9)
-    with pytest.raises(ValueError, match="p0: expected 15x15, got 9x9"):
+    with pytest.raises(ValueError, match="p0: expected the 15 x 15 INS block, got 9x9"):
         position_aided_ins(**kw)
 
 
@@ -101,7 +101,7 @@ def test_bad_fix_covariance():
 def test_bad_unsorted_fixes():
     kw, _ = _args()
     kw.update(fix_time=[0.5, 0.4], fix_lla=[[LAT, LON, H]] * 2, fix_cov=np.tile(np.eye(3), (2, 1, 1)))
-    with pytest.raises(ValueError, match="fix_t: time not strictly increasing: decreasing stamp 0.4 at index 1"):
+    with pytest.raises(ValueError, match="fix_time: time not strictly increasing: decreasing stamp 0.4 at index 1"):
         position_aided_ins(**kw)
 
 

@@ -4,7 +4,7 @@
 //! loop is in `crate::cai`.
 
 use super::convert::{count, counts, flags, quat_rows, real, real_opt, register_choices, rows, seed as seed_arg, to_py_rows, vec3, vec3_rows, vec3_to_py, vec_to_py, vector, Wrap};
-use super::filter::{mats, AidedSetup, PyAidedIns};
+use super::filter::mats;
 use super::sources::AidingSource;
 use super::imu::triad_from_dict;
 use super::trajectory::Motion;
@@ -362,7 +362,7 @@ fn error_model(accel: &Bound<'_, PyDict>, gyro: &Bound<'_, PyDict>, name: &str) 
 /// The CAI sensor as the aiding sees it (channels, T, readout, R inflation, predictor and
 /// Jacobian options, extra states, force mode), checked once; built by
 /// `atomnav.cai.CaiSensor._native()` and taken, with their shots, by the Monte Carlo
-/// (`CaiHybrid`), `cai_aided_ins` and `cai_in_shot_noise`.
+/// (`CaiHybrid`), `cai_source` and `cai_in_shot_noise`.
 #[pyclass(name = "CaiSensor", module = "atomnav._core", frozen)]
 pub struct CaiSensor(CaiConfig);
 super::pickle::picklable!(CaiSensor, 0, "CaiSensor");
@@ -584,26 +584,6 @@ fn cai_parts(
     Ok((cfg, data))
 }
 
-/// CAI-aided INS on the generic engine (`atomnav.filter.AidedIns`): sensor, shots and
-/// data as for `cai_parts`; `extra0` the initial values of the sensor's extra states.
-#[pyfunction]
-#[pyo3(signature = (ins, extra0, sensor, shots, data_kind, data_a, data_b, incomplete_shots))]
-#[allow(clippy::too_many_arguments)]
-fn cai_aided_ins(
-    ins: PyRef<'_, AidedSetup>,
-    extra0: PyReadonlyArray1<'_, f64>,
-    sensor: &CaiSensor,
-    shots: PyReadonlyArray1<'_, f64>,
-    data_kind: Wrap<DataKind>,
-    data_a: PyReadonlyArray2<'_, f64>,
-    data_b: PyReadonlyArray2<'_, f64>,
-    incomplete_shots: Wrap<IncompleteShots>,
-) -> PyResult<PyAidedIns> {
-    let (cfg, data) = cai_parts(sensor, &shots, data_kind.0, &data_a, &data_b, incomplete_shots.0)?;
-    let aiding = CaiAiding::new(CaiConfig { kind: ins.setup.kind, ..cfg }, data)?;
-    PyAidedIns::from_aiding(&ins, DVector::from_vec(vector(&extra0, "extra0")?), Box::new(aiding))
-}
-
 /// CAI shots as one measurement source of an aided INS (`aided_ins_from_sources`):
 /// sensor, shots and data as for `cai_parts`, `extra0` the initial values of the sensor's
 /// extra states and `extra_var` their initial variances (None: the setup's P₀ covers the
@@ -654,7 +634,6 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<CaiMotion>()?;
     m.add_class::<CaiHybrid>()?;
     m.add_class::<CaiSensor>()?;
-    m.add_function(wrap_pyfunction!(cai_aided_ins, m)?)?;
     m.add_function(wrap_pyfunction!(cai_source, m)?)?;
     m.add_function(wrap_pyfunction!(cai_in_shot_noise, m)?)?;
     m.add_function(wrap_pyfunction!(cai_incomplete_shots, m)?)?;

@@ -5,7 +5,7 @@ use super::convert::{count, index_count, mat, quat_rows, real, real_opt, registe
 use crate::earth::Ellipsoid;
 use crate::error::{check_finite, invalid, invalid_at, NavError};
 use pyo3::exceptions::PyTypeError;
-use crate::filter::aided::{AidedConfig, AidedIns, AidedOutput, Aiding, DampedVertical, ForwardPass, InsSetup, PositionAiding, PositionFix, NOMINAL_WIDTH};
+use crate::filter::aided::{AidedConfig, AidedIns, AidedOutput, Aiding, DampedVertical, ForwardPass, InsSetup, NOMINAL_WIDTH};
 use crate::strapdown::Vertical;
 use crate::filter::discretize::Discretization;
 use crate::filter::initial_error::perturbed_start;
@@ -94,7 +94,7 @@ fn ins_error_dynamics<'py>(
 }
 
 /// The aided INS (filter/aided.rs) with any aiding sensor, fed chunk by chunk. Built by
-/// a sensor's factory function (`position_aided_ins`, ...). `process` and `finish` return
+/// `aided_ins_from_sources`. `process` and `finish` return
 /// (nav (14, E) column table, accel_bias (E, 3), gyro_bias (E, 3), extra (E, n_extra),
 /// sigma (E, n), meas_time (M,), meas_rows (M,), innovation (ΣM rows,), nis (M,),
 /// rejected (M,), source (list of M sensor names), forward) for the epochs and
@@ -179,14 +179,9 @@ impl AidedSetup {
 }
 
 impl PyAidedIns {
-    /// The aided INS of `ins` with the sensor's model and the initial estimate of its
-    /// extra blocks.
-    pub(crate) fn from_aiding(ins: &AidedSetup, extra0: DVector<f64>, aiding: Box<dyn Aiding>) -> PyResult<Self> {
-        Self::from_aiding_with(ins, extra0, None, aiding)
-    }
-
-    /// [`Self::from_aiding`] with P₀ over the whole layout when the sensor assembles it.
-    pub(crate) fn from_aiding_with(ins: &AidedSetup, extra0: DVector<f64>, p0: Option<DMatrix<f64>>, aiding: Box<dyn Aiding>) -> PyResult<Self> {
+    /// The aided INS of `ins` with the sensor's model, the initial estimate of its extra
+    /// blocks and, when the sensor assembles it, P₀ over the whole layout.
+    pub(crate) fn from_aiding(ins: &AidedSetup, extra0: DVector<f64>, p0: Option<DMatrix<f64>>, aiding: Box<dyn Aiding>) -> PyResult<Self> {
         let engine = AidedIns::from_setup(&ins.setup, extra0, p0, aiding)?;
         Ok(PyAidedIns { inner: std::sync::Mutex::new(engine) })
     }
@@ -364,14 +359,6 @@ pub(crate) fn ins_noise(accel_psd: f64, gyro_psd: f64, accel_bias: &(String, f64
     Ok(InsNoise::new(accel_psd, gyro_psd, ba, bg)?)
 }
 
-/// Position-aided INS: fixes at `fix_t` (M,) with (lat, lon, h) `fix_lla` (M, 3) and NED
-/// covariance `fix_cov` (M, 3, 3) m².
-#[pyfunction]
-fn position_aided_ins(ins: PyRef<'_, AidedSetup>, fix_t: PyReadonlyArray1<'_, f64>, fix_lla: PyReadonlyArray2<'_, f64>, fix_cov: PyReadonlyArray3<'_, f64>) -> PyResult<PyAidedIns> {
-    let fixes = PositionFix::table(["fix_t", "fix_lla", "fix_cov"], &vector(&fix_t, "fix_t")?, &vec3_rows(&fix_lla, "fix_lla")?, &mats(&fix_cov, "fix_cov")?)?;
-    PyAidedIns::from_aiding(&ins, DVector::zeros(0), Box::new(PositionAiding::new(fixes)?))
-}
-
 /// The estimate at the start of a run whose truth is (`lla` rad/rad/m, `vel_ned` m/s,
 /// `q_nb`): the truth ⊕ δx with δx = L u drawn from the navigation block of `p0` and the
 /// standard normals `normals` (9,) (filter/initial_error.rs). Returns (lla, vel_ned, q_nb).
@@ -391,7 +378,6 @@ fn initial_error<'py>(
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(layout_ranges, m)?)?;
     m.add_function(wrap_pyfunction!(ins_error_dynamics, m)?)?;
-    m.add_function(wrap_pyfunction!(position_aided_ins, m)?)?;
     m.add_function(wrap_pyfunction!(initial_error, m)?)?;
     m.add("STATE_BLOCKS", STANDARD_BLOCKS.to_vec())?;
     m.add("INS15", INS15.to_vec())?;

@@ -3,7 +3,7 @@
 //! arrays, with one options object ([`PyGnssOptions`]) for all of them.
 
 use super::convert::{real, real_opt, register_choices, rows, seed as seed_arg, to_py_rows, vec3, vec3_rows, vector, Wrap};
-use super::filter::{floats, AidedSetup, PyAidedIns};
+use super::filter::floats;
 use crate::earth::Helmert;
 use crate::error::invalid;
 use crate::gnss::constellation::{nominal, ConstellationConfig};
@@ -198,25 +198,8 @@ fn gnss_spp<'py>(
     Ok(to_py_rows(py, &out))
 }
 
-/// Tightly coupled GNSS/INS on the aided-INS engine (see `gnss/tight.rs`). Observation
-/// table as for `gnss_spp`; `ins` with P₀ of the 15 INS states (the extra blocks' initial
-/// values and σ come from `options`).
-#[pyfunction]
-#[allow(clippy::too_many_arguments)]
-fn gnss_tight_ins<'py>(
-    eph: &PyEphemerides, time: PyReadonlyArray1<'py, f64>, sat: Vec<String>, channel: PyReadonlyArray1<'py, i64>, code: PyReadonlyArray1<'py, f64>,
-    rate: PyReadonlyArray1<'py, f64>, options: &PyGnssOptions, ins: PyRef<'py, AidedSetup>,
-) -> PyResult<PyAidedIns> {
-    let ep = epochs(&time, &sat, &channel, &code, &rate)?;
-    let o = &options.inner;
-    let (x0, var) = o.tight_initial();
-    let p0 = ins.setup.p0_with_extra(&var)?;
-    let aiding = TightAiding::new(eph.inner.clone(), ep, o.tight(ins.setup.kind))?;
-    PyAidedIns::from_aiding_with(&ins, DVector::from_vec(x0), Some(p0), Box::new(aiding))
-}
-
 /// Tightly coupled GNSS as one measurement source of an aided INS
-/// (`aided_ins_from_sources`): observation table and options as for `gnss_tight_ins`; the
+/// (`aided_ins_from_sources`): observation table as for `gnss_spp`, options as for the tightly coupled model (`gnss/tight.rs`); the
 /// initial values and σ of its extra states come from `options`. The sensor is made when
 /// the INS is built (it needs the IMU kind of the setup).
 #[pyfunction]
@@ -238,7 +221,6 @@ fn gnss_source<'py>(
 }
 
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
-    m.add_function(wrap_pyfunction!(gnss_tight_ins, m)?)?;
     m.add_function(wrap_pyfunction!(gnss_source, m)?)?;
     m.add_class::<PyEphemerides>()?;
     m.add_class::<PyGnssOptions>()?;

@@ -82,7 +82,7 @@ fn aided_ins_from_sources(py: Python<'_>, setup: PyRef<'_, AidedSetup>, sources:
     }
     let parts = taken.into_iter().flatten().map(|b| b(&setup.setup)).collect::<Result<Vec<Source>>>()?;
     let (sources, extra0, p0) = combine(&setup.setup, parts)?;
-    PyAidedIns::from_aiding_with(&setup, extra0, Some(p0), Box::new(sources))
+    PyAidedIns::from_aiding(&setup, extra0, Some(p0), Box::new(sources))
 }
 
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {

@@ -441,13 +441,12 @@ def position_aided_ins(t0: float, lla0, vel0, q0, kind: str, fix_time, fix_lla, 
     >>> result = ins.run(time, gyro, accel)        # doctest: +SKIP
     >>> truth.errors(result.nav)                   # doctest: +SKIP
     """
+    from .sources import _PositionFixArguments, aided_ins  # the one construction path (sources import this module)
+
     setup = InsSetup(t0=t0, lla0=lla0, vel0=vel0, q0=q0, kind=kind, p0=p0, accel_psd=accel_psd, gyro_psd=gyro_psd,
                      **options)
-    fix_lla = plausibility.lla(rows(fix_lla, 3, "fix_lla"), "fix_lla")
-    cov = as_floats(fix_cov, "fix_cov")
-    if cov.size % 9:
-        raise input_error("fix_cov", f"expected an (M, 3, 3) stack, got shape {cov.shape}")
-    core = _core.position_aided_ins(
-        setup.native, np.ascontiguousarray(as_floats(fix_time, "fix_time").ravel()), fix_lla,
-        np.ascontiguousarray(cov.reshape(-1, 3, 3)))
-    return AidedIns(core, setup)
+    # types and shapes named by this call's arguments; the values are checked by the source
+    fix_time, fix_lla = as_floats(fix_time, "fix_time").ravel(), rows(fix_lla, 3, "fix_lla")
+    with renamed(time="fix_time", lla="fix_lla", cov="fix_cov"):
+        fixes = _PositionFixArguments(fix_time, fix_lla, as_floats(fix_cov, "fix_cov"))
+    return aided_ins(setup, fixes)

@@ -111,10 +111,17 @@ class PositionFixes(_Fixes):
         super().__init__(time, lla, cov, epoch=epoch)
 
     def _plausible(self, value):
-        return plausibility.lla(value, "lla")
+        return plausibility.lla(value, self.VALUE)
 
     def _native(self) -> _core.AidingSource:
         return _core.position_fixes(self.time, self.value, self.cov)
+
+
+class _PositionFixArguments(PositionFixes):
+    """The fixes of :func:`atomnav.filter.position_aided_ins`, whose unit warnings name its
+    argument ``fix_lla`` (a module-level class, so an INS built from it pickles)."""
+
+    VALUE = "fix_lla"
 
 
 class VelocityFixes(_Fixes):

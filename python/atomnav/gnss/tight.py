@@ -9,7 +9,7 @@ import pandas as pd
 
 from .. import _core
 from ..filter.aided import AidedIns, InsSetup
-from ..filter.sources import Source
+from ..filter.sources import Source, aided_ins
 from .._validate import instance
 from .ephemeris import Ephemerides
 from .observations import obs_arrays
@@ -41,8 +41,7 @@ def tight_ins(eph: Ephemerides, obs: pd.DataFrame, options: GnssOptions | None =
         setup = InsSetup(**{"sequential": True, "gate": 10.83, **ins_fields})
     elif ins_fields:
         setup = InsSetup.from_dict({**setup.to_dict(), **ins_fields})
-    core = _core.gnss_tight_ins(eph._core, *obs_arrays(obs), opts.native, setup.native)
-    result = AidedIns(core, setup)
+    result = aided_ins(setup, GnssObservations(eph, obs, opts))  # the one construction path
     result.options = opts
     return result
 
