@@ -201,6 +201,25 @@ PLOTS = ("import matplotlib.pyplot as plt\n"
          "plt.close(fig))[0]")
 PLOTS_AIDED = PLOTS + "\n" + AIDED + "\nres = ins.run(time, gyro, accel, progress=False)"
 
+LOG = ("log_columns = {'time': 't', **{f'gyro_{a}': f'w{a}_dps' for a in 'xyz'}, **{f'accel_{a}': f'a{a}_g' for a in 'xyz'}}\n"
+       "log = pd.DataFrame({'t': imu_t, **{f'w{a}_dps': np.degrees(imu_gyro[:, i]) for i, a in enumerate('xyz')}, "
+       "**{f'a{a}_g': imu_accel[:, i] / 9.80665 for i, a in enumerate('xyz')}})")
+REF = ("ref_columns = {'time': 't', 'lat': 'lat_deg', 'lon': 'lon_deg', 'h': 'alt_m', "
+       "**{k: k for k in ('vn', 've', 'vd', 'roll', 'pitch', 'yaw')}}\n"
+       "ref = pd.DataFrame({'t': traj.time, 'lat_deg': np.degrees(traj.lla[:, 0]), 'lon_deg': np.degrees(traj.lla[:, 1]), "
+       "'alt_m': traj.lla[:, 2], **dict(zip(['vn', 've', 'vd'], traj.vel_ned.T)), "
+       "**dict(zip(['roll', 'pitch', 'yaw'], an.rotation.euler_from_quat(traj.q_nb).T))})")
+ALIGN = 'imu, lla = still_meas, still_init["lla"]'
+ZUPT = ('time = still.time[50::100]\n'
+        'still_setup = an.filter.InsSetup(t0=still_init["t0"], lla0=still_init["lla"], vel0=still_init["vel_ned"], '
+        'q0=still_init["q_nb"], kind="increments", **ins_noise)\n'
+        'still_imu = [still_meas["time_s"].to_numpy(), still_meas[["dtheta_x_rad", "dtheta_y_rad", "dtheta_z_rad"]].to_numpy(), '
+        'still_meas[["dv_x_mps", "dv_y_mps", "dv_z_mps"]].to_numpy()]\n'
+        'still_aided = lambda source: an.filter.aided_ins(still_setup, source).run(*still_imu, progress=False)')
+FIX_TABLE = ('fix_table = pd.DataFrame({"time_s": fixes["fix_time"], "lat_rad": fixes["fix_lla"][:, 0], '
+             '"lon_rad": fixes["fix_lla"][:, 1], "h_m": fixes["fix_lla"][:, 2], "sigma_n_m": 1.0, "sigma_e_m": 1.0, '
+             '"sigma_d_m": 1.0})')
+
 CATALOGUE: tuple[Clean, ...] = (
     # strapdown
     _c("atomnav.strapdown.integrate", "an.strapdown.integrate(imu, **init)", "imu = meas", ["imu"], time_origin="t0"),
@@ -363,6 +382,40 @@ CATALOGUE: tuple[Clean, ...] = (
        (Unit("time", "time"), Unit("gyro", "gyro"))),
     _c("atomnav.plausibility.specific_force", 'an.plausibility.specific_force(f, "f")', "f = imu_accel", (),
        (Unit("f", "accel"),)),
+    # reading a user's own files (a DataFrame already read; the files are read by pandas)
+    _c("atomnav.io.read_imu", 'an.io.read_imu(log, columns=log_columns, units={"gyro": "deg/s", "accel": "g"}, kind="rates")',
+       LOG, ["log"]),
+    _c("atomnav.io.read_trajectory", 'an.io.read_trajectory(ref, columns=ref_columns, units={"lat": "deg", "lon": "deg", "euler": "rad"})',
+       REF, ["ref"]),
+    # (it reads column names only: its mistakes are those of the calls that use it)
+    _c("atomnav.trajectory.imu_kind", "an.trajectory.imu_kind(None, imu)", "imu = meas"),
+    _c("atomnav.plausibility.swapped_blocks", 'an.plausibility.swapped_blocks(time, gyro, accel, "rates")',
+       "time, gyro, accel = imu_t, imu_gyro, imu_accel"),
+    # initial alignment on the 10 s static record
+    _c("atomnav.alignment.coarse", 'an.alignment.coarse(imu, lla, errors="tactical")', ALIGN, ["imu"], LLA),
+    _c("atomnav.alignment.fine", "an.alignment.fine(imu, lla, start)",
+       ALIGN + '\nstart = an.alignment.coarse(imu, lla, errors="tactical")', ["imu"], LLA),
+    _c("atomnav.filter.sources.ZeroVelocity", "still_aided(an.filter.ZeroVelocity(time, 0.01))", ZUPT, (),
+       (Unit("time", "time"),)),
+    _c("atomnav.filter.sources.ZeroRate", "still_aided(an.filter.ZeroRate(time, 1e-12))", ZUPT, (),
+       (Unit("time", "time"),)),
+    # measurement sources (a source is what it holds: times, values, covariances)
+    _c("atomnav.filter.sources.PositionFixes", "an.filter.PositionFixes(time, lla, cov)",
+       'time, lla, cov = fixes["fix_time"], fixes["fix_lla"], fixes["fix_cov"]', (),
+       (Unit("time", "time"),) + LLA_ROWS),
+    _c("atomnav.filter.sources.PositionFixes", "an.filter.PositionFixes(fix_table)", FIX_TABLE, ["fix_table"]),
+    _c("atomnav.filter.sources.VelocityFixes", "an.filter.VelocityFixes(time, vel_ned, np.eye(3) * 0.01)",
+       "time, vel_ned = traj.time[50::100], traj.vel_ned[50::100]", (), (Unit("time", "time"),)),
+    _c("atomnav.filter.sources.aided_ins",
+       "an.filter.aided_ins(setup, sources).run(time, gyro, accel, progress=False)",
+       AIDED + '\nsetup = ins.setup\nsources = [an.filter.PositionFixes(fixes["fix_time"], fixes["fix_lla"], fixes["fix_cov"]), '
+       'an.filter.VelocityFixes(traj.time[50::100], traj.vel_ned[50::100], np.eye(3) * 0.01)]', (), AIDED_UNITS),
+    # atom-interferometer campaigns on a trajectory of the user's
+    _c("atomnav.cai.sensor.incomplete_shots", "an.cai.incomplete_shots(an.cai.seed003_sensor(), shots, time)",
+       "shots, time = np.array([0.0, 0.5, 1.9]), slalom.time", (), (Unit("shots", "time"), Unit("time", "time"))),
+    _c("atomnav.cai.campaign.run_campaign",
+       "an.cai.run_campaign(slalom, config, runs=2, seed=1, progress=False)",
+       "config = an.cai.ScenarioConfig(an.cai.seed003_sensor(), an.cai.seed003_filter())"),
     # plots: compared by what they draw (every line's axes title, label and data)
     _c("atomnav.plots.trajectory", "drawn(an.plots.trajectory(nav, reference))",
        PLOTS + '\nnav, reference = nav[["lat_rad", "lon_rad", "h_m"]], truth[["lat_rad", "lon_rad", "h_m"]]',
@@ -394,6 +447,11 @@ EXEMPT = {
     "atomnav.cai.predictor.PhasePrediction": "the result of cai.predict_phase",
     "atomnav.cai.results.HybridResult": "the result of a CAI hybrid Monte Carlo",
     "atomnav.noise.filters.KalmanResult": "the result of noise.filters.kalman",
+    "atomnav.alignment.CoarseAlignment": "the result of alignment.coarse",
+    "atomnav.alignment.FineAlignment": "the result of alignment.fine",
+    "atomnav.filter.aided.SmoothedResult": "the result of smoothing an aided INS",
+    # its constructor takes an error model and options; the arrays are those of its corrupt()
+    "atomnav.imu.ImuSimulator": "takes an error model and options; ImuSimulator.corrupt has the clean call",
 }
 """Public callables whose docstring mentions a table or an array but that take none from
 the user, each with the reason it has no clean call (``table_or_array_callables`` finds
@@ -720,10 +778,12 @@ def _eq(a, b) -> bool:
 
 
 FORWARDS = {"atomnav.cai.predictor.check_jacobian": "atomnav.cai.predictor.phase_jacobian",
-            "atomnav.astro.star_attitudes": "atomnav.astro.results.Observations"}
+            "atomnav.astro.star_attitudes": "atomnav.astro.results.Observations",
+            "atomnav.filter.sources.aided_ins": "atomnav.filter.aided.AidedIns.run"}
 """Callables that pass ``*args``/``**kwargs`` on to another public callable, or whose clean
 call builds its argument with one (``star_attitudes(Observations(epoch, camera, s_cf, g),
-...)``: a mutated ``s_cf`` is rejected by ``Observations``), whose parameters are then the
+...)``: a mutated ``s_cf`` is rejected by ``Observations``) or runs what it returns
+(``aided_ins(setup, sources).run(time, gyro, accel)``), whose parameters are then the
 names of the call's arguments."""
 
 

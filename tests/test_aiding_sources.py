@@ -12,7 +12,7 @@ import pytest
 
 import atomnav as an
 from atomnav import InputError
-from atomnav.filter import BiasModel, InsSetup, PositionFixes, VelocityFixes, aided_ins, position_aided_ins
+from atomnav.filter import BiasModel, InsSetup, PositionFixes, VelocityFixes, ZeroVelocity, aided_ins, position_aided_ins
 
 RATE, DURATION = 100.0, 300.0
 SIGMA_VEL, SIGMA_POS = 0.05, 2.0  # fix noise: m/s, m
@@ -215,18 +215,13 @@ def test_latitude_beyond_half_pi_names_lla_and_its_row():
     _raises(lambda: PositionFixes(T, lla, COV), "lla", 1)
 
 
-def test_used_source_and_bad_source_list_name_sources(run):
-    from atomnav.alignment import zero_velocity
-
-    zupt = zero_velocity(np.array([1.0, 2.0]), 0.01)
+def test_a_source_feeds_any_number_of_ins_and_bad_source_lists_name_sources(run):
+    zupt = ZeroVelocity(np.array([1.0, 2.0]), 0.01)
     fixes = _velocity(run)
-    aided_ins(run["setup"], [fixes, zupt])
-    # the core's zero-velocity source was used up by the first INS
-    assert "used to build an INS already" in _raises(lambda: aided_ins(run["setup"], [fixes, zupt]), "sources", 1)
-    fresh = zero_velocity(np.array([1.0, 2.0]), 0.01)
-    _raises(lambda: aided_ins(run["setup"], [fresh, fresh]), "sources", 1)
-    # a failed call used up nothing: the source still builds an INS
-    assert aided_ins(run["setup"], [fresh]).pending == 2
+    first = aided_ins(run["setup"], [fixes, zupt]).run(*run["imu"], progress=False)
+    again = aided_ins(run["setup"], [fixes, zupt]).run(*run["imu"], progress=False)
+    pd.testing.assert_frame_equal(first.nav, again.nav, check_exact=True)
+    assert (first.measurements["source"] == "zero_velocity").sum() == 2
     with pytest.raises(TypeError, match="sources"):
         aided_ins(run["setup"], [fixes, "velocity.csv"])
     with pytest.raises(TypeError, match="sources"):

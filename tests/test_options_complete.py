@@ -34,7 +34,7 @@ ELSEWHERE = {
     "TaylorVariant": "test_astro_boundary.py",
     "ClosedForm": "test_cai_options.py", "ForceMode": "test_cai_options.py", "Gravity": "test_cai_options.py",
     "Interpolation": "test_cai_options.py", "MlMethod": "test_cai_options.py", "OmegaDot": "test_cai_options.py",
-    "PhaseSource": "test_cai_options.py", "CaiData": "test_cai_options.py",
+    "PhaseSource": "test_cai_options.py", "CaiData": "test_cai_options.py", "IncompleteShots": "test_cai_own_data.py",
     "Ellipsoid": "test_bad_input.py", "ImuKind": "test_bad_input.py", "Vertical": "test_bad_input.py",
     "BiasKind": "test_filter_aided_config.py",
     "Verdict": None,

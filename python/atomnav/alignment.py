@@ -15,8 +15,9 @@ Multisensor Integrated Navigation Systems*, 2nd ed., §5.6):
 the coarse attitude with zero-velocity and zero-angular-rate updates (Groves 2013,
 §15.3), estimating the attitude and the IMU biases together; its initial covariance keeps
 the correlation between the coarse attitude error and the biases that caused it.
-:func:`zero_velocity` and :func:`zero_rate` are these updates as measurement sources for
-any aided INS built with :func:`atomnav.filter.sources.aided_ins`.
+:class:`atomnav.filter.ZeroVelocity` and :class:`atomnav.filter.ZeroRate` are these
+updates as measurement sources for any aided INS built with
+:func:`atomnav.filter.aided_ins`.
 
 >>> c = coarse(imu, lla, errors="tactical")                  # doctest: +SKIP
 >>> print(c)                                                 # attitude and its accuracy
@@ -32,9 +33,10 @@ import numpy as np
 import pandas as pd
 
 from . import _core, plausibility, units
-from ._validate import choice, finite, flag, input_error, instance, nonnegative, positive, renamed, vector
-from .filter.aided import AidedIns, AidedResult, InsSetup, _concat
+from ._validate import choice, finite, flag, input_error, instance, positive, renamed, vector
+from .filter.aided import AidedResult, InsSetup, _concat
 from .filter.engine import BiasModel
+from .filter.sources import ZeroRate, ZeroVelocity, aided_ins
 from .imu import KINDS, ImuErrors
 from .strapdown import _imu_arrays, _imu_errors
 from .trajectory import imu_kind
@@ -269,22 +271,6 @@ class FineAlignment:
         p.text(str(self))
 
 
-def zero_velocity(time, sigma: float) -> _core.AidingSource:
-    """Zero-velocity updates (ZUPT) at ``time`` (M,) s with velocity noise σ ``sigma``
-    (m/s): z = v̂ − 0 on the velocity states. A source for
-    :func:`atomnav.filter.sources.aided_ins`."""
-    return _core.zero_velocity(vector(time, None, "time"), positive(sigma, "sigma"))
-
-
-def zero_rate(time, gyro_psd: float, sigma: float = 0.0) -> _core.AidingSource:
-    """Zero-angular-rate updates (ZARU) at ``time`` (M,) s: the Earth-relative body rate
-    ω̂_ib − Ĉ_n^b ω_ie^n, from the mean bias-compensated gyro output since the previous
-    update, is zero. Noise: the gyro white-noise PSD ``gyro_psd`` (rad²/s, ARW²) over the
-    time averaged, plus ``sigma`` (rad/s) for motion the record may hold. A source for
-    :func:`atomnav.filter.sources.aided_ins`; it reads the IMU kind of the INS it feeds."""
-    return _core.zero_rate(vector(time, None, "time"), nonnegative(gyro_psd, "gyro_psd"), nonnegative(sigma, "sigma"))
-
-
 def fine(imu, lla, coarse: CoarseAlignment, *, errors=None, interval: float = 1.0, zupt_sigma: float = 0.01,
          rate_updates: bool = True, rate_sigma: float = 0.0, pos_sigma: float = 1.0, vel_sigma: float = 0.01,
          predict_s: float = 0.1) -> FineAlignment:
@@ -358,12 +344,13 @@ def fine(imu, lla, coarse: CoarseAlignment, *, errors=None, interval: float = 1.
         site, coarse.q_nb, psi_cov_noise=coarse.psi_cov_noise, mean_f=coarse.mean_f, mean_w=coarse.mean_w,
         gravity=coarse.gravity, horizon=span, accel_errors=accel_errors, gyro_errors=gyro_errors,
         pos_sigma=positive(pos_sigma, "pos_sigma"), vel_sigma=positive(vel_sigma, "vel_sigma"), ellipsoid=coarse.ellipsoid)
-    setup = InsSetup(t0=t0, lla0=site, vel0=(0.0, 0.0, 0.0), q0=coarse.q_nb, kind=kind, p0=p0, accel_psd=accel_psd,
-                     gyro_psd=gyro_psd, accel_bias=BiasModel(kind="random_walk", psd=accel_walk),
-                     gyro_bias=BiasModel(kind="random_walk", psd=gyro_walk), predict_every=max(1, int(round(predict_s / step))),
-                     ellipsoid=coarse.ellipsoid)
-    sources = [zero_velocity(times, zupt_sigma)] + ([zero_rate(times, gyro_psd, rate_sigma)] if rate_updates else [])
-    ins = AidedIns(_core.aided_ins_from_sources(setup.native, sources), setup)
+    with renamed(lla0="lla"):
+        setup = InsSetup(t0=t0, lla0=site, vel0=(0.0, 0.0, 0.0), q0=coarse.q_nb, kind=kind, p0=p0, accel_psd=accel_psd,
+                         gyro_psd=gyro_psd, accel_bias=BiasModel(kind="random_walk", psd=accel_walk),
+                         gyro_bias=BiasModel(kind="random_walk", psd=gyro_walk),
+                         predict_every=max(1, int(round(predict_s / step))), ellipsoid=coarse.ellipsoid)
+    sources = [ZeroVelocity(times, zupt_sigma)] + ([ZeroRate(times, gyro_psd, rate_sigma)] if rate_updates else [])
+    ins = aided_ins(setup, sources)
     # feed the record up to the updates where the covariance is kept, reading it after each
     kept = np.unique(np.linspace(0, len(times) - 1, min(len(times), COVARIANCE_EPOCHS)).round().astype(int))
     ends = np.searchsorted(t, times[kept], side="left") + 1

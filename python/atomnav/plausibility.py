@@ -231,7 +231,9 @@ def swapped_blocks(time, gyro, accel, kind: str) -> str | None:
     way, the "gyro" block is a specific force: its mean magnitude is gravity,
     :data:`ACCEL_G_BAND` in m/s² (a sustained 450 to 700 °/s as a rate, which no navigation
     record has on average), while the "accel" block is an angular rate, below the band's
-    lower end, where an Earth-bound specific force never is. Both at once is the swap."""
+    lower end, where an Earth-bound specific force never is. Both at once is the swap.
+    Anything that is not numbers (strings included) is a ``TypeError`` naming its argument."""
+    time, gyro, accel = as_floats(time, "time"), as_floats(gyro, "gyro"), as_floats(accel, "accel")
     low, high = ACCEL_G_BAND[0] * units.G0, ACCEL_G_BAND[1] * units.G0
     scale = _rate_scale(kind, _median_step(time))
     rate, force = _mean_norm(gyro, scale), _mean_norm(accel, scale)

@@ -1,7 +1,8 @@
 """Measurement sources for one aided INS (Rust core, ``rust/filter/sources.rs``).
 
-Each aiding sensor is a source — :class:`PositionFixes`, :class:`VelocityFixes`, and the
-sources other modules make (zero-velocity updates, CAI shots, GNSS) — and
+Each aiding sensor is a source — :class:`PositionFixes`, :class:`VelocityFixes`, the
+zero-velocity and zero-angular-rate updates :class:`ZeroVelocity` and :class:`ZeroRate`,
+and the sources other modules make (CAI shots, GNSS) — and
 :func:`aided_ins` builds one :class:`~atomnav.filter.AidedIns` fed by all of them. The
 measurements of all sources are applied in time order (equal times in the order the
 sources are given), each at the first IMU epoch at or after its time; the sources' extra
@@ -19,7 +20,7 @@ import numpy as np
 import pandas as pd
 
 from .. import _core, plausibility
-from .._validate import as_floats, input_error, instance, rows, table, vector
+from .._validate import as_floats, input_error, instance, nonnegative, positive, rows, table, vector
 from .aided import AidedIns, InsSetup
 
 
@@ -148,6 +149,49 @@ class VelocityFixes(_Fixes):
         return _core.velocity_fixes(self.time, self.value, self.cov)
 
 
+class ZeroVelocity(Source):
+    """Zero-velocity updates (ZUPT; Groves 2013, *Principles of GNSS, Inertial, and
+    Multisensor Integrated Navigation Systems*, 2nd ed., §15.3) at ``time`` (M,) s, with
+    velocity noise σ ``sigma`` (m/s): z = v̂ − 0 on the velocity error states. A bad
+    ``time`` or ``sigma`` raises :class:`atomnav.InputError` naming it (and the row)."""
+
+    def __init__(self, time, sigma: float):
+        #: Times of the updates (M,), s.
+        self.time: np.ndarray = vector(time, None, "time")
+        #: Velocity noise σ, m/s.
+        self.sigma: float = positive(sigma, "sigma")
+        self._native()  # the core checks every time now
+
+    def _native(self) -> _core.AidingSource:
+        return _core.zero_velocity(self.time, self.sigma)
+
+    def __repr__(self) -> str:
+        return f"ZeroVelocity({len(self.time)} updates, sigma={self.sigma:g} m/s)"
+
+
+class ZeroRate(Source):
+    """Zero-angular-rate updates (ZARU; Groves 2013, §15.3) at ``time`` (M,) s: the
+    Earth-relative body rate ω̂_ib − Ĉ_n^b ω_ie^n, from the mean bias-compensated gyro
+    output since the previous update, is zero. Noise: the gyro white-noise PSD
+    ``gyro_psd`` (rad²/s, ARW²) over the time averaged, plus ``sigma`` (rad/s) for motion
+    the record may hold. It reads the IMU kind of the INS it feeds."""
+
+    def __init__(self, time, gyro_psd: float, sigma: float = 0.0):
+        #: Times of the updates (M,), s.
+        self.time: np.ndarray = vector(time, None, "time")
+        #: Gyro white-noise PSD, rad²/s.
+        self.gyro_psd: float = nonnegative(gyro_psd, "gyro_psd")
+        #: Allowance for motion, σ in rad/s.
+        self.sigma: float = nonnegative(sigma, "sigma")
+        self._native()
+
+    def _native(self) -> _core.AidingSource:
+        return _core.zero_rate(self.time, self.gyro_psd, self.sigma)
+
+    def __repr__(self) -> str:
+        return f"ZeroRate({len(self.time)} updates, gyro_psd={self.gyro_psd:g} rad²/s, sigma={self.sigma:g} rad/s)"
+
+
 def _covariances(cov, m: int) -> np.ndarray:
     """``cov`` as a C-contiguous (m, 3, 3) stack; one (3, 3) matrix serves every fix."""
     c = as_floats(cov, "cov")
@@ -170,9 +214,9 @@ def aided_ins(setup: InsSetup, sources) -> "SourcedIns":
         covariance of the whole state (INS states, then every source's extra states in
         source order), which replaces the sources' own.
     sources : source or sequence of sources
-        :class:`PositionFixes`, :class:`VelocityFixes`,
-        :class:`atomnav.gnss.tight.GnssObservations`, :class:`atomnav.cai.CaiShots`, the zero-velocity and zero-rate
-        updates of :mod:`atomnav.alignment` (those are used up by one INS).
+        :class:`PositionFixes`, :class:`VelocityFixes`, :class:`ZeroVelocity`,
+        :class:`ZeroRate`, :class:`atomnav.gnss.tight.GnssObservations`,
+        :class:`atomnav.cai.CaiShots`.
         Each source's measurements must lie inside the IMU record. Equal times of
         different sources are applied at the same epoch in the order given.
 
@@ -186,8 +230,8 @@ def aided_ins(setup: InsSetup, sources) -> "SourcedIns":
     ------
     atomnav.InputError
         Naming ``sources`` (and the source's place in ``.index``) for two sources with a
-        state of the same name, a core source given twice or used before, or a source with
-        extra states but no initial covariance when ``setup.p0`` is (15, 15).
+        state of the same name, or a source with extra states but no initial covariance
+        when ``setup.p0`` is (15, 15).
     TypeError
         For a ``setup`` that is no :class:`InsSetup` or a source that is no source.
     """
@@ -199,13 +243,13 @@ def aided_ins(setup: InsSetup, sources) -> "SourcedIns":
 def _listed(sources) -> list:
     """``sources`` (one source or a sequence of them) as a list; a ``TypeError`` naming
     ``sources`` for anything else."""
-    if isinstance(sources, (Source, _core.AidingSource)):
+    if isinstance(sources, Source):
         return [sources]
     if isinstance(sources, (str, bytes, pd.DataFrame)) or not hasattr(sources, "__iter__"):
         raise TypeError(f"sources: expected a measurement source or a sequence of them, got {type(sources).__name__}")
     sources = list(sources)
     for i, s in enumerate(sources):
-        if not isinstance(s, (Source, _core.AidingSource)):
+        if not isinstance(s, Source):
             raise TypeError(f"sources: item {i} is a {type(s).__name__}, not a measurement source "
                             "(PositionFixes, VelocityFixes, ...)")
     return sources
@@ -213,7 +257,7 @@ def _listed(sources) -> list:
 
 def _native_ins(setup: InsSetup, sources: list) -> _core.AidedIns:
     """The core aided INS of ``setup`` fed by ``sources`` (a list of sources)."""
-    native = [s._native() if isinstance(s, Source) else s for s in sources]
+    native = [s._native() for s in sources]
     return _core.aided_ins_from_sources(setup.native, native)
 
 
@@ -221,13 +265,11 @@ class SourcedIns(AidedIns):
     """The aided INS of :func:`aided_ins`: an :class:`AidedIns` whose sources check the IMU
     record before it starts — :class:`atomnav.cai.CaiShots` reports the shots the record
     cannot complete. When a source leaves measurements out, ``run`` rebuilds the filter
-    without them (unless a core source, used up by the first build, is among the sources:
-    then the engine skips them when it reaches them)."""
+    without them."""
 
     def __init__(self, core: _core.AidedIns, setup: InsSetup, sources: list):
         super().__init__(core, setup)
-        # the sources the filter can be rebuilt from (None for a core source)
-        self._sources = [s if isinstance(s, Source) else None for s in sources]
+        self._sources = sources  # the sources the filter is rebuilt from
         self._started = False
 
     def _start(self, time, whole: bool) -> None:
@@ -239,8 +281,8 @@ class SourcedIns(AidedIns):
         t = np.ascontiguousarray(t)
         checked = []
         for s in self._sources:  # a loop, not a comprehension: a source's warning points at the caller
-            checked.append(None if s is None else s._check_record(t, whole))
-        if None not in checked and any(c is not s for c, s in zip(checked, self._sources)):
+            checked.append(s._check_record(t, whole))
+        if any(c is not s for c, s in zip(checked, self._sources)):
             self._core = _native_ins(self.setup, checked)
             if self._store is not None:
                 self._core.store_forward_pass()
