@@ -30,3 +30,14 @@ def test_optional_float_none_and_text():
     _core.Strapdown(**args, zeta=None)
     with pytest.raises(TypeError, match="zeta"):
         _core.Strapdown(**args, zeta=np.array("0.7"))
+
+
+@pytest.mark.parametrize("call, name", [
+    (lambda x: _core.zero_velocity(np.array([1.0, 2.0]), x), "sigma"),
+    (lambda x: _core.zero_rate(np.array([1.0, 2.0]), x, 0.0), "gyro_psd"),
+    (lambda x: _core.zero_rate(np.array([1.0, 2.0]), 1e-12, x), "sigma"),
+])
+def test_alignment_sources_refuse_text(call, name):
+    call(0.01)  # a number is read
+    with pytest.raises(TypeError, match=name):
+        call(np.str_("0.01"))

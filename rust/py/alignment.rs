@@ -2,7 +2,7 @@
 //! covariance of a fine alignment, and the zero-velocity / zero-angular-rate updates as
 //! measurement sources (`AidingSource`) of an aided INS.
 
-use super::convert::{mat, mat_to_py, vec3, vec3_rows, vector, Wrap};
+use super::convert::{mat, mat_to_py, real, vec3, vec3_rows, vector, Wrap};
 use super::imu::triad_from_dict;
 use super::sources::AidingSource;
 use crate::earth::Ellipsoid;
@@ -67,12 +67,12 @@ fn fine_alignment_p0<'py>(
     psi_cov_noise: numpy::PyReadonlyArray2<'py, f64>,
     mean_f: numpy::PyReadonlyArray1<'py, f64>,
     mean_w: numpy::PyReadonlyArray1<'py, f64>,
-    gravity: f64,
-    horizon: f64,
+    #[pyo3(from_py_with = real)] gravity: f64,
+    #[pyo3(from_py_with = real)] horizon: f64,
     accel_errors: &Bound<'py, PyDict>,
     gyro_errors: &Bound<'py, PyDict>,
-    pos_sigma: f64,
-    vel_sigma: f64,
+    #[pyo3(from_py_with = real)] pos_sigma: f64,
+    #[pyo3(from_py_with = real)] vel_sigma: f64,
     ellipsoid: Wrap<Ellipsoid>,
 ) -> PyResult<(Bound<'py, numpy::PyArray2<f64>>, (f64, f64, f64, f64))> {
     let model = ImuErrorModel { accel: triad_from_dict(accel_errors, "accel")?, gyro: triad_from_dict(gyro_errors, "gyro")? };
@@ -106,14 +106,14 @@ fn alignment_euler_sigma<'py>(py: Python<'py>, euler: numpy::PyReadonlyArray1<'p
 
 /// Zero-velocity updates at `time` (M,) s with velocity noise σ `sigma` (m/s).
 #[pyfunction]
-fn zero_velocity(time: numpy::PyReadonlyArray1<'_, f64>, sigma: f64) -> PyResult<AidingSource> {
+fn zero_velocity(time: numpy::PyReadonlyArray1<'_, f64>, #[pyo3(from_py_with = real)] sigma: f64) -> PyResult<AidingSource> {
     Ok(AidingSource::new(Box::new(ZeroVelocity::new(vector(&time, "time")?, sigma)?)))
 }
 
 /// Zero-angular-rate updates at `time` (M,) s: gyro white-noise PSD `gyro_psd` (rad²/s)
 /// and a motion allowance σ `sigma` (rad/s); the IMU kind is the INS's.
 #[pyfunction]
-fn zero_rate(time: numpy::PyReadonlyArray1<'_, f64>, gyro_psd: f64, sigma: f64) -> PyResult<AidingSource> {
+fn zero_rate(time: numpy::PyReadonlyArray1<'_, f64>, #[pyo3(from_py_with = real)] gyro_psd: f64, #[pyo3(from_py_with = real)] sigma: f64) -> PyResult<AidingSource> {
     let t = vector(&time, "time")?;
     // checked now, with the setup's IMU kind when the INS is built
     ZeroRate::new(t.clone(), ImuKind::Rates, gyro_psd, sigma)?;
