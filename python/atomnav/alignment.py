@@ -231,7 +231,9 @@ class FineAlignment:
         Covariance (rad²) of the attitude error ψ (north, east, down) at the end.
     accel_bias, gyro_bias : ndarray (3,)
         Bias estimates (m/s², rad/s) at the end: ``ba0``/``bg0`` of an aided INS that
-        continues from here; ``accel_bias_sigma``, ``gyro_bias_sigma`` their σ.
+        continues from here.
+    accel_bias_sigma, gyro_bias_sigma : ndarray (3,)
+        σ of ``accel_bias`` (m/s²) and ``gyro_bias`` (rad/s) at the end.
     covariance_time : ndarray (M,)
         Times (s) of the zero-motion updates at which the covariance is kept: at most
         :data:`COVARIANCE_EPOCHS`, spread evenly, the last one included.

@@ -77,12 +77,26 @@ _PARQUET = (".parquet", ".pq")
 
 @dataclass(frozen=True)
 class SamplingReport:
-    """The time stamps of a log: ``samples`` (rows), ``start_s`` and ``end_s`` (s),
-    ``median_interval_s`` (s) and ``rate_hz`` (its inverse, Hz), ``max_gap_s`` (s, the
-    longest interval not counted as a gap: the stated ``max_gap`` or 1.5 × the median
-    interval) and ``gaps``, one row per interval longer than that: ``row`` (the data row
-    after the gap), ``start_s`` and ``end_s`` (the stamps either side, s), ``length_s``
-    (s) and ``missing_samples`` (the interval in median intervals, rounded, less one)."""
+    """The sampling of a log's time stamps, the ``report`` of an :class:`ImuLog`.
+
+    Attributes
+    ----------
+    samples : int
+        Rows of the log.
+    start_s, end_s : float
+        First and last time stamp (s).
+    median_interval_s : float
+        Median interval between stamps (s).
+    rate_hz : float
+        Its inverse (Hz).
+    max_gap_s : float
+        The longest interval not counted as a gap (s): the stated ``max_gap`` or 1.5 × the
+        median interval.
+    gaps : DataFrame
+        One row per interval longer than ``max_gap_s``: ``row`` (the data row after the
+        gap), ``start_s`` and ``end_s`` (the stamps either side, s), ``length_s`` (s) and
+        ``missing_samples`` (the interval in median intervals, rounded, less one).
+    """
 
     samples: int
     start_s: float
@@ -102,12 +116,22 @@ class SamplingReport:
 
 @dataclass(frozen=True)
 class ImuLog:
-    """An IMU log read by :func:`read_imu`: ``data``, the table of
-    ``atomnav.trajectory.IMU_COLUMNS[kind]`` in SI units (time s; rates rad/s and m/s², or
-    increments rad and m/s), one row per data row of the source in the same order (its
-    index is that row); ``kind``; ``report``, the :class:`SamplingReport` of its time
-    stamps; ``epoch``, the datetime of time 0 when the time column held datetimes (pass it
-    on as ``epoch=`` where a call compares with other datetimes), else None."""
+    """An IMU log read by :func:`read_imu`.
+
+    Attributes
+    ----------
+    data : DataFrame
+        The table of ``atomnav.trajectory.IMU_COLUMNS[kind]`` in SI units (time s; rates
+        rad/s and m/s², or increments rad and m/s), one row per data row of the source in
+        the same order (its index is that row).
+    kind : str
+        ``"rates"`` or ``"increments"``.
+    report : SamplingReport
+        The sampling of its time stamps.
+    epoch : pandas.Timestamp or None
+        The datetime of time 0 when the time column held datetimes (pass it on as
+        ``epoch=`` where a call compares with other datetimes), else None.
+    """
 
     data: pd.DataFrame
     kind: str
