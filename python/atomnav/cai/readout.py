@@ -20,8 +20,36 @@ def _contrast(contrast) -> np.ndarray:
 
 def readout(phi, phi0=0.0, *, offset=0.5, contrast=1.0, sigma_p: float = 0.0, sigma_phi: float = 0.0,
             sigma_contrast: float = 0.0, seed=None) -> np.ndarray:
-    """Population p = o − (C/2) cos(φ + φ0 + n_φ) + n_p with C → C + n_C; noise σ's are
-    per-shot standard deviations (population, rad, contrast), drawn with ``seed``."""
+    """Population p = o − (C/2) cos(φ + φ0 + n_φ) + n_p with C → C + n_C.
+
+    Tennstedt et al. 2021, Eqs. 8–10. The noise σ's are per-shot standard deviations,
+    drawn with ``seed``.
+
+    Parameters
+    ----------
+    phi : float or array_like
+        Interferometer phase φ (rad), any shape.
+    phi0 : float or array_like
+        Laser phase φ0 (rad), broadcast against ``phi``.
+    offset : float
+        Population offset o (0–1).
+    contrast : float or array_like
+        Contrast C ∈ (0, 1], broadcast against ``phi``.
+    sigma_p : float
+        Standard deviation of the additive population noise n_p (population units).
+    sigma_phi : float
+        Standard deviation of the phase noise n_φ (rad).
+    sigma_contrast : float
+        Standard deviation of the contrast noise n_C.
+    seed : int, numpy.random.Generator or None
+        Seed (an int ≥ 0) or generator of the noise draws; None draws fresh entropy.
+
+    Returns
+    -------
+    float or numpy.ndarray
+        Population p, with the broadcast shape of ``phi``, ``phi0`` and ``contrast``
+        (a float for scalar inputs).
+    """
     phi = as_floats(phi, "phi")
     finite(np.atleast_1d(phi).reshape(-1), "phi")
     phi0 = as_floats(phi0, "phi0")
@@ -44,15 +72,46 @@ def readout(phi, phi0=0.0, *, offset=0.5, contrast=1.0, sigma_p: float = 0.0, si
 
 
 def steer_mid_fringe(phi_hat) -> np.ndarray:
-    """Laser phase φ0 = (π/2 − φ̂) mod 2π (rad) putting the predicted phase at mid-fringe."""
+    """Laser phase φ0 = (π/2 − φ̂) mod 2π putting the predicted phase at mid-fringe.
+
+    Parameters
+    ----------
+    phi_hat : float or array_like
+        Predicted phase φ̂ (rad), any shape.
+
+    Returns
+    -------
+    float or numpy.ndarray
+        Laser phase φ0 (rad) in [0, 2π), the shape of ``phi_hat``.
+    """
     phi_hat = as_floats(phi_hat, "phi_hat")
     phi0 = _core.cai_steer_mid_fringe(np.ascontiguousarray(phi_hat).ravel()).reshape(phi_hat.shape)
     return phi0[()] if phi0.ndim == 0 else phi0
 
 
 def invert_readout(p, phi0=0.0, *, offset=0.5, contrast=1.0, flank: str = "rising") -> np.ndarray:
-    """Phase φ (rad) of a readout on a known flank: φ + φ0 ∈ [0, π] ("rising", p grows with
-    φ) or [−π, 0] ("falling"). Readouts beyond the fringe extremes are clipped to them."""
+    """Phase φ of a readout on a known flank of the fringe p = o − (C/2) cos(φ + φ0).
+
+    Readouts beyond the fringe extremes are clipped to them.
+
+    Parameters
+    ----------
+    p : float or array_like
+        Measured population (0–1), any shape.
+    phi0 : float or array_like
+        Laser phase φ0 (rad), broadcast against ``p``.
+    offset : float
+        Population offset o (0–1).
+    contrast : float or array_like
+        Contrast C ∈ (0, 1], broadcast against ``p``.
+    flank : {"rising", "falling"}
+        "rising": φ + φ0 ∈ [0, π] (p grows with φ); "falling": φ + φ0 ∈ [−π, 0].
+
+    Returns
+    -------
+    float or numpy.ndarray
+        Phase φ (rad), the broadcast shape of ``p``, ``phi0`` and ``contrast``.
+    """
     if not isinstance(flank, str) or flank not in ("rising", "falling"):
         raise input_error("flank", f"unknown option {flank!r}; choose 'falling', 'rising'")
     c = _contrast(contrast)
@@ -70,15 +129,37 @@ def invert_readout(p, phi0=0.0, *, offset=0.5, contrast=1.0, flank: str = "risin
 
 
 def fringes_crossed(phi) -> np.ndarray:
-    """Number of whole fringes (2π) between zero phase and each predicted phase (rad)."""
+    """Number of whole fringes (2π) between zero phase and each predicted phase.
+
+    Parameters
+    ----------
+    phi : float or array_like
+        Predicted phase (rad), any shape.
+
+    Returns
+    -------
+    int or numpy.ndarray of int64
+        floor(|φ| / 2π), the shape of ``phi``.
+    """
     phi = as_floats(phi, "phi")
     finite(np.atleast_1d(phi).reshape(-1), "phi")
     return np.floor(np.abs(phi) / (2 * np.pi)).astype(np.int64)
 
 
 def capture_region(delta) -> np.ndarray:
-    """Capture region of a true-minus-predicted phase Δ (rad) (Tennstedt et al. 2021, Fig. 3):
-    "A" |Δ| < π/2 (correct update), "B" π/2 ≤ |Δ| < π (right sign, too small), "slip"."""
+    """Capture region of a true-minus-predicted phase Δ (Tennstedt et al. 2021, Fig. 3).
+
+    Parameters
+    ----------
+    delta : float or array_like
+        True minus predicted phase Δ (rad), any shape.
+
+    Returns
+    -------
+    str or numpy.ndarray of str
+        The shape of ``delta``: "A" where |Δ| < π/2 (correct update), "B" where
+        π/2 ≤ |Δ| < π (right sign, too small), "slip" otherwise.
+    """
     a = np.abs(as_floats(delta, "delta"))
     finite(np.atleast_1d(a).reshape(-1), "delta")
     return np.where(a < np.pi / 2, "A", np.where(a < np.pi, "B", "slip"))
