@@ -108,8 +108,7 @@ def _diverged(err, table: np.ndarray, done: int, first_row: int, time: np.ndarra
 
 
 class Strapdown(Stateful):
-    """Streaming strapdown INS from an initial state: time ``t0`` (s), ``lla`` (lat rad,
-    lon rad, h m), NED velocity ``vel_ned`` (m/s) and attitude ``q_nb`` (scalar first).
+    """Streaming strapdown INS from an initial state (time, position, velocity, attitude).
 
     Times are in seconds. A timedelta64 ``time_s`` column of the IMU tables is read as
     seconds. A datetime64 one needs an epoch, the datetime of time 0: ``epoch``, or else
@@ -124,6 +123,14 @@ class Strapdown(Stateful):
 
     Parameters
     ----------
+    t0 : float or datetime
+        Time of the initial state (s), or a datetime (then time 0, see above).
+    lla : array_like (3,)
+        Initial position: latitude (rad), longitude (rad), height (m).
+    vel_ned : array_like (3,)
+        Initial NED velocity (m/s).
+    q_nb : array_like (4,)
+        Initial attitude, body to NED, scalar first, unit norm.
     kind : str, optional
         ``"rates"`` (rad/s, m/s²) or ``"increments"`` (rad, m/s). With rates, the first
         sample must be at ``t0`` (it primes the integrator). With increments, each row
@@ -225,7 +232,13 @@ class Strapdown(Stateful):
 
     @serialized
     def state(self) -> pd.DataFrame:
-        """The current state as a one-row DataFrame (the columns of :meth:`run`)."""
+        """The current state.
+
+        Returns
+        -------
+        DataFrame
+            One row with the columns of :meth:`run`.
+        """
         return _table(self._core.state())
 
     @serialized
@@ -326,12 +339,24 @@ def integrate(imu, t0, lla, vel_ned, q_nb, *, kind: str | None = None, ellipsoid
 
 
 def integrate_attitude(q0, dtheta, dtheta_prev=None) -> np.ndarray:
-    """Body attitude from gyro increments (rad) with the multi-interval coning correction
-    (see ``rust/strapdown/mod.rs``), no navigation-frame rotation: q (N, 4) after each
-    increment.
+    """Body attitude from gyro increments with the multi-interval coning correction
+    (see ``rust/strapdown/mod.rs``), no navigation-frame rotation.
 
-    ``dtheta_prev`` holds the increments of up to two intervals before the first one,
-    oldest first, if known (a running INS has them); without them the first step has no
-    coning term, a one-time error of about |Δθ₀ × Δθ₁|/12 rad."""
+    Parameters
+    ----------
+    q0 : array_like (4,)
+        Initial attitude, scalar first (normalised before use).
+    dtheta : array_like (N, 3)
+        Gyro angle increments (rad), one row per interval.
+    dtheta_prev : array_like (K, 3), optional
+        The increments of up to two intervals before the first one (rad), oldest first, if
+        known (a running INS has them; only the last two rows are used). Without them the
+        first step has no coning term, a one-time error of about |Δθ₀ × Δθ₁|/12 rad.
+
+    Returns
+    -------
+    ndarray (N, 4)
+        The attitude q after each increment, scalar first.
+    """
     prev = None if dtheta_prev is None else rows(dtheta_prev, 3, "dtheta_prev")
     return _core.integrate_attitude_increments(rows(q0, 4, "q0"), rows(dtheta, 3, "dtheta"), prev)
