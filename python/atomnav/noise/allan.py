@@ -71,14 +71,50 @@ def allan_variance(data, tau0: float, m="octave", kind: str = "allan", data_type
     """Allan-family variance of a rate series (or of a phase/angle series) sampled every
     ``tau0`` s.
 
-    ``kind``: "allan" (overlapping), "modified" or "hadamard" (overlapping).
-    ``m``: "octave" (1, 2, 4, …), "decade" (1, 2, 4, 10, 20, 40, …), "all", or a list of
-    averaging factors; alternatively ``taus`` in seconds (multiples of tau0). Factors
-    that leave fewer than two terms are dropped from the named sets and rejected (with
-    :class:`atomnav.InputError` naming ``m`` and the index) in a user list.
-    ``data_type="phase"``: data are the integral of the rate (e.g. angle in rad), the
-    variance is then of the rate (rad/s)².
+    Parameters
+    ----------
+    data : array_like (N,)
+        Rate samples in some unit U (e.g. rad/s, °/h), or with ``data_type="phase"`` their
+        integral (e.g. angle, rad). NaN marks a missing rate sample (see Notes).
+    tau0 : float
+        Sampling interval, s.
+    m : str or sequence of int, default "octave"
+        Averaging factors: "octave" (1, 2, 4, …), "decade" (1, 2, 4, 10, 20, 40, …),
+        "all", or a list of integers. Factors that leave fewer than two terms are dropped
+        from the named sets and rejected (with :class:`atomnav.InputError` naming ``m``
+        and the index) in a user list.
+    kind : {"allan", "modified", "hadamard"}, default "allan"
+        Overlapping Allan, modified Allan or overlapping Hadamard variance.
+    data_type : {"rate", "phase"}, default "rate"
+        "phase": ``data`` are the integral of the rate (e.g. angle in rad), the variance
+        is then of the rate ((rad/s)²).
+    taus : array_like (K,), optional
+        Averaging times, s, positive multiples of ``tau0``; given, they replace ``m``.
+    noise : str, default "white_fm"
+        Noise type for the equivalent degrees of freedom (Howe's approximation), one of
+        :data:`NOISE_TYPES`.
+    confidence : float, default 0.683
+        Probability of the χ² confidence interval, in (0, 1).
 
+    Returns
+    -------
+    pandas.DataFrame
+        One row per averaging factor. Columns: ``m``, ``tau_s`` (s), ``var`` (U²),
+        ``dev`` (U), ``n_terms``, ``edf`` (equivalent degrees of freedom: Howe's
+        approximation for the overlapping Allan variance with the given ``noise`` type;
+        the conservative non-overlapping count for modified and Hadamard; with gaps,
+        that of a gap-free record of the same number of samples), and the χ² confidence
+        interval ``dev_lo``, ``dev_hi`` (U) at ``confidence``. ``table.attrs["n_missing"]``
+        counts the NaN samples.
+
+    Raises
+    ------
+    atomnav.InputError
+        Naming ``tau0``, ``confidence``, ``data`` (NaN in phase data, ±inf anywhere),
+        ``m`` or ``taus``.
+
+    Notes
+    -----
     **Gaps.** A NaN rate sample is missing (a gap is marked, not filled: Riley, NIST
     SP 1065, "Gaps, jumps, and outliers"). Every term of the sum whose rate samples
     include a NaN is left out and the variance is the mean of the others, the rule of
@@ -91,11 +127,13 @@ def allan_variance(data, tau0: float, m="octave", kind: str = "allan", data_type
     ±inf anywhere, raise :class:`atomnav.InputError`. A constant series (a stuck or
     quantised sensor) has variance 0 at every τ.
 
-    Columns: ``m``, ``tau_s``, ``var`` (rate unit²), ``dev``, ``n_terms``, ``edf``
-    (equivalent degrees of freedom: Howe's approximation for the overlapping Allan
-    variance with the given ``noise`` type; the conservative non-overlapping count for
-    modified and Hadamard; with gaps, that of a gap-free record of the same number of
-    samples), and the χ² confidence interval ``dev_lo``, ``dev_hi`` at ``confidence``.
+    References
+    ----------
+    IEEE Std 952-1997, *IEEE Standard Specification Format Guide and Test Procedure for
+    Single-Axis Interferometric Fiber Optic Gyros*, Annex C. IEEE Std 1139-2008,
+    *Standard Definitions of Physical Quantities for Fundamental Frequency and Time
+    Metrology*. W. J. Riley, *Handbook of Frequency Stability Analysis*, NIST SP 1065
+    (2008).
     """
     tau0 = positive(tau0, "tau0")
     confidence = probability(confidence, "confidence")
@@ -119,6 +157,35 @@ class AllanStream(Stateful):
     naming ``m`` while a factor has fewer than two terms, as the batch does. One object
     may be shared by threads (calls run one after another) and pickled mid-record.
 
+    Parameters
+    ----------
+    m : sequence of int
+        Averaging factors (explicit integers: a set name is rejected, the record length
+        being unknown).
+    tau0 : float
+        Sampling interval, s.
+    data_type : {"rate", "phase"}, default "rate"
+        As in :func:`allan_variance`.
+    noise : str, default "white_fm"
+        Noise type for the equivalent degrees of freedom, as in :func:`allan_variance`.
+    confidence : float, default 0.683
+        Probability of the χ² confidence interval, in (0, 1).
+
+    Raises
+    ------
+    atomnav.InputError
+        Naming ``m``, ``tau0`` or ``confidence``.
+
+    See Also
+    --------
+    allan_variance : the batch computation.
+
+    References
+    ----------
+    W. J. Riley, *Handbook of Frequency Stability Analysis*, NIST SP 1065 (2008).
+
+    Examples
+    --------
     >>> s = AllanStream([1, 2, 4], tau0=1.0)
     >>> for chunk in chunks: s.update(chunk)
     >>> s.result("allan")
@@ -137,17 +204,38 @@ class AllanStream(Stateful):
 
     @serialized
     def update(self, chunk) -> None:
-        """Add the next samples (same units as construction; NaN marks a missing rate
-        sample)."""
+        """Add the next samples.
+
+        Parameters
+        ----------
+        chunk : array_like (K,)
+            Next samples, in the units of the stream (rate U, or phase with
+            ``data_type="phase"``); NaN marks a missing rate sample.
+        """
         c = _series(chunk, "chunk", check_finite=False)
         self._s.update(c)
         self.n_samples += c.size
 
     @serialized
     def result(self, kind: str = "allan") -> pd.DataFrame:
-        """The table of :func:`allan_variance` for the samples seen so far (an
-        :class:`atomnav.InputError` naming ``m`` and the samples it needs while a factor
-        has fewer than two terms)."""
+        """The table of :func:`allan_variance` for the samples seen so far.
+
+        Parameters
+        ----------
+        kind : {"allan", "modified", "hadamard"}, default "allan"
+            Which variance, as in :func:`allan_variance`.
+
+        Returns
+        -------
+        pandas.DataFrame
+            The table of :func:`allan_variance` (columns ``m``, ``tau_s``, ``var``,
+            ``dev``, ``n_terms``, ``edf``, ``dev_lo``, ``dev_hi``).
+
+        Raises
+        ------
+        atomnav.InputError
+            Naming ``m`` and the samples it needs while a factor has fewer than two terms.
+        """
         mm, tau, var, n, missing = self._s.result(kind)
         return _table(mm, tau, var, n, missing, kind, _phase_points(self.n_samples - missing, self.data_type), self.noise, self.confidence)
 
@@ -156,10 +244,33 @@ class AllanStream(Stateful):
 class AllanFit:
     """Five-term fit σ²(τ) = Σ_{k=−2}^{2} A_k τ^k (Niu et al. 2025 Eq. 19, IEEE Std 952).
 
-    With rate unit U and τ in s: ``coeffs`` A₋₂…A₂ in U²·s^k; ``quantization`` Q_q =
-    √(A₋₂/3) (U·s); ``arw`` N = √A₋₁ (U·√s), the paper's SS (Eq. 20);
-    ``bias_instability`` B = √(πA₀/(2 ln 2)) (U), the paper's LS (Eq. 21); ``rrw`` K =
-    √(3A₁) (U/√s); ``ramp`` R = √(2A₂) (U/s)."""
+    Returned by :func:`fit_allan` and :func:`fit_allan_table`; rate unit U, τ in s.
+
+    Attributes
+    ----------
+    coeffs : numpy.ndarray (5,)
+        A₋₂ … A₂, in U²·s^k.
+    quantization : float
+        Q_q = √(A₋₂/3), U·s.
+    arw : float
+        Angle random walk N = √A₋₁, U·√s: the paper's SS (Eq. 20).
+    bias_instability : float
+        B = √(πA₀/(2 ln 2)), U: the paper's LS (Eq. 21).
+    rrw : float
+        Rate random walk K = √(3A₁), U/√s.
+    ramp : float
+        Rate ramp R = √(2A₂), U/s.
+    points : int
+        Number of Allan points used by the fit.
+    tau_min, tau_max : float
+        τ range of the fit, s (0 and inf when not limited).
+    table : pandas.DataFrame
+        The :func:`allan_variance` table that was fitted.
+
+    References
+    ----------
+    IEEE Std 952-1997, Annex C. X. Niu et al. 2025, Eqs. 19–21.
+    """
 
     coeffs: np.ndarray
     quantization: float
@@ -173,14 +284,37 @@ class AllanFit:
     table: pd.DataFrame = field(repr=False)
 
     def curve(self, tau) -> np.ndarray:
-        """Fitted Allan variance at ``tau`` (s)."""
+        """Fitted Allan variance at ``tau``.
+
+        Parameters
+        ----------
+        tau : float or array_like
+            Averaging time(s), s.
+
+        Returns
+        -------
+        float or numpy.ndarray
+            Σ A_k τ^k, U², in the shape of ``tau``.
+        """
         t = as_floats(tau, "tau")
         return sum(self.coeffs[k] * t ** (k - 2) for k in range(5))
 
     def arw_in(self, rate_unit: float, arw_unit: float) -> float:
-        """ARW converted: ``rate_unit`` is the SI factor of the data's unit (e.g.
-        ``units.DEG_PER_HOUR``), ``arw_unit`` the SI factor of the wanted unit (e.g.
-        ``units.DEG_PER_SQRT_HOUR``, or 1.0 for rad/√s)."""
+        """ARW converted to another unit.
+
+        Parameters
+        ----------
+        rate_unit : float
+            SI factor of the data's unit (e.g. ``units.DEG_PER_HOUR``).
+        arw_unit : float
+            SI factor of the wanted unit (e.g. ``units.DEG_PER_SQRT_HOUR``, or 1.0 for
+            rad/√s).
+
+        Returns
+        -------
+        float
+            ``arw · rate_unit / arw_unit``, in the wanted unit.
+        """
         return self.arw * rate_unit / arw_unit
 
     def to_triad(self, rate_unit: float = 1.0, *, f_lo: float | None = None, f_hi: float | None = None) -> TriadErrors:
@@ -221,10 +355,38 @@ class AllanFit:
 
 
 def fit_allan_table(table: pd.DataFrame, n_samples: int, terms=TERMS, tau_min: float | None = None, tau_max: float | None = None) -> AllanFit:
-    """Five-term fit to an :func:`allan_variance` table (overlapping Allan, docs/departures.md#allan-fit):
-    weighted NNLS with weights 1/σ_j², σ_j = AVAR_j/√max(1, ⌊N/m_j⌋ − 1); only the
+    """Five-term fit to an :func:`allan_variance` table (overlapping Allan).
+
+    Weighted NNLS with weights 1/σ_j², σ_j = AVAR_j/√max(1, ⌊N/m_j⌋ − 1); only the
     named ``terms`` are free, only points with tau_min ≤ τ ≤ tau_max (s) and positive
-    variance are used."""
+    variance are used (docs/departures.md#allan-fit).
+
+    Parameters
+    ----------
+    table : pandas.DataFrame
+        An :func:`allan_variance` table; columns ``m`` (integers ≥ 1), ``tau_s`` (s) and
+        ``var`` (U²) are read.
+    n_samples : int
+        Number N of samples of the series the table was computed from (≥ 1).
+    terms : sequence of str, default TERMS
+        Free terms, from ("quantization", "arw", "bias_instability", "rrw", "ramp").
+    tau_min, tau_max : float, optional
+        τ range of the points used, s (default: all).
+
+    Returns
+    -------
+    AllanFit
+        The coefficients and the derived noise parameters.
+
+    Raises
+    ------
+    atomnav.InputError
+        Naming ``table``, ``n_samples``, ``terms``, ``tau_min`` or ``tau_max``.
+
+    References
+    ----------
+    IEEE Std 952-1997, Annex C. X. Niu et al. 2025, Eq. 19.
+    """
     m, tau, var = read_table(table, ["m", "tau_s", "var"], "table").T  # an allan_variance table, by name
     bad = np.flatnonzero(~(m >= 1) | (m != np.round(m)))
     if bad.size:
@@ -243,7 +405,26 @@ def fit_allan_table(table: pd.DataFrame, n_samples: int, terms=TERMS, tau_min: f
 
 def fit_allan(omega, tau0: float, terms=TERMS, tau_min: float | None = None, tau_max: float | None = None, m="octave") -> AllanFit:
     """Overlapping Allan variance of the rate series ``omega`` at ``m`` (default octave τ)
-    and its five-term fit (:func:`fit_allan_table`)."""
+    and its five-term fit (:func:`fit_allan_table`).
+
+    Parameters
+    ----------
+    omega : array_like (N,)
+        Rate series, unit U.
+    tau0 : float
+        Sampling interval, s.
+    terms : sequence of str, default TERMS
+        Free terms of the fit, as in :func:`fit_allan_table`.
+    tau_min, tau_max : float, optional
+        τ range of the fit, s (default: all points).
+    m : str or sequence of int, default "octave"
+        Averaging factors, as in :func:`allan_variance`.
+
+    Returns
+    -------
+    AllanFit
+        The five-term fit, with its Allan table.
+    """
     x = _series(omega, "omega")
     # too few Allan points in the τ range is a record too short unless the range was given
     with renamed(data="omega", **{"tau_min/tau_max": "omega" if tau_min is None and tau_max is None else "tau_min"}):
@@ -251,24 +432,76 @@ def fit_allan(omega, tau0: float, terms=TERMS, tau_min: float | None = None, tau
 
 
 def short_term_sensitivity(omega, tau0: float, **fit_kw) -> float:
-    """SS = √A₋₁ (Niu et al. 2025 Eq. 20) in U·√s; divide by 60 for °/√h when U = °/h and τ in s
-    (or use :meth:`AllanFit.arw_in`)."""
+    """Short-term sensitivity SS = √A₋₁ (Niu et al. 2025 Eq. 20).
+
+    Parameters
+    ----------
+    omega : array_like (N,)
+        Rate series, unit U.
+    tau0 : float
+        Sampling interval, s.
+    **fit_kw
+        Passed to :func:`fit_allan` (``terms``, ``tau_min``, ``tau_max``, ``m``).
+
+    Returns
+    -------
+    float
+        SS in U·√s; divide by 60 for °/√h when U = °/h and τ in s (or use
+        :meth:`AllanFit.arw_in`).
+    """
     return fit_allan(omega, tau0, **fit_kw).arw
 
 
 def long_term_stability(omega, tau0: float, **fit_kw) -> float:
-    """LS = √(π A₀ / (2 ln 2)) (Niu et al. 2025 Eq. 21) in the rate unit."""
+    """Long-term stability LS = √(π A₀ / (2 ln 2)) (Niu et al. 2025 Eq. 21).
+
+    Parameters
+    ----------
+    omega : array_like (N,)
+        Rate series, unit U.
+    tau0 : float
+        Sampling interval, s.
+    **fit_kw
+        Passed to :func:`fit_allan` (``terms``, ``tau_min``, ``tau_max``, ``m``).
+
+    Returns
+    -------
+    float
+        LS (the bias instability B), in the rate unit U.
+    """
     return fit_allan(omega, tau0, **fit_kw).bias_instability
 
 
 def ss_deg_per_sqrt_hour(fit: AllanFit) -> float:
-    """SS of a fit to a rate in °/h with τ in s, in °/√h (Niu et al. 2025 Eq. 20: √A₋₁/60)."""
+    """SS of a fit to a rate in °/h with τ in s, in °/√h (Niu et al. 2025 Eq. 20: √A₋₁/60).
+
+    Parameters
+    ----------
+    fit : AllanFit
+        Fit to a rate series in °/h sampled with τ in s.
+
+    Returns
+    -------
+    float
+        Short-term sensitivity, °/√h.
+    """
     instance(fit, AllanFit, "fit")
     return fit.arw_in(units.DEG_PER_HOUR, units.DEG_PER_SQRT_HOUR)
 
 
 def bias(omega) -> float:
-    """Bias: the mean of the series, in the rate unit."""
+    """Bias: the mean of the series.
+
+    Parameters
+    ----------
+    omega : array_like (N,)
+        Rate series, unit U.
+
+    Returns
+    -------
+    float
+        Mean, in the rate unit U.
+    """
     return float(np.mean(_series(omega, "omega")))
 
 
@@ -276,7 +509,20 @@ def bias_stability(omega, window: int = 1) -> float:
     """Bias stability (Niu et al. 2025): standard deviation (ddof = 1) of the ⌊N/w⌋
     non-overlapping means of ``window`` samples (incomplete tail dropped), in the rate
     unit. The paper does not state its window; the default ``window = 1`` averages nothing.
-    Report ``window`` with the value."""
+    Report ``window`` with the value.
+
+    Parameters
+    ----------
+    omega : array_like (N,)
+        Rate series, unit U; at least 2·``window`` samples.
+    window : int, default 1
+        Samples per averaging window (≥ 1).
+
+    Returns
+    -------
+    float
+        Standard deviation of the window means, in the rate unit U.
+    """
     w = integer(window, "window", 1)
     x = _series(omega, "omega", min_len=2 * w)
     k = x.size // w
@@ -292,7 +538,28 @@ def bias_stability(omega, window: int = 1) -> float:
 def improvement_ratio(before, after, absolute: bool = False):
     """Improvement ratio in percent (Niu et al. 2025 Eq. 18): (M_raw − M_filt)/M_raw·100, signed
     by default (docs/departures.md#signed-improvement-ratio: negative means the filter made the metric worse);
-    ``absolute=True`` gives the paper's |M_raw − M_filt|/M_raw·100."""
+    ``absolute=True`` gives the paper's |M_raw − M_filt|/M_raw·100.
+
+    Parameters
+    ----------
+    before : float or array_like
+        Metric of the raw series, M_raw (non-zero).
+    after : float or array_like
+        Metric of the filtered series, M_filt, in the unit and shape of ``before`` (or a
+        scalar).
+    absolute : bool, default False
+        True for the paper's absolute value.
+
+    Returns
+    -------
+    float or numpy.ndarray
+        Improvement ratio, %, in the broadcast shape of ``before`` and ``after``.
+
+    Raises
+    ------
+    atomnav.InputError
+        Naming ``before`` (a zero metric) or ``after`` (a shape mismatch).
+    """
     b = as_floats(before, "before")
     a = as_floats(after, "after")
     absolute = flag(absolute, "absolute")
