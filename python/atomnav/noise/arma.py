@@ -24,7 +24,25 @@ def _series(x, name: str, min_len: int) -> np.ndarray:
 
 
 def difference(omega, d: int = 1) -> np.ndarray:
-    """d-th difference (Niu et al. 2025 Eq. 11; docs/departures.md#first-difference): d_k = ω_k − ω_{k−1}, length N − d."""
+    """d-th difference (Niu et al. 2025 Eq. 11; docs/departures.md#first-difference): d_k = ω_k − ω_{k−1}, length N − d.
+
+    Parameters
+    ----------
+    omega : array_like (N,)
+        Rate series, unit U.
+    d : int, default 1
+        Order of differencing (N > d).
+
+    Returns
+    -------
+    numpy.ndarray (N − d,)
+        The d-th difference, unit U.
+
+    References
+    ----------
+    G. E. P. Box and G. M. Jenkins, *Time Series Analysis: Forecasting and Control*
+    (Holden-Day, 1970).
+    """
     d = integer(d, "d")
     x = vector(omega, None, "omega")
     if x.size <= d:
@@ -33,7 +51,20 @@ def difference(omega, d: int = 1) -> np.ndarray:
 
 
 def undifference(diffs, initial) -> np.ndarray:
-    """Inverse of :func:`difference` for d = 1: ω = [ω₁, ω₁ + cumsum(d)]."""
+    """Inverse of :func:`difference` for d = 1: ω = [ω₁, ω₁ + cumsum(d)].
+
+    Parameters
+    ----------
+    diffs : array_like (N − 1,)
+        First differences, unit U.
+    initial : float
+        First value ω₁ of the series, unit U.
+
+    Returns
+    -------
+    numpy.ndarray (N,)
+        The series ω, unit U.
+    """
     dd = vector(diffs, None, "diffs")
     w0 = scalar(initial, "initial")
     return np.concatenate([[w0], w0 + np.cumsum(dd)])
@@ -43,7 +74,19 @@ def undifference(diffs, initial) -> np.ndarray:
 class Stationarity:
     """ADF (H₀: unit root) and KPSS (H₀: level-stationary) results. ``passed`` when ADF
     rejects its null (p < alpha) and KPSS does not reject its null (p > alpha).
-    KPSS p-values are clipped by statsmodels to [0.01, 0.10]."""
+    KPSS p-values are clipped by statsmodels to [0.01, 0.10].
+
+    Returned by :func:`stationarity`.
+
+    Attributes
+    ----------
+    adf_stat, adf_p : float
+        Augmented Dickey–Fuller statistic and its p-value.
+    kpss_stat, kpss_p : float
+        KPSS statistic and its p-value (clipped to [0.01, 0.10]).
+    alpha : float
+        Significance level of both verdicts.
+    """
 
     adf_stat: float
     adf_p: float
@@ -72,8 +115,22 @@ class Stationarity:
 
 def stationarity(z, regression: str = "c", alpha: float = 0.05) -> Stationarity:
     """ADF (``adfuller(regression, autolag='AIC')``) and KPSS (``kpss(regression,
-    nlags='auto')``) on the series z (docs/departures.md#statsmodels-defaults). ``regression``: "c" (level) or "ct"
-    (trend); Matlab's defaults differ, hence exposed."""
+    nlags='auto')``) on the series z (docs/departures.md#statsmodels-defaults).
+
+    Parameters
+    ----------
+    z : array_like (N,)
+        Series to test (N ≥ 20, not constant).
+    regression : {"c", "ct"}, default "c"
+        "c" (level) or "ct" (trend); Matlab's defaults differ, hence exposed.
+    alpha : float, default 0.05
+        Significance level of the verdicts.
+
+    Returns
+    -------
+    Stationarity
+        Both statistics, their p-values and the verdict.
+    """
     from statsmodels.tsa.stattools import adfuller, kpss
     from statsmodels.tools.sm_exceptions import InterpolationWarning
 
@@ -91,7 +148,25 @@ def stationarity(z, regression: str = "c", alpha: float = 0.05) -> Stationarity:
 
 def acf_pacf(z, nlags: int = 40) -> pd.DataFrame:
     """ACF (``acf(fft=True)``) and PACF (``pacf(method='ywadjusted')``) to ``nlags`` with the
-    ±1.96/√N white-noise band. Columns: lag, acf, pacf, band."""
+    ±1.96/√N white-noise band.
+
+    Parameters
+    ----------
+    z : array_like (N,)
+        Series (N ≥ 2·nlags + 2, not constant).
+    nlags : int, default 40
+        Largest lag (≥ 1).
+
+    Returns
+    -------
+    pandas.DataFrame
+        ``nlags`` + 1 rows; columns lag, acf, pacf, band.
+
+    References
+    ----------
+    G. E. P. Box and G. M. Jenkins, *Time Series Analysis: Forecasting and Control*
+    (Holden-Day, 1970).
+    """
     from statsmodels.tsa.stattools import acf, pacf
 
     nlags = integer(nlags, "nlags", 1)
@@ -116,7 +191,25 @@ def _arima(d, p: int, q: int):
 def select_arma(d, max_p: int = 3, max_q: int = 3) -> pd.DataFrame:
     """AIC and BIC of ARMA(p, q) fits to the (already differenced) series d for every
     p ≤ max_p, q ≤ max_q (docs/departures.md#order-selection). AIC = 2n_p − 2 ln L, BIC = n_p ln n − 2 ln L, n_p
-    including σ². Columns: p, q, llf, aic, bic, sorted by BIC."""
+    including σ².
+
+    Parameters
+    ----------
+    d : array_like (N,)
+        The (already differenced) series; at least 10·(max_p + max_q + 1) samples.
+    max_p, max_q : int, default 3
+        Largest AR and MA orders of the grid.
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row per (p, q); columns p, q, llf, aic, bic, sorted by BIC.
+
+    References
+    ----------
+    G. E. P. Box and G. M. Jenkins, *Time Series Analysis: Forecasting and Control*
+    (Holden-Day, 1970).
+    """
     max_p, max_q = integer(max_p, "max_p"), integer(max_q, "max_q")
     x = _series(d, "d", _min_len(max_p, max_q))
     rows = []
@@ -129,10 +222,34 @@ def select_arma(d, max_p: int = 3, max_q: int = 3) -> pd.DataFrame:
 
 @dataclass(kw_only=True)
 class ArmaFit:
-    """Exact-ML ARMA(p, q) fit of d (statsmodels). ``ar`` φ, ``ma`` β, ``sigma2`` σ_a²;
-    ``se`` standard errors by parameter name (``ar.L1``, ``ma.L1``, ``sigma2``);
-    ``residuals`` the one-step residuals; ``dw`` their Durbin–Watson statistic;
-    ``ljung_box`` the Ljung–Box table; ``aic``, ``bic``."""
+    """Exact-ML ARMA(p, q) fit of d (statsmodels), returned by :func:`fit_arma`.
+
+    Attributes
+    ----------
+    order : tuple of int
+        (p, q).
+    ar : numpy.ndarray (p,)
+        AR coefficients φ.
+    ma : numpy.ndarray (q,)
+        MA coefficients β.
+    sigma2 : float
+        Innovation variance σ_a², U².
+    se : dict
+        Standard errors by parameter name (``ar.L1``, ``ma.L1``, ``sigma2``).
+    residuals : numpy.ndarray (N,)
+        The one-step residuals, unit U.
+    dw : float
+        Their Durbin–Watson statistic.
+    ljung_box : pandas.DataFrame
+        The Ljung–Box table (:func:`ljung_box`).
+    aic, bic : float
+        Akaike and Bayesian information criteria.
+
+    References
+    ----------
+    G. E. P. Box and G. M. Jenkins, *Time Series Analysis: Forecasting and Control*
+    (Holden-Day, 1970).
+    """
 
     order: tuple
     ar: np.ndarray
@@ -149,7 +266,38 @@ class ArmaFit:
 def fit_arma(omega, order=(2, 1), differenced: bool = False, lags: int = 10) -> ArmaFit:
     """Fit ARMA(p, q) = ``order`` by exact ML to the first difference of ``omega`` (i.e.
     ARIMA(p,1,q) on ω), or to ``omega`` itself when ``differenced=True``.
-    ``ARIMA(d, order=(p,0,q), trend='n')`` (docs/departures.md#statsmodels-defaults)."""
+    ``ARIMA(d, order=(p,0,q), trend='n')`` (docs/departures.md#statsmodels-defaults).
+
+    Parameters
+    ----------
+    omega : array_like (N,)
+        Rate series, unit U; at least 10·(p + q + 1) samples (one more when differenced
+        here).
+    order : tuple of int, default (2, 1)
+        (p, q).
+    differenced : bool, default False
+        True when ``omega`` is already the series to model.
+    lags : int, default 10
+        Lags of the Ljung–Box test of the residuals.
+
+    Returns
+    -------
+    ArmaFit
+        Coefficients, σ_a², standard errors and residual diagnostics.
+
+    Raises
+    ------
+    TypeError
+        ``order`` is not a pair.
+    atomnav.InputError
+        Naming ``order``, ``differenced`` or ``omega`` (too short, constant, or a pure
+        ramp).
+
+    References
+    ----------
+    G. E. P. Box and G. M. Jenkins, *Time Series Analysis: Forecasting and Control*
+    (Holden-Day, 1970).
+    """
     try:
         p, q = order
     except (TypeError, ValueError):
@@ -182,7 +330,18 @@ def fit_arma(omega, order=(2, 1), differenced: bool = False, lags: int = 10) -> 
 
 def durbin_watson(e) -> float:
     """DW = Σ(e_k − e_{k−1})² / Σe_k² (Niu et al. 2025 Eq. 13); 2 for white residuals, 0 for a
-    constant series."""
+    constant series.
+
+    Parameters
+    ----------
+    e : array_like (N,)
+        Residuals (N ≥ 2, not all zero).
+
+    Returns
+    -------
+    float
+        The Durbin–Watson statistic, in [0, 4].
+    """
     from statsmodels.stats.stattools import durbin_watson as dw
 
     x = vector(e, None, "e")
@@ -195,7 +354,25 @@ def durbin_watson(e) -> float:
 
 
 def ljung_box(e, lags: int = 10) -> pd.DataFrame:
-    """Ljung–Box Q test of the residuals at lags 1…``lags`` (columns lb_stat, lb_pvalue)."""
+    """Ljung–Box Q test of the residuals at lags 1…``lags``.
+
+    Parameters
+    ----------
+    e : array_like (N,)
+        Residuals (N > lags + 1, not constant).
+    lags : int, default 10
+        Largest lag (≥ 1).
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row per lag; columns lb_stat, lb_pvalue.
+
+    References
+    ----------
+    G. M. Ljung and G. E. P. Box, "On a measure of lack of fit in time series models",
+    *Biometrika* 65 (1978).
+    """
     from statsmodels.stats.diagnostic import acorr_ljungbox
 
     x = vector(e, None, "e")
