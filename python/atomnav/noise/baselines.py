@@ -14,7 +14,32 @@ MAX_BUTTERWORTH_ORDER = 24
 def butterworth_lowpass(omega, tau0: float, fc: float = 0.002, order: int = 2, zero_phase: bool = True) -> np.ndarray:
     """Butterworth low-pass at cutoff ``fc`` (Hz) of a series sampled every ``tau0`` s:
     ``butter(order, fc, fs=1/tau0, output='sos')`` with ``sosfiltfilt`` (zero phase, the
-    default: |H|⁴, no lag) or causal ``sosfilt`` started at the first sample (docs/departures.md#low-pass-baseline)."""
+    default: |H|⁴, no lag) or causal ``sosfilt`` started at the first sample (docs/departures.md#low-pass-baseline).
+
+    Parameters
+    ----------
+    omega : array_like (N,)
+        Rate series, unit U.
+    tau0 : float
+        Sampling interval, s.
+    fc : float, default 0.002
+        Cutoff frequency, Hz, below the Nyquist frequency 1/(2 tau0).
+    order : int, default 2
+        Butterworth order, 1 … ``MAX_BUTTERWORTH_ORDER``.
+    zero_phase : bool, default True
+        True for forward-backward ``sosfiltfilt``, False for causal ``sosfilt``.
+
+    Returns
+    -------
+    numpy.ndarray (N,)
+        Filtered series, unit U.
+
+    Raises
+    ------
+    atomnav.InputError
+        Naming ``tau0``, ``fc``, ``order`` or ``omega`` (too short for zero-phase
+        filtering).
+    """
     from scipy.signal import butter, sosfilt, sosfilt_zi, sosfiltfilt
 
     x = vector(omega, None, "omega")
@@ -40,7 +65,39 @@ def wavelet_denoise(omega, wavelet: str = "db4", level: int = 5, threshold: str 
     """Wavelet-threshold denoising (VisuShrink, docs/departures.md#wavelet-baseline): ``wavedec(ω, wavelet,
     level, mode='symmetric')``; σ̂ = median|cD₁|/0.6745; λ = σ̂√(2 ln N); ``mode``
     ("soft" or "hard") threshold on every detail level, approximation kept; inverse
-    transform truncated to N."""
+    transform truncated to N.
+
+    Parameters
+    ----------
+    omega : array_like (N,)
+        Rate series, unit U.
+    wavelet : str, default "db4"
+        PyWavelets discrete wavelet name.
+    level : int, default 5
+        Decomposition levels (≥ 1, at most ``pywt.dwt_max_level`` for N).
+    threshold : {"universal"}, default "universal"
+        Threshold rule: the universal λ = σ̂√(2 ln N).
+    mode : {"soft", "hard"}, default "soft"
+        Thresholding of the detail coefficients.
+
+    Returns
+    -------
+    numpy.ndarray (N,)
+        Denoised series, unit U.
+
+    Raises
+    ------
+    TypeError
+        ``wavelet`` is not a str.
+    atomnav.InputError
+        Naming ``wavelet``, ``threshold``, ``mode``, ``level`` or ``omega`` (too short for
+        ``level``).
+
+    References
+    ----------
+    D. L. Donoho and I. M. Johnstone, "Ideal spatial adaptation by wavelet shrinkage",
+    *Biometrika* 81 (1994).
+    """
     import pywt
 
     x = vector(omega, None, "omega")
