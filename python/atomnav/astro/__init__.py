@@ -55,33 +55,95 @@ def _single(fn, x):
 
 
 def euler_dcm(beta) -> np.ndarray:
-    """C(ψ, ϑ, γ) = R_ψ(ψ) R_ϑ(ϑ) R_γ(γ) (rad); (3,) → (3, 3), (N, 3) → (N, 3, 3)."""
+    """Rotation matrix C(ψ, ϑ, γ) = R_ψ(ψ) R_ϑ(ϑ) R_γ(γ) of Euler angles.
+
+    Parameters
+    ----------
+    beta : array_like, shape (3,) or (N, 3)
+        Euler angles β = (ψ, ϑ, γ), rad (heading clockwise from North, pitch nose-up,
+        roll); angles that look like degrees give an :class:`atomnav.UnitWarning`.
+
+    Returns
+    -------
+    numpy.ndarray, shape (3, 3) or (N, 3, 3)
+        C(β): (3,) → (3, 3), (N, 3) → (N, 3, 3).
+    """
     return _single(_core.astro_euler_dcm, beta)
 
 
 def euler_from_dcm(c) -> np.ndarray:
-    """Canonical (ψ ∈ [0, 2π), ϑ, γ) in rad of rotation matrices
-    (docs/departures.md#rotations-not-euler-angles)."""
+    """Canonical Euler angles (ψ ∈ [0, 2π), ϑ, γ) of rotation matrices.
+
+    Parameters
+    ----------
+    c : array_like, shape (3, 3) or (N, 3, 3)
+        Rotation matrices C(β) = R_ψ R_ϑ R_γ.
+
+    Returns
+    -------
+    numpy.ndarray, shape (3,) or (N, 3)
+        β = (ψ, ϑ, γ), rad; (3, 3) → (3,), (N, 3, 3) → (N, 3).
+
+    Notes
+    -----
+    Euler angles appear only in reports; the estimation works on rotations
+    (docs/departures.md#rotations-not-euler-angles).
+    """
     c = as_floats(c, "c")
     out = _core.astro_euler_from_dcm(_mats(c, "c"))
     return out[0] if c.ndim == 2 else out
 
 
 def d1(beta) -> np.ndarray:
-    """D1(β): θ^clb = D1 δβ (Vasilyuk et al. 2024 Eq. 8)."""
+    """Jacobian D1(β) of the mount error: θ^clb = D1 δβ (Vasilyuk et al. 2024, Eq. 8).
+
+    Parameters
+    ----------
+    beta : array_like, shape (3,) or (N, 3)
+        Euler angles β = (ψ, ϑ, γ), rad.
+
+    Returns
+    -------
+    numpy.ndarray, shape (3, 3) or (N, 3, 3)
+        D1(β), rad/rad.
+    """
     return _single(lambda b: _core.astro_d1_d2(b)[0], beta)
 
 
 def d2(beta) -> np.ndarray:
-    """D2(β) = C(β) D1(β): θ^mfa = Cθ^avu − D2 δβ (Vasilyuk et al. 2024 Eq. 8)."""
+    """D2(β) = C(β) D1(β): θ^mfa = Cθ^avu − D2 δβ (Vasilyuk et al. 2024, Eq. 8).
+
+    Parameters
+    ----------
+    beta : array_like, shape (3,) or (N, 3)
+        Euler angles β = (ψ, ϑ, γ), rad.
+
+    Returns
+    -------
+    numpy.ndarray, shape (3, 3) or (N, 3, 3)
+        D2(β), rad/rad.
+    """
     return _single(lambda b: _core.astro_d1_d2(b)[1], beta)
 
 
 @dataclass(frozen=True)
 class GyroErrorModel:
-    """Gyro errors of Vasilyuk et al. 2024: misalignment σ_φ (rad), scale factor σ_k (–), angle random
-    walk σ_w (rad/√s), bias σ_b (rad/s); ``mode`` "paper" (white per sample, as the paper propagates them) or
-    "consistent" (constant over the calibration) (docs/departures.md#constant-gyro-errors)."""
+    """Gyro error budget of Vasilyuk et al. 2024.
+
+    Parameters
+    ----------
+    sigma_phi_rad : float
+        Misalignment σ_φ of the gyro triad, rad.
+    sigma_k : float
+        Scale-factor error σ_k, dimensionless (–).
+    sigma_w_rad_sqrt_s : float
+        Angle random walk σ_w, rad/√s.
+    sigma_b_rad_s : float
+        Rate bias σ_b, rad/s.
+    mode : {"paper", "consistent"}, default "paper"
+        "paper": errors white per sample, as the paper propagates them; "consistent":
+        constant over the calibration (docs/departures.md#constant-gyro-errors).
+    """
 
     sigma_phi_rad: float
     sigma_k: float
@@ -91,7 +153,19 @@ class GyroErrorModel:
 
     @classmethod
     def vasilyuk2024(cls, mode: str = "paper") -> "GyroErrorModel":
-        """The paper's budget: 3″, 1e-5, 0.0012 °/√h, 0.007 °/h."""
+        """The paper's budget (Vasilyuk et al. 2024): 3″, 1e-5, 0.0012 °/√h, 0.007 °/h.
+
+        Parameters
+        ----------
+        mode : {"paper", "consistent"}, default "paper"
+            How the errors are propagated, as for :class:`GyroErrorModel`.
+
+        Returns
+        -------
+        GyroErrorModel
+            σ_φ = 3″, σ_k = 1e-5, σ_w = 0.0012 °/√h, σ_b = 0.007 °/h, in the SI units of
+            the fields (rad, –, rad/√s, rad/s).
+        """
         return cls(*_core.astro_vasilyuk2024_gyro_budget(), mode=mode)
 
     def _sigmas(self):
@@ -100,9 +174,23 @@ class GyroErrorModel:
 
 @dataclass(frozen=True)
 class Increments:
-    """Gyro increments between epochs: q (M, 4) scalar first with R(q) = ΔS^imu (dcm),
-    covariance E^imu (M, 3, 3) rad²; in "consistent" mode the sensitivities j_m (M, 3, 9)
-    to vec_rowmajor(M_G) and j_b (M, 3, 3) to the rate bias (rad/s → rad), else None."""
+    """Gyro increments between camera epochs, as returned by :func:`gyro_increments`.
+
+    Attributes
+    ----------
+    q : numpy.ndarray, shape (M, 4)
+        Increment quaternions, scalar first, with R(q) = ΔS^imu.
+    dcm : numpy.ndarray, shape (M, 3, 3)
+        ΔS^imu = R(q).
+    cov : numpy.ndarray, shape (M, 3, 3)
+        Increment covariance E^imu, rad².
+    j_m : numpy.ndarray, shape (M, 3, 9), or None
+        In "consistent" mode the sensitivity of the increment to vec_rowmajor(M_G) (the
+        gyro misalignment/scale matrix), rad; else None.
+    j_b : numpy.ndarray, shape (M, 3, 3), or None
+        In "consistent" mode the sensitivity to the rate bias (rad/s → rad, i.e. s);
+        else None.
+    """
 
     q: np.ndarray
     dcm: np.ndarray
@@ -121,10 +209,27 @@ def gyro_increments(t_start: float, period: float, rho, epochs, model: GyroError
     """Third-order asynchronous quaternion integration between camera epochs
     (Vasilyuk et al. 2024), with the increment covariance of the gyro error ``model``.
 
-    ``rho`` (K, 3) rad: gyro increments in MF, row j over [t_start + jT, t_start + (j+1)T]
-    with T = ``period`` (s); ``epochs`` (N,) s strictly increasing inside the record.
-    ``taylor_variant`` "corrected" (c = 1/8, default) or "paper_literal" (c = 1/4)
-    (docs/departures.md#second-order-quaternion-term).
+    Parameters
+    ----------
+    t_start : float
+        Start time of the gyro record, s.
+    period : float
+        Gyro sampling period T, s (> 0).
+    rho : array_like, shape (K, 3)
+        Gyro angle increments in MF, rad; row j over [t_start + jT, t_start + (j+1)T].
+    epochs : array_like, shape (N,)
+        Camera epochs, s, strictly increasing and inside the record.
+    model : GyroErrorModel
+        Gyro error budget giving the increment covariance.
+    taylor_variant : {"corrected", "paper_literal"}, default "corrected"
+        Second-order quaternion term: "corrected" (c = 1/8) or "paper_literal" (c = 1/4)
+        (docs/departures.md#second-order-quaternion-term).
+
+    Returns
+    -------
+    Increments
+        The M = N − 1 increments ΔS^imu between consecutive epochs, their covariance
+        E^imu (rad²) and, in "consistent" mode, the sensitivities ``j_m``, ``j_b``.
     """
     instance(model, GyroErrorModel, "model")
     with renamed(gyro_increments="rho"):
@@ -136,7 +241,27 @@ def gyro_increments(t_start: float, period: float, rho, epochs, model: GyroError
 
 
 def dead_reckoning_cov(t_start: float, period: float, rho, epochs, model: GyroErrorModel) -> np.ndarray:
-    """P^imu at every epoch (rad², (N, 3, 3)): the increment covariance recursion run from the first epoch."""
+    """Dead-reckoning attitude covariance P^imu at every epoch: the increment covariance
+    recursion run from the first epoch.
+
+    Parameters
+    ----------
+    t_start : float
+        Start time of the gyro record, s.
+    period : float
+        Gyro sampling period T, s (> 0).
+    rho : array_like, shape (K, 3)
+        Gyro angle increments in MF, rad; row j over [t_start + jT, t_start + (j+1)T].
+    epochs : array_like, shape (N,)
+        Camera epochs, s, strictly increasing and inside the record.
+    model : GyroErrorModel
+        Gyro error budget.
+
+    Returns
+    -------
+    numpy.ndarray, shape (N, 3, 3)
+        P^imu at each epoch, rad².
+    """
     instance(model, GyroErrorModel, "model")
     with renamed(gyro_increments="rho"):
         return _core.astro_dead_reckoning_cov(scalar(t_start, "t_start"), positive(period, "period"),
@@ -145,11 +270,24 @@ def dead_reckoning_cov(t_start: float, period: float, rho, epochs, model: GyroEr
 
 
 def observability(ds_avu) -> dict:
-    """Identifiability of the mount (Vasilyuk et al. 2024; thresholds in
-    docs/departures.md#identifiability-thresholds): axes_vf, angles (rad), cluster labels
-    (−1 below 0.5°), n_clusters (5° radius), eigenvalues/eigenvectors of
-    G = Σ(I − ΔS)(I − ΔS)ᵀ, kappa = λ_min/λ_max, weak_axis_vf and verdict "ok" | "warn"
-    (κ < 1e-4) | "reject" (κ < 1e-12)."""
+    """Identifiability of the mount from the star-attitude increments (Vasilyuk et al. 2024;
+    thresholds in docs/departures.md#identifiability-thresholds).
+
+    Parameters
+    ----------
+    ds_avu : array_like, shape (M, 3, 3)
+        Star-attitude increments ΔS^avu in VF.
+
+    Returns
+    -------
+    dict
+        ``axes_vf`` (M, 3) unit rotation axes in VF (zero for a null rotation);
+        ``angles`` (M,) rotation angles, rad; ``cluster`` (M,) cluster labels (−1 below
+        0.5°); ``n_clusters`` (5° radius, axes taken as lines); ``eigenvalues`` (3,), ascending,
+        and ``eigenvectors`` (3, 3) as columns of G = Σ(I − ΔS)(I − ΔS)ᵀ;
+        ``kappa`` = λ_min/λ_max; ``weak_axis_vf`` (3,); ``verdict`` "ok" | "warn"
+        (κ < 1e-4) | "reject" (κ < 1e-12).
+    """
     return _core.astro_observability(_mats(ds_avu, "ds_avu"))
 
 
@@ -157,16 +295,51 @@ def calibrate(ds_imu, ds_avu, *, init: str = "axes", c0=None, solver: str = "so3
               tol: float = 1e-9, residual_form: str = "full", gyro_error_model: str = "unspecified") -> Calibration:
     """Mount C_MF^VF from increment pairs ΔS^avu = Cᵀ ΔS^imu C (Vasilyuk et al. 2024, §3).
 
-    Gauss–Newton from ``init`` "axes" (closed-form alignment of rotation axes, default),
-    "zero" (paper's β0 = 0) or "given" (``c0``); ``solver`` "so3" (C ← C exp([Δθ×]),
-    analytic Jacobian, default) or "paper_euler" (β ← β + Δβ, central differences with
-    dx = 1e-6); stops at a step ≤ ``tol`` rad, at most ``max_iter`` iterations. P_β is the paper's
-    residual sandwich with P_S "full" (default) or "diagonal". The option names are
-    ``_core.OPTIONS["CalibrationInit"]``, ``["CalibrationSolver"]`` and ``["ResidualForm"]``.
+    Gauss–Newton on the increment residuals; P_β is the paper's residual sandwich. The
+    option names are ``_core.OPTIONS["CalibrationInit"]``, ``["CalibrationSolver"]`` and
+    ``["ResidualForm"]``.
 
-    Raises :class:`atomnav.InputError` when the trajectory cannot determine the mount
-    (κ < 1e-12; the message names the null direction) and atomnav.NumericalError when
-    Gauss–Newton does not converge or stops at a wrong stationary point; warns when κ < 1e-4.
+    Parameters
+    ----------
+    ds_imu : array_like, shape (M, 3, 3)
+        Gyro increments ΔS^imu in MF (e.g. :attr:`Increments.dcm`).
+    ds_avu : array_like, shape (M, 3, 3)
+        Star-attitude increments ΔS^avu in VF (from :func:`astro_increments`).
+    init : {"axes", "zero", "given"}, default "axes"
+        Starting point: closed-form alignment of rotation axes, the paper's β0 = 0, or
+        ``c0``.
+    c0 : array_like, shape (3, 3), optional
+        Initial mount C_MF^VF for ``init="given"``.
+    solver : {"so3", "paper_euler"}, default "so3"
+        "so3": C ← C exp([Δθ×]) with the analytic Jacobian; "paper_euler": β ← β + Δβ with
+        central differences, dx = 1e-6.
+    max_iter : int, default 50
+        Maximum number of Gauss–Newton iterations.
+    tol : float, default 1e-9
+        Stop at a step ≤ ``tol``, rad.
+    residual_form : {"full", "diagonal"}, default "full"
+        Form of the residual covariance P_S in the sandwich.
+    gyro_error_model : str, default "unspecified"
+        Provenance label of the gyro model, stored in the result.
+
+    Returns
+    -------
+    Calibration
+        The mount, its Euler angles and covariances (rad, rad²) and the identifiability
+        report.
+
+    Raises
+    ------
+    atomnav.InputError
+        When the trajectory cannot determine the mount (κ < 1e-12; the message names the
+        null direction).
+    atomnav.NumericalError
+        When Gauss–Newton does not converge or stops at a wrong stationary point.
+
+    Warns
+    -----
+    RuntimeWarning
+        When the mount is weakly observable (κ < 1e-4), naming the weak direction in VF.
     """
     c0 = None if c0 is None else rows(c0, 3, "c0")
     d = _core.astro_calibrate(_mats(ds_imu, "ds_imu"), _mats(ds_avu, "ds_avu"), init=init, c0=c0, solver=solver,
@@ -182,10 +355,21 @@ def calibrate(ds_imu, ds_avu, *, init: str = "axes", c0=None, solver: str = "so3
 
 @dataclass(frozen=True)
 class Catalog:
-    """Star catalog: GCRS unit vectors ``dirs`` (N, 3) (annual aberration applied),
-    magnitudes ``mags`` (N,), integer ``ids`` (N,). Converted on construction to float64
-    and int64 arrays: numbers given as strings are a ``TypeError``, a wrong shape or row
-    count an :class:`atomnav.InputError`, both naming the field."""
+    """Star catalog.
+
+    Converted on construction to float64 and int64 arrays: numbers given as strings are a
+    ``TypeError``, a wrong shape or row count an :class:`atomnav.InputError`, both naming
+    the field.
+
+    Parameters
+    ----------
+    dirs : array_like, shape (N, 3)
+        GCRS unit vectors of the stars (annual aberration applied).
+    mags : array_like, shape (N,)
+        Visual magnitudes.
+    ids : array_like of int, shape (N,)
+        Star identifiers.
+    """
 
     dirs: np.ndarray
     mags: np.ndarray
@@ -196,14 +380,43 @@ class Catalog:
 
 
 def synthetic_catalog(m_lim: float = 5.6, seed: int = 1) -> Catalog:
-    """Deterministic uniform sky (docs/departures.md#synthetic-star-catalog): round(10^(0.985 + 0.455 m_lim)) stars,
-    xoshiro256** seeded through SplitMix64 (identical on every platform)."""
+    """Deterministic uniform sky (docs/departures.md#synthetic-star-catalog).
+
+    Parameters
+    ----------
+    m_lim : float, default 5.6
+        Limiting magnitude: round(10^(0.985 + 0.455 m_lim)) stars.
+    seed : int, default 1
+        Seed of xoshiro256** (seeded through SplitMix64, identical on every platform).
+
+    Returns
+    -------
+    Catalog
+        The synthetic stars.
+    """
     return Catalog(*_core.astro_synthetic_catalog(scalar(m_lim, "m_lim"), seed))
 
 
 def load_catalog(path) -> Catalog:
-    """A user catalog from a CSV file with header ``id,ra_deg,dec_deg,mag`` (GCRS right
-    ascension and declination in degrees) or ``id,x,y,z,mag`` (unit vectors)."""
+    """A user catalog from a CSV file.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        CSV file with header ``id,ra_deg,dec_deg,mag`` (GCRS right ascension and
+        declination in degrees) or ``id,x,y,z,mag`` (GCRS unit vectors).
+
+    Returns
+    -------
+    Catalog
+        The stars of the file.
+
+    Raises
+    ------
+    atomnav.InputError
+        Naming ``path`` when the file is not such a CSV, a direction is not a unit vector
+        or an id is not an integer.
+    """
     try:
         data = np.genfromtxt(checked_path(path), delimiter=",", names=True, dtype=float)
     except ValueError as e:  # a path with a NUL byte, or a file that is not such a CSV
@@ -234,37 +447,107 @@ def load_catalog(path) -> Catalog:
 
 
 def refractive_index(height_m: float) -> float:
-    """Refractive index of air at height ``height_m`` (m, ≥ −10 km):
-    n(H) = 1 + 2.7783e-4 (1 − 2.25577e-5 H)^4.25588 (Vasilyuk et al. 2024). Above
-    H = 1/2.25577e-5 ≈ 44.3 km the model's air density is zero and n = 1."""
+    """Refractive index of air n(H) = 1 + 2.7783e-4 (1 − 2.25577e-5 H)^4.25588
+    (Vasilyuk et al. 2024).
+
+    Parameters
+    ----------
+    height_m : float
+        Height H, m (≥ −10 km).
+
+    Returns
+    -------
+    float
+        n(H), dimensionless. Above H = 1/2.25577e-5 ≈ 44.3 km the model's air density is
+        zero and n = 1.
+    """
     with renamed(height="height_m"):
         return _core.astro_refractive_index(scalar(height_m, "height_m"))
 
 
 def refraction_correct(s, up, n: float) -> np.ndarray:
-    """Remove refraction from observed unit directions about the local vertical ``up``
-    (same frame, (N, 3)), plane-parallel atmosphere (Snell's law, sin z_true = n sin z_obs)."""
+    """Remove refraction from observed unit directions about the local vertical, for a
+    plane-parallel atmosphere (Snell's law, sin z_true = n sin z_obs).
+
+    Parameters
+    ----------
+    s : array_like, shape (N, 3)
+        Observed (apparent) unit directions.
+    up : array_like, shape (N, 3)
+        Local vertical unit vectors, same frame as ``s``.
+    n : float
+        Refractive index of air (≥ 1, dimensionless; see :func:`refractive_index`).
+
+    Returns
+    -------
+    numpy.ndarray, shape (N, 3)
+        True unit directions.
+    """
     with renamed(directions="s", n_refr="n"):
         return _core.astro_refraction(rows(s, 3, "s"), rows(up, 3, "up"), scalar(n, "n"), False)
 
 
 def refraction_apply(s, up, n: float) -> np.ndarray:
-    """Apparent directions of true unit directions (inverse of :func:`refraction_correct`, for simulation)."""
+    """Apparent directions of true unit directions (inverse of :func:`refraction_correct`,
+    for simulation).
+
+    Parameters
+    ----------
+    s : array_like, shape (N, 3)
+        True unit directions.
+    up : array_like, shape (N, 3)
+        Local vertical unit vectors, same frame as ``s``.
+    n : float
+        Refractive index of air (≥ 1, dimensionless).
+
+    Returns
+    -------
+    numpy.ndarray, shape (N, 3)
+        Apparent (refracted) unit directions.
+    """
     with renamed(directions="s", n_refr="n"):
         return _core.astro_refraction(rows(s, 3, "s"), rows(up, 3, "up"), scalar(n, "n"), True)
 
 
 def star_attitudes(obs: Observations, n_epochs: int, cameras, sigma_s_rad: float, p_alpha=None,
                    up_gcrs=None, n_refr: float = 1.0, p_avu=None):
-    """Merge the cameras into VF (``cameras`` (I, 3, 3) = C_VF^CFⁱ, camera 0 = identity), remove
-    refraction about ``up_gcrs`` (N, 3) with index ``n_refr``, solve Wahba per epoch and form
-    P^avu = σ_s²K + K(Σ Cᵢ Aᵢ D1(αⁱ) P_aⁱ D1ᵀ Aᵢ Cᵢᵀ)K (docs/departures.md#star-attitude-covariance;
-    ``p_alpha`` (I, 3, 3) rad²),
-    or take the user's ``p_avu`` (N, 3, 3) rad² in VF (finite, symmetric, PSD) in place of that
-    default model; it then flows into :func:`astro_increments`,
+    """Star attitudes of the virtual camera VF per epoch and their covariance.
+
+    Merges the cameras into VF, removes refraction, solves Wahba's problem per epoch and
+    forms P^avu = σ_s²K + K(Σ Cᵢ Aᵢ D1(αⁱ) P_aⁱ D1ᵀ Aᵢ Cᵢᵀ)K
+    (docs/departures.md#star-attitude-covariance), or takes the user's ``p_avu`` in place
+    of that default model; it then flows into :func:`astro_increments`,
     :func:`model_covariance` and :meth:`Calibration.p_mfa`.
 
-    Returns (S_GCRS^VF (N, 3, 3), P^avu (N, 3, 3) rad², stars per epoch (N,)).
+    Parameters
+    ----------
+    obs : Observations
+        Star observations (epoch and camera indices, directions).
+    n_epochs : int
+        Number of epochs N (≥ 1).
+    cameras : array_like, shape (I, 3, 3)
+        Camera mounts C_VF^CFⁱ; camera 0 = identity.
+    sigma_s_rad : float
+        Star direction noise σ_s, rad.
+    p_alpha : array_like, shape (I, 3, 3), optional
+        Covariance of each camera's mount angles αⁱ, rad² (default zero).
+    up_gcrs : array_like, shape (N, 3), optional
+        Local vertical in GCRS per epoch; refraction is removed about it (default: no
+        refraction correction).
+    n_refr : float, default 1.0
+        Refractive index of air (dimensionless).
+    p_avu : array_like, shape (N, 3, 3), optional
+        User star-attitude covariance in VF, rad² (finite, symmetric, PSD), used instead of
+        the default model.
+
+    Returns
+    -------
+    s_gcrs_vf : numpy.ndarray, shape (N, 3, 3)
+        Star attitudes S_GCRS^VF.
+    p_avu : numpy.ndarray, shape (N, 3, 3)
+        P^avu, rad².
+    stars : numpy.ndarray of int64, shape (N,)
+        Stars used per epoch.
     """
     instance(obs, Observations, "obs")
     cams = _mats(cameras, "cameras")
@@ -280,18 +563,65 @@ def star_attitudes(obs: Observations, n_epochs: int, cameras, sigma_s_rad: float
 
 
 def astro_increments(s_vf, p_avu):
-    """ΔS_n^avu = S_{n−1}ᵀ S_n and E_n^avu = P_n + ΔS_nᵀ P_{n−1} ΔS_n (Vasilyuk et al. 2024)."""
+    """Star-attitude increments ΔS_n^avu = S_{n−1}ᵀ S_n and their covariance
+    E_n^avu = P_n + ΔS_nᵀ P_{n−1} ΔS_n (Vasilyuk et al. 2024).
+
+    Parameters
+    ----------
+    s_vf : array_like, shape (N, 3, 3)
+        Star attitudes S_GCRS^VF (rotation matrices).
+    p_avu : array_like, shape (N, 3, 3)
+        Their covariances P^avu, rad².
+
+    Returns
+    -------
+    ds_avu : numpy.ndarray, shape (N − 1, 3, 3)
+        ΔS_n^avu.
+    e_avu : numpy.ndarray, shape (N − 1, 3, 3)
+        E_n^avu, rad².
+    """
     return _core.astro_astro_increments(_mats(s_vf, "s_vf"), _mats(p_avu, "p_avu"))
 
 
 def model_covariance(cal: Calibration, ds_imu, ds_avu, e_imu, p_avu, increments: Increments | None = None,
                      model: GyroErrorModel | None = None):
-    """Model-form (P_β^model, P_β^sys) in rad² at ``cal``'s mount: the sandwich
-    (HᵀH)⁻¹HᵀΣ_fH(HᵀH)⁻¹ with Σ_f built from the gyro interval covariances ``e_imu``
-    (M, 3, 3) and the star-attitude covariances ``p_avu`` (M + 1, 3, 3) — diagonal blocks
-    CᵀE_n^imuC + E_n^avu and the neighbour correlations of shared star attitudes — converted to Euler angles.
-    With ``model.mode == "consistent"`` the constant-error cross terms use
-    ``increments.j_m``/``j_b``; P_β^sys is their part (zero otherwise)."""
+    """Model-form mount covariance at ``cal``'s mount: the sandwich
+    (HᵀH)⁻¹HᵀΣ_fH(HᵀH)⁻¹, converted to Euler angles.
+
+    Σ_f has the diagonal blocks CᵀE_n^imuC + E_n^avu and the neighbour correlations of
+    shared star attitudes.
+
+    Parameters
+    ----------
+    cal : Calibration
+        The calibration whose mount ``cal.c`` is used.
+    ds_imu : array_like, shape (M, 3, 3)
+        Gyro increments ΔS^imu in MF.
+    ds_avu : array_like, shape (M, 3, 3)
+        Star-attitude increments ΔS^avu in VF.
+    e_imu : array_like, shape (M, 3, 3)
+        Gyro interval covariances E^imu, rad².
+    p_avu : array_like, shape (M + 1, 3, 3)
+        Star-attitude covariances P^avu, rad².
+    increments : Increments, optional
+        The gyro increments; needed (with ``j_m``/``j_b``) when ``model.mode`` is
+        "consistent", for the constant-error cross terms.
+    model : GyroErrorModel, optional
+        Gyro error budget; only its "consistent" mode changes the result.
+
+    Returns
+    -------
+    p_beta_model : numpy.ndarray, shape (3, 3)
+        P_β^model, rad².
+    p_beta_sys : numpy.ndarray, shape (3, 3)
+        P_β^sys, rad²: the part of the constant-error cross terms (zero unless
+        ``model.mode == "consistent"``).
+
+    Raises
+    ------
+    atomnav.InputError
+        Naming ``increments`` when the consistent mode lacks the sensitivities.
+    """
     instance(cal, Calibration, "cal")
     if model is not None:
         instance(model, GyroErrorModel, "model")
@@ -304,10 +634,24 @@ def model_covariance(cal: Calibration, ds_imu, ds_avu, e_imu, p_avu, increments:
 
 
 def aberration(directions, velocity_mps) -> np.ndarray:
-    """First-order stellar aberration: apparent unit directions normalize(s + v/c) of stars
-    with geometric unit directions ``directions`` (N, 3) seen by an observer moving with
-    ``velocity_mps`` ((3,) or (N, 3), m/s, same frame, |v| < 1e-3 c); exact special
-    relativity differs by O((v/c)²) ≈ 1e-8 rad at Earth's orbital 30 km/s."""
+    """First-order stellar aberration: apparent unit directions normalize(s + v/c).
+
+    Parameters
+    ----------
+    directions : array_like, shape (N, 3)
+        Geometric unit directions s of the stars.
+    velocity_mps : array_like, shape (3,) or (N, 3)
+        Observer velocity, m/s, same frame, |v| < 1e-3 c.
+
+    Returns
+    -------
+    numpy.ndarray, shape (N, 3)
+        Apparent unit directions.
+
+    Notes
+    -----
+    Exact special relativity differs by O((v/c)²) ≈ 1e-8 rad at Earth's orbital 30 km/s.
+    """
     with renamed(velocity="velocity_mps"):
         return _core.astro_aberration(rows(directions, 3, "directions"), rows(velocity_mps, 3, "velocity_mps"))
 
@@ -315,8 +659,34 @@ def aberration(directions, velocity_mps) -> np.ndarray:
 def simulate_observations(catalog: Catalog, s_gcrs_vf, up_gcrs, cameras, *, fov_half_rad: float, m_lim: float,
                           sigma_s_rad: float, n_refr: float, seed: int) -> Observations:
     """Camera simulator: stars brighter than ``m_lim``, above the horizon, within
-    ``fov_half_rad`` of each camera's +z after refraction (index ``n_refr`` ≥ 1), with
-    isotropic tangent noise ``sigma_s_rad``; ``seed`` any integer in [0, 2**64)."""
+    ``fov_half_rad`` of each camera's +z after refraction, with isotropic tangent noise.
+
+    Parameters
+    ----------
+    catalog : Catalog
+        The star catalog.
+    s_gcrs_vf : array_like, shape (N, 3, 3)
+        True attitudes S_GCRS^VF of the virtual camera per epoch.
+    up_gcrs : array_like, shape (N, 3)
+        Local vertical in GCRS per epoch.
+    cameras : array_like, shape (I, 3, 3)
+        Camera mounts C_VF^CFⁱ.
+    fov_half_rad : float
+        Half-angle of each camera's field of view, rad.
+    m_lim : float
+        Limiting magnitude.
+    sigma_s_rad : float
+        Isotropic tangent noise σ_s of the measured directions, rad.
+    n_refr : float
+        Refractive index of air (≥ 1, dimensionless).
+    seed : int
+        Noise seed, any integer in [0, 2**64).
+
+    Returns
+    -------
+    Observations
+        One row per observed star.
+    """
     instance(catalog, Catalog, "catalog")
     d = _core.astro_simulate_observations(rows(catalog.dirs, 3, "catalog_directions"),
                                           vector(catalog.mags, None, "magnitudes"), _mats(s_gcrs_vf, "s_gcrs_vf"),

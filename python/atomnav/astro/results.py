@@ -18,10 +18,47 @@ _RESULT_ARRAYS = ("c", "beta", "residuals", "p_s", "p_theta", "p_beta", "p_clb",
 
 @dataclass(kw_only=True)
 class Calibration:
-    """Calibrated mount C = C_MF^VF with β (rad), Gauss–Newton iterations, residuals f_n
-    (rad), P_S, P_θ (VF), P_β, P^clb (MF) (rad²), singular values and condition number
-    of the stacked Jacobian, the weakest direction in MF with σ_weak = σ̂_f/√λ_min (rad),
-    the identifiability report (:func:`observability`) and the gyro-model provenance."""
+    """Calibrated mount C = C_MF^VF, as returned by :func:`atomnav.astro.calibrate`
+    (Vasilyuk et al. 2024).
+
+    Attributes
+    ----------
+    c : numpy.ndarray, shape (3, 3)
+        The mount C = C_MF^VF.
+    beta : numpy.ndarray, shape (3,)
+        Its Euler angles β = (ψ, ϑ, γ), rad.
+    iterations : int
+        Gauss–Newton iterations.
+    residuals : numpy.ndarray, shape (M, 3)
+        Residuals f_n, rad.
+    relative_misfit : float
+        Largest |f_n|/chord(φ_n) over the rotating intervals (dimensionless).
+    p_s : numpy.ndarray, shape (3, 3)
+        Residual covariance P_S, rad².
+    p_theta : numpy.ndarray, shape (3, 3)
+        Covariance P_θ of the mount error θ^clb in VF, rad².
+    p_beta : numpy.ndarray, shape (3, 3)
+        Covariance P_β of the Euler angles, rad².
+    p_clb : numpy.ndarray, shape (3, 3)
+        Calibration error covariance P^clb = D2 P_β D2ᵀ in MF, rad² (Vasilyuk et al.
+        2024, Eq. 8).
+    singular_values : numpy.ndarray, shape (3,)
+        Singular values of the stacked Jacobian H at the solution, descending.
+    condition_number : float
+        Their ratio, the condition number of H.
+    weak_axis_mf : numpy.ndarray, shape (3,)
+        Weakest direction of θ^clb in MF.
+    sigma_weak : float
+        σ_weak = σ̂_f/√λ_min(G) along it, rad, with σ̂_f² = tr P_S / 3.
+    observability : dict
+        The identifiability report of :func:`atomnav.astro.observability`.
+    gyro_error_model : str, default "unspecified"
+        Provenance of the gyro error model.
+    caveat : str
+        P_β is precision conditional on the IMU calibration: a constant rotation of the
+        gyro triad is indistinguishable from a mount error (accuracy against the nominal MF
+        ≥ ~σ_φG/√2).
+    """
 
     c: np.ndarray
     beta: np.ndarray
@@ -42,15 +79,34 @@ class Calibration:
 
     @property
     def sigma_beta_rad(self) -> np.ndarray:
+        """√diag P_β, rad, for (ψ, ϑ, γ)."""
         return np.sqrt(np.diag(self.p_beta))
 
     def p_mfa(self, p_avu) -> np.ndarray:
-        """P^mfa = C P^avu Cᵀ + P^clb (rad²) of IMU attitude from a new star fix (Eq. 8)."""
+        """Covariance of the IMU attitude from a new star fix, P^mfa = C P^avu Cᵀ + P^clb
+        (Vasilyuk et al. 2024, Eq. 8).
+
+        Parameters
+        ----------
+        p_avu : array_like, shape (3, 3)
+            Star-attitude covariance P^avu in VF, rad².
+
+        Returns
+        -------
+        numpy.ndarray, shape (3, 3)
+            P^mfa in MF, rad².
+        """
         p = np.asarray(p_avu, dtype=float)
         return self.c @ p @ self.c.T + self.p_clb
 
     def save(self, path) -> None:
-        """Save as .npz (arrays, scalars, observability, provenance, caveat)."""
+        """Save as .npz (arrays, scalars, observability, provenance, caveat).
+
+        Parameters
+        ----------
+        path : str or os.PathLike
+            Output file; read back with :meth:`load`.
+        """
         obs = {f"obs_{k}": np.asarray(v) for k, v in self.observability.items()}
         np.savez(checked_path(path), **{k: getattr(self, k) for k in _RESULT_ARRAYS}, iterations=self.iterations,
                  relative_misfit=self.relative_misfit, condition_number=self.condition_number, sigma_weak=self.sigma_weak,
@@ -58,6 +114,23 @@ class Calibration:
 
     @classmethod
     def load(cls, path) -> "Calibration":
+        """A calibration saved by :meth:`save`.
+
+        Parameters
+        ----------
+        path : str or os.PathLike
+            The .npz file.
+
+        Returns
+        -------
+        Calibration
+            The saved calibration.
+
+        Raises
+        ------
+        atomnav.InputError
+            Naming ``path`` when the file is not a calibration saved by :meth:`save`.
+        """
         import zipfile
 
         try:
@@ -84,11 +157,23 @@ def _store_rows(obj, **fields) -> None:
 
 @dataclass(frozen=True)
 class Observations:
-    """Star observations, one row per star: epoch index, camera index (N,) integers,
-    measured unit direction in the camera frame ``s_cf`` (N, 3), catalog direction in
-    GCRS ``g`` (N, 3). Converted on construction to int64 and float64 arrays: numbers given
-    as strings are a ``TypeError``, a wrong shape or row count an
-    :class:`atomnav.InputError`, both naming the field."""
+    """Star observations, one row per star.
+
+    Converted on construction to int64 and float64 arrays: numbers given as strings are a
+    ``TypeError``, a wrong shape or row count an :class:`atomnav.InputError`, both naming
+    the field.
+
+    Parameters
+    ----------
+    epoch : array_like of int, shape (N,)
+        Epoch index of each star.
+    camera : array_like of int, shape (N,)
+        Camera index of each star.
+    s_cf : array_like, shape (N, 3)
+        Measured unit direction in the camera frame.
+    g : array_like, shape (N, 3)
+        Catalog unit direction in GCRS.
+    """
 
     epoch: np.ndarray
     camera: np.ndarray
