@@ -36,7 +36,26 @@ class ArimaStateSpace:
 
     ``ar`` = φ, ``ma`` = β (statsmodels' sign convention, Niu et al. 2025 Eqs. 6–8), ``sigma2`` = σ_a² in
     the rate unit squared. ``noise_form="paper"``: the paper's B with Q = σ²I
-    (default); ``"exact"``: X = [ω…, a_k…], G = e₀ + e_r, scalar Q = σ² (docs/departures.md#arma-noise-form)."""
+    (default); ``"exact"``: X = [ω…, a_k…], G = e₀ + e_r, scalar Q = σ² (docs/departures.md#arma-noise-form).
+
+    Parameters
+    ----------
+    ar : sequence of float (p,)
+        AR coefficients φ (statsmodels' sign convention).
+    ma : sequence of float (q,)
+        MA coefficients β.
+    sigma2 : float
+        Innovation variance σ_a², rate unit squared (> 0).
+    d : int, default 1
+        Order of differencing.
+    noise_form : {"paper", "exact"}, default "paper"
+        Form of the process noise, as above.
+
+    References
+    ----------
+    G. E. P. Box and G. M. Jenkins, *Time Series Analysis: Forecasting and Control*
+    (Holden-Day, 1970). X. Niu et al. 2025, Eqs. 6–8, 14, 16.
+    """
 
     ar: tuple
     ma: tuple
@@ -55,12 +74,34 @@ class ArimaStateSpace:
     @classmethod
     def from_arma(cls, ar, ma, sigma2: float, d: int = 1, noise_form: str = "paper") -> "ArimaStateSpace":
         """The state-space form of an ARIMA(len(ar), d, len(ma)) model (checked as the
-        constructor checks it)."""
+        constructor checks it).
+
+        Parameters
+        ----------
+        ar, ma, sigma2, d, noise_form
+            As in :class:`ArimaStateSpace`.
+
+        Returns
+        -------
+        ArimaStateSpace
+            The model.
+        """
         return cls(ar, ma, sigma2, d, noise_form)
 
     @classmethod
     def paper(cls, noise_form: str = "paper") -> "ArimaStateSpace":
-        """The paper's ARIMA(2,1,1): φ = (−0.018, 0.029), β₁ = −0.99, σ_a² = 0.035 (°/h)²."""
+        """The paper's ARIMA(2,1,1): φ = (−0.018, 0.029), β₁ = −0.99, σ_a² = 0.035 (°/h)².
+
+        Parameters
+        ----------
+        noise_form : {"paper", "exact"}, default "paper"
+            As in :class:`ArimaStateSpace`.
+
+        Returns
+        -------
+        ArimaStateSpace
+            The model of Niu et al. 2025, Eq. 10 (rate in °/h).
+        """
         return cls(PAPER_AR, PAPER_MA, PAPER_SIGMA2, 1, noise_form)
 
     @property
@@ -111,7 +152,34 @@ class ArmaFilterConfig:
     R₀ = Q); ``adaptive`` one of ``_core.OPTIONS["Adaptive"]`` ("fixed", "literal",
     "differenced" — Niu et al. 2025, Eq. 17 — or "sage_husa" with forgetting factor ``b``,
     optional Q adaptation ``adapt_q`` and fading ``fading``); ``x0`` "zeros" or "first";
-    P₀ = ``p0``·I."""
+    P₀ = ``p0``·I.
+
+    Parameters
+    ----------
+    ar, ma : sequence of float
+        AR coefficients φ (p,) and MA coefficients β (q,).
+    sigma2 : float
+        Innovation variance σ_a², rate unit squared.
+    d : int, default 1
+        Order of differencing.
+    noise_form : {"paper", "exact"}, default "paper"
+        As in :class:`ArimaStateSpace`.
+    r0 : float, optional
+        Initial (and, for "fixed", constant) measurement variance R₀, rate unit squared;
+        None: ``sigma2`` (the paper's R₀ = Q).
+    adaptive : {"fixed", "literal", "differenced", "sage_husa"}, default "fixed"
+        Measurement-variance adaptation.
+    b : float, default 0.98
+        Sage–Husa forgetting factor.
+    adapt_q : bool, default False
+        Sage–Husa: adapt Q as well.
+    fading : bool, default False
+        Sage–Husa: strong-tracking fading factor.
+    x0 : {"zeros", "first"}, default "zeros"
+        Initial state: zeros (paper) or the first sample ω₁.
+    p0 : float, default 1.0
+        Initial covariance P₀ = p0·I, rate unit squared.
+    """
 
     ar: tuple
     ma: tuple
@@ -135,24 +203,80 @@ class ArmaFilterConfig:
 
     @classmethod
     def for_model(cls, model: ArimaStateSpace, **options) -> "ArmaFilterConfig":
-        """The configuration of a filter on ``model`` with the given filter ``options``."""
+        """The configuration of a filter on ``model`` with the given filter ``options``.
+
+        Parameters
+        ----------
+        model : ArimaStateSpace
+            Gives ``ar``, ``ma``, ``sigma2``, ``d`` and ``noise_form``.
+        **options
+            The filter fields (``r0``, ``adaptive``, ``b``, ``adapt_q``, ``fading``,
+            ``x0``, ``p0``).
+
+        Returns
+        -------
+        ArmaFilterConfig
+            The checked configuration.
+        """
         instance(model, ArimaStateSpace, "model")
         return cls(model.ar, model.ma, model.sigma2, d=model.d, noise_form=model.noise_form, **options)
 
     def to_dict(self) -> dict:
-        """The fields as plain Python values (lists for ``ar`` and ``ma``)."""
+        """The fields as plain Python values.
+
+        Returns
+        -------
+        dict
+            Field name to value (lists for ``ar`` and ``ma``).
+        """
         d = {f.name: getattr(self, f.name) for f in fields(self) if f.init}
         return {**d, "ar": list(self.ar), "ma": list(self.ma)}
 
     @classmethod
     def from_dict(cls, d: dict) -> "ArmaFilterConfig":
+        """The configuration saved by :meth:`to_dict`.
+
+        Parameters
+        ----------
+        d : dict
+            Field name to value.
+
+        Returns
+        -------
+        ArmaFilterConfig
+            The checked configuration.
+        """
         return cls(**d)
 
     def to_json(self) -> str:
+        """The configuration as JSON, to save beside the results.
+
+        Returns
+        -------
+        str
+            JSON object of :meth:`to_dict`.
+        """
         return json.dumps(self.to_dict())
 
     @classmethod
     def from_json(cls, text: str) -> "ArmaFilterConfig":
+        """The configuration saved by :meth:`to_json`.
+
+        Parameters
+        ----------
+        text : str
+            JSON object of the fields.
+
+        Returns
+        -------
+        ArmaFilterConfig
+            The checked configuration.
+
+        Raises
+        ------
+        atomnav.InputError
+            Naming ``text`` when it is not JSON.
+        """
         try:
             d = json.loads(text)
         except json.JSONDecodeError as e:
@@ -162,8 +286,18 @@ class ArmaFilterConfig:
 
 @dataclass
 class KalmanResult:
-    """Filtered rate ``omega_hat`` (N,), the measurement variance ``r`` used at each step
-    (N,) and the gains ``gain`` (N, n); the histories are empty when not recorded."""
+    """Result of a Kalman filter run on a rate series; the histories are empty when not
+    recorded.
+
+    Attributes
+    ----------
+    omega_hat : numpy.ndarray (N,)
+        Filtered rate, unit of the input.
+    r : numpy.ndarray (N,)
+        Measurement variance used at each step, unit squared.
+    gain : numpy.ndarray (N, n)
+        Kalman gains.
+    """
 
     omega_hat: np.ndarray
     r: np.ndarray
@@ -180,7 +314,22 @@ def _mode(adaptive) -> str:
 
 def filter_series(omega, config: ArmaFilterConfig, *, record: bool = True) -> KalmanResult:
     """Kalman filter of the rate series ``omega`` as ``config`` describes (Niu et al.
-    2025, Eq. 15); the R and gain histories only when ``record``."""
+    2025, Eq. 15); the R and gain histories only when ``record``.
+
+    Parameters
+    ----------
+    omega : array_like (N,)
+        Rate series, unit U (N ≥ 1).
+    config : ArmaFilterConfig
+        Model and filter settings.
+    record : bool, default True
+        Keep the R and gain histories.
+
+    Returns
+    -------
+    KalmanResult
+        Filtered rate and histories.
+    """
     instance(config, ArmaFilterConfig, "config")
     w = vector(omega, None, "omega")
     if w.size == 0:
@@ -193,7 +342,30 @@ def kalman(omega, model: ArimaStateSpace, r0: float | None = None, adaptive=None
 
     ``adaptive``: None (fixed R ≡ r0), ``"differenced"`` (default reading of Eq. 17, also
     selected by ``True``) or ``"literal"``. ``r0`` defaults to model.sigma2 (the paper's
-    R₀ = Q); ``x0="zeros"`` (paper) or ``"first"`` (start at ω₁); P₀ = p0·I."""
+    R₀ = Q); ``x0="zeros"`` (paper) or ``"first"`` (start at ω₁); P₀ = p0·I.
+
+    Parameters
+    ----------
+    omega : array_like (N,)
+        Rate series, unit U.
+    model : ArimaStateSpace
+        ARIMA model of the series.
+    r0 : float, optional
+        Measurement variance R₀, U² (default ``model.sigma2``).
+    adaptive : None, bool or str, default None
+        None/False (fixed), True or "differenced", or "literal".
+    x0 : {"zeros", "first"}, default "zeros"
+        Initial state.
+    p0 : float, default 1.0
+        Initial covariance P₀ = p0·I, U².
+    record : bool, default True
+        Keep the R and gain histories.
+
+    Returns
+    -------
+    KalmanResult
+        Filtered rate and histories.
+    """
     cfg = ArmaFilterConfig.for_model(model, r0=r0, adaptive=_mode(adaptive), x0=x0, p0=p0)
     return filter_series(omega, cfg, record=record)
 
@@ -201,14 +373,58 @@ def kalman(omega, model: ArimaStateSpace, r0: float | None = None, adaptive=None
 def sage_husa(omega, model: ArimaStateSpace, b: float = 0.98, *, adapt_q: bool = False, fading: bool = False, r0: float | None = None, x0: str = "zeros", p0: float = 1.0, record: bool = True) -> KalmanResult:
     """Sage–Husa adaptive filter (the standard form; Niu et al. 2025 give no equations for it):
     R̂_k = (1−d_k)R̂_{k−1} + d_k(ε_k² − HP⁻Hᵀ), d_k = (1−b)/(1−b^k); optional Q
-    adaptation and strong-tracking fading factor (ρ = 0.95)."""
+    adaptation and strong-tracking fading factor (ρ = 0.95).
+
+    Parameters
+    ----------
+    omega : array_like (N,)
+        Rate series, unit U.
+    model : ArimaStateSpace
+        ARIMA model of the series.
+    b : float, default 0.98
+        Forgetting factor.
+    adapt_q : bool, default False
+        Adapt Q as well.
+    fading : bool, default False
+        Apply the strong-tracking fading factor.
+    r0 : float, optional
+        Initial measurement variance R₀, U² (default ``model.sigma2``).
+    x0 : {"zeros", "first"}, default "zeros"
+        Initial state.
+    p0 : float, default 1.0
+        Initial covariance P₀ = p0·I, U².
+    record : bool, default True
+        Keep the R and gain histories.
+
+    Returns
+    -------
+    KalmanResult
+        Filtered rate and histories.
+
+    References
+    ----------
+    A. P. Sage and G. W. Husa, "Adaptive filtering with unknown prior statistics",
+    Proc. Joint Automatic Control Conference (1969).
+    """
     cfg = ArmaFilterConfig.for_model(model, r0=r0, adaptive="sage_husa", b=b, adapt_q=adapt_q, fading=fading, x0=x0, p0=p0)
     return filter_series(omega, cfg, record=record)
 
 
 def steady_state_gain(model: ArimaStateSpace, r: float):
-    """Steady state of the fixed filter with measurement variance ``r``:
-    (K∞ (n,), P⁻∞ (n, n), P⁺∞ (n, n))."""
+    """Steady state of the fixed filter with measurement variance ``r``.
+
+    Parameters
+    ----------
+    model : ArimaStateSpace
+        ARIMA model.
+    r : float
+        Measurement variance, rate unit squared (> 0).
+
+    Returns
+    -------
+    tuple
+        (K∞ (n,), P⁻∞ (n, n), P⁺∞ (n, n)).
+    """
     instance(model, ArimaStateSpace, "model")
     return _core.steady_state_gain(*model._args()[:3], r=positive(r, "r"), d=model.d, noise_form=model.noise_form)
 
@@ -218,7 +434,19 @@ class KalmanStream(Stateful):
     :class:`KalmanResult` of that chunk; the state carries over between chunks. One object
     may be shared by threads (calls run one after another) and pickled mid-stream.
     ``adaptive`` as in :class:`ArmaFilterConfig` (None or False: "fixed", True: the
-    default reading of Eq. 17); :meth:`from_config` takes a saved configuration."""
+    default reading of Eq. 17); :meth:`from_config` takes a saved configuration.
+
+    Parameters
+    ----------
+    model : ArimaStateSpace
+        ARIMA model of the series.
+    adaptive : None, bool or str, default "fixed"
+        As above.
+    r0, b, adapt_q, fading, x0, p0
+        As in :class:`ArmaFilterConfig`.
+    record : bool, default True
+        Keep the R and gain histories.
+    """
 
     def __init__(self, model: ArimaStateSpace, adaptive="fixed", *, r0: float | None = None, b: float = 0.98, adapt_q: bool = False, fading: bool = False, x0: str = "zeros", p0: float = 1.0, record: bool = True):
         cfg = ArmaFilterConfig.for_model(model, r0=r0, adaptive=_mode(adaptive), b=b, adapt_q=adapt_q, fading=fading, x0=x0, p0=p0)
@@ -227,6 +455,20 @@ class KalmanStream(Stateful):
 
     @classmethod
     def from_config(cls, config: ArmaFilterConfig, *, record: bool = True) -> "KalmanStream":
+        """A stream of the filter a saved configuration describes.
+
+        Parameters
+        ----------
+        config : ArmaFilterConfig
+            Model and filter settings.
+        record : bool, default True
+            Keep the R and gain histories.
+
+        Returns
+        -------
+        KalmanStream
+            A stream at the start of the record.
+        """
         instance(config, ArmaFilterConfig, "config")
         s = cls.__new__(cls)
         s._f, s.config = _core.KalmanStream(config._core, record=record), config
@@ -234,4 +476,16 @@ class KalmanStream(Stateful):
 
     @serialized
     def update(self, chunk) -> KalmanResult:
+        """Filter the next samples; the state carries over from the previous chunk.
+
+        Parameters
+        ----------
+        chunk : array_like (K,)
+            Next rate samples, unit of the stream.
+
+        Returns
+        -------
+        KalmanResult
+            The result for this chunk.
+        """
         return KalmanResult(*self._f.update(vector(chunk, None, "chunk")))
