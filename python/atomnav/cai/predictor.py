@@ -32,17 +32,44 @@ JACOBIAN_PARAMS = tuple(_core.CAI_JACOBIAN_PARAMS)
 
 
 def k_eff(wavelength: float = LAMBDA_RB87) -> float:
-    """Effective two-photon wave number 4π/λ (rad/m) of a wavelength λ (m)."""
+    """Effective two-photon wave number 4π/λ of a wavelength λ.
+
+    Parameters
+    ----------
+    wavelength : float
+        Laser wavelength λ (m); default the ⁸⁷Rb D2 line, :data:`LAMBDA_RB87`.
+
+    Returns
+    -------
+    float
+        k_eff = 4π/λ (rad/m).
+    """
     with np.errstate(over="ignore"):
         return float(finite_result(4.0 * np.pi / np.float64(plausibility.wavelength(positive(wavelength, "wavelength"), "wavelength")), "wavelength", "the wave number 4π/λ"))
 
 
 @dataclass
 class Channels(ConfigMixin):
-    """Interferometer channels: k (C, 3) rad/m in s, lever (C, 3) m from the IMU to the
-    release point in b, c_sb (C, 3, 3) rotation b → s, v0 (C, 3) m/s initial atom velocity
-    relative to s, and a name per channel. Convertible to and from dict / JSON
-    (``to_dict``, ``from_dict``, ``to_json``, ``from_json``)."""
+    """Interferometer channels: wave vectors, lever arms, mounting and launch velocities.
+
+    Convertible to and from dict / JSON (``to_dict``, ``from_dict``, ``to_json``,
+    ``from_json``).
+
+    Parameters
+    ----------
+    k : array_like, shape (C, 3)
+        Effective wave vector of each channel in the sensor frame s (rad/m).
+    lever : array_like, shape (C, 3) or (3,)
+        Lever arm from the IMU to the release point of each channel in the body frame b
+        (m); one row is used for all channels.
+    c_sb : array_like, shape (C, 3, 3) or (3, 3)
+        Rotation b → s of each channel (may carry a misalignment); one matrix is used for
+        all channels.
+    v0 : array_like, shape (C, 3) or (3,)
+        Initial atom velocity relative to s, in s (m/s).
+    names : list of str, optional
+        A name per channel (default ``ch0``, ``ch1``, ...).
+    """
 
     _ARRAYS = ("k", "lever", "c_sb", "v0", "names")
 
@@ -74,8 +101,27 @@ class Channels(ConfigMixin):
 
     @classmethod
     def cyclic(cls, k: float = K_RB87, v0: float = 2.8, lever=(0.0, 0.0, 0.0), c_sb=None) -> "Channels":
-        """Six channels of the multi-axis sensor of Tennstedt et al. 2023: k along e_j, ensembles
-        A/B with v0 = ±v0 e_{(j+1) mod 3} (docs/departures.md#ensemble-geometry); names x_A, x_B, y_A, ..."""
+        """Six channels of the multi-axis sensor of Tennstedt et al. 2023.
+
+        k along e_j, ensembles A/B with v0 = ±v0 e_{(j+1) mod 3} (the geometry is
+        described in ``docs/departures.md#ensemble-geometry``); names x_A, x_B, y_A, ...
+
+        Parameters
+        ----------
+        k : float
+            Magnitude of the effective wave number (rad/m).
+        v0 : float
+            Launch speed of the atoms relative to the sensor (m/s).
+        lever : array_like, shape (3,) or (6, 3)
+            Lever arm from the IMU to the release point, body frame (m).
+        c_sb : array_like, shape (3, 3) or (6, 3, 3), optional
+            Rotation b → s (default identity).
+
+        Returns
+        -------
+        Channels
+            The six channels x_A, x_B, y_A, y_B, z_A, z_B.
+        """
         k, v0 = finite_scalar(k, "k"), finite_scalar(v0, "v0")
         ks, vs, names = [], [], []
         for j, ax in enumerate("xyz"):
@@ -121,8 +167,20 @@ def _setup(t, specific_force, angular_rate, shots, T, channels, angular_accelera
 
 @dataclass
 class PhasePrediction:
-    """Predicted phases (rad), each array (n_shots, n_channels); ``total`` is the sum of the
-    terms acc, rot, cen, eul, mix, gg (docs/departures.md#per-term-breakdown)."""
+    """Predicted phases of every shot and channel, with their breakdown into terms.
+
+    ``total`` is the sum of the terms acc, rot, cen, eul, mix, gg (the breakdown is
+    described in ``docs/departures.md#per-term-breakdown``).
+
+    Attributes
+    ----------
+    shots : numpy.ndarray, shape (S,)
+        Shot start times (s).
+    channels : Channels
+        The C interferometer channels.
+    terms : dict of str to numpy.ndarray, shape (S, C)
+        Phase (rad) per term, keyed by :data:`TERMS` (``total`` first).
+    """
 
     shots: np.ndarray
     channels: Channels
@@ -133,7 +191,14 @@ class PhasePrediction:
         return self.terms["total"]
 
     def frame(self) -> pd.DataFrame:
-        """Long table: shot_start_s, channel, and one ``<term>_rad`` column per term."""
+        """The prediction as a long table.
+
+        Returns
+        -------
+        pandas.DataFrame
+            One row per shot and channel: ``shot_start_s``, ``channel`` and one
+            ``<term>_rad`` column per term of :data:`TERMS` (rad).
+        """
         n, c = self.total.shape
         d = {"shot_start_s": np.repeat(self.shots, c), "channel": np.tile(self.channels.names, n)}
         d.update({f"{k}_rad": v.ravel() for k, v in self.terms.items()})
@@ -143,19 +208,53 @@ class PhasePrediction:
 def predict_phase(t, specific_force, angular_rate, shots, T: float, channels: Channels, *, angular_acceleration=None,
                   omega_dot: str | None = None, savgol_half_width: int = 2, interpolation: str = "linear",
                   substeps: int = 1, gradient=None, bias_a=0.0, bias_g=0.0) -> PhasePrediction:
-    """Atom strapdown phase of every shot and channel (Tennstedt et al. 2023 Eqs. 5–8;
-    docs/departures.md#full-phase-predictor), with breakdown.
+    """Atom strapdown phase of every shot and channel, with breakdown (Tennstedt et al. 2023, Eqs. 5–8).
 
-    t (N,) s; specific_force (N, 3) m/s² and angular_rate (N, 3) rad/s in the IMU body
-    frame; shots: start times (s) of non-overlapping shots (pulses at t_s, t_s + T,
-    t_s + 2T, inside the record; need not coincide with samples); T pulse separation (s).
-    omega_dot: source of ω̇ for the Euler terms — "given" (default when
-    ``angular_acceleration`` (N, 3) rad/s² is passed, e.g. from a simulator), "savgol"
-    (default otherwise: 5-point quadratic Savitzky–Golay derivative of the gyro, half width
-    ``savgol_half_width``), "pwl"
-    (derivative of the gyro interpolant), "zero" (no Euler terms). interpolation "linear" or "cubic" (error ∝ h⁴ instead
-    of h²). gradient: Γ_s (3, 3) 1/s² in s. bias_a (m/s²), bias_g (rad/s): estimated IMU
-    biases, subtracted from the inputs.
+    Departures from the paper are described in
+    ``docs/departures.md#full-phase-predictor``.
+
+    Parameters
+    ----------
+    t : array_like, shape (N,)
+        IMU sample times (s), increasing.
+    specific_force : array_like, shape (N, 3)
+        Specific force in the IMU body frame (m/s²).
+    angular_rate : array_like, shape (N, 3)
+        Angular rate in the IMU body frame (rad/s).
+    shots : float or array_like, shape (S,)
+        Start times (s) of non-overlapping shots: pulses at t_s, t_s + T, t_s + 2T, inside
+        the record; they need not coincide with samples.
+    T : float
+        Pulse separation (s).
+    channels : Channels
+        The interferometer channels (C of them).
+    angular_acceleration : array_like, shape (N, 3), optional
+        Angular acceleration ω̇ in the body frame (rad/s²), e.g. from a simulator.
+    omega_dot : {"given", "savgol", "pwl", "zero"}, optional
+        Source of ω̇ for the Euler terms: "given" (default when ``angular_acceleration``
+        is passed), "savgol" (default otherwise: quadratic Savitzky–Golay derivative of the
+        gyro, 5 points with half width ``savgol_half_width`` = 2), "pwl" (derivative of the
+        gyro interpolant), "zero" (no Euler terms).
+    savgol_half_width : int
+        Half width m of the Savitzky–Golay window (2m + 1 samples).
+    interpolation : {"linear", "cubic"}
+        Interpolation of the IMU inputs between samples; "cubic" makes the error ∝ h⁴
+        instead of h² (h the sample interval).
+    substeps : int
+        RK4 steps per interval of the integration grid (the IMU sample times and the pulse
+        times).
+    gradient : array_like, shape (3, 3), optional
+        Gravity-gradient tensor Γ_s in the sensor frame s (1/s²); None: no gradient.
+    bias_a : float or array_like, shape (3,)
+        Estimated accelerometer bias (m/s²), subtracted from ``specific_force``
+        (measured = true + bias).
+    bias_g : float or array_like, shape (3,)
+        Estimated gyro bias (rad/s), subtracted from ``angular_rate``.
+
+    Returns
+    -------
+    PhasePrediction
+        Phases (rad) of shape (S, C), total and per term.
     """
     shots, setup = _setup(t, specific_force, angular_rate, shots, T, channels, angular_acceleration, omega_dot,
                           savgol_half_width, interpolation, substeps, gradient, bias_a, bias_g)
@@ -167,11 +266,60 @@ def phase_jacobian(t, specific_force, angular_rate, shots, T: float, channels: C
                    fd_steps=None, angular_acceleration=None, omega_dot: str | None = None, savgol_half_width: int = 2,
                    interpolation: str = "linear", substeps: int = 1, gradient=None, bias_a=0.0,
                    bias_g=0.0) -> np.ndarray:
-    """∂φ/∂(b_a, b_g, l, γ) (n_shots, n_channels, 12), columns :data:`JACOBIAN_PARAMS`, units
-    rad per (m/s², rad/s, m, rad). Analytic tangent-linear derivative of the predictor at
-    the given bias estimates; Euler terms (ω̇) are excluded from the linearisation unless
-    ``euler``. With ``fd_steps = (db_a, db_g, dl, dγ)`` the same derivative is computed by
-    central finite differences of :func:`predict_phase` (the checker)."""
+    """Jacobian ∂φ/∂(b_a, b_g, l, γ) of the predicted phase.
+
+    Analytic tangent-linear derivative of the predictor of :func:`predict_phase` at the
+    given bias estimates; Euler terms (ω̇) are excluded from the linearisation unless
+    ``euler``.
+
+    Parameters
+    ----------
+    t : array_like, shape (N,)
+        IMU sample times (s), increasing.
+    specific_force : array_like, shape (N, 3)
+        Specific force in the IMU body frame (m/s²).
+    angular_rate : array_like, shape (N, 3)
+        Angular rate in the IMU body frame (rad/s).
+    shots : float or array_like, shape (S,)
+        Start times (s) of non-overlapping shots: pulses at t_s, t_s + T, t_s + 2T, inside
+        the record; they need not coincide with samples.
+    T : float
+        Pulse separation (s).
+    channels : Channels
+        The interferometer channels (C of them).
+    euler : bool
+        Keep the Euler terms (ω̇) in the linearisation.
+    fd_steps : array_like, shape (4,), optional
+        Steps (db_a m/s², db_g rad/s, dl m, dγ rad): compute the same derivative by
+        central finite differences of :func:`predict_phase` instead (the checker).
+    angular_acceleration : array_like, shape (N, 3), optional
+        Angular acceleration ω̇ in the body frame (rad/s²), e.g. from a simulator.
+    omega_dot : {"given", "savgol", "pwl", "zero"}, optional
+        Source of ω̇ for the Euler terms: "given" (default when ``angular_acceleration``
+        is passed), "savgol" (default otherwise: quadratic Savitzky–Golay derivative of the
+        gyro, 5 points with half width ``savgol_half_width`` = 2), "pwl" (derivative of the
+        gyro interpolant), "zero" (no Euler terms).
+    savgol_half_width : int
+        Half width m of the Savitzky–Golay window (2m + 1 samples).
+    interpolation : {"linear", "cubic"}
+        Interpolation of the IMU inputs between samples; "cubic" makes the error ∝ h⁴
+        instead of h² (h the sample interval).
+    substeps : int
+        RK4 steps per interval of the integration grid (the IMU sample times and the pulse
+        times).
+    gradient : array_like, shape (3, 3), optional
+        Gravity-gradient tensor Γ_s in the sensor frame s (1/s²); None: no gradient.
+    bias_a : float or array_like, shape (3,)
+        Estimated accelerometer bias (m/s²), subtracted from ``specific_force``
+        (measured = true + bias).
+    bias_g : float or array_like, shape (3,)
+        Estimated gyro bias (rad/s), subtracted from ``angular_rate``.
+
+    Returns
+    -------
+    numpy.ndarray, shape (S, C, 12)
+        Columns :data:`JACOBIAN_PARAMS`, in rad per (m/s², rad/s, m, rad).
+    """
     shots, setup = _setup(t, specific_force, angular_rate, shots, T, channels, angular_acceleration, omega_dot,
                           savgol_half_width, interpolation, substeps, gradient, bias_a, bias_g)
     steps = None if fd_steps is None else tuple(vector(fd_steps, 4, "fd_steps"))
@@ -179,8 +327,25 @@ def phase_jacobian(t, specific_force, angular_rate, shots, T: float, channels: C
 
 
 def check_jacobian(*args, fd_steps=(1e-3, 1e-4, 1e-3, 1e-4), **kwargs) -> dict:
-    """Compare :func:`phase_jacobian` with its finite-difference version. Returns the
-    analytic and FD arrays and the maximum relative difference per parameter."""
+    """Compare :func:`phase_jacobian` with its finite-difference version.
+
+    Parameters
+    ----------
+    *args
+        Positional arguments of :func:`phase_jacobian` (t, specific_force, angular_rate,
+        shots, T, channels).
+    fd_steps : array_like, shape (4,)
+        Finite-difference steps (db_a m/s², db_g rad/s, dl m, dγ rad).
+    **kwargs
+        Keyword arguments of :func:`phase_jacobian`.
+
+    Returns
+    -------
+    dict
+        ``analytic`` and ``finite_difference``: the two (S, C, 12) Jacobians (rad per
+        parameter unit); ``max_rel_diff``: the maximum relative difference per parameter
+        of :data:`JACOBIAN_PARAMS`.
+    """
     an = phase_jacobian(*args, **kwargs)
     fd = phase_jacobian(*args, fd_steps=fd_steps, **kwargs)
     scale = np.maximum(np.abs(an), 1e-12 + 1e-9 * np.abs(an).max())
@@ -189,8 +354,27 @@ def check_jacobian(*args, fd_steps=(1e-3, 1e-4, 1e-3, 1e-4), **kwargs) -> dict:
 
 
 def readout_jacobian(phase_jac, phi_hat, phi0, contrast: float = 1.0) -> np.ndarray:
-    """∂p/∂θ of p = o − (C/2) cos(φ̂ + φ0) (Tennstedt et al. 2021 Eq. 10): (C/2) sin(φ̂ + φ0) ∂φ/∂θ;
-    at mid-fringe (φ̂ + φ0 = π/2) it is (C/2) ∂φ/∂θ. Shapes broadcast over (shots, channels)."""
+    """Readout Jacobian ∂p/∂θ = (C/2) sin(φ̂ + φ0) ∂φ/∂θ of p = o − (C/2) cos(φ̂ + φ0).
+
+    Tennstedt et al. 2021, Eq. 10; at mid-fringe (φ̂ + φ0 = π/2) it is (C/2) ∂φ/∂θ.
+    Shapes broadcast over (shots, channels).
+
+    Parameters
+    ----------
+    phase_jac : array_like, shape (S, C, P)
+        Phase Jacobian ∂φ/∂θ (rad per parameter unit), e.g. from :func:`phase_jacobian`.
+    phi_hat : float or array_like, shape (S, C)
+        Predicted phase φ̂ (rad).
+    phi0 : float or array_like, shape (S, C)
+        Laser phase φ0 (rad).
+    contrast : float
+        Fringe contrast C ∈ (0, 1].
+
+    Returns
+    -------
+    numpy.ndarray, shape (S, C, P)
+        ∂p/∂θ (population per parameter unit).
+    """
     jac = as_floats(phase_jac, "phase_jac")
     phi_hat, phi0 = as_floats(phi_hat, "phi_hat"), as_floats(phi0, "phi0")
     for a, name in ((jac, "phase_jac"), (phi_hat, "phi_hat"), (phi0, "phi0")):
@@ -207,10 +391,22 @@ _EMPTY_SINES = np.zeros((0, 4))
 
 @dataclass
 class SineMotion:
-    """IMU motion in an inertial frame: per axis c0 + c1 t + c2 t² + Σ A sin(2πft + ϕ) for the
-    position (m) and for the z-y-x Euler angles roll, pitch, yaw (rad). ``*_poly`` (3, 3):
-    row = axis, columns c0, c1, c2; ``*_sines`` rows [axis, amplitude, frequency Hz,
-    phase rad]."""
+    """IMU motion in an inertial frame, polynomial plus sines per axis.
+
+    Per axis c0 + c1 t + c2 t² + Σ A sin(2πft + ϕ) for the position (m) and for the
+    z-y-x Euler angles roll, pitch, yaw (rad).
+
+    Parameters
+    ----------
+    position_poly : array_like, shape (3, 3)
+        Row = axis, columns c0 (m), c1 (m/s), c2 (m/s²).
+    position_sines : array_like, shape (M, 4)
+        Rows [axis, amplitude m, frequency Hz, phase rad].
+    attitude_poly : array_like, shape (3, 3)
+        Row = Euler angle (roll, pitch, yaw), columns c0 (rad), c1 (rad/s), c2 (rad/s²).
+    attitude_sines : array_like, shape (M, 4)
+        Rows [axis, amplitude rad, frequency Hz, phase rad].
+    """
 
     position_poly: np.ndarray = field(default_factory=lambda: np.zeros((3, 3)))
     position_sines: np.ndarray = field(default_factory=lambda: _EMPTY_SINES)
@@ -227,8 +423,17 @@ class SineMotion:
 
 @dataclass
 class YawDrive:
-    """Drive of Tennstedt et al. 2023, Fig. 7: forward speed (m/s) along body x, level, yaw rate
-    ω_z = amplitude · sin(2πt/period) (rad/s)."""
+    """Drive of Tennstedt et al. 2023, Fig. 7: level, forward along body x, sinusoidal yaw rate.
+
+    Parameters
+    ----------
+    speed : float
+        Forward speed along body x (m/s).
+    yaw_rate_amplitude : float
+        Amplitude of the yaw rate ω_z = amplitude · sin(2πt/period) (rad/s).
+    period : float
+        Period of the yaw rate (s).
+    """
 
     speed: float = 1.0
     yaw_rate_amplitude: float = 0.05
@@ -245,10 +450,31 @@ def _gravity(gravity, gradient, t_ref):
 
 
 def motion_imu(motion, t, *, gravity=(0.0, 0.0, 0.0), gradient=None, t_ref: float = 0.0):
-    """Ideal IMU output of an analytic motion at times t (s): specific force (N, 3) m/s²,
-    angular rate (N, 3) rad/s and angular acceleration (N, 3) rad/s², body frame.
-    gravity: uniform g (m/s², inertial; zero = kinematic mode); gradient Γ_i (3, 3) 1/s²
-    about the IMU position at ``t_ref``."""
+    """Ideal IMU output of an analytic motion, body frame.
+
+    Parameters
+    ----------
+    motion : SineMotion or YawDrive
+        The analytic body motion.
+    t : float or array_like, shape (N,)
+        Times (s).
+    gravity : array_like, shape (3,)
+        Uniform gravity g in the inertial frame (m/s²); zero = kinematic mode.
+    gradient : array_like, shape (3, 3), optional
+        Gravity-gradient tensor Γ_i in the inertial frame (1/s²), about the IMU position
+        at ``t_ref``; None: no gradient.
+    t_ref : float
+        Time (s) of the position the gradient is taken about.
+
+    Returns
+    -------
+    specific_force : numpy.ndarray, shape (N, 3)
+        Specific force (m/s²).
+    angular_rate : numpy.ndarray, shape (N, 3)
+        Angular rate (rad/s).
+    angular_acceleration : numpy.ndarray, shape (N, 3)
+        Angular acceleration (rad/s²).
+    """
     instance(motion, (SineMotion, YawDrive), "motion")
     g = _gravity(gravity, gradient, t_ref)
     return motion._native().imu(vector(np.atleast_1d(as_floats(t, "t")), None, "t"), g)
@@ -256,8 +482,33 @@ def motion_imu(motion, t, *, gravity=(0.0, 0.0, 0.0), gradient=None, t_ref: floa
 
 def oracle_phase(motion, shots, T: float, channels: Channels, *, gravity=(0.0, 0.0, 0.0), gradient=None,
                  t_ref: float = 0.0) -> np.ndarray:
-    """Exact phase (rad) (n_shots, n_channels) from the inertial oracle: ballistic
-    atom in the inertial frame, transformed into the rotating sensor frame at the pulses."""
+    """Exact phase from the inertial oracle.
+
+    The atom flies ballistically in the inertial frame and is transformed into the
+    rotating sensor frame at the pulses.
+
+    Parameters
+    ----------
+    motion : SineMotion or YawDrive
+        The analytic body motion.
+    shots : float or array_like, shape (S,)
+        Shot start times (s): pulses at t_s, t_s + T, t_s + 2T.
+    T : float
+        Pulse separation (s).
+    channels : Channels
+        The C interferometer channels.
+    gravity : array_like, shape (3,)
+        Uniform gravity g in the inertial frame (m/s²); zero = kinematic mode.
+    gradient : array_like, shape (3, 3), optional
+        Gravity-gradient tensor Γ_i (1/s²) about the IMU position at ``t_ref``.
+    t_ref : float
+        Time (s) of the position the gradient is taken about.
+
+    Returns
+    -------
+    numpy.ndarray, shape (S, C)
+        Phase (rad).
+    """
     instance(motion, (SineMotion, YawDrive), "motion")
     instance(channels, Channels, "channels")
     g = _gravity(gravity, gradient, t_ref)
@@ -279,29 +530,109 @@ def _closed(kind, k, v0, angular_rate, specific_force, T, angular_acceleration=(
 
 
 def phase_constant(k, v0, angular_rate, specific_force, T: float) -> np.ndarray:
-    """Exact phase (rad) per row of k (C, 3) for constant ω_s (rad/s) and f_s (m/s²) in s
-    (closed-form solution of the atom motion in the rotating sensor frame)."""
+    """Exact phase for constant angular rate and specific force.
+
+    Closed-form solution of the atom motion in the rotating sensor frame.
+
+    Parameters
+    ----------
+    k : array_like, shape (C, 3)
+        Effective wave vectors in the sensor frame s (rad/m).
+    v0 : array_like, shape (C, 3) or (3,)
+        Initial atom velocities relative to s (m/s).
+    angular_rate : array_like, shape (3,)
+        Constant angular rate ω_s in s (rad/s).
+    specific_force : array_like, shape (3,)
+        Constant specific force f_s in s (m/s²).
+    T : float
+        Pulse separation (s).
+
+    Returns
+    -------
+    numpy.ndarray, shape (C,)
+        Phase per row of ``k`` (rad).
+    """
     return _closed("exact", k, v0, plausibility.angular_rate(angular_rate, "angular_rate"), specific_force, plausibility.pulse_separation(T, "T"))
 
 
 def phase_series(k, v0, angular_rate, specific_force, T: float, angular_acceleration=(0.0, 0.0, 0.0),
                  gradient=None) -> np.ndarray:
-    """Fourth-order series in T of :func:`phase_constant` incl. ω̇ (rad/s²) and gradient Γ (1/s²) terms."""
+    """Fourth-order series in T of :func:`phase_constant`, including ω̇ and gravity-gradient terms.
+
+    Parameters
+    ----------
+    k : array_like, shape (C, 3)
+        Effective wave vectors in the sensor frame s (rad/m).
+    v0 : array_like, shape (C, 3) or (3,)
+        Initial atom velocities relative to s (m/s).
+    angular_rate : array_like, shape (3,)
+        Constant angular rate ω_s in s (rad/s).
+    specific_force : array_like, shape (3,)
+        Constant specific force f_s in s (m/s²).
+    T : float
+        Pulse separation (s).
+    angular_acceleration : array_like, shape (3,)
+        Constant angular acceleration ω̇ in s (rad/s²).
+    gradient : array_like, shape (3, 3), optional
+        Gravity-gradient tensor Γ in s (1/s²); None: no gradient.
+
+    Returns
+    -------
+    numpy.ndarray, shape (C,)
+        Phase per row of ``k`` (rad).
+    """
     return _closed("series", k, v0, plausibility.angular_rate(angular_rate, "angular_rate"), specific_force, plausibility.pulse_separation(T, "T"),
                    angular_acceleration, gradient)
 
 
 def phase_seed000(k, vbar, angular_rate, specific_force, T_total: float) -> np.ndarray:
-    """Tennstedt et al. 2021 Eq. 52 in the paper's convention: k·(¼ f − ½ ω×v̄) T0², T0 = total
-    interrogation time. Equals the library's first-order phase with k → −k, v0 = −v̄,
-    T = T0/2 (docs/departures.md#phase-convention-of-eq-52)."""
+    """Phase of Tennstedt et al. 2021, Eq. 52 in the paper's convention: k·(¼ f − ½ ω×v̄) T0².
+
+    Equals the library's first-order phase with k → −k, v0 = −v̄, T = T0/2 (see
+    ``docs/departures.md#phase-convention-of-eq-52``).
+
+    Parameters
+    ----------
+    k : array_like, shape (C, 3)
+        Effective wave vectors (rad/m).
+    vbar : array_like, shape (C, 3) or (3,)
+        Mean atom velocity v̄ of the paper (m/s).
+    angular_rate : array_like, shape (3,)
+        Constant angular rate ω (rad/s).
+    specific_force : array_like, shape (3,)
+        Constant specific force f (m/s²).
+    T_total : float
+        Total interrogation time T0 = 2T (s).
+
+    Returns
+    -------
+    numpy.ndarray, shape (C,)
+        Phase per row of ``k`` (rad).
+    """
     with renamed(v0="vbar", T="T_total"):
         return _closed("seed000", k, vbar, plausibility.angular_rate(angular_rate, "angular_rate"), specific_force,
                        plausibility.pulse_separation(T_total, "T_total", pulses=2))
 
 
 def sagnac_phase(k, v0, angular_rate, T: float) -> np.ndarray:
-    """Sagnac (Coriolis) term −2T² k·(ω×v0) (rad)."""
+    """Sagnac (Coriolis) term −2T² k·(ω×v0) of the phase.
+
+    Parameters
+    ----------
+    k : array_like, shape (C, 3) or (3,)
+        Effective wave vectors (rad/m).
+    v0 : array_like, shape (C, 3) or (3,)
+        Initial atom velocities relative to the sensor (m/s).
+    angular_rate : array_like, shape (3,)
+        Angular rate ω (rad/s).
+    T : float
+        Pulse separation (s).
+
+    Returns
+    -------
+    numpy.ndarray, shape (C,)
+        Sagnac phase per row of ``k`` (rad).
+    """
     k = rows(np.atleast_2d(as_floats(k, "k")), 3, "k")
     v0 = rows(broadcast(v0, k.shape, "v0"), 3, "v0")
     w = plausibility.angular_rate(vector(angular_rate, 3, "angular_rate"), "angular_rate")
@@ -311,20 +642,58 @@ def sagnac_phase(k, v0, angular_rate, T: float) -> np.ndarray:
 
 
 def t_sep_from_total(T_total: float) -> float:
-    """Pulse separation T = T0/2 of Tennstedt et al. 2021's total interrogation time T0 (s)
-    (docs/departures.md#interrogation-time-t0)."""
+    """Pulse separation T = T0/2 of Tennstedt et al. 2021's total interrogation time T0.
+
+    See ``docs/departures.md#interrogation-time-t0``.
+
+    Parameters
+    ----------
+    T_total : float
+        Total interrogation time T0 (s).
+
+    Returns
+    -------
+    float
+        Pulse separation T (s).
+    """
     return 0.5 * plausibility.pulse_separation(positive(T_total, "T_total"), "T_total", pulses=2)
 
 
 def total_from_t_sep(T: float) -> float:
-    """Tennstedt et al. 2021's total interrogation time T0 = 2T (s)."""
+    """Tennstedt et al. 2021's total interrogation time T0 = 2T.
+
+    Parameters
+    ----------
+    T : float
+        Pulse separation (s).
+
+    Returns
+    -------
+    float
+        Total interrogation time T0 (s).
+    """
     with np.errstate(over="ignore"):
         return float(finite_result(2.0 * np.float64(plausibility.pulse_separation(positive(T, "T"), "T")), "T", "2T"))
 
 
 def scale_factors(T: float, k: float = K_RB87, v0: float = 2.8) -> dict:
-    """Phase scale factors: ``acceleration`` kT² (rad per m/s²), ``sagnac`` 2kv0T² (rad per
-    rad/s), ``euler`` kv0T³ (rad per rad/s²)."""
+    """Phase scale factors of acceleration, rotation (Sagnac) and angular acceleration (Euler).
+
+    Parameters
+    ----------
+    T : float
+        Pulse separation (s).
+    k : float
+        Effective wave number (rad/m).
+    v0 : float
+        Atom launch speed relative to the sensor (m/s).
+
+    Returns
+    -------
+    dict
+        ``acceleration`` kT² (rad per m/s²), ``sagnac`` 2kv0T² (rad per rad/s),
+        ``euler`` kv0T³ (rad per rad/s²).
+    """
     T, k, v0 = np.float64(plausibility.pulse_separation(positive(T, "T"), "T")), finite_scalar(k, "k"), finite_scalar(v0, "v0")
     with np.errstate(over="ignore"):
         out = {"acceleration": k * T**2, "sagnac": 2 * k * v0 * T**2, "euler": k * v0 * T**3}
@@ -332,7 +701,20 @@ def scale_factors(T: float, k: float = K_RB87, v0: float = 2.8) -> dict:
 
 
 def dynamic_range(T: float, k: float = K_RB87) -> float:
-    """Acceleration span of one fringe flank, π/(kT²) (m/s²) (Tennstedt et al. 2023 Eq. 3)."""
+    """Acceleration span of one fringe flank, π/(kT²) (Tennstedt et al. 2023, Eq. 3).
+
+    Parameters
+    ----------
+    T : float
+        Pulse separation (s).
+    k : float
+        Effective wave number (rad/m).
+
+    Returns
+    -------
+    float
+        Dynamic range (m/s²).
+    """
     return np.pi / _kt2(k, T)
 
 
@@ -346,8 +728,22 @@ def _kt2(k: float, T: float) -> float:
 
 
 def capture_limits(T: float, k: float = K_RB87, v0: float = 2.8) -> dict:
-    """Largest bias errors keeping the phase error below π/2: accelerometer π/(2kT²) (m/s²),
-    gyro π/(2·2kv0T²) (rad/s) (Tennstedt et al. 2021, Fig. 3)."""
+    """Largest bias errors keeping the phase error below π/2 (Tennstedt et al. 2021, Fig. 3).
+
+    Parameters
+    ----------
+    T : float
+        Pulse separation (s).
+    k : float
+        Effective wave number (rad/m).
+    v0 : float
+        Atom launch speed relative to the sensor (m/s).
+
+    Returns
+    -------
+    dict
+        ``accelerometer`` π/(2kT²) (m/s²) and ``gyro`` π/(2·2kv0T²) (rad/s).
+    """
     s = scale_factors(T, positive(k, "k"), positive(v0, "v0"))
     with np.errstate(over="ignore", divide="ignore"):
         limits = {"accelerometer": 0.5 * np.pi / np.float64(s["acceleration"]), "gyro": 0.5 * np.pi / np.float64(s["sagnac"])}
@@ -355,9 +751,28 @@ def capture_limits(T: float, k: float = K_RB87, v0: float = 2.8) -> dict:
 
 
 def in_shot_noise_phase(q_accel: float, q_gyro: float, T: float, k: float = K_RB87, v0: float = 2.8) -> dict:
-    """Phase standard deviation (rad) caused by IMU white noise inside one shot:
-    ``accel`` k√(2q_a/3) T^{3/2} and ``gyro`` (Sagnac) 2kv0√(2q_g/3) T^{3/2},
-    with q the white-noise PSDs (m²/s³, rad²/s), from Var = q k² ∫w² dt, ∫w² = 2T³/3."""
+    """Phase standard deviation caused by IMU white noise inside one shot.
+
+    From Var = q k² ∫w² dt with ∫w² = 2T³/3 (Tennstedt et al. 2021, §2.4).
+
+    Parameters
+    ----------
+    q_accel : float
+        Accelerometer white-noise PSD q_a (m²/s³).
+    q_gyro : float
+        Gyro white-noise PSD q_g (rad²/s).
+    T : float
+        Pulse separation (s).
+    k : float
+        Effective wave number (rad/m).
+    v0 : float
+        Atom launch speed relative to the sensor (m/s).
+
+    Returns
+    -------
+    dict
+        ``accel`` k√(2q_a/3) T^{3/2} and ``gyro`` (Sagnac) 2kv0√(2q_g/3) T^{3/2}, in rad.
+    """
     T = np.float64(plausibility.pulse_separation(positive(T, "T"), "T"))
     q_accel, q_gyro = nonnegative(q_accel, "q_accel"), nonnegative(q_gyro, "q_gyro")
     k, v0 = finite_scalar(k, "k"), finite_scalar(v0, "v0")
@@ -367,14 +782,42 @@ def in_shot_noise_phase(q_accel: float, q_gyro: float, T: float, k: float = K_RB
 
 
 def phase_noise(sigma_p: float, contrast: float = 1.0) -> float:
-    """Phase noise (rad) of a mid-fringe readout with population noise σ_p: 2σ_p/C."""
+    """Phase noise 2σ_p/C of a mid-fringe readout with population noise σ_p.
+
+    Parameters
+    ----------
+    sigma_p : float
+        Population noise σ_p (population units).
+    contrast : float
+        Fringe contrast C ∈ (0, 1].
+
+    Returns
+    -------
+    float
+        Phase noise (rad).
+    """
     with np.errstate(over="ignore"):
         noise = 2.0 * np.float64(positive(sigma_p, "sigma_p")) / plausibility.fraction(positive(contrast, "contrast"), "contrast", "contrast")
     return float(finite_result(noise, "sigma_p", "2σ_p/C"))
 
 
 def acceleration_noise(sigma_phi: float, T: float, k: float = K_RB87) -> float:
-    """Acceleration noise (m/s²) of a phase noise σ_φ (rad): σ_φ/(kT²)."""
+    """Acceleration noise σ_φ/(kT²) of a phase noise σ_φ.
+
+    Parameters
+    ----------
+    sigma_phi : float
+        Phase noise σ_φ (rad).
+    T : float
+        Pulse separation (s).
+    k : float
+        Effective wave number (rad/m).
+
+    Returns
+    -------
+    float
+        Acceleration noise (m/s²).
+    """
     with np.errstate(over="ignore"):
         noise = finite_scalar(sigma_phi, "sigma_phi") / np.float64(_kt2(k, T))
     return float(finite_result(noise, "T", "σ_φ/(kT²) (kT² too small)"))
