@@ -33,7 +33,15 @@ METHODS = ("raw", "fixed KF", "adaptive KF (literal)", "adaptive KF (differenced
 def paper_tables() -> pd.DataFrame:
     """Niu et al. 2025 Tables 2–4. Table 4's BS entries for LPF and WD (0.7020,
     0.6970) equal the bias, not BS: kept in ``bs_table4_misprint`` and NaN in ``bs_dph``.
-    Entries the paper does not give are NaN, so the table may be non-finite."""
+    Entries the paper does not give are NaN, so the table may be non-finite.
+
+    Returns
+    -------
+    pandas.DataFrame
+        Indexed by method (raw, fixed KF, adaptive KF, LPF, WD); columns ``bias_dph``
+        (°/h), ``bs_dph`` (°/h), ``ss_dpsh`` (°/√h), ``ls_dph`` (°/h) and
+        ``bs_table4_misprint`` (°/h).
+    """
     return pd.DataFrame(
         {
             "method": ["raw", "fixed KF", "adaptive KF", "LPF", "WD"],
@@ -48,11 +56,24 @@ def paper_tables() -> pd.DataFrame:
 
 @dataclass
 class Comparison:
-    """Result of :func:`compare`: ``table`` (one row per method: bias_dph, bs1_dph,
-    bs3_dph, ss_dpsh, ls_dph and their signed improvement ratios in %), ``fit`` the ARMA
-    fit, ``model`` the state space used, ``outputs`` each method's filtered series,
-    ``allan_fits`` each method's five-term fit, ``claims`` the paper's directional
-    claims checked on these data."""
+    """Result of :func:`compare`.
+
+    Attributes
+    ----------
+    table : pandas.DataFrame
+        One row per method: bias_dph, bs1_dph, bs3_dph (°/h), ss_dpsh (°/√h), ls_dph
+        (°/h) and their signed improvement ratios in %.
+    fit : ArmaFit
+        The ARMA fit.
+    model : ArimaStateSpace
+        The state space used.
+    outputs : dict
+        Each method's filtered series, °/h.
+    allan_fits : dict
+        Each method's five-term fit (:class:`~atomnav.noise.allan.AllanFit`).
+    claims : pandas.DataFrame
+        The paper's directional claims checked on these data (columns claim, holds).
+    """
 
     table: pd.DataFrame
     fit: arma.ArmaFit
@@ -64,7 +85,24 @@ class Comparison:
 
 def compare(omega, tau0: float = 52.0, order=(2, 1), bs_windows=(1, 3)) -> Comparison:
     """Run the paper's pipeline on the rate series ``omega`` (°/h): fit ARMA(``order``)
-    to its first difference, Q = R₀ = σ̂_a² (docs/departures.md#q-from-the-data), then filter with every method."""
+    to its first difference, Q = R₀ = σ̂_a² (docs/departures.md#q-from-the-data), then filter with every method.
+
+    Parameters
+    ----------
+    omega : array_like (N,)
+        Rate series, °/h.
+    tau0 : float, default 52.0
+        Sampling interval, s.
+    order : tuple of int, default (2, 1)
+        ARMA order (p, q) of the differenced series.
+    bs_windows : sequence of int, default (1, 3)
+        Windows (samples) of the bias-stability columns.
+
+    Returns
+    -------
+    Comparison
+        The metrics table, fits, filtered series and claims.
+    """
     w = vector(omega, None, "omega")
     tau0 = positive(tau0, "tau0")
     fit = arma.fit_arma(w, order)
@@ -110,7 +148,20 @@ def _claims(t: pd.DataFrame, bs_windows) -> pd.DataFrame:
 
 def plot_allan(cmp: Comparison, methods=("raw", "fixed KF", "adaptive KF (differenced)", "LPF", "WD")):
     """Overlapping Allan deviation (points with EDF error bars) of each method with its
-    five-term fit (lines)."""
+    five-term fit (lines).
+
+    Parameters
+    ----------
+    cmp : Comparison
+        Result of :func:`compare`.
+    methods : sequence of str, default ("raw", "fixed KF", "adaptive KF (differenced)", "LPF", "WD")
+        Methods to draw, from :data:`METHODS`.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        The figure (deviation in °/h against τ in s).
+    """
     instance(cmp, Comparison, "cmp")
     import matplotlib.pyplot as plt
 
@@ -128,7 +179,22 @@ def plot_allan(cmp: Comparison, methods=("raw", "fixed KF", "adaptive KF (differ
 
 
 def plot_psd(cmp: Comparison, tau0: float = 52.0, methods=("raw", "fixed KF", "adaptive KF (differenced)", "LPF", "WD")):
-    """Welch power spectral density of each method's output (mean removed)."""
+    """Welch power spectral density of each method's output (mean removed).
+
+    Parameters
+    ----------
+    cmp : Comparison
+        Result of :func:`compare`.
+    tau0 : float, default 52.0
+        Sampling interval, s.
+    methods : sequence of str, default ("raw", "fixed KF", "adaptive KF (differenced)", "LPF", "WD")
+        Methods to draw, from :data:`METHODS`.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        The figure (PSD in (°/h)²/Hz against frequency in Hz).
+    """
     instance(cmp, Comparison, "cmp")
     import matplotlib.pyplot as plt
     from scipy.signal import welch
