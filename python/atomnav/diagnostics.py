@@ -22,7 +22,40 @@ def stationary_errors(lat: float, hours: float, *, rate_hz: float = 10.0, h: flo
     velocity error ``dv0`` (m/s), with constant body-frame gyro (rad/s) and accelerometer
     (m/s²) biases. The vertical channel is held to the true height by default (baro loop).
     The vehicle is at rest, so a low ``rate_hz`` is exact; ``hours × 3600 × rate_hz`` may be
-    at most :data:`STATIONARY_MAX_SAMPLES` (a 3-day test at 1 Hz)."""
+    at most :data:`STATIONARY_MAX_SAMPLES` (a 3-day test at 1 Hz).
+
+    Parameters
+    ----------
+    lat : float
+        Geodetic latitude, rad.
+    hours : float
+        Duration of the test, h (> 0).
+    rate_hz : float, default 10.0
+        IMU sample rate, Hz (> 0).
+    h : float, default 100.0
+        Height above the ellipsoid, m, inside ``earth.HEIGHT_RANGE``.
+    dv0 : array_like (3,), default (0, 0, 0)
+        Initial NED velocity error, m/s.
+    gyro_bias : array_like (3,), default (0, 0, 0)
+        Constant body-frame gyro bias, rad/s.
+    accel_bias : array_like (3,), default (0, 0, 0)
+        Constant body-frame accelerometer bias, m/s².
+    vertical : str, default "damped"
+        Vertical channel of :func:`atomnav.strapdown.integrate`; "damped" holds it to the
+        true height (baro loop).
+
+    Returns
+    -------
+    pandas.DataFrame
+        The error table of :meth:`atomnav.trajectory.Trajectory.errors`, one row per
+        epoch from the (perturbed) initial state.
+
+    Raises
+    ------
+    atomnav.InputError
+        Naming ``lat``, ``h`` (outside the height range), ``hours`` (too many samples),
+        ``rate_hz``, ``dv0``, ``gyro_bias`` or ``accel_bias``.
+    """
     lat, h = float(floats(scalar(lat, "lat"), "lat")), float(floats(scalar(h, "h"), "h"))
     lo, hi = earth.HEIGHT_RANGE
     if not lo <= h <= hi:  # checked here: inside, h reaches the INS as part of lla
@@ -48,8 +81,26 @@ def stationary_errors(lat: float, hours: float, *, rate_hz: float = 10.0, h: flo
 
 
 def zero_crossing_periods(t: np.ndarray, v: np.ndarray) -> np.ndarray:
-    """Oscillation periods (s) from the zero crossings of ``v(t)`` (linear interpolation):
-    T = 2·Δt between successive crossings."""
+    """Oscillation periods from the zero crossings of ``v(t)`` (linear interpolation):
+    T = 2·Δt between successive crossings.
+
+    Parameters
+    ----------
+    t : array_like (N,)
+        Times, s.
+    v : array_like (N,)
+        Oscillating values (any unit), one per time.
+
+    Returns
+    -------
+    numpy.ndarray (C − 1,)
+        Periods, s, for C zero crossings.
+
+    Raises
+    ------
+    atomnav.InputError
+        Naming ``v`` when its length differs from that of ``t``.
+    """
     t, v = vector(t, None, "t"), vector(v, None, "v")
     if v.size != t.size:
         raise input_error("v", f"{v.size} values for {t.size} times")
@@ -61,9 +112,32 @@ def zero_crossing_periods(t: np.ndarray, v: np.ndarray) -> np.ndarray:
 
 def schuler_test(lat: float = np.deg2rad(55.75), *, v0: float = 200.0, hours: float = 4.5, h: float = 100.0) -> dict:
     """The Schuler test: a stationary INS started with a ``v0`` m/s north velocity error.
-    Returns the error table and the measured quantities: zero-crossing periods of v_N
-    (min), the Schuler period 2π√((√(MN)+h)/γ) (min), and the first-period peaks of the
-    horizontal position error (m) and tilt (rad)."""
+
+    Parameters
+    ----------
+    lat : float, default 55.75° in rad
+        Geodetic latitude, rad.
+    v0 : float, default 200.0
+        Initial north velocity error, m/s.
+    hours : float, default 4.5
+        Duration of the test, h.
+    h : float, default 100.0
+        Height above the ellipsoid, m.
+
+    Returns
+    -------
+    dict
+        The error table and the measured quantities: ``errors`` (DataFrame of
+        :func:`stationary_errors`), ``periods_min`` the zero-crossing periods of v_N
+        (min), ``schuler_period_min`` the Schuler period 2π√((√(MN)+h)/γ) (min), and the
+        first-period peaks ``position_peak_m`` of the horizontal position error (m) and
+        ``tilt_peak_rad`` of the tilt (rad).
+
+    References
+    ----------
+    D. H. Titterton and J. L. Weston, *Strapdown Inertial Navigation Technology*, 2nd ed.
+    (2004), §12.3.
+    """
     # 1 Hz is exact at rest and keeps multi-day tests to seconds
     err = stationary_errors(lat, hours, rate_hz=1.0, dv0=(scalar(v0, "v0"), 0.0, 0.0), h=h)
     periods = zero_crossing_periods(err["time_s"].to_numpy(), err["dvel_n_mps"].to_numpy()) / 60.0

@@ -34,7 +34,21 @@ def _mat(x, name: str) -> np.ndarray:
 
 @dataclass(frozen=True)
 class SteadyState:
-    """Steady state of a Kalman filter: a-priori and a-posteriori covariance and gain."""
+    """Steady state of a Kalman filter: a-priori and a-posteriori covariance and gain.
+
+    Returned by :func:`dare`.
+
+    Attributes
+    ----------
+    p_prior : numpy.ndarray (n, n)
+        A-priori covariance P⁻, squared state units.
+    p_post : numpy.ndarray (n, n)
+        A-posteriori covariance P⁺, squared state units.
+    gain : numpy.ndarray (n, m)
+        Steady-state gain K∞, state units per measurement unit.
+    iterations : int
+        Number of doubling iterations.
+    """
 
     p_prior: np.ndarray
     p_post: np.ndarray
