@@ -25,13 +25,44 @@ _QUANTITIES = {"position": slice(0, 3), "velocity": slice(3, 6), "attitude": sli
 
 @dataclass
 class HybridResult:
-    """Monte-Carlo result of one scenario. Arrays: ``time`` (E,) s; ``hybrid`` and ``free``
-    (R, E, 9) errors (:data:`ERROR_COLUMNS`) of the CAI-aided and the IMU-only solutions;
-    ``bias`` / ``bias_true`` (R, E, 6) estimated and true biases (:data:`BIAS_COLUMNS`);
-    ``sigma`` (R, E, n) filter σ of every state (SI units); ``accel_error`` (R, N, 3) accelerometer error
-    (measured − ideal, m/s²) of every IMU sample at ``imu_time`` (N,); ``phase_error`` (R, S, C) true − predicted phase (rad) per
-    shot and channel; ``shots`` (S,) shot start times; ``nees`` (R, E) NEES of the 15 INS
-    states (navigation errors and b̂ − b) under the filter's P."""
+    """Monte-Carlo result of one scenario, as :func:`atomnav.cai.run_campaign` returns it.
+
+    R runs, E output epochs, N IMU samples, S shots, C channels, n filter states.
+
+    Attributes
+    ----------
+    name : str
+        Name of the scenario.
+    params : dict
+        The scenario's parameters (e.g. ``gravity``, ``lever_m``, ``duration_s``; the
+        satellite scenario also ``T``, ``shot_period_s``, ``contrast``, ``sigma_p``,
+        ``q_rw``).
+    time : numpy.ndarray, shape (E,)
+        Output epochs (s).
+    hybrid, free : numpy.ndarray, shape (R, E, 9)
+        Errors (:data:`ERROR_COLUMNS`: NED position m, NED velocity m/s, ψ rad) of the
+        CAI-aided and of the IMU-only solutions.
+    bias, bias_true : numpy.ndarray, shape (R, E, 6)
+        Estimated and true biases (:data:`BIAS_COLUMNS`, m/s² and rad/s).
+    sigma : numpy.ndarray, shape (R, E, n)
+        Filter σ of every state (SI units).
+    accel_error : numpy.ndarray, shape (R, N, 3)
+        Accelerometer error (measured − ideal, m/s²) of every IMU sample at ``imu_time``.
+    phase_error : numpy.ndarray, shape (R, S, C)
+        True − predicted phase (rad) per shot and channel; NaN for a skipped shot.
+    shots : numpy.ndarray, shape (S,)
+        Shot start times (s).
+    nees : numpy.ndarray, shape (R, E)
+        NEES of the 15 INS states (navigation errors and b̂ − b) under the filter's P.
+    imu_time : numpy.ndarray, shape (N,)
+        IMU sample times (s).
+    channel_names : list of str
+        Names of the C channels.
+    config : dict
+        The scenario configuration (``ScenarioConfig.to_dict()``) the runs were made with.
+    complete : bool
+        False when the campaign stopped early (interrupt or error): the finished runs only.
+    """
 
     name: str
     params: dict
@@ -58,11 +89,34 @@ class HybridResult:
         return self.hybrid.shape[0]
 
     def epoch(self, t: float) -> int:
-        """Index of the output epoch nearest to t (s)."""
+        """Index of the output epoch nearest to a time.
+
+        Parameters
+        ----------
+        t : float
+            Time (s).
+
+        Returns
+        -------
+        int
+            Index into ``time`` of the nearest output epoch.
+        """
         return int(np.argmin(np.abs(self.time - finite_scalar(t, "t"))))
 
     def errors(self, which: str = "hybrid") -> pd.DataFrame:
-        """Long table run, time_s and :data:`ERROR_COLUMNS` of ``"hybrid"`` or ``"free"``."""
+        """Navigation errors of every run as a long table.
+
+        Parameters
+        ----------
+        which : {"hybrid", "free"}
+            The CAI-aided or the IMU-only solution.
+
+        Returns
+        -------
+        pandas.DataFrame
+            One row per run and epoch: ``run``, ``time_s`` and :data:`ERROR_COLUMNS`
+            (m, m/s, rad).
+        """
         choice(which, ("hybrid", "free"), "which")
         e = getattr(self, which)
         r, n = e.shape[:2]
@@ -72,8 +126,19 @@ class HybridResult:
         return df
 
     def rms(self, which: str = "hybrid") -> pd.DataFrame:
-        """RMS over runs per epoch: per axis (:data:`ERROR_COLUMNS`) and the norms
-        ``pos_norm_m``, ``vel_norm_mps``, ``att_norm_rad``."""
+        """RMS over runs of the navigation error, per epoch.
+
+        Parameters
+        ----------
+        which : {"hybrid", "free"}
+            The CAI-aided or the IMU-only solution.
+
+        Returns
+        -------
+        pandas.DataFrame
+            One row per epoch: ``time_s``, the RMS per axis (:data:`ERROR_COLUMNS`) and of
+            the norms ``pos_norm_m``, ``vel_norm_mps``, ``att_norm_rad``.
+        """
         choice(which, ("hybrid", "free"), "which")
         e = getattr(self, which)
         df = pd.DataFrame(np.sqrt(np.mean(e**2, axis=0)), columns=ERROR_COLUMNS)
@@ -83,8 +148,20 @@ class HybridResult:
         return df
 
     def improvement(self, times) -> pd.DataFrame:
-        """IMU-only / hybrid RMS-over-runs error ratio at each time (s): one row per (time,
-        quantity, axis ∈ n, e, d, norm)."""
+        """IMU-only / hybrid ratio of the RMS-over-runs error at given times (Tennstedt et al. 2023, §4).
+
+        Parameters
+        ----------
+        times : float or array_like
+            Times (s); each is taken at the nearest output epoch.
+
+        Returns
+        -------
+        pandas.DataFrame
+            One row per (time, quantity, axis): ``time_s``, ``quantity`` (position,
+            velocity, attitude), ``axis`` (n, e, d, norm), ``imu_only_rms``,
+            ``hybrid_rms`` (m, m/s or rad) and ``ratio`` (inf when the hybrid RMS is 0).
+        """
         rows = []
         times = np.atleast_1d(as_floats(times, "times")).reshape(-1)
         finite(times, "times")
@@ -100,8 +177,16 @@ class HybridResult:
         return pd.DataFrame(rows)
 
     def bias_errors(self) -> pd.DataFrame:
-        """Per epoch and bias component: mean and empirical σ over runs of the estimation
-        error b̂ − b, the mean filter σ, and the share of runs inside the filter's 3σ."""
+        """Statistics over runs of the bias estimation error b̂ − b, per epoch.
+
+        Returns
+        -------
+        pandas.DataFrame
+            One row per epoch: ``time_s`` and, per component ``c`` of :data:`BIAS_COLUMNS`,
+            the mean ``c_mean`` and empirical σ ``c_std`` over runs of b̂ − b, the mean
+            filter σ ``c_sigma`` (m/s² or rad/s) and the share of runs inside the filter's
+            3σ ``c_in3sigma``.
+        """
         err = self.bias - self.bias_true
         sig = self.sigma[:, :, 9:15]
         d = {"time_s": self.time}
@@ -113,9 +198,14 @@ class HybridResult:
         return pd.DataFrame(d)
 
     def bias_table(self) -> pd.DataFrame:
-        """Long table of the bias estimates: ``run``, ``time_s`` and, per component of
-        :data:`BIAS_COLUMNS`, the estimate, the truth (``_true``) and the filter σ
-        (``_sigma``), in m/s² or rad/s."""
+        """Bias estimates of every run as a long table.
+
+        Returns
+        -------
+        pandas.DataFrame
+            ``run``, ``time_s`` and, per component of :data:`BIAS_COLUMNS`, the estimate,
+            the truth (``_true``) and the filter σ (``_sigma``), in m/s² or rad/s.
+        """
         r, n = self.bias.shape[:2]
         d = {"run": np.repeat(np.arange(r), n), "time_s": np.tile(self.time, r)}
         for i, c in enumerate(BIAS_COLUMNS):
@@ -125,13 +215,30 @@ class HybridResult:
         return pd.DataFrame(d)
 
     def nees_table(self) -> pd.DataFrame:
-        """Long table ``run``, ``time_s``, ``nees`` (dimensionless, 15 INS states; χ²(15)
-        for a consistent filter)."""
+        """NEES of every run and epoch as a long table.
+
+        Returns
+        -------
+        pandas.DataFrame
+            ``run``, ``time_s``, ``nees`` (dimensionless, 15 INS states; χ²(15) for a
+            consistent filter).
+        """
         r, n = self.nees.shape
         return pd.DataFrame({"run": np.repeat(np.arange(r), n), "time_s": np.tile(self.time, r), "nees": self.nees.ravel()})
 
     def nees_inside(self, p: float = 0.95) -> float:
-        """Share of (run, epoch) NEES values inside the two-sided p band of χ²(15)."""
+        """Share of (run, epoch) NEES values inside the two-sided p band of χ²(15).
+
+        Parameters
+        ----------
+        p : float
+            Probability of the band, in (0, 1).
+
+        Returns
+        -------
+        float
+            Share of NEES values inside the band (0–1); p for a consistent filter.
+        """
         from scipy.stats import chi2
 
         p = scalar(p, "p")
@@ -141,15 +248,39 @@ class HybridResult:
         return float(np.mean((self.nees >= lo) & (self.nees <= hi)))
 
     def phase_exceedance(self, limit: float = np.pi / 2) -> float:
-        """Share of shot-channels with |true − predicted phase| > limit (rad), over the
-        shots applied (a skipped shot's NaN phase error is left out)."""
+        """Share of shot-channels with |true − predicted phase| > ``limit``.
+
+        Taken over the shots applied (a skipped shot's NaN phase error is left out).
+
+        Parameters
+        ----------
+        limit : float
+            Phase limit (rad); π/2 is the edge of the capture region.
+
+        Returns
+        -------
+        float
+            Share (0–1).
+
+        Raises
+        ------
+        atomnav.InputError
+            Naming ``phase_error`` when no shot was applied.
+        """
         e = np.abs(self.phase_error[np.isfinite(self.phase_error)])
         if not e.size:
             raise input_error("phase_error", "no shot was applied, so there is no share to take")
         return float(np.mean(e > scalar(limit, "limit")))
 
     def phase_errors(self) -> pd.DataFrame:
-        """Long table run, shot_start_s, channel, phase_error_rad."""
+        """Phase errors of every run, shot and channel as a long table.
+
+        Returns
+        -------
+        pandas.DataFrame
+            ``run``, ``shot_start_s``, ``channel``, ``phase_error_rad`` (true − predicted,
+            rad).
+        """
         r, s, c = self.phase_error.shape
         return pd.DataFrame({"run": np.repeat(np.arange(r), s * c), "shot_start_s": np.tile(np.repeat(self.shots, c), r),
                              "channel": np.tile(self.channel_names or list(range(c)), r * s), "phase_error_rad": self.phase_error.ravel()})
@@ -165,10 +296,31 @@ def _satellite_params(res) -> dict:
 
 
 def satellite_steady_state(res: HybridResult) -> dict:
-    """Steady state of the satellite filter's along-track bias state, against the scalar
-    Riccati closed form (Tennstedt et al. 2021, Eqs. 26–27, Table 1 case A) for the same Q, R and T:
-    filter P⁺ (median over the second half of the updates), closed-form P⁺ and P⁻, and the
-    empirical σ of the tracking error b̂ − b (bias truth = random walk + Gauss–Markov)."""
+    """Steady state of the satellite filter's along-track bias state against the scalar Riccati closed form.
+
+    Closed form of Tennstedt et al. 2021, Eqs. 26–27, Table 1 case A, for the same Q, R
+    and T.
+
+    Parameters
+    ----------
+    res : HybridResult
+        A result of :func:`atomnav.cai.satellite`.
+
+    Returns
+    -------
+    dict
+        ``filter_p_post``: filter P⁺ (median over the second half of the updates);
+        ``closed_form_p_post`` and ``closed_form_p_prior``: closed-form P⁺ and P⁻
+        ((m/s²)²); ``tracking_error_std``: empirical σ of the tracking error b̂ − b (m/s²;
+        bias truth = random walk + Gauss–Markov); ``H`` = (C/2) k T² (population per
+        m/s²), ``Q`` ((m/s²)² per shot) and ``R`` = σ_p² (population²) of the scalar
+        model.
+
+    Raises
+    ------
+    atomnav.InputError
+        Naming ``res`` when it is not a result of :func:`atomnav.cai.satellite`.
+    """
     from ..filter import riccati_scalar
 
     p = _satellite_params(res)
@@ -183,9 +335,23 @@ def satellite_steady_state(res: HybridResult) -> dict:
 
 
 def satellite_psd(res: HybridResult, nperseg: int = 2**15) -> pd.DataFrame:
-    """One-sided Welch ASD (m/s²/√Hz) of the along-track accelerometer error of the IMU and
-    of the CAI-corrected accelerometer (IMU error − b̂). ``attrs["cai_asd"]`` is the white
-    level of the CAI alone: σ_a √Δt_shot with σ_a = σ_p/((C/2) k T²) (Tennstedt et al. 2021, §4)."""
+    """One-sided Welch ASD of the along-track accelerometer error, IMU alone and CAI-corrected.
+
+    Parameters
+    ----------
+    res : HybridResult
+        A result of :func:`atomnav.cai.satellite` (its first run is used).
+    nperseg : int
+        Samples per Welch segment (at most the record length).
+
+    Returns
+    -------
+    pandas.DataFrame
+        ``frequency_hz``, ``imu_asd`` (IMU error) and ``filtered_asd`` (IMU error − b̂),
+        in m/s²/√Hz, zero frequency left out. ``attrs["cai_asd"]`` is the white level of
+        the CAI alone: σ_a √Δt_shot with σ_a = σ_p/((C/2) k T²) (Tennstedt et al. 2021,
+        §4).
+    """
     from scipy.signal import welch
 
     p = _satellite_params(res)
