@@ -61,8 +61,16 @@ BIAS_COLUMNS = ([f"accel_bias_{a}_mps2" for a in _AXES], [f"gyro_bias_{a}_rad_s"
 
 @dataclass(frozen=True)
 class GaussMarkov:
-    """First-order Gauss–Markov term: stationary ``sigma`` (m/s² or rad/s) and correlation
-    time ``tau`` (s). Where a triad takes one, a ``(sigma, tau)`` tuple is read as this."""
+    """First-order Gauss–Markov term. Where a triad takes one, a ``(sigma, tau)`` tuple is
+    read as this.
+
+    Parameters
+    ----------
+    sigma : float
+        Stationary σ (m/s² for an accelerometer, rad/s for a gyro).
+    tau : float
+        Correlation time (s).
+    """
 
     sigma: float
     tau: float
@@ -70,9 +78,17 @@ class GaussMarkov:
 
 @dataclass(frozen=True)
 class Flicker:
-    """Flicker (1/f) term of bias instability ``b`` (m/s² or rad/s), valid between ``f_lo``
-    and ``f_hi`` (Hz; ``f_hi`` must not exceed the Nyquist frequency 1/(2Δt)). Where a
-    triad takes one, a tuple ``(b,)``, ``(b, f_lo)`` or ``(b, f_lo, f_hi)`` is read as this."""
+    """Flicker (1/f) term. Where a triad takes one, a tuple ``(b,)``, ``(b, f_lo)`` or
+    ``(b, f_lo, f_hi)`` is read as this.
+
+    Parameters
+    ----------
+    b : float
+        Bias instability B (m/s² or rad/s): one-sided PSD B²/(πf).
+    f_lo, f_hi : float
+        The band (Hz) in which the PSD is B²/(πf), by default 1e-4 to 0.1 Hz; ``f_hi``
+        must not exceed the Nyquist frequency 1/(2Δt).
+    """
 
     b: float
     f_lo: float = 1e-4
@@ -81,16 +97,32 @@ class Flicker:
 
 @dataclass
 class TriadErrors:
-    """Errors of one sensor triad (accelerometer: m/s² units, gyro: rad/s units).
+    """Errors of one sensor triad (accelerometer: m/s² units, gyro: rad/s units):
+    measured = (I + diag(scale) + misalignment) · true + bias terms + noise.
 
-    ``bias`` (3,) fixed bias; ``bias_sigma`` σ of a random turn-on bias per axis;
-    ``scale`` (3,) scale-factor errors (1e-6 = 1 ppm); ``misalignment`` (3, 3) with zero
-    diagonal, measured = (I + diag(scale) + misalignment) · true; ``white`` density N
-    (m/s/√s or rad/√s); ``bias_rw`` density K (m/s²/√s or rad/s/√s); ``gauss_markov``
-    (a :class:`GaussMarkov` or a ``(sigma, tau)`` tuple); ``flicker`` (a :class:`Flicker`
-    or a tuple of its fields in order). Fields may be set after construction; they are
-    checked when used: a string where a number is expected (``white = '1e-4'``) or a term
-    of another type is a ``TypeError`` naming the field (``gyro.white``)."""
+    Fields may be set after construction; they are checked when used: a string where a
+    number is expected (``white = '1e-4'``) or a term of another type is a ``TypeError``
+    naming the field (``gyro.white``).
+
+    Parameters
+    ----------
+    bias : array_like (3,)
+        Fixed bias per axis (m/s² or rad/s).
+    bias_sigma : float
+        σ of a random turn-on bias per axis, drawn once (m/s² or rad/s).
+    scale : array_like (3,)
+        Scale-factor errors (dimensionless; 1e-6 = 1 ppm).
+    misalignment : array_like (3, 3)
+        Axis misalignment (dimensionless) with zero diagonal.
+    white : float
+        White-noise density N: VRW (m/s/√s) or ARW (rad/√s).
+    bias_rw : float
+        Bias random-walk density K (m/s²/√s or rad/s/√s).
+    gauss_markov : GaussMarkov or tuple, optional
+        A :class:`GaussMarkov` or a ``(sigma, tau)`` tuple.
+    flicker : Flicker or tuple, optional
+        A :class:`Flicker` or a tuple of its fields in order.
+    """
 
     bias: tuple = (0.0, 0.0, 0.0)
     bias_sigma: float = 0.0
@@ -155,8 +187,15 @@ _USER_PRESETS: dict[str, "ImuErrors"] = {}
 
 @dataclass
 class ImuErrors:
-    """The error model of an IMU: ``accel`` and ``gyro`` triads. ``ImuErrors.preset(preset)``
-    gives a named grade; :func:`register_preset` adds user grades."""
+    """The error model of an IMU. ``ImuErrors.preset(preset)`` gives a named grade;
+    :func:`register_preset` adds user grades.
+
+    Parameters
+    ----------
+    accel, gyro : TriadErrors
+        The accelerometer (m/s² units) and gyro (rad/s units) triads; error-free by
+        default.
+    """
 
     accel: TriadErrors = field(default_factory=TriadErrors)
     gyro: TriadErrors = field(default_factory=TriadErrors)
@@ -165,17 +204,40 @@ class ImuErrors:
         return self.accel._to_core("accel"), self.gyro._to_core("gyro")
 
     def validate(self) -> "ImuErrors":
-        """Raise ValueError naming the first invalid parameter (e.g. ``gyro.white``)."""
+        """Check every parameter.
+
+        Returns
+        -------
+        ImuErrors
+            This object, unchanged.
+
+        Raises
+        ------
+        InputError
+            (a ``ValueError``) naming the first invalid parameter (e.g. ``gyro.white``).
+        """
         _core.imu_validate_errors(*self._to_core())
         return self
 
     @classmethod
     def preset(cls, preset: str) -> "ImuErrors":
-        """A copy of the named ``preset``: built-in ``navigation`` (RLG IMU of Tennstedt et al. 2023),
-        ``tactical`` (typical class values), ``mems`` (hexapod MEMS of Tennstedt et al. 2021),
-        ``electrostatic_space`` / ``electrostatic_space_drift`` (satellite accelerometer
-        of Tennstedt et al. 2021), ``precise`` / ``medium`` / ``coarse`` (Demidov 2009 classes), or a
-        name added with :func:`register_preset`. Sources are in ``rust/imu/presets.rs``."""
+        """A copy of a named grade.
+
+        Parameters
+        ----------
+        preset : str
+            Built-in ``navigation`` (RLG IMU of Tennstedt et al. 2023), ``tactical``
+            (typical class values), ``mems`` (hexapod MEMS of Tennstedt et al. 2021),
+            ``electrostatic_space`` / ``electrostatic_space_drift`` (satellite
+            accelerometer of Tennstedt et al. 2021), ``precise`` / ``medium`` / ``coarse``
+            (Demidov 2009 classes), or a name added with :func:`register_preset`
+            (:func:`preset_names`). Sources are in ``rust/imu/presets.rs``.
+
+        Returns
+        -------
+        ImuErrors
+            A copy: changing it changes no preset.
+        """
         if not isinstance(preset, str):
             raise TypeError(f"preset: expected a str, got {type(preset).__name__}")
         choice(preset, preset_names(), "preset")
@@ -185,8 +247,15 @@ class ImuErrors:
         return cls(TriadErrors._from_core(a), TriadErrors._from_core(g))
 
     def summary(self) -> pd.DataFrame:
-        """The parameters in SI and in the units datasheets use (µg, µg/√Hz, µg/√h, °/h,
-        °/√h, °/h/√h), one row per (sensor, parameter)."""
+        """The parameters in SI and in the units datasheets use.
+
+        Returns
+        -------
+        DataFrame
+            One row per (sensor, parameter), columns ``sensor``, ``parameter``,
+            ``value_si``, ``unit_si``, ``value_field``, ``unit_field``; field units µg,
+            µg/√Hz, µg/√h, °/h, °/√h, °/h/√h.
+        """
         sqrt_h = np.sqrt(units.HOUR)
         out = []
         for sensor, t, si, u, u_name, dens, dens_name in (
@@ -207,12 +276,26 @@ class ImuErrors:
 
 
 def preset_names() -> list[str]:
-    """Built-in preset names followed by user-registered ones."""
+    """The names :meth:`ImuErrors.preset` accepts.
+
+    Returns
+    -------
+    list of str
+        Built-in preset names followed by user-registered ones.
+    """
     return list(_core.imu_preset_names()) + list(_USER_PRESETS)
 
 
 def register_preset(name: str, errors: ImuErrors) -> None:
-    """Add a named user preset (validated; a built-in name cannot be replaced)."""
+    """Add a named user preset (validated; a built-in name cannot be replaced).
+
+    Parameters
+    ----------
+    name : str
+        The preset's name, for :meth:`ImuErrors.preset`.
+    errors : ImuErrors
+        The error model; a copy is kept.
+    """
     if not isinstance(name, str):
         raise TypeError(f"name: expected a str, got {type(name).__name__}")
     if name in _core.imu_preset_names():
@@ -221,16 +304,33 @@ def register_preset(name: str, errors: ImuErrors) -> None:
 
 
 class ImuSimulator(Stateful):
-    """Seeded, stateful corruption of an ideal IMU stream with sampling interval ``dt``
-    (s) and output ``kind`` (``"rates"`` or ``"increments"``). Successive :meth:`corrupt`
+    """Seeded, stateful corruption of an ideal IMU stream. Successive :meth:`corrupt`
     calls continue the random processes, so chunks give the numbers of one batch call.
 
     ``kind``, ``dt`` and ``errors`` are fixed at construction (read-only: build a new
-    simulator for another kind); ``kind=None`` (default) takes the kind of the column
-    names of the first DataFrame :meth:`corrupt` reads (:func:`atomnav.trajectory.imu_kind`)
-    and fixes it then (:attr:`kind` is None until then); arrays need ``kind`` given here.
-    One simulator may be shared by threads (calls run one after another) and pickled or
-    deep-copied mid-record: the copy continues the same random streams bit for bit."""
+    simulator for another kind). One simulator may be shared by threads (calls run one
+    after another) and pickled or deep-copied mid-record: the copy continues the same
+    random streams bit for bit.
+
+    Parameters
+    ----------
+    errors : ImuErrors or str
+        The error model, or the name of a preset (:func:`preset_names`); a copy is kept.
+    dt : float
+        Sampling interval (s).
+    kind : str, optional
+        Output kind, ``"rates"`` or ``"increments"``. None (default) takes the kind of the
+        column names of the first DataFrame :meth:`corrupt` reads
+        (:func:`atomnav.trajectory.imu_kind`) and fixes it then (:attr:`kind` is None
+        until then); arrays need ``kind`` given here.
+    seed : int
+        Master seed of the random streams (module docstring).
+
+    Warns
+    -----
+    atomnav.UnitWarning
+        ``dt`` beyond 1 s, likely in ms (:func:`atomnav.plausibility.sample_interval`).
+    """
 
     def __init__(self, errors: ImuErrors | str, dt: float, kind: str | None = None, seed: int = 0):
         if isinstance(errors, str):
@@ -263,15 +363,28 @@ class ImuSimulator(Stateful):
 
     @serialized
     def corrupt(self, accel, gyro=None) -> pd.DataFrame:
-        """Corrupt the next chunk. ``accel``, ``gyro``: (N, 3) true specific force (m/s²)
-        and angular rate (rad/s), or Δv (m/s) and Δθ (rad) for increments; or one DataFrame
-        in ``accel`` with the stream columns of this kind (module docstring), read by name
-        (extra columns ignored; with ``kind=None`` the first one fixes the kind); its errors
-        name ``accel`` and the column. Returns a
-        DataFrame indexed by the running sample number with the measured columns (same
-        names) and the bias truth columns; a ``time_s`` column is carried through as given
-        (datetime64 included). No other column is carried: a time column under another
-        name (``time``) is ignored like any extra column, and the output then has none."""
+        """Corrupt the next chunk.
+
+        Parameters
+        ----------
+        accel : array_like (N, 3) or DataFrame
+            True specific force (m/s²), or Δv (m/s) for increments; or one DataFrame with
+            the stream columns of this kind (module docstring), read by name (extra
+            columns ignored; with ``kind=None`` the first one fixes the kind); its errors
+            name ``accel`` and the column.
+        gyro : array_like (N, 3), optional
+            True angular rate (rad/s), or Δθ (rad) for increments; required with an array
+            ``accel``, None with a DataFrame.
+
+        Returns
+        -------
+        DataFrame
+            Indexed by the running sample number: the measured columns (same names as the
+            input) and the bias truth columns :data:`BIAS_COLUMNS`. A ``time_s`` column is
+            carried through as given (datetime64 included). No other column is carried: a
+            time column under another name (``time``) is ignored like any extra column,
+            and the output then has none.
+        """
         sim, kind = self._sim, self._kind
         if kind is None:  # the first table fixes the kind; no sample was drawn yet
             kind = imu_kind(None, accel, "accel")
@@ -306,54 +419,195 @@ class ImuSimulator(Stateful):
 
 
 def corrupt(accel, gyro=None, *, errors: ImuErrors | str, dt: float, kind: str | None = None, seed: int = 0) -> pd.DataFrame:
-    """One-shot :class:`ImuSimulator` ``(errors, dt, kind, seed).corrupt(accel, gyro)``;
-    ``kind=None`` (default) is the kind of the column names of the DataFrame ``accel``
-    (:func:`atomnav.trajectory.imu_kind`), and arrays need ``kind``."""
+    """One-shot :class:`ImuSimulator` ``(errors, dt, kind, seed).corrupt(accel, gyro)``.
+
+    Parameters
+    ----------
+    accel, gyro
+        As for :meth:`ImuSimulator.corrupt`: (N, 3) arrays of true specific force (m/s²)
+        and angular rate (rad/s), or Δv (m/s) and Δθ (rad); or one DataFrame in ``accel``.
+    errors, dt, seed
+        As for :class:`ImuSimulator`: the error model (or a preset name), the sampling
+        interval (s) and the master seed.
+    kind : str, optional
+        ``"rates"`` or ``"increments"``; None (default) is the kind of the column names of
+        the DataFrame ``accel`` (:func:`atomnav.trajectory.imu_kind`), and arrays need
+        ``kind``.
+
+    Returns
+    -------
+    DataFrame
+        As :meth:`ImuSimulator.corrupt` returns it.
+    """
     return ImuSimulator(errors, dt, imu_kind(kind, accel, "accel"), seed).corrupt(accel, gyro)
 
 
 def white_sigma(density: float, dt: float, kind: str = "rates") -> float:
-    """Per-sample σ of white noise of density N at interval Δt: N/√Δt (rate, m/s² or
-    rad/s) or N·√Δt (increment, m/s or rad)."""
+    """Per-sample σ of white noise of density N at interval Δt: N/√Δt (rates) or N·√Δt
+    (increments).
+
+    Parameters
+    ----------
+    density : float
+        Density N (m/s/√s or rad/√s).
+    dt : float
+        Sample interval Δt (s).
+    kind : str
+        ``"rates"`` (default) or ``"increments"``.
+
+    Returns
+    -------
+    float
+        σ per sample: m/s² or rad/s (rates), m/s or rad (increments).
+    """
     return _core.imu_white_sigma(scalar(density, "density"), scalar(dt, "dt"), kind)
 
 
 def white_density(sigma: float, dt: float, kind: str = "rates") -> float:
-    """Density N (m/s/√s or rad/√s) of white noise with per-sample σ at Δt (inverse of
-    :func:`white_sigma`)."""
+    """Density N of white noise with per-sample σ at Δt (inverse of :func:`white_sigma`).
+
+    Parameters
+    ----------
+    sigma : float
+        σ per sample: m/s² or rad/s (rates), m/s or rad (increments).
+    dt : float
+        Sample interval Δt (s).
+    kind : str
+        ``"rates"`` (default) or ``"increments"``.
+
+    Returns
+    -------
+    float
+        Density N (m/s/√s or rad/√s).
+    """
     return _core.imu_white_density(scalar(sigma, "sigma"), scalar(dt, "dt"), kind)
 
 
 def random_walk_step_sigma(density: float, dt: float) -> float:
-    """σ of the per-sample bias step K·√Δt of a random walk of density K."""
+    """σ of the per-sample bias step K·√Δt of a random walk of density K.
+
+    Parameters
+    ----------
+    density : float
+        Density K (m/s²/√s or rad/s/√s).
+    dt : float
+        Sample interval Δt (s).
+
+    Returns
+    -------
+    float
+        σ of the bias step per sample (m/s² or rad/s).
+    """
     return _core.imu_random_walk_step_sigma(scalar(density, "density"), scalar(dt, "dt"))
 
 
 def random_walk_density(step_sigma: float, dt: float) -> float:
-    """Density K of a random walk whose per-sample step has σ ``step_sigma`` at Δt."""
+    """Density K of a random walk whose per-sample step has σ ``step_sigma`` at Δt
+    (inverse of :func:`random_walk_step_sigma`).
+
+    Parameters
+    ----------
+    step_sigma : float
+        σ of the bias step per sample (m/s² or rad/s).
+    dt : float
+        Sample interval Δt (s).
+
+    Returns
+    -------
+    float
+        Density K (m/s²/√s or rad/s/√s).
+    """
     return _core.imu_random_walk_density(scalar(step_sigma, "step_sigma"), scalar(dt, "dt"))
 
 
 def gauss_markov_driving_sigma(sigma: float, tau: float, dt: float) -> float:
-    """Per-sample driving σ_u = σ√(1 − e^{−2Δt/τ}) of m_{k+1} = e^{−Δt/τ} m_k + u_k."""
+    """Per-sample driving σ_u = σ√(1 − e^{−2Δt/τ}) of m_{k+1} = e^{−Δt/τ} m_k + u_k.
+
+    Parameters
+    ----------
+    sigma : float
+        Stationary σ (m/s² or rad/s).
+    tau : float
+        Correlation time τ (s).
+    dt : float
+        Sample interval Δt (s).
+
+    Returns
+    -------
+    float
+        σ_u (m/s² or rad/s).
+    """
     return _core.imu_gauss_markov_driving_sigma(scalar(sigma, "sigma"), scalar(tau, "tau"), scalar(dt, "dt"))
 
 
 def gauss_markov_sigma(driving_sigma: float, tau: float, dt: float) -> float:
-    """Stationary σ of the discrete Gauss–Markov with per-sample driving σ_u at Δt."""
+    """Stationary σ of the discrete Gauss–Markov with per-sample driving σ_u at Δt
+    (inverse of :func:`gauss_markov_driving_sigma`).
+
+    Parameters
+    ----------
+    driving_sigma : float
+        σ_u (m/s² or rad/s).
+    tau : float
+        Correlation time τ (s).
+    dt : float
+        Sample interval Δt (s).
+
+    Returns
+    -------
+    float
+        Stationary σ (m/s² or rad/s).
+    """
     return _core.imu_gauss_markov_sigma(scalar(driving_sigma, "driving_sigma"), scalar(tau, "tau"), scalar(dt, "dt"))
 
 
 def gauss_markov_low_freq_asd(sigma: float, tau: float) -> float:
-    """Low-frequency amplitude spectral density σ√(2τ) of a Gauss–Markov process."""
+    """Low-frequency amplitude spectral density σ√(2τ) of a Gauss–Markov process.
+
+    Parameters
+    ----------
+    sigma : float
+        Stationary σ (m/s² or rad/s).
+    tau : float
+        Correlation time τ (s).
+
+    Returns
+    -------
+    float
+        ASD (m/s²/√Hz or rad/s/√Hz).
+    """
     return _core.imu_gauss_markov_low_freq_asd(scalar(sigma, "sigma"), scalar(tau, "tau"))
 
 
 def flicker_psd(b: float, f: float) -> float:
-    """One-sided PSD B²/(πf) of flicker noise of bias instability B at f (Hz)."""
+    """One-sided PSD B²/(πf) of flicker noise of bias instability B.
+
+    Parameters
+    ----------
+    b : float
+        Bias instability B (m/s² or rad/s).
+    f : float
+        Frequency (Hz).
+
+    Returns
+    -------
+    float
+        PSD ((m/s²)²/Hz or (rad/s)²/Hz).
+    """
     return _core.imu_flicker_psd(scalar(b, "b"), scalar(f, "f"))
 
 
 def flicker_allan_floor(b: float) -> float:
-    """Allan-deviation floor B·√(2 ln 2/π) of flicker noise."""
+    """Allan-deviation floor B·√(2 ln 2/π) of flicker noise.
+
+    Parameters
+    ----------
+    b : float
+        Bias instability B (m/s² or rad/s).
+
+    Returns
+    -------
+    float
+        Allan deviation floor (m/s² or rad/s).
+    """
     return _core.imu_flicker_allan_floor(scalar(b, "b"))
