@@ -46,13 +46,34 @@ class Config:
     _NESTED: dict = {}
 
     def to_dict(self) -> dict:
-        """Every field as plain Python (nested configs as dicts, arrays as lists)."""
+        """Every field as plain Python.
+
+        Returns
+        -------
+        dict
+            Field name to value (nested configs as dicts, arrays as lists).
+        """
         return {f.name: _plain(getattr(self, f.name)) for f in dataclasses.fields(self)}
 
     @classmethod
     def from_dict(cls, d: dict):
-        """The configuration of :meth:`to_dict`'s dict; an unknown key is an
-        :class:`atomnav.InputError` naming it."""
+        """The configuration of :meth:`to_dict`'s dict.
+
+        Parameters
+        ----------
+        d : dict
+            Field name to value; nested configs may be dicts.
+
+        Returns
+        -------
+        Config
+            An instance of the class it is called on.
+
+        Raises
+        ------
+        atomnav.InputError
+            Naming an unknown key.
+        """
         instance(d, dict, "d")
         names = {f.name for f in dataclasses.fields(cls)}
         unknown = sorted(set(d) - names)
@@ -62,12 +83,39 @@ class Config:
         return cls(**kw)
 
     def to_json(self, **kwargs) -> str:
-        """:meth:`to_dict` as JSON (``kwargs`` go to :func:`json.dumps`)."""
+        """:meth:`to_dict` as JSON.
+
+        Parameters
+        ----------
+        **kwargs
+            Passed to :func:`json.dumps` (e.g. ``indent``).
+
+        Returns
+        -------
+        str
+            The JSON text.
+        """
         return json.dumps(self.to_dict(), **kwargs)
 
     @classmethod
     def from_json(cls, text: str):
-        """The configuration of :meth:`to_json`'s text."""
+        """The configuration of :meth:`to_json`'s text.
+
+        Parameters
+        ----------
+        text : str
+            A JSON object of the fields.
+
+        Returns
+        -------
+        Config
+            An instance of the class it is called on.
+
+        Raises
+        ------
+        atomnav.InputError
+            Naming ``text`` when it is not a JSON object, or an unknown key.
+        """
         return cls.from_dict(json_object(text, "text"))
 
 
@@ -96,6 +144,17 @@ class Layout:
 
     Indices are derived: ``layout["gyro_bias"]`` is a slice; an unknown name raises
     ValueError.
+
+    Parameters
+    ----------
+    blocks : sequence of str or (str, int), default INS15
+        Block names in state order: a standard block by name (:data:`STANDARD_BLOCKS`
+        gives its size) or an extra block as a ``(name, size)`` pair.
+
+    Raises
+    ------
+    TypeError
+        ``blocks`` is not a sequence of names or (name, size) pairs.
     """
 
     def __init__(self, blocks=INS15):
@@ -126,7 +185,29 @@ class Layout:
 def discretize(f, qc, dt: float, method: str = "van_loan") -> tuple[np.ndarray, np.ndarray]:
     """(Φ, Q_d) of ẋ = Fx + w, E[wwᵀ] = Q_c δ(t−s), over dt (s).
 
-    method "van_loan" (exact for constant F) or "first_order" (Φ = I + FΔt, Q_d = Q_cΔt).
+    Parameters
+    ----------
+    f : array_like (n, n)
+        System matrix F, 1/s.
+    qc : array_like (n, n)
+        Continuous process-noise PSD Q_c, squared state units per s.
+    dt : float
+        Interval, s.
+    method : {"van_loan", "first_order"}, default "van_loan"
+        "van_loan" (exact for constant F) or "first_order" (Φ = I + FΔt, Q_d = Q_cΔt).
+
+    Returns
+    -------
+    phi : numpy.ndarray (n, n)
+        Transition matrix Φ over ``dt``.
+    qd : numpy.ndarray (n, n)
+        Discrete process-noise covariance Q_d, squared state units.
+
+    References
+    ----------
+    C. F. Van Loan, "Computing integrals involving the matrix exponential", *IEEE Trans.
+    Automatic Control* 23 (1978). P. D. Groves, *Principles of GNSS, Inertial, and
+    Multisensor Integrated Navigation Systems*, 2nd ed. (2013), ch. 3.
     """
     return _core.discretize_model(_mat(f, "f"), _mat(qc, "qc"), finite_scalar(dt, "dt"), method)
 
@@ -136,7 +217,20 @@ class BiasModel(Config):
     """Per-axis bias process: ``kind`` one of :data:`BIAS_KINDS` — ``random_constant``,
     ``random_walk`` (psd in units²/s) or ``gauss_markov`` (tau in s, sigma = steady-state σ
     in the bias unit). The core checks the kind where the model is used and names that
-    argument (e.g. ``accel_bias``)."""
+    argument (e.g. ``accel_bias``).
+
+    Parameters
+    ----------
+    kind : str, default "random_constant"
+        One of :data:`BIAS_KINDS`.
+    psd : float, default 0.0
+        Random-walk PSD, bias unit²/s (m²/s⁵ for an accelerometer, rad²/s³ for a gyro);
+        ``random_walk`` only.
+    tau : float, default 0.0
+        Gauss–Markov correlation time, s; ``gauss_markov`` only.
+    sigma : float, default 0.0
+        Gauss–Markov steady-state σ, bias unit (m/s² or rad/s); ``gauss_markov`` only.
+    """
 
     kind: str = "random_constant"
     psd: float = 0.0
@@ -154,9 +248,38 @@ def ins_error_model(lla, vel_ned, q_nb, f_b, accel_psd: float, gyro_psd: float,
                     layout: Layout | None = None, ellipsoid: str = "WGS84") -> tuple[np.ndarray, np.ndarray]:
     """Continuous 15-state NED INS error model F, Q_c (docs/departures.md#error-states-in-metres) along a trajectory.
 
-    lla (N, 3) rad/rad/m, vel_ned (N, 3) m/s, q_nb (N, 4), f_b (N, 3) compensated specific
-    force m/s²; accel_psd ((m/s²)²/Hz = VRW²) and gyro_psd (rad²/s = ARW²) white noise.
-    Returns (F, Q_c) stacks of shape (N, n, n) for ``layout`` (default 15 states).
+    Parameters
+    ----------
+    lla : array_like (N, 3)
+        Geodetic latitude, longitude (rad) and height (m).
+    vel_ned : array_like (N, 3)
+        NED velocity, m/s.
+    q_nb : array_like (N, 4)
+        Attitude quaternion body → NED, scalar first.
+    f_b : array_like (N, 3)
+        Compensated specific force in the body frame, m/s².
+    accel_psd : float
+        Accelerometer white-noise PSD, (m/s²)²/Hz = VRW².
+    gyro_psd : float
+        Gyro white-noise PSD, rad²/s = ARW².
+    accel_bias, gyro_bias : BiasModel, default BiasModel()
+        Bias processes (default random constant).
+    layout : Layout, optional
+        State layout (default the 15 states of :data:`INS15`).
+    ellipsoid : str, default "WGS84"
+        Earth ellipsoid.
+
+    Returns
+    -------
+    f : numpy.ndarray (N, n, n)
+        System matrices F, 1/s.
+    qc : numpy.ndarray (N, n, n)
+        Continuous process-noise PSDs Q_c.
+
+    References
+    ----------
+    P. D. Groves, *Principles of GNSS, Inertial, and Multisensor Integrated Navigation
+    Systems*, 2nd ed. (2013), §14.2.
     """
     layout = Layout() if layout is None else instance(layout, Layout, "layout")
     instance(accel_bias, BiasModel, "accel_bias")
@@ -174,7 +297,26 @@ def ins_error_model(lla, vel_ned, q_nb, f_b, accel_psd: float, gyro_psd: float,
 class UpdateResult(tuple):
     """What :meth:`KalmanFilter.update` returns: the tuple ``(innovation, nis, rejected)``,
     whose parts are also the attributes of those names, and ``skipped``, the list of the
-    rows of z that were NaN (missing) and left out of the update."""
+    rows of z that were NaN (missing) and left out of the update.
+
+    Parameters
+    ----------
+    values : sequence
+        The three parts (innovation, nis, rejected).
+    skipped : sequence of int, default ()
+        Rows of z that were NaN.
+
+    Attributes
+    ----------
+    innovation : numpy.ndarray (m,)
+        Innovation per row of z (NaN at the skipped rows).
+    nis : float or numpy.ndarray (m,)
+        Normalised innovation squared.
+    rejected : list of int
+        Rows rejected by the χ² gate.
+    skipped : list of int
+        Rows of z that were NaN.
+    """
 
     def __new__(cls, values, skipped=()):
         if isinstance(values, (str, bytes)) or not hasattr(values, "__len__"):
@@ -198,6 +340,19 @@ class KalmanFilter:
     that loses positive definiteness raises :class:`atomnav.NumericalError` naming the epoch.
     One filter may be shared by threads (calls run one after another; the core holds the
     lock) and pickled or deep-copied between steps: the copy continues bit for bit.
+
+    Parameters
+    ----------
+    p0 : array_like (n, n)
+        Initial covariance (positive definite), squared state units.
+    mode : {"closed", "open"}, default "closed"
+        "closed" (feedback: :meth:`take_correction` hands δx̂ to the caller and resets
+        it) or "open" (δx̂ propagated by Φ and kept).
+
+    References
+    ----------
+    P. D. Groves, *Principles of GNSS, Inertial, and Multisensor Integrated Navigation
+    Systems*, 2nd ed. (2013), ch. 3.
     """
 
     def __init__(self, p0, mode: str = "closed"):
@@ -205,7 +360,17 @@ class KalmanFilter:
 
     def predict(self, phi, qd, steps: int = 1) -> None:
         """P ← ΦPΦᵀ + Q_d (and δx̂ ← Φδx̂ in open loop), ``steps`` times (multirate: pass
-        Φ(ΔT), Q_d(ΔT) for ΔT = MΔt and steps=1)."""
+        Φ(ΔT), Q_d(ΔT) for ΔT = MΔt and steps=1).
+
+        Parameters
+        ----------
+        phi : array_like (n, n)
+            Transition matrix Φ over one step.
+        qd : array_like (n, n)
+            Process-noise covariance Q_d per step, squared state units.
+        steps : int, default 1
+            Number of steps (≥ 0).
+        """
         if isinstance(steps, (int, np.integer)) and not isinstance(steps, (bool, np.bool_)) and steps == 1:
             self._core.predict(_mat(phi, "phi"), _mat(qd, "qd"))
         else:
@@ -253,6 +418,15 @@ class KalmanFilter:
         return UpdateResult(values, skipped)
 
     def take_correction(self) -> np.ndarray:
+        """Hand the estimated error δx̂ to the caller: in closed loop it is then reset to
+        zero, in open loop it is kept.
+
+        Returns
+        -------
+        numpy.ndarray (n,)
+            δx̂ = estimate − true, in the state units, to be removed from the navigation
+            solution.
+        """
         return self._core.take_correction()
 
     @property
@@ -271,8 +445,26 @@ class KalmanFilter:
 def rts_smooth(phi, x_prior, p_prior, x_post, p_post) -> tuple[np.ndarray, np.ndarray]:
     """Rauch–Tung–Striebel smoother over a stored open-loop run of N epochs.
 
-    phi (N, n, n): transition into epoch k (phi[0] unused); x_prior/x_post (N, n);
-    p_prior/p_post (N, n, n). Returns smoothed (x (N, n), P (N, n, n)).
+    Parameters
+    ----------
+    phi : array_like (N, n, n)
+        Transition into epoch k (phi[0] unused).
+    x_prior, x_post : array_like (N, n)
+        A-priori and a-posteriori state estimates, state units.
+    p_prior, p_post : array_like (N, n, n)
+        A-priori and a-posteriori covariances, squared state units.
+
+    Returns
+    -------
+    x : numpy.ndarray (N, n)
+        Smoothed states.
+    p : numpy.ndarray (N, n, n)
+        Smoothed covariances.
+
+    References
+    ----------
+    H. E. Rauch, F. Tung and C. T. Striebel, "Maximum likelihood estimates of linear
+    dynamic systems", *AIAA Journal* 3 (1965).
     """
     a = [np.ascontiguousarray(as_floats(v, name)) for v, name in
          ((phi, "phi"), (x_prior, "x_prior"), (p_prior, "p_prior"), (x_post, "x_post"), (p_post, "p_post"))]
