@@ -226,13 +226,33 @@ def _rate_scale(kind, step: float) -> float:
 
 def swapped_blocks(time, gyro, accel, kind: str) -> str | None:
     """Evidence that the gyro and accel blocks of a plain IMU array were given in the other
-    order (time, accel, gyro: the stream order of :data:`atomnav.imu.COLUMNS`), else None.
-    ``time`` (N,) s, ``gyro`` and ``accel`` (N, 3) as read, of ``kind``. Read that
-    way, the "gyro" block is a specific force: its mean magnitude is gravity,
+    order (time, accel, gyro: the stream order of :data:`atomnav.imu.COLUMNS`).
+
+    Read that way, the "gyro" block is a specific force: its mean magnitude is gravity,
     :data:`ACCEL_G_BAND` in m/s² (a sustained 450 to 700 °/s as a rate, which no navigation
     record has on average), while the "accel" block is an angular rate, below the band's
     lower end, where an Earth-bound specific force never is. Both at once is the swap.
-    Anything that is not numbers (strings included) is a ``TypeError`` naming its argument."""
+
+    Parameters
+    ----------
+    time : array_like (N,)
+        Time stamps (s), as read.
+    gyro, accel : array_like (N, 3)
+        The gyro and accel blocks as read, of ``kind``.
+    kind : str
+        ``"rates"`` (rad/s, m/s²) or ``"increments"`` (rad, m/s; scaled to rates by the
+        median time step).
+
+    Returns
+    -------
+    str or None
+        The evidence (the two mean magnitudes), or None when the blocks are not swapped.
+
+    Raises
+    ------
+    TypeError
+        Anything that is not numbers (strings included), naming its argument.
+    """
     time, gyro, accel = as_floats(time, "time"), as_floats(gyro, "gyro"), as_floats(accel, "accel")
     low, high = ACCEL_G_BAND[0] * units.G0, ACCEL_G_BAND[1] * units.G0
     scale = _rate_scale(kind, _median_step(time))
@@ -243,18 +263,60 @@ def swapped_blocks(time, gyro, accel, kind: str) -> str | None:
 
 
 def specific_force(f: np.ndarray, name: str, scale: float = 1.0) -> None:
-    """Warn if the specific force ``f`` (N, 3) times ``scale`` (1 for m/s², 1/Δt for Δv
-    in m/s) has a mean magnitude in :data:`ACCEL_G_BAND`: the record is in g. An ``f``
-    that is not numbers (strings included) is a ``TypeError`` naming ``f``."""
+    """Warn if a specific force has a mean magnitude in :data:`ACCEL_G_BAND`: the record
+    is in g.
+
+    Parameters
+    ----------
+    f : array_like (N, 3)
+        Specific force (m/s²) or Δv (m/s).
+    name : str
+        The argument of the function the user called, named in the warning.
+    scale : float
+        Factor to m/s²: 1 for a specific force, 1/Δt (1/s) for Δv.
+
+    Raises
+    ------
+    TypeError
+        An ``f`` that is not numbers (strings included), naming ``f``.
+
+    Warns
+    -----
+    UnitWarning
+        The mean magnitude is gravity in g.
+    """
     mean = _mean_norm(as_floats(f, "f"), scale)
     if ACCEL_G_BAND[0] <= mean <= ACCEL_G_BAND[1]:
         _warn(name, "specific force", "g", "m/s²", f"mean |f| = {mean:.3g}, Earth's gravity is 9.8 m/s²", units.G0)
 
 
 def angular_rate(w, name: str, scale: float = 1.0, *, static: bool = False):
-    """Warn if an angular rate ``w`` (rad/s; times ``scale``, 1/Δt for Δθ in rad) exceeds
-    :data:`MAX_ANGULAR_RATE` anywhere or, with ``static`` (a full IMU record that may be
-    at rest), if it is static with a mean of 57.3 × Earth rate: it is in °/s. Returns ``w``."""
+    """Warn if an angular rate is in °/s: it exceeds :data:`MAX_ANGULAR_RATE` anywhere
+    or, with ``static``, it is static with a mean of 57.3 × Earth rate.
+
+    Parameters
+    ----------
+    w : array_like (N, 3)
+        Angular rate (rad/s) or Δθ (rad).
+    name : str
+        The argument of the function the user called, named in the warning.
+    scale : float
+        Factor to rad/s: 1 for rates, 1/Δt (1/s) for Δθ.
+    static : bool
+        ``w`` is a full IMU record that may be at rest: also test its mean against Earth
+        rate in °/s (:data:`EARTH_RATE_TOLERANCE`, :data:`EARTH_RATE_SIGMAS`,
+        :data:`STATIC_VARIANCE_RATIO`).
+
+    Returns
+    -------
+    array_like
+        ``w``, unchanged.
+
+    Warns
+    -----
+    UnitWarning
+        The rate is likely in °/s.
+    """
     scale = _value(scale)
     peak = _max_abs(_rows_sample(w)) * scale
     if _converts(peak, MAX_ANGULAR_RATE, _DEG):
@@ -291,8 +353,26 @@ def _static(s: np.ndarray, mean: np.ndarray) -> bool:
 
 
 def time_steps(t, name: str):
-    """Warn if the median step of the IMU time stamps ``t`` (s) exceeds
-    :data:`MAX_IMU_STEP`: they are in ms. Returns ``t``."""
+    """Warn if the median step of IMU time stamps exceeds :data:`MAX_IMU_STEP`: they are
+    in ms.
+
+    Parameters
+    ----------
+    t : array_like (N,)
+        Time stamps (s).
+    name : str
+        The argument of the function the user called, named in the warning.
+
+    Returns
+    -------
+    array_like
+        ``t``, unchanged.
+
+    Warns
+    -----
+    UnitWarning
+        The time stamps are likely in ms.
+    """
     _step(_median_step(t), name)
     return t
 
@@ -304,8 +384,25 @@ def _step(step: float, name: str) -> None:
 
 
 def sample_interval(dt, name: str):
-    """Warn if an IMU sample interval ``dt`` (s) exceeds :data:`MAX_IMU_STEP`: it is in
-    ms. Returns ``dt``."""
+    """Warn if an IMU sample interval exceeds :data:`MAX_IMU_STEP`: it is in ms.
+
+    Parameters
+    ----------
+    dt : float
+        Sample interval (s).
+    name : str
+        The argument of the function the user called, named in the warning.
+
+    Returns
+    -------
+    float
+        ``dt``, unchanged.
+
+    Warns
+    -----
+    UnitWarning
+        The interval is likely in ms.
+    """
     if _converts(_value(dt), MAX_IMU_STEP, _MS):
         _warn(name, "sample interval", "ms", "s", f"{_value(dt):.4g} s, an IMU samples at least every {MAX_IMU_STEP} s", _MS)
     return dt
@@ -329,13 +426,36 @@ def _stated_interval(step: float, dt: float, name: str, dt_name: str) -> None:
 
 def imu(time, gyro, accel, kind: str, name: str = "imu", *, gyro_name: str | None = None, time_name: str | None = None,
         dt: float | None = None) -> None:
-    """All checks of one IMU record: ``time`` (N,) s or None, ``gyro`` and ``accel``
-    (N, 3) of ``kind`` ``"rates"`` (rad/s, m/s²) or ``"increments"`` (rad, m/s over the
-    sample interval). ``name`` is the argument holding the record (and its accelerations),
-    ``gyro_name`` and ``time_name`` the ones holding the gyro and the time stamps if they
-    differ; ``dt`` the stated sample interval (s), compared with the time stamps when both
-    are given. A ``time``, ``gyro`` or ``accel`` that is not numbers (strings included)
-    is a ``TypeError`` naming it."""
+    """All checks of one IMU record: specific force in g, angular rate in °/s, time
+    stamps or a stated interval in ms.
+
+    Parameters
+    ----------
+    time : array_like (N,) or None
+        Time stamps (s).
+    gyro, accel : array_like (N, 3)
+        Of ``kind``: rates (rad/s, m/s²) or increments (rad, m/s over the sample
+        interval).
+    kind : str
+        ``"rates"`` or ``"increments"``.
+    name : str
+        The argument holding the record (and its accelerations).
+    gyro_name, time_name : str, optional
+        The arguments holding the gyro and the time stamps, if they differ from ``name``.
+    dt : float, optional
+        The stated sample interval (s), compared with the time stamps when both are given.
+
+    Raises
+    ------
+    TypeError
+        A ``time``, ``gyro`` or ``accel`` that is not numbers (strings included), naming
+        it.
+
+    Warns
+    -----
+    UnitWarning
+        A value likely in g, °/s or ms, or a ``dt`` that contradicts the time stamps.
+    """
     time, gyro, accel = (None if time is None else as_floats(time, "time")), as_floats(gyro, "gyro"), as_floats(accel, "accel")
     gyro_name = name if gyro_name is None else gyro_name
     time_name = name if time_name is None else time_name
@@ -354,8 +474,25 @@ def imu(time, gyro, accel, kind: str, name: str = "imu", *, gyro_name: str | Non
 
 
 def longitude(lon, name: str):
-    """Warn if a longitude (rad; any shape) exceeds :data:`MAX_ANGLE` in magnitude: it is
-    in degrees. Returns ``lon``."""
+    """Warn if a longitude exceeds :data:`MAX_ANGLE` in magnitude: it is in degrees.
+
+    Parameters
+    ----------
+    lon : float or array_like
+        Longitude(s) (rad), any shape.
+    name : str
+        The argument of the function the user called, named in the warning.
+
+    Returns
+    -------
+    float or array_like
+        ``lon``, unchanged.
+
+    Warns
+    -----
+    UnitWarning
+        The longitude is likely in degrees.
+    """
     peak = _max_abs(lon)
     if _converts(peak, MAX_ANGLE, _DEG):
         _warn(name, "longitude", "deg", "rad", f"|lon| = {peak:.4g}, beyond 2π", _DEG)
@@ -363,8 +500,26 @@ def longitude(lon, name: str):
 
 
 def lla(p, name: str):
-    """:func:`longitude` of positions ``p`` (..., 3) of (lat rad, lon rad, h m), unless a
-    latitude is beyond ±π/2 (an input error of its own). Returns ``p``."""
+    """:func:`longitude` of positions, unless a latitude is beyond ±π/2 (an input error
+    of its own).
+
+    Parameters
+    ----------
+    p : array_like (..., 3)
+        Positions: latitude (rad), longitude (rad), height (m).
+    name : str
+        The argument of the function the user called, named in the warning.
+
+    Returns
+    -------
+    array_like
+        ``p``, unchanged.
+
+    Warns
+    -----
+    UnitWarning
+        A longitude is likely in degrees.
+    """
     a = _floats(p)
     if a.ndim and a.shape[-1] == 3 and a.size and not _max_abs(a[..., 0]) > np.pi / 2:
         longitude(a[..., 1], name)
@@ -372,8 +527,27 @@ def lla(p, name: str):
 
 
 def angles(a, name: str, quantity: str = "Euler angles"):
-    """Warn if any angle in ``a`` (rad) exceeds :data:`MAX_ANGLE` in magnitude: it is in
-    degrees. Returns ``a``."""
+    """Warn if any angle exceeds :data:`MAX_ANGLE` in magnitude: it is in degrees.
+
+    Parameters
+    ----------
+    a : float or array_like
+        Angles (rad), any shape.
+    name : str
+        The argument of the function the user called, named in the warning.
+    quantity : str
+        What the angles are, for the message.
+
+    Returns
+    -------
+    float or array_like
+        ``a``, unchanged.
+
+    Warns
+    -----
+    UnitWarning
+        The angles are likely in degrees.
+    """
     peak = _max_abs(a)
     if _converts(peak, MAX_ANGLE, _DEG):
         _warn(name, quantity, "deg", "rad", f"max |angle| = {peak:.4g}, beyond 2π", _DEG)
@@ -381,9 +555,28 @@ def angles(a, name: str, quantity: str = "Euler angles"):
 
 
 def pulse_separation(T, name: str, pulses: float = 1.0):
-    """Warn if an interferometer time ``T`` (s), spanning ``pulses`` pulse separations (2
-    for a total interrogation time 2T), exceeds ``pulses`` × :data:`MAX_PULSE_SEPARATION`:
-    it is in ms. Returns ``T``."""
+    """Warn if an interferometer time exceeds ``pulses`` × :data:`MAX_PULSE_SEPARATION`:
+    it is in ms.
+
+    Parameters
+    ----------
+    T : float
+        Interferometer time (s).
+    name : str
+        The argument of the function the user called, named in the warning.
+    pulses : float
+        Pulse separations ``T`` spans (2 for a total interrogation time 2T).
+
+    Returns
+    -------
+    float
+        ``T``, unchanged.
+
+    Warns
+    -----
+    UnitWarning
+        The time is likely in ms.
+    """
     limit = _value(pulses) * MAX_PULSE_SEPARATION
     if _converts(_value(T), limit, _MS):
         _warn(name, "pulse timing", "ms", "s", f"{_value(T):.4g} s, beyond {limit:g} s", _MS)
@@ -391,16 +584,52 @@ def pulse_separation(T, name: str, pulses: float = 1.0):
 
 
 def wavelength(x, name: str):
-    """Warn if a laser wavelength (m) exceeds :data:`MAX_WAVELENGTH`: it is in nm. Returns
-    ``x``."""
+    """Warn if a laser wavelength exceeds :data:`MAX_WAVELENGTH`: it is in nm.
+
+    Parameters
+    ----------
+    x : float
+        Wavelength (m).
+    name : str
+        The argument of the function the user called, named in the warning.
+
+    Returns
+    -------
+    float
+        ``x``, unchanged.
+
+    Warns
+    -----
+    UnitWarning
+        The wavelength is likely in nm.
+    """
     if _converts(_value(x), MAX_WAVELENGTH, 1e-9):
         _warn(name, "wavelength", "nm", "m", f"{_value(x):.6g} m, beyond {MAX_WAVELENGTH:g} m", 1e-9)
     return x
 
 
 def fraction(x, name: str, quantity: str = "fraction"):
-    """Warn if a contrast, offset or probability (any shape) exceeds :data:`MAX_FRACTION`:
-    it is in %. Returns ``x``."""
+    """Warn if a contrast, offset or probability exceeds :data:`MAX_FRACTION`: it is in %.
+
+    Parameters
+    ----------
+    x : float or array_like
+        Fraction(s) in [0, 1], any shape.
+    name : str
+        The argument of the function the user called, named in the warning.
+    quantity : str
+        What the values are, for the message.
+
+    Returns
+    -------
+    float or array_like
+        ``x``, unchanged.
+
+    Warns
+    -----
+    UnitWarning
+        The values are likely in %.
+    """
     peak = _max_abs(x)
     if _converts(peak, MAX_FRACTION, 0.01):
         _warn(name, quantity, "%", "a fraction in [0, 1]", f"{peak:.4g}", 0.01)
@@ -408,8 +637,25 @@ def fraction(x, name: str, quantity: str = "fraction"):
 
 
 def population(p, name: str):
-    """Warn if a measured population (any shape) exceeds :data:`MAX_POPULATION`: it is in
-    %. Returns ``p``."""
+    """Warn if a measured population exceeds :data:`MAX_POPULATION`: it is in %.
+
+    Parameters
+    ----------
+    p : float or array_like
+        Population(s), fractions in [0, 1] plus readout noise, any shape.
+    name : str
+        The argument of the function the user called, named in the warning.
+
+    Returns
+    -------
+    float or array_like
+        ``p``, unchanged.
+
+    Warns
+    -----
+    UnitWarning
+        The populations are likely in %.
+    """
     peak = _max_abs(p)
     if _converts(peak, MAX_POPULATION, 0.01):
         _warn(name, "population", "%", "a fraction in [0, 1]", f"max {peak:.4g}", 0.01)
