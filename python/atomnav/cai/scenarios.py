@@ -31,17 +31,40 @@ MAX_SATELLITE_DAYS = 1000.0
 
 @dataclass(frozen=True)
 class ScenarioConfig(ConfigMixin):
-    """Everything of a Monte-Carlo scenario but its motion: the CAI ``sensor``, the filter
-    ``setup``, the navigation IMU (``imu``, an :meth:`atomnav.imu.ImuErrors.preset` name or
-    an :class:`atomnav.imu.ImuErrors`),
-    ``gravity`` (:data:`GRAVITY_OPTIONS`: "kinematic" = no gravity or Earth rate, "earth" =
-    WGS84), the IMU rate ``rate_hz`` (Hz), the source of the instrument's true phase
-    ``phase_source`` (:data:`PHASE_SOURCE_OPTIONS`: "ideal" = a perfect CAI on the truth
-    sampled at ``truth_rate_hz`` Hz; "reference" = a CAI emulated from the ``reference``
-    IMU, a preset name or an :class:`atomnav.imu.ImuErrors`), ``aiding`` (False: the same filter without CAI updates) and
-    ``draw_initial`` (draw the initial navigation error from P0 instead of starting at the
-    truth). Checked by the core when the scenario is built; convertible to and from dict /
-    JSON, and saved in :attr:`HybridResult.config`."""
+    """Everything of a Monte-Carlo scenario but its motion.
+
+    Checked by the core when the scenario is built; convertible to and from dict / JSON,
+    and saved in :attr:`HybridResult.config`.
+
+    Parameters
+    ----------
+    sensor : CaiSensor
+        The CAI.
+    setup : FilterSetup
+        The filter tuning.
+    imu : str or atomnav.imu.ImuErrors
+        The navigation IMU: an :meth:`atomnav.imu.ImuErrors.preset` name or an
+        :class:`atomnav.imu.ImuErrors`.
+    reference : str or atomnav.imu.ImuErrors, optional
+        The reference IMU the CAI is emulated from when ``phase_source`` is
+        "reference": a preset name or an :class:`atomnav.imu.ImuErrors`.
+    gravity : {"kinematic", "earth"}
+        :data:`GRAVITY_OPTIONS`: "kinematic" = no gravity or Earth rate, "earth" = WGS84.
+    rate_hz : float
+        IMU rate (Hz).
+    truth_rate_hz : float, optional
+        Rate (Hz) of the truth the ideal phases are computed on ("ideal" phase source;
+        may equal ``rate_hz``). None for a trajectory sampled from data, or with a
+        reference IMU.
+    phase_source : {"ideal", "reference"}
+        :data:`PHASE_SOURCE_OPTIONS`, the source of the instrument's true phase: "ideal"
+        = a perfect CAI on the truth sampled at ``truth_rate_hz``; "reference" = a CAI
+        emulated from the ``reference`` IMU.
+    aiding : bool
+        False: the same filter without CAI updates.
+    draw_initial : bool
+        Draw the initial navigation error from P0 instead of starting at the truth.
+    """
 
     _NESTED = {"sensor": CaiSensor, "setup": FilterSetup, "imu": _ImuModel, "reference": _ImuModel}
 
@@ -67,14 +90,55 @@ def seed003_sensor(lever=(0.0, 0.0, 0.1), v0: float = 2.8, T: float = 0.025, inf
     with cubic Hermite splines and takes ω̇ from the same interpolant ("pwl"): with linear
     inputs and the Savitzky–Golay ω̇ of the paper's default, the 15.1 Hz, 0.005 rad/s angular
     vibration of the car profile is mispredicted by several rad (its Coriolis and atom-Euler
-    phases are ≈170 and ≈330 rad), and most shots slip a fringe."""
+    phases are ≈170 and ≈330 rad), and most shots slip a fringe.
+
+    Parameters
+    ----------
+    lever : array_like, shape (3,)
+        IMU → release-point lever arm in the body frame (m).
+    v0 : float
+        Launch speed of the A/B ensembles (m/s).
+    T : float
+        Pulse separation (s).
+    inflation : tuple of float, optional
+        White-noise PSDs (q_a m²/s³, q_g rad²/s) of the IMU for the in-shot R inflation;
+        None: no inflation.
+    interpolation : {"linear", "cubic"}
+        Interpolation of the IMU inputs in the predictor.
+    omega_dot : {"pwl", "savgol", "zero"}
+        Source of ω̇ for the Euler terms (see :class:`CaiSensor`).
+
+    Returns
+    -------
+    CaiSensor
+        The sensor.
+    """
     return CaiSensor(Channels.cyclic(K_RB87, v0, lever=lever), T, inflation=inflation, interpolation=interpolation, omega_dot=omega_dot)
 
 
 def accelerometer_sensor(lever=(0.0, 0.0, 0.1), T: float = 0.025, inflation=(1.25e-11, 1.0576e-12)) -> CaiSensor:
     """Accelerometer-only CAI: one channel per body axis with atoms at rest in s (v0 = 0), so
     the readout carries no Coriolis phase and observes the accelerometer biases only (the
-    gyro biases enter only through the small mixed term 2T³k·(ω×f))."""
+    gyro biases enter only through the small mixed term 2T³k·(ω×f)).
+
+    Channels x, y, z with k = 4π/780.241 nm; the predictor interpolates the IMU with
+    cubic splines and takes ω̇ from the interpolant ("pwl"), as :func:`seed003_sensor`.
+
+    Parameters
+    ----------
+    lever : array_like, shape (3,)
+        IMU → release-point lever arm in the body frame (m).
+    T : float
+        Pulse separation (s).
+    inflation : tuple of float, optional
+        White-noise PSDs (q_a m²/s³, q_g rad²/s) of the IMU for the in-shot R inflation;
+        None: no inflation.
+
+    Returns
+    -------
+    CaiSensor
+        The sensor.
+    """
     ch = Channels(np.eye(3) * K_RB87, lever, np.eye(3), np.zeros(3), ["x", "y", "z"])
     return CaiSensor(ch, T, inflation=inflation, interpolation="cubic", omega_dot="pwl")
 
@@ -89,7 +153,20 @@ def seed003_filter(attitude_sigma0: float = 1e-7) -> FilterSetup:
     remedy: the CAI cannot observe it (the phase does not depend on the navigation attitude), and in kinematic mode
     1e-5 rad × 1 m/s² × 20 s = 2e-4 m/s of velocity error, five times the 25 s hybrid error
     (≈ 4e-5 m/s): with the slalom's 25 s free-INS error of 3.8e-3 m/s the gain is capped at ≈ 19; in Earth gravity
-    1e-5 rad × 9.81 m/s² × 60 s = 5.9e-3 m/s, above the 60 s hybrid error (≈ 3.8e-3 m/s)."""
+    1e-5 rad × 9.81 m/s² × 60 s = 5.9e-3 m/s, above the 60 s hybrid error (≈ 3.8e-3 m/s).
+
+    Parameters
+    ----------
+    attitude_sigma0 : float
+        Initial attitude σ (rad).
+
+    Returns
+    -------
+    FilterSetup
+        PSDs 1.25e-11 m²/s³ (accel), 1.0576e-12 rad²/s (gyro), bias random walks
+        9e-10 m²/s⁵ and 4e-14 rad²/s³, prediction every 10 IMU steps, initial σ
+        (1e-6 m, 1e-6 m/s, ``attitude_sigma0`` rad, 2e-5 m/s², 1e-6 rad/s).
+    """
     return FilterSetup(1.25e-11, 1.0576e-12, 9e-10, 4e-14, 10, sigma0=(1e-6, 1e-6, positive(attitude_sigma0, "attitude_sigma0"), 2e-5, 1e-6))
 
 
@@ -105,9 +182,30 @@ def car_mc(runs: int = 100, seed: int = 2023, *, gravity: str = "kinematic", lev
     k T² l ω̇ = 10066 · 0.1 · 0.474 ≈ 477 rad must be predicted from the 200 Hz gyro; the
     derivative of its cubic interpolant errs by up to 3.7 % at 15.1 Hz (≈ 18 rad before the
     shot's averaging), and the lever arm also carries 0.37 rad of in-shot gyro noise into the
-    phase (2Tq_g(kl)², :func:`in_shot_noise`). Measured (100 runs, lead's reproduce run): the
-    25 s velocity gain drops from 36.3 to 26.6 (< 30 required) and fringe slips rise from
-    1.84 % to 5.83 %; the reproduce section reports both."""
+    phase (2Tq_g(kl)², :func:`in_shot_noise`). Measured over 100 runs: the 25 s velocity
+    gain drops from 36.3 to 26.6 (< 30 required) and fringe slips rise from 1.84 % to
+    5.83 %; the report of :mod:`atomnav.reproduce` shows both.
+
+    Parameters
+    ----------
+    runs : int
+        Number of Monte-Carlo runs.
+    seed : int
+        Master seed (0 … 2⁶⁴ − 1); run r uses stream r, so any subset reproduces.
+    gravity : {"kinematic", "earth"}
+        "kinematic" (the paper's kinematic mode) or "earth".
+    lever : array_like, shape (3,)
+        IMU → release-point lever arm in the body frame (m).
+    vibration : bool
+        Include the vibration, the shock and the vibration window of the profile.
+    progress : bool
+        Show a progress bar over runs.
+
+    Returns
+    -------
+    HybridResult
+        The Monte-Carlo result (see :func:`atomnav.cai.run_campaign`).
+    """
     motion = _core.Motion.car(vector(HANNOVER, 3, "origin"), 0.0, bool(instance(vibration, (bool, np.bool_), "vibration")))
     config = ScenarioConfig(seed003_sensor(lever), seed003_filter(), gravity=gravity)
     return run_campaign(motion, config, runs=runs, seed=seed, name="car_mc", progress=progress,
@@ -121,7 +219,35 @@ def slalom(runs: int = 100, seed: int = 2024, *, gravity: str = "kinematic", dur
     level, heading along the path, 60 s; otherwise as :func:`car_mc`. ``aiding=False`` runs
     the same filter without CAI updates; ``sensor`` / ``setup`` replace the paper's CAI and
     filter (e.g. :func:`accelerometer_sensor`, the 21-state filter with misalignment and
-    lever-arm states, or option a)."""
+    lever-arm states, or option a).
+
+    Parameters
+    ----------
+    runs : int
+        Number of Monte-Carlo runs.
+    seed : int
+        Master seed (0 … 2⁶⁴ − 1); run r uses stream r, so any subset reproduces.
+    gravity : {"kinematic", "earth"}
+        "kinematic" (the paper's kinematic mode) or "earth".
+    duration : float
+        Length of the profile (s).
+    lever : array_like, shape (3,)
+        IMU → release-point lever arm in the body frame (m) of the paper's CAI (ignored
+        when ``sensor`` is given).
+    aiding : bool
+        False: the same filter without CAI updates.
+    sensor : CaiSensor, optional
+        Replaces the paper's CAI (:func:`seed003_sensor`).
+    setup : FilterSetup, optional
+        Replaces the paper's filter (:func:`seed003_filter`).
+    progress : bool
+        Show a progress bar over runs.
+
+    Returns
+    -------
+    HybridResult
+        The Monte-Carlo result (see :func:`atomnav.cai.run_campaign`).
+    """
     if sensor is not None:
         instance(sensor, CaiSensor, "sensor")._checked("sensor")
     if setup is not None:
@@ -141,7 +267,25 @@ def satellite(days: float = 4.0, seed: int = 2021, *, drift: bool = True, progre
     q_rw = 1e-21 m²/s⁵), one CAI shot every 10 s with T0 = 10 s (T = 5 s), |A| = 0.15
     (C = 0.3), R = 1.024e-3; the filter's bias model is the random walk q_rw
     (Q = 1e-20 (m/s²)² per shot, Table 1 case A). Kinematic frame (drag-free, no
-    gravity); one run; output at every shot; at most ``MAX_SATELLITE_DAYS`` days."""
+    gravity); one run; output at every shot; at most ``MAX_SATELLITE_DAYS`` days.
+
+    Parameters
+    ----------
+    days : float
+        Length of the record (days), at most ``MAX_SATELLITE_DAYS``.
+    seed : int
+        Seed of the run (0 … 2⁶⁴ − 1).
+    drift : bool
+        Add the bias random walk q_rw to the accelerometer (preset
+        ``electrostatic_space_drift`` instead of ``electrostatic_space``).
+    progress : bool
+        Show a progress bar over runs.
+
+    Returns
+    -------
+    HybridResult
+        The Monte-Carlo result (see :func:`atomnav.cai.run_campaign`).
+    """
     days = positive(days, "days")
     if days > MAX_SATELLITE_DAYS:
         raise input_error("days", f"must be <= {MAX_SATELLITE_DAYS} (one IMU sample per second), got {days}")
@@ -162,7 +306,22 @@ def hexapod(runs: int = 100, seed: int = 2000, *, progress: bool = True) -> Hybr
     (preset ``mems``: biases (2e-3, −1.5e-3, 1e-3) m/s², (5e-5, −4e-5, 3e-5) rad/s) corrected
     by a CAI emulated from a navigation-grade reference IMU (preset ``navigation``):
     T = 5 ms, one shot per 10 ms, cyclic ±2.8 m/s ensembles, R = 1e-3, Earth gravity. The
-    estimated biases are relative to the reference IMU (truth = MEMS − reference)."""
+    estimated biases are relative to the reference IMU (truth = MEMS − reference).
+
+    Parameters
+    ----------
+    runs : int
+        Number of Monte-Carlo runs.
+    seed : int
+        Master seed (0 … 2⁶⁴ − 1); run r uses stream r, so any subset reproduces.
+    progress : bool
+        Show a progress bar over runs.
+
+    Returns
+    -------
+    HybridResult
+        The Monte-Carlo result (see :func:`atomnav.cai.run_campaign`).
+    """
     motion = _core.Motion.hexapod(vector(HANNOVER, 3, "origin"), 0.0654, 5.0, 0.0)
     mems, nav = ImuErrors.preset("mems"), ImuErrors.preset("navigation")
     q_a = mems.accel.white**2 + nav.accel.white**2
@@ -199,7 +358,27 @@ def slalom_covariance(gravity: str = "earth", *, duration: float = 60.0, attitud
     attitude columns; the tilt driven by gyro white noise (ARW) stays unobserved and projects
     gravity into the velocity (δv̇ = [f^n×]ψ, |f^n| ≈ g). That error is common to the free and
     the hybrid solution, which caps their ratio; in kinematic mode f^n is the small vehicle
-    acceleration and the cap disappears; an attitude aid observes ψ directly and lifts it."""
+    acceleration and the cap disappears; an attitude aid observes ψ directly and lifts it.
+
+    Parameters
+    ----------
+    gravity : {"earth", "kinematic"}
+        "earth" (WGS84) or "kinematic" (no gravity or Earth rate).
+    duration : float
+        Length of the slalom (s).
+    attitude_sigma : float, optional
+        σ (rad) of a direct attitude measurement ψ + n at every shot; None: none.
+    lever : array_like, shape (3,)
+        IMU → release-point lever arm in the body frame (m).
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row per epoch: ``time_s``, the RMS velocity-error norms √tr P_vv
+        ``free_vel_rms_mps`` (free INS), ``hybrid_vel_rms_mps`` (the hybrid filter's own
+        covariance), ``hybrid_true_vel_rms_mps`` (its true error), in m/s, and the ratios
+        ``ratio`` = free / hybrid and ``ratio_true`` = free / hybrid true.
+    """
     from ..filter import BiasModel, Scenario, covariance_analysis, ins_error_model
     from ..filter.analysis import true_error_analysis
     from ..trajectory import slalom as slalom_trajectory
