@@ -30,13 +30,27 @@ def _table(df, columns, name) -> np.ndarray:
 
 
 class Ephemerides:
-    """Broadcast ephemerides of both systems (Rust ``gnss/ephemeris.rs``)."""
+    """Broadcast ephemerides of both systems: GPS Keplerian sets (IS-GPS-200) and GLONASS
+    state vectors (GLONASS ICD 2008) (Rust ``gnss/ephemeris.rs``).
+
+    Parameters
+    ----------
+    gps : pandas.DataFrame, optional
+        GPS sets with the columns :data:`GPS_COLUMNS` (angles rad, times GPS s, clock s,
+        s/s, s/s²); None: no GPS satellites.
+    glonass : pandas.DataFrame, optional
+        GLONASS sets with the columns :data:`GLONASS_COLUMNS` (tb GLONASS s; PZ-90 m, m/s,
+        m/s²; tau_n s); None: no GLONASS satellites.
+    n_leap : float, default 18.0
+        GPS−UTC leap seconds, s (15 in 2009, 18 since 2017).
+    datum : {"identity", "pz90_02_to_wgs84"}, default "identity"
+        PZ-90 → WGS-84 transformation.
+    _core_obj : optional
+        Internal: an already built core object (as :meth:`nominal` makes); not for users.
+    """
 
     def __init__(self, gps: pd.DataFrame | None = None, glonass: pd.DataFrame | None = None,
                  n_leap: float = 18.0, datum: str = "identity", *, _core_obj=None):
-        """``gps``/``glonass``: tables with :data:`GPS_COLUMNS` / :data:`GLONASS_COLUMNS`;
-        ``n_leap`` GPS−UTC leap seconds (15 in 2009, 18 since 2017); ``datum`` PZ-90 → WGS-84
-        transformation ``"identity"`` or ``"pz90_02_to_wgs84"``."""
         self._core = instance(_core_obj, _core.GnssEphemerides, "_core_obj") if _core_obj is not None else _core.GnssEphemerides(
             _table(gps, GPS_COLUMNS, "gps"), _table(glonass, GLONASS_COLUMNS, "glonass"), finite_scalar(n_leap, "n_leap"), datum)
 
@@ -44,15 +58,45 @@ class Ephemerides:
     def nominal(cls, t_start: float, t_end: float, gps: bool = True, glonass: bool = True, tau_gps: float = 0.0,
                 n_leap: float = 18.0, clocks: bool = True, seed: int = 0) -> "Ephemerides":
         """Nominal 24-satellite GPS (6 planes) and GLONASS (3 planes, FDMA channels)
-        constellations covering GPS times [t_start, t_end] s; ``tau_gps`` (s) is the true
-        GPS−GLONASS offset used to reference the GLONASS sets; ``clocks``: random satellite
-        clocks (b ~ U(±0.5 ms), drift ~ N(0, 1e-11²)) from ``seed``."""
+        constellations: circular orbits of the nominal planes and slots.
+
+        Parameters
+        ----------
+        t_start, t_end : float
+            GPS times covered, s (seconds of the GPS week).
+        gps : bool, default True
+            Include the GPS constellation.
+        glonass : bool, default True
+            Include the GLONASS constellation.
+        tau_gps : float, default 0.0
+            True GPS−GLONASS system-time offset τ_GPS used to reference the GLONASS sets, s.
+        n_leap : float, default 18.0
+            GPS−UTC leap seconds, s.
+        clocks : bool, default True
+            Random satellite clocks (bias b ~ U(±0.5 ms), drift ~ N(0, 1e-11²) s/s); False:
+            ideal clocks.
+        seed : int, default 0
+            Seed of the satellite clocks, in [0, 2**64).
+
+        Returns
+        -------
+        Ephemerides
+            The nominal broadcast sets.
+        """
         return cls(_core_obj=_core.GnssEphemerides.nominal(
             finite_scalar(t_start, "t_start"), finite_scalar(t_end, "t_end"), gps, glonass, finite_scalar(tau_gps, "tau_gps"),
             finite_scalar(n_leap, "n_leap"), clocks, integer(seed, "seed", 0, 2**64 - 1)))
 
     def tables(self) -> tuple[pd.DataFrame, pd.DataFrame]:
-        """The GPS and GLONASS sets as DataFrames (:data:`GPS_COLUMNS`, :data:`GLONASS_COLUMNS`)."""
+        """The broadcast sets as tables.
+
+        Returns
+        -------
+        gps : pandas.DataFrame
+            GPS sets, columns :data:`GPS_COLUMNS`.
+        glonass : pandas.DataFrame
+            GLONASS sets, columns :data:`GLONASS_COLUMNS`.
+        """
         return (pd.DataFrame(self._core.gps_table(), columns=GPS_COLUMNS),
                 pd.DataFrame(self._core.glonass_table(), columns=GLONASS_COLUMNS))
 
@@ -62,24 +106,83 @@ class Ephemerides:
         return list(self._core.satellites())
 
     def channel(self, sat: str) -> int:
-        """FDMA channel k of a GLONASS satellite (0 for GPS)."""
+        """FDMA channel k of a GLONASS satellite.
+
+        Parameters
+        ----------
+        sat : str
+            Satellite name, e.g. "G01" or "R05".
+
+        Returns
+        -------
+        int
+            Frequency channel k (−7..6); 0 for GPS.
+        """
         return self._core.channel(sat)
 
     def state(self, sat: str, t, tau_gps: float = 0.0) -> pd.DataFrame:
-        """Satellite position ``x_m, y_m, z_m`` and velocity (WGS-84 ECEF) and clock
-        ``clock_s``, ``clock_rate`` at GPS times ``t`` (GLONASS at t − ΔT_leap − tau_gps)."""
+        """Satellite position, velocity and clock at GPS times ``t``.
+
+        Parameters
+        ----------
+        sat : str
+            Satellite name, e.g. "G01" or "R05".
+        t : float or array_like, shape (N,)
+            GPS times, s; GLONASS sets are evaluated at t − ΔT_leap − ``tau_gps``.
+        tau_gps : float, default 0.0
+            GPS−GLONASS system-time offset τ_GPS, s.
+
+        Returns
+        -------
+        pandas.DataFrame
+            One row per time: WGS-84 ECEF position ``x_m, y_m, z_m`` (m) and velocity
+            ``vx_mps, vy_mps, vz_mps`` (m/s), satellite clock ``clock_s`` (s) and
+            ``clock_rate`` (s/s).
+        """
         t = np.atleast_1d(as_floats(t, "t"))
         s = self._core.state(sat, vector(t, None, "t"), finite_scalar(tau_gps, "tau_gps"))
         return pd.DataFrame(s, columns=["x_m", "y_m", "z_m", "vx_mps", "vy_mps", "vz_mps", "clock_s", "clock_rate"])
 
     def look_angles(self, sat: str, t, lla) -> pd.DataFrame:
-        """Elevation and azimuth (rad) of ``sat`` from geodetic ``lla`` at GPS times ``t``."""
+        """Elevation and azimuth of a satellite seen from a geodetic position.
+
+        Parameters
+        ----------
+        sat : str
+            Satellite name, e.g. "G01" or "R05".
+        t : float or array_like, shape (N,)
+            GPS times, s.
+        lla : array_like, shape (3,)
+            Receiver latitude (rad), longitude (rad), height (m).
+
+        Returns
+        -------
+        pandas.DataFrame
+            One row per time: ``elevation_rad``, ``azimuth_rad`` (rad).
+        """
         t = np.atleast_1d(as_floats(t, "t"))
         a = self._core.look_angles(sat, vector(t, None, "t"), vector(lla, 3, "lla"))
         return pd.DataFrame(a, columns=["elevation_rad", "azimuth_rad"])
 
     def top(self, n: int, t: float, lla, mask_deg: float = 10.0) -> list[str]:
-        """The ``n`` highest satellites above the mask at time ``t`` (fixed subsets)."""
+        """The ``n`` highest satellites above the mask at time ``t`` (for fixed subsets).
+
+        Parameters
+        ----------
+        n : int
+            Number of satellites (≥ 0).
+        t : float
+            GPS time, s.
+        lla : array_like, shape (3,)
+            Receiver latitude (rad), longitude (rad), height (m).
+        mask_deg : float, default 10.0
+            Elevation mask, degrees.
+
+        Returns
+        -------
+        list of str
+            Up to ``n`` satellite names, highest first.
+        """
         n, t, lla = integer(n, "n", 0), finite_scalar(t, "t"), vector(lla, 3, "lla")
         mask = np.radians(finite_scalar(mask_deg, "mask_deg"))
         el = {s: self.look_angles(s, [t], lla)["elevation_rad"].iloc[0] for s in self.satellites}
@@ -88,13 +191,36 @@ class Ephemerides:
 
 
 def glonass_propagate(pos, vel, acc, dt: float, step: float = 30.0, j2: float = 1082625.75e-9) -> np.ndarray:
-    """RK4 propagation of a GLONASS PZ-90 state (m, m/s) with constant luni-solar
-    acceleration ``acc`` (m/s²) over ``dt`` s in steps ≤ ``step`` s (GLONASS ICD 2008,
-    A.3.1.2). Returns [x, y, z, vx, vy, vz].
+    """RK4 propagation of a GLONASS PZ-90 state with constant luni-solar acceleration
+    (GLONASS ICD 2008, A.3.1.2).
 
-    The equations of motion hold outside the Earth: a position whose radius is below
-    the equatorial radius a_e = 6 378 136 m is an :class:`atomnav.InputError` naming
-    ``pos``, and an orbit that descends below it (at an RK4 step point) or leaves the
-    floating-point range within ``dt`` one naming ``vel``."""
+    Parameters
+    ----------
+    pos : array_like, shape (3,)
+        PZ-90 position, m.
+    vel : array_like, shape (3,)
+        PZ-90 velocity, m/s.
+    acc : array_like, shape (3,)
+        Constant luni-solar acceleration, m/s².
+    dt : float
+        Propagation interval, s (may be negative).
+    step : float, default 30.0
+        Largest RK4 step, s (> 0).
+    j2 : float, default 1082625.75e-9
+        Second zonal harmonic J2 of the geopotential (dimensionless; PZ-90 value).
+
+    Returns
+    -------
+    numpy.ndarray, shape (6,)
+        [x, y, z, vx, vy, vz] after ``dt``, m and m/s.
+
+    Raises
+    ------
+    atomnav.InputError
+        The equations of motion hold outside the Earth: a position whose radius is below
+        the equatorial radius a_e = 6 378 136 m names ``pos``; an orbit that descends
+        below it (at an RK4 step point) or leaves the floating-point range within ``dt``
+        names ``vel``.
+    """
     return _core.glonass_propagate(vector(pos, 3, "pos"), vector(vel, 3, "vel"), vector(acc, 3, "acc"),
                                    finite_scalar(dt, "dt"), finite_scalar(step, "step"), finite_scalar(j2, "j2"))

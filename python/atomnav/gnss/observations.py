@@ -19,17 +19,64 @@ OBS_COLUMNS = ["time_s", "sat", "channel", "code_m", "rate_mps"]
 def simulate(eph: Ephemerides, time, lla, vel_ned, options: GnssOptions | None = None, *, tau_gps: float = 0.0,
              clock_bias: float = 0.0, clock_drift: float = 0.0, mask_deg: float = 10.0, only: list[str] | None = None,
              outages=(), sat_outages=(), seed: int = 0, **option_fields) -> pd.DataFrame:
-    """Observations of a receiver at ``lla`` (N, 3) rad/rad/m with NED velocity ``vel_ned``
-    (N, 3) m/s at GPS times ``time`` (N,) s. A latitude beyond ±π/2 is an
-    :class:`atomnav.InputError`, a longitude beyond 2π a :class:`atomnav.UnitWarning`.
+    """Simulated code and pseudorange-rate observations of a moving receiver.
 
-    Noise and atmosphere from ``options`` (:class:`GnssOptions`; its fields may also be
-    given as keywords, e.g. ``sigma_code=1.0, iono=False``): code σ, rate σ, Klobuchar
-    and Saastamoinen. Truth: ``tau_gps`` (s) on GLONASS code, receiver clock
-    δt_r = clock_bias + clock_drift·t (s). Visibility: elevation mask ``mask_deg``,
-    ``only`` a fixed satellite subset, ``outages`` [(start, end)] s of all satellites,
-    ``sat_outages`` [(sat, start, end)]. Seeded. The table also carries the true
-    ``elevation_rad``."""
+    Noise and atmosphere come from the options: code σ, rate σ, Klobuchar ionosphere and
+    Saastamoinen troposphere. GLONASS code is delivered with c·ΔT_leap removed (as in
+    Demidov 2009).
+
+    Parameters
+    ----------
+    eph : Ephemerides
+        Broadcast ephemerides of the satellites.
+    time : array_like, shape (N,)
+        GPS times of the epochs, s.
+    lla : array_like, shape (N, 3)
+        Receiver latitude (rad), longitude (rad), height (m) per epoch.
+    vel_ned : array_like, shape (N, 3)
+        Receiver NED velocity per epoch, m/s.
+    options : GnssOptions, optional
+        Noise and atmosphere options (default ``GnssOptions()``).
+    tau_gps : float, default 0.0
+        True GPS−GLONASS system-time offset τ_GPS on the GLONASS code, s.
+    clock_bias : float, default 0.0
+        Receiver clock bias, s: δt_r = clock_bias + clock_drift·t.
+    clock_drift : float, default 0.0
+        Receiver clock drift, s/s.
+    mask_deg : float, default 10.0
+        Elevation mask, degrees.
+    only : list of str, optional
+        A fixed satellite subset (names such as "G01"); None: every satellite above the
+        mask.
+    outages : sequence of (float, float), default ()
+        Intervals (start, end), s, without any satellite.
+    sat_outages : sequence of (str, float, float), default ()
+        Outages (sat, start, end), s, of single satellites.
+    seed : int, default 0
+        Noise seed, in [0, 2**64).
+    **option_fields
+        Fields of :class:`GnssOptions` given as keywords (e.g. ``sigma_code=1.0,
+        iono=False``), replacing those of ``options``.
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row per satellite and epoch: :data:`OBS_COLUMNS` ``time_s`` (GPS s), ``sat``,
+        ``channel`` (FDMA channel k, 0 for GPS), ``code_m`` (m), ``rate_mps`` (m/s), and
+        the true ``elevation_rad`` (rad).
+
+    Raises
+    ------
+    atomnav.InputError
+        Naming ``lla`` for a latitude beyond ±π/2.
+    TypeError
+        For a keyword that is not a field of :class:`GnssOptions`.
+
+    Warns
+    -----
+    atomnav.UnitWarning
+        For a longitude beyond 2π (degrees given for radians).
+    """
     instance(eph, Ephemerides, "eph")
     opts, rest = split_options(options, option_fields)
     if rest:
@@ -50,7 +97,30 @@ def simulate(eph: Ephemerides, time, lla, vel_ned, options: GnssOptions | None =
 
 
 def doppler_to_rate(doppler_hz, sat, channel) -> np.ndarray:
-    """Pseudorange rate (m/s) = −λ·D with the per-channel GLONASS wavelength (FDMA carrier)."""
+    """Pseudorange rate = −λ·D of Doppler measurements, with the per-channel GLONASS
+    wavelength (FDMA carrier).
+
+    Parameters
+    ----------
+    doppler_hz : float or array_like, shape (N,)
+        Doppler shifts D, Hz.
+    sat : str or sequence of str, shape (N,)
+        Satellite names ("G01", "R05", ...); the first letter selects the system.
+    channel : int or array_like, shape (N,)
+        FDMA channels k of GLONASS satellites (−7..6; ignored for GPS). Carrier
+        f = 1602 + 0.5625 k MHz for GLONASS, 1575.42 MHz for GPS L1.
+
+    Returns
+    -------
+    numpy.ndarray, shape (N,)
+        Pseudorange rates, m/s.
+
+    Raises
+    ------
+    atomnav.InputError
+        Naming ``sat`` or ``channel`` for a count other than one per Doppler, or
+        ``channel`` for an unknown GLONASS channel.
+    """
     d = np.atleast_1d(as_floats(doppler_hz, "doppler_hz")).reshape(-1)
     finite(d, "doppler_hz")
     sats = np.atleast_1d(np.asarray(sat, dtype=object)).reshape(-1)
@@ -85,8 +155,26 @@ def _gps_week_start(obs: pd.DataFrame):
 
 def obs_arrays(obs: pd.DataFrame) -> tuple:
     """The observation table as the arrays the core takes, read by column name (extra
-    columns ignored). ``time_s`` is GPS seconds of week, or naive GPS-time datetime64
-    (converted to seconds since the start of its GPS week)."""
+    columns ignored).
+
+    Parameters
+    ----------
+    obs : pandas.DataFrame
+        Observation table with :data:`OBS_COLUMNS`. ``time_s`` is GPS seconds of week, or
+        naive GPS-time datetime64 (converted to seconds since the start of its GPS week).
+
+    Returns
+    -------
+    tuple
+        ``(time, sat, channel, code, rate)``: times (N,) GPS s, satellite names (list of
+        str), FDMA channels (N,) int64, code (N,) m and pseudorange rate (N,) m/s.
+
+    Raises
+    ------
+    atomnav.InputError
+        Naming ``obs`` for a missing column, non-integer channels, or a tz-aware
+        ``time_s`` (civil time differs from GPS time by the leap seconds).
+    """
     instance(obs, pd.DataFrame, "obs")
     numeric = ["time_s", "channel", "code_m", "rate_mps"]
     time, channel, code, rate = (np.ascontiguousarray(c) for c in table(obs, numeric, "obs", epoch=_gps_week_start(obs),

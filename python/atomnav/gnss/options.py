@@ -20,18 +20,51 @@ FORMULATIONS = tuple(_core.OPTIONS["Formulation"])
 class GnssOptions(Config):
     """GNSS processing options; an invalid field raises :class:`atomnav.InputError` naming it.
 
-    Noise: code σ ``sigma_code`` (m; GLONASS ``sigma_code_glonass``, None = the same),
-    pseudorange-rate σ ``sigma_rate`` (m/s). Corrections: Klobuchar ``iono`` (broadcast
-    coefficients of 2009-01-01) and Saastamoinen ``tropo``. Single-point positioning:
-    ``use_tau`` estimates τ_GPS (5 unknowns when GLONASS is present; False gives the
-    thesis's "no-τ" diagnostic), ``elevation_weight`` σ/sin E. Tight coupling:
-    ``formulation`` one of :data:`FORMULATIONS` ("first_difference": between-satellite
-    differences with c·τ_GPS as an extra state; "clock_states": undifferenced rows with
-    the receiver clock states), ``lever_arm`` IMU → antenna in body axes (m), ``use_rate``;
-    τ_GPS initial value ``tau0`` ± ``sigma_tau0`` (s) and random-walk PSD ``tau_psd``
-    (s²/s; default (0.1 ns)²/h); clock states (c·δt_r m, c·δṫ_r m/s)
-    ``clock0`` ± ``sigma_clock0`` with oscillator h₀ ``clock_h0`` (s), h₋₂ ``clock_hm2``
-    (1/s) (Brown & Hwang 2012, Table 9.1: a TCXO)."""
+    All fields are keyword-only.
+
+    Parameters
+    ----------
+    sigma_code : float, default 3.0
+        Code σ, m.
+    sigma_code_glonass : float, optional
+        GLONASS code σ, m; None = ``sigma_code``.
+    sigma_rate : float, default 0.05
+        Pseudorange-rate σ, m/s.
+    iono : bool, default True
+        Klobuchar ionosphere (broadcast coefficients of 2009-01-01), in simulation and
+        correction.
+    tropo : bool, default True
+        Saastamoinen troposphere, in simulation and correction.
+    use_tau : bool, default True
+        Single-point positioning estimates τ_GPS (5 unknowns when GLONASS is present);
+        False gives the "no-τ" diagnostic of Demidov 2009.
+    elevation_weight : bool, default False
+        Single-point positioning weights with σ/sin E.
+    formulation : str, default "first_difference"
+        Tight coupling, one of :data:`FORMULATIONS`: "first_difference" (between-satellite
+        differences with c·τ_GPS as an extra state) or "clock_states" (undifferenced rows
+        with the receiver clock states).
+    lever_arm : array_like, shape (3,), default (0, 0, 0)
+        IMU → antenna lever arm in body axes, m.
+    use_rate : bool, default True
+        Tight coupling uses the pseudorange rates.
+    tau0 : float, default 0.0
+        Initial τ_GPS, s.
+    sigma_tau0 : float, default 1e-6
+        Initial σ of τ_GPS, s.
+    tau_psd : float, default (0.1 ns)²/h
+        Random-walk PSD of τ_GPS, s²/s.
+    clock0 : array_like, shape (2,), default (0, 0)
+        Initial receiver clock states (c·δt_r m, c·δṫ_r m/s).
+    sigma_clock0 : array_like, shape (2,), default (3e5, 300)
+        Their initial σ (m, m/s).
+    clock_h0 : float, default 2e-19
+        Oscillator white-frequency coefficient h₀, s (Brown & Hwang 2012, Table 9.1: a
+        TCXO).
+    clock_hm2 : float, default 2e-20
+        Oscillator random-walk-frequency coefficient h₋₂, 1/s (Brown & Hwang 2012,
+        Table 9.1).
+    """
 
     sigma_code: float = 3.0
     sigma_code_glonass: float | None = None
@@ -65,7 +98,22 @@ class GnssOptions(Config):
 
 
 def split_options(options: GnssOptions | None, kw: dict) -> tuple[GnssOptions, dict]:
-    """``options`` with the fields among the keywords ``kw`` replaced, and the other keywords."""
+    """Split keywords into GNSS option fields and the rest.
+
+    Parameters
+    ----------
+    options : GnssOptions or None
+        Base options (None: ``GnssOptions()``).
+    kw : dict
+        Keywords, some of them fields of :class:`GnssOptions`.
+
+    Returns
+    -------
+    options : GnssOptions
+        ``options`` with the fields among ``kw`` replaced.
+    rest : dict
+        The other keywords.
+    """
     instance(kw, dict, "kw")
     names = set(GnssOptions.__dataclass_fields__)
     mine = {k: v for k, v in kw.items() if k in names}

@@ -34,7 +34,25 @@ def _stamp(t: datetime) -> str:
 
 
 def write_nav(path, eph: Ephemerides, n_leap: float = 18.0, week_start: datetime = WEEK_START) -> Path:
-    """Write the broadcast sets of ``eph`` as a RINEX 3.04 mixed navigation file."""
+    """Write the broadcast sets of ``eph`` as a RINEX 3.04 mixed navigation file.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        Output file.
+    eph : Ephemerides
+        The GPS and GLONASS broadcast sets.
+    n_leap : float, default 18.0
+        GPS−UTC leap seconds, s.
+    week_start : datetime.datetime, default 2017-01-01
+        Start (a Sunday, GPS time) of the GPS week the times refer to; GLONASS epochs are
+        written in UTC, t_GLO = UTC − week_start + 10800 s.
+
+    Returns
+    -------
+    pathlib.Path
+        The written file.
+    """
     path, week_start = checked_path(path), _week_start(week_start)
     instance(eph, Ephemerides, "eph")
     gps, glo = eph.tables()
@@ -57,8 +75,29 @@ def write_nav(path, eph: Ephemerides, n_leap: float = 18.0, week_start: datetime
 
 
 def write_obs(path, obs: pd.DataFrame, week_start: datetime = WEEK_START) -> Path:
-    """Write an observation table (``time_s, sat, channel, code_m, rate_mps``) as a RINEX
-    3.04 file with C1C (m) and D1C (Hz, D = −rate/λ_k)."""
+    """Write an observation table as a RINEX 3.04 file with C1C (m) and D1C (Hz,
+    D = −rate/λ_k).
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        Output file.
+    obs : pandas.DataFrame
+        Observation table (``time_s`` GPS s, ``sat``, ``channel``, ``code_m`` m,
+        ``rate_mps`` m/s), as :func:`atomnav.gnss.simulate` gives it.
+    week_start : datetime.datetime, default 2017-01-01
+        Start (a Sunday, GPS time) of the GPS week of ``time_s``.
+
+    Returns
+    -------
+    pathlib.Path
+        The written file.
+
+    Raises
+    ------
+    atomnav.InputError
+        Naming ``obs`` for an empty or malformed table.
+    """
     path, week_start = checked_path(path), _week_start(week_start)
     obs_arrays(obs)
     if not len(obs):
@@ -102,7 +141,33 @@ def _seconds(times, week_start: datetime) -> np.ndarray:
 
 
 def read_nav(path, n_leap: float = 18.0, datum: str = "identity", week_start: datetime = WEEK_START) -> Ephemerides:
-    """Broadcast ephemerides from a RINEX 3 navigation file (GPS and GLONASS records)."""
+    """Broadcast ephemerides from a RINEX 3 navigation file (GPS and GLONASS records),
+    read through georinex.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        RINEX 3 navigation file.
+    n_leap : float, default 18.0
+        GPS−UTC leap seconds, s.
+    datum : {"identity", "pz90_02_to_wgs84"}, default "identity"
+        PZ-90 → WGS-84 transformation of the GLONASS states.
+    week_start : datetime.datetime, default 2017-01-01
+        Start (a Sunday, GPS time) of the GPS week the times are counted from; GLONASS
+        epochs are UTC, t_GLO = UTC − week_start + 10800 s.
+
+    Returns
+    -------
+    Ephemerides
+        The broadcast sets of the file.
+
+    Raises
+    ------
+    FileNotFoundError
+        When ``path`` is not a file.
+    atomnav.InputError
+        Naming ``path`` for a malformed file or one without satellite records.
+    """
     week_start = _week_start(week_start)
     nav = _load(path, "nav")
     if "sv" not in nav.coords or not len(nav.sv):
@@ -131,8 +196,31 @@ def read_nav(path, n_leap: float = 18.0, datum: str = "identity", week_start: da
 
 
 def read_obs(path, eph: Ephemerides, week_start: datetime = WEEK_START) -> pd.DataFrame:
-    """Observation table (``time_s, sat, channel, code_m, rate_mps``) from a RINEX 3
-    observation file with C1C and D1C; GLONASS channels come from ``eph``."""
+    """Observation table from a RINEX 3 observation file with C1C and D1C, read through
+    georinex.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        RINEX 3 observation file.
+    eph : Ephemerides
+        Ephemerides giving the GLONASS FDMA channels.
+    week_start : datetime.datetime, default 2017-01-01
+        Start (a Sunday, GPS time) of the GPS week the times are counted from.
+
+    Returns
+    -------
+    pandas.DataFrame
+        ``time_s`` (GPS s), ``sat``, ``channel``, ``code_m`` (m), ``rate_mps`` (m/s, NaN
+        without D1C), GPS and GLONASS only, sorted by time and satellite.
+
+    Raises
+    ------
+    FileNotFoundError
+        When ``path`` is not a file.
+    atomnav.InputError
+        Naming ``path`` for a malformed file or one without C1C pseudoranges.
+    """
     week_start = _week_start(week_start)
     instance(eph, Ephemerides, "eph")
     ds = _load(path, "obs")
