@@ -22,12 +22,39 @@ from .riccati import _mat
 class Scenario:
     """Linearised scenario (see module docstring).
 
-    f, qc: (N, n, n) continuous models per step; dt: (N,) step lengths (s); p0 (n, n);
-    h (m, n); r (m, m); measure: (N + 1,) bool, a measurement at epoch k (epoch 0 is the
-    start); times: (N + 1,) epoch times (s) for the tables (default cumulative dt);
-    labels: state names (default ``x[i]``); method "van_loan" or "first_order";
-    sequential: decorrelated scalar updates instead of one stacked update.
     Picklable (it keeps its inputs), so it can be shipped to Dask workers.
+
+    Parameters
+    ----------
+    f : array_like (N, n, n)
+        Continuous system matrices F_k per step, 1/s.
+    qc : array_like (N, n, n)
+        Continuous process-noise PSDs Q_c,k per step, squared state units per s.
+    dt : array_like (N,)
+        Step lengths, s.
+    p0 : array_like (n, n)
+        Initial covariance P₀, squared state units.
+    h : array_like (m, n)
+        Measurement matrix H.
+    r : array_like (m, m)
+        Measurement noise covariance R, squared measurement units.
+    measure : sequence of bool (N + 1,)
+        A measurement at epoch k (epoch 0 is the start).
+    times : array_like (N + 1,), optional
+        Epoch times for the tables, s (default cumulative dt).
+    labels : list of str, optional
+        State names (default ``x[i]``).
+    method : {"van_loan", "first_order"}, default "van_loan"
+        Discretisation used by the filter (:func:`atomnav.filter.engine.discretize`).
+    sequential : bool, default False
+        Decorrelated scalar updates instead of one stacked update.
+
+    Raises
+    ------
+    TypeError
+        ``measure`` is not a sequence of bools, or ``labels`` not a list of names.
+    atomnav.InputError
+        Naming the argument of a bad shape (``f``, ``qc``, ``times``, ``labels``, …).
     """
 
     def __init__(self, f, qc, dt, p0, h, r, measure, *, times=None, labels=None,
@@ -74,8 +101,19 @@ class Scenario:
 
 
 def covariance_analysis(scenario: Scenario) -> pd.DataFrame:
-    """σ of every state after each epoch (no noise simulated): columns time_s and one
-    column per state label (units of the state)."""
+    """σ of every state after each epoch (no noise simulated).
+
+    Parameters
+    ----------
+    scenario : Scenario
+        The linearised scenario.
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row per epoch (N + 1); columns time_s (s) and one column per state label
+        (units of the state).
+    """
     s = instance(scenario, Scenario, "scenario")._core.sigmas()
     df = pd.DataFrame(s, columns=scenario.labels)
     df.insert(0, "time_s", scenario.times)
@@ -88,7 +126,24 @@ def true_error_analysis(scenario: Scenario, r_true, cross) -> pd.DataFrame:
     covariance ``r_true`` (m, m) and is correlated with the process noise of the step before
     each measurement, ``cross`` (steps, n, m) = E[w_{k−1} v_kᵀ] (e.g. a CAI readout that
     also senses the IMU noise of its shot). With ``r_true`` = R and zero ``cross`` it equals
-    :func:`covariance_analysis`. Columns as there."""
+    :func:`covariance_analysis`.
+
+    Parameters
+    ----------
+    scenario : Scenario
+        The linearised scenario; its P and R give the gains.
+    r_true : array_like (m, m)
+        Covariance of the real measurement noise, squared measurement units.
+    cross : array_like (steps, n, m)
+        E[w_{k−1} v_kᵀ], the correlation of the process noise of the step before each
+        measurement with its measurement noise.
+
+    Returns
+    -------
+    pandas.DataFrame
+        Columns as in :func:`covariance_analysis`: time_s (s) and the σ of the true
+        error of every state (units of the state).
+    """
     instance(scenario, Scenario, "scenario")
     cross = np.ascontiguousarray(as_floats(cross, "cross"))
     if cross.ndim != 3:
@@ -101,7 +156,27 @@ def true_error_analysis(scenario: Scenario, r_true, cross) -> pd.DataFrame:
 
 def chi2_band(dof: int, runs: int, p: float = 0.95) -> tuple[float, float]:
     """Two-sided p band of the run-average of ``runs`` χ²(dof) variables (NEES or NIS):
-    χ²_{runs·dof} quantiles / runs."""
+    χ²_{runs·dof} quantiles / runs.
+
+    Parameters
+    ----------
+    dof : int
+        Degrees of freedom of each variable (the state or measurement size).
+    runs : int
+        Number of runs averaged.
+    p : float, default 0.95
+        Probability of the band, in (0, 1).
+
+    Returns
+    -------
+    (float, float)
+        Lower and upper bound of the run-averaged statistic.
+
+    References
+    ----------
+    Y. Bar-Shalom, X. R. Li and T. Kirubarajan, *Estimation with Applications to
+    Tracking and Navigation* (2001), §5.4.
+    """
     dof, runs = integer(dof, "dof", 1, 2**32), integer(runs, "runs", 1, 2**32)
     p = scalar(p, "p")
     if not 0 < p < 1:
@@ -117,7 +192,21 @@ class MonteCarlo:
     """Monte-Carlo result: the tidy table (run, time_s, state, error, sigma) and NEES/NIS
     per run and epoch (NIS NaN where no measurement); ``runs`` holds the run number of
     each row of ``nees``/``nis`` (all runs 0…R−1, or the finished ones of an incomplete
-    campaign, see :class:`MonteCarloIncomplete`)."""
+    campaign, see :class:`MonteCarloIncomplete`).
+
+    Attributes
+    ----------
+    table : pandas.DataFrame
+        Tidy table: run, time_s (s), state, error and sigma (units of the state).
+    nees : numpy.ndarray (R, N + 1)
+        NEES per run and epoch.
+    nis : numpy.ndarray (R, N + 1)
+        NIS per run and epoch (NaN where no measurement).
+    times : numpy.ndarray (N + 1,)
+        Epoch times, s.
+    runs : numpy.ndarray (R,)
+        Run number of each row of ``nees``/``nis``.
+    """
 
     table: pd.DataFrame
     nees: np.ndarray
@@ -126,7 +215,20 @@ class MonteCarlo:
     runs: np.ndarray
 
     def nees_inside(self, dof: int, p: float = 0.95) -> float:
-        """Fraction of epochs whose run-averaged NEES lies in the two-sided p χ² band."""
+        """Fraction of epochs whose run-averaged NEES lies in the two-sided p χ² band.
+
+        Parameters
+        ----------
+        dof : int
+            Degrees of freedom of the NEES (the state size).
+        p : float, default 0.95
+            Probability of the band (:func:`chi2_band`).
+
+        Returns
+        -------
+        float
+            Fraction in [0, 1].
+        """
         lo, hi = chi2_band(dof, self.nees.shape[0], p)
         m = self.nees.mean(axis=0)
         return float(np.mean((m >= lo) & (m <= hi)))
@@ -245,6 +347,39 @@ def monte_carlo(scenario: Scenario, runs: int, seed: int, mode: str = "closed", 
     The same happens, for the runs not yet done, when the cluster has had no worker for
     ``timeout`` seconds (none came back) or a finished result could not be fetched within
     ``timeout`` s; ``timeout=None`` waits for workers without bound.
+
+    Parameters
+    ----------
+    scenario : Scenario
+        The linearised scenario.
+    runs : int
+        Number of runs (≥ 1).
+    seed : int
+        Master seed (0 … 2⁶⁴ − 1).
+    mode : {"closed", "open"}, default "closed"
+        Loop mode of the filter, as in :class:`atomnav.filter.engine.KalmanFilter`.
+    client : dask.distributed.Client, optional
+        Cluster to run on (default: all local cores).
+    chunk : int, default 10
+        Runs per task on the cluster.
+    retries : int, default 3
+        Resubmissions of a failed group (0 … 1000).
+    timeout : float or None, default 60.0
+        Seconds without a worker, or to fetch a finished result, before giving up.
+
+    Returns
+    -------
+    MonteCarlo
+        Errors, sigmas, NEES and NIS of every run.
+
+    Raises
+    ------
+    MonteCarloIncomplete
+        Some groups failed; ``.partial`` carries every finished run.
+    TypeError
+        ``timeout`` is not a number or None, or ``client`` not a Dask client.
+    atomnav.InputError
+        Naming ``runs``, ``seed``, ``chunk``, ``retries`` or ``timeout``.
     """
     runs, seed = integer(runs, "runs", 1, 2**32), integer(seed, "seed", 0, 2**64 - 1)
     chunk, retries = integer(chunk, "chunk", 1, 2**32), integer(retries, "retries", 0, 1000)
