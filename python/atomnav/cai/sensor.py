@@ -37,24 +37,57 @@ INCOMPLETE_SHOTS_OPTIONS = tuple(_core.OPTIONS["IncompleteShots"])
 class CaiSensor(ConfigMixin):
     """The interferometer as the filter sees it.
 
-    channels: interferometer geometry (:class:`Channels`, e.g. ``Channels.cyclic`` for the
-    six-channel sensor of Tennstedt et al. 2023); T: pulse separation (s); shot_period: time
-    between shot starts (s, ≥ 2T; None = 2T, no dead time); offset, contrast, sigma_p:
-    readout p = o − (C/2) cos(φ + φ0) + n, n ~ N(0, σ_p²); inflation: white-noise PSDs
-    (q_a m²/s³, q_g rad²/s) of the IMU(s) for the in-shot R inflation (Tennstedt et al.
-    2021, §2.4) or None; omega_dot (:data:`OMEGA_DOT_OPTIONS` but "given"),
-    savgol_half_width, interpolation (:data:`INTERPOLATION_OPTIONS`), substeps: predictor
-    options; jacobian_euler: keep the Euler terms in H (needed when the lever arm is
-    estimated: its main signature is the Euler term ω̇ × l); misalignment_psd,
-    lever_arm_psd: estimate the CAI misalignment γ / lever-arm correction l as extra
-    random-walk states (21-state filter of Tennstedt et al. 2021) with this PSD; force:
-    "bias" = estimate biases (option b of Tennstedt et al. 2021, Eq. 11), "direct" =
-    correct the specific force through a Gauss–Markov force-error block of correlation time
-    ``force_tau`` (s) and σ ``force_sigma`` (m/s²) (option a); first_shot: start of the
-    first shot (s) after the record start in a Monte-Carlo campaign
-    (:func:`atomnav.cai.run_campaign`; a shot whose Savitzky–Golay ω̇ window of 2m + 1
-    samples does not fit between the record start and its end is skipped). Checked by the core when handed to it
-    (:meth:`_native`); convertible to and from dict / JSON."""
+    The readout is p = o − (C/2) cos(φ + φ0) + n, n ~ N(0, σ_p²). Checked by the core
+    when handed to it (:meth:`_native`); convertible to and from dict / JSON.
+
+    Parameters
+    ----------
+    channels : Channels
+        Interferometer geometry, e.g. ``Channels.cyclic`` for the six-channel sensor of
+        Tennstedt et al. 2023.
+    T : float
+        Pulse separation (s).
+    shot_period : float, optional
+        Time between shot starts (s, ≥ 2T); None = 2T, no dead time.
+    offset : float
+        Readout offset o (population, 0–1).
+    contrast : float
+        Readout contrast C ∈ (0, 1].
+    sigma_p : float
+        Readout noise σ_p (population).
+    inflation : tuple of float, optional
+        White-noise PSDs (q_a m²/s³, q_g rad²/s) of the IMU(s) for the in-shot R
+        inflation (Tennstedt et al. 2021, §2.4); None: no inflation.
+    omega_dot : {"savgol", "pwl", "zero"}
+        Source of ω̇ for the Euler terms of the predictor (:data:`OMEGA_DOT_OPTIONS` but
+        "given"), as in :func:`predict_phase`.
+    savgol_half_width : int
+        Half width m of the Savitzky–Golay ω̇ window (2m + 1 samples).
+    interpolation : {"linear", "cubic"}
+        Interpolation of the IMU inputs in the predictor (:data:`INTERPOLATION_OPTIONS`).
+    substeps : int
+        RK4 steps per interval of the predictor's integration grid.
+    jacobian_euler : bool
+        Keep the Euler terms in H (needed when the lever arm is estimated: its main
+        signature is the Euler term ω̇ × l).
+    misalignment_psd : float, optional
+        Estimate the CAI misalignment γ as three extra random-walk states with this PSD
+        (rad²/s) (21-state filter of Tennstedt et al. 2021); None: not estimated.
+    lever_arm_psd : float, optional
+        Estimate a lever-arm correction l as three extra random-walk states with this
+        PSD (m²/s); None: not estimated.
+    force : {"bias", "direct"}
+        "bias" = estimate biases (option b of Tennstedt et al. 2021, Eq. 11); "direct" =
+        correct the specific force through a Gauss–Markov force-error block (option a).
+    force_tau : float, optional
+        Correlation time of the force-error block (s), with ``force="direct"``.
+    force_sigma : float, optional
+        σ of the force-error block (m/s²), with ``force="direct"``.
+    first_shot : float
+        Start of the first shot (s) after the record start in a Monte-Carlo campaign
+        (:func:`atomnav.cai.run_campaign`; a shot whose Savitzky–Golay ω̇ window of
+        2m + 1 samples does not fit between the record start and its end is skipped).
+    """
 
     _NESTED = {"channels": Channels}
 
@@ -79,15 +112,37 @@ class CaiSensor(ConfigMixin):
     first_shot: float = 0.0
 
     def shots(self, t0: float, t_end: float) -> np.ndarray:
-        """Shot start times (s) from t0, one per ``shot_period``, the last ending by t_end
-        (an :class:`atomnav.InputError` naming ``T`` or ``shot_period`` when the sensor's own
-        timing is invalid)."""
+        """Shot start times from t0, one per ``shot_period``, the last ending by t_end.
+
+        Parameters
+        ----------
+        t0 : float
+            Start of the first shot (s).
+        t_end : float
+            Time (s) by which the last shot ends (its start + 2T).
+
+        Returns
+        -------
+        numpy.ndarray, shape (S,)
+            Shot start times (s).
+
+        Raises
+        ------
+        atomnav.InputError
+            Naming ``T`` or ``shot_period`` when the sensor's own timing is invalid.
+        """
         T = scalar(self.T, "T")
         period = 2 * T if self.shot_period is None else scalar(self.shot_period, "shot_period")
         return _core.cai_shot_times(finite_scalar(t0, "t0"), finite_scalar(t_end, "t_end"), T, period)
 
     def n_extra(self) -> int:
-        """Number of extra filter states (misalignment, lever arm, force error)."""
+        """Number of extra filter states (misalignment, lever arm, force error).
+
+        Returns
+        -------
+        int
+            3 per estimated block: 0, 3, 6 or 9.
+        """
         return 3 * ((self.misalignment_psd is not None) + (self.lever_arm_psd is not None) + (self.force == "direct"))
 
     def _checked(self, name: str):
@@ -114,10 +169,27 @@ class CaiSensor(ConfigMixin):
 
 @dataclass
 class FilterSetup(ConfigMixin):
-    """Filter tuning: white-noise PSDs (accel m²/s³, gyro rad²/s), bias random-walk PSDs
-    (m²/s⁵, rad²/s³), prediction interval in IMU steps, and the initial σ of
-    (position m, velocity m/s, attitude rad, accel bias m/s², gyro bias rad/s) and of the
-    extra CAI states. Convertible to and from dict / JSON."""
+    """Filter tuning of the CAI-aided INS. Convertible to and from dict / JSON.
+
+    Parameters
+    ----------
+    accel_psd : float
+        Accelerometer white-noise PSD (m²/s³).
+    gyro_psd : float
+        Gyro white-noise PSD (rad²/s).
+    accel_bias_psd : float
+        Accelerometer bias random-walk PSD (m²/s⁵).
+    gyro_bias_psd : float
+        Gyro bias random-walk PSD (rad²/s³).
+    predict_every : int
+        Prediction interval in IMU steps.
+    sigma0 : tuple of float
+        Initial σ of (position m, velocity m/s, attitude rad, accel bias m/s², gyro bias
+        rad/s), each for all three axes.
+    sigma0_extra : tuple of float
+        Initial σ of the extra CAI states (misalignment rad, lever arm m, force error
+        m/s²), one per state.
+    """
 
     accel_psd: float
     gyro_psd: float
@@ -128,7 +200,24 @@ class FilterSetup(ConfigMixin):
     sigma0_extra: tuple = ()
 
     def p0(self, n_extra: int) -> np.ndarray:
-        """Diagonal P0 of the 15 INS states and ``n_extra`` extra states."""
+        """Diagonal P0 of the 15 INS states and ``n_extra`` extra states.
+
+        Parameters
+        ----------
+        n_extra : int
+            Number of extra CAI states (:meth:`CaiSensor.n_extra`); must equal the length
+            of ``sigma0_extra``.
+
+        Returns
+        -------
+        numpy.ndarray, shape (15 + n_extra, 15 + n_extra)
+            Initial covariance (SI units of the states).
+
+        Raises
+        ------
+        atomnav.InputError
+            Naming ``n_extra`` when it differs from the length of ``sigma0_extra``.
+        """
         n_extra = integer(n_extra, "n_extra", 0, 2**20)
         s = np.repeat(vector(self.sigma0, 5, "sigma0"), 3)
         extra = vector(self.sigma0_extra, None, "sigma0_extra")
@@ -147,7 +236,30 @@ def in_shot_noise(sensor: CaiSensor, dt: float, q_accel: float, q_gyro: float, f
     lever-arm Euler term (2Tq_g|l × k|², 0.370 rad for l = 0.1 m ⊥ k) — and, for each
     15-state model ``f`` (S, 15, 15) held over a filter step of one shot, the
     cross-covariance E[w δφ̂ᵀ] (S, 15, C) of the step's process noise with the shot's phase
-    noise (the readout senses the same IMU noise that drives the error)."""
+    noise (the readout senses the same IMU noise that drives the error).
+
+    Parameters
+    ----------
+    sensor : CaiSensor
+        The interferometer (C channels).
+    dt : float
+        IMU sample interval (s).
+    q_accel : float
+        Accelerometer white-noise PSD (m²/s³).
+    q_gyro : float
+        Gyro white-noise PSD (rad²/s).
+    f : array_like, shape (S, 15, 15), optional
+        15-state error models, each held over a filter step of one shot; None: no
+        cross-covariance.
+
+    Returns
+    -------
+    sigma : numpy.ndarray, shape (C, C)
+        Phase covariance Σ (rad²).
+    cross : numpy.ndarray, shape (S, 15, C)
+        Cross-covariance E[w δφ̂ᵀ] of each step's process noise with the shot's phase
+        noise (SI units of the states × rad).
+    """
     instance(sensor, CaiSensor, "sensor")
     f = np.zeros((0, 15, 15)) if f is None else np.ascontiguousarray(as_floats(f, "f"))
     if f.ndim != 3:
@@ -162,7 +274,26 @@ def expected_phase_exceedance(sensor: CaiSensor, dt: float, q_accel: float, q_gy
     over the channels: mean_j 2Φ(−limit/σ_j). Bias-estimation errors and dynamics add to it.
     Six-channel sensor at 200 Hz: σ = 0.40 rad on every channel with l = 0 (→ 8.5e-5), but
     0.53 / 0.68 / 0.33 rad on x / y-A / y-B with l = [0, 0, 0.1] m, where the lever-arm Euler
-    term adds 0.37 rad of gyro noise (→ 4.4e-3, 2.0 % on channel y-A)."""
+    term adds 0.37 rad of gyro noise (→ 4.4e-3, 2.0 % on channel y-A).
+
+    Parameters
+    ----------
+    sensor : CaiSensor
+        The interferometer.
+    dt : float
+        IMU sample interval (s).
+    q_accel : float
+        Accelerometer white-noise PSD (m²/s³).
+    q_gyro : float
+        Gyro white-noise PSD (rad²/s).
+    limit : float
+        Phase limit (rad); π/2 is the edge of the capture region.
+
+    Returns
+    -------
+    float
+        Expected share of shot-channels beyond ``limit`` (0–1).
+    """
     from scipy.stats import norm
 
     limit = positive(limit, "limit")
@@ -340,8 +471,19 @@ class CaiShots(Source):
         return _core.cai_source(self.extra0, var, self._sensor, self.shots, self.data_kind, *self.data, self.incomplete_shots)
 
     def incomplete(self, time) -> pd.DataFrame:
-        """The shots the IMU record ``time`` (s, increasing) cannot complete, as
-        :func:`incomplete_shots` lists them."""
+        """The shots the IMU record ``time`` cannot complete, as :func:`incomplete_shots` lists them.
+
+        Parameters
+        ----------
+        time : array_like, shape (N,)
+            The IMU time stamps (s), increasing.
+
+        Returns
+        -------
+        pandas.DataFrame
+            One row per incomplete shot: ``shot``, ``start_s``, ``samples_before``,
+            ``samples_after`` and ``reason``.
+        """
         return incomplete_shots(self.sensor, self.shots, time)
 
     def _report(self, time: np.ndarray, start_only: bool) -> list:
