@@ -178,8 +178,9 @@ class PhasePrediction:
         Shot start times (s).
     channels : Channels
         The C interferometer channels.
-    terms : dict of str to numpy.ndarray, shape (S, C)
-        Phase (rad) per term, keyed by :data:`TERMS` (``total`` first).
+    terms : dict of str to numpy.ndarray
+        Phase (rad) per term, each an array (S, C), keyed by :data:`TERMS` (``total``
+        first).
     """
 
     shots: np.ndarray
