@@ -40,15 +40,73 @@ class InsSetup(Config):
     checked once by the core when built (an invalid field raises
     :class:`atomnav.InputError` naming it).
 
-    Initial state ``t0`` (s), ``lla0`` (rad, rad, m), ``vel0`` NED (m/s), ``q0`` = q_nb;
-    IMU output ``kind`` "rates" or "increments"; ``p0`` the initial covariance (in the
-    order of :data:`atomnav.filter.INS15`, then the sensor's extra states where the
-    sensor does not supply them); white-noise PSDs ``accel_psd`` ((m/s²)²/Hz) and
-    ``gyro_psd`` (rad²/s); bias processes; initial bias estimates ``ba0`` (m/s²), ``bg0``
-    (rad/s); the filter predicts every ``predict_every`` IMU steps and at every
-    measurement; ``method`` "van_loan" or "first_order"; ``mode`` "closed" or "open";
-    ``sequential`` scalar updates; ``gate`` χ² threshold; ``ellipsoid``.
+    Parameters
+    ----------
+    t0 : float
+        Time of the initial state, s.
+    lla0 : array_like (3,)
+        Initial latitude, longitude (rad) and height (m).
+    vel0 : array_like (3,)
+        Initial NED velocity, m/s.
+    q0 : array_like (4,)
+        Initial attitude q_nb (body → NED, scalar first).
+    kind : {"rates", "increments"}
+        IMU output: rates (rad/s, m/s²) or increments (rad, m/s).
+    p0 : array_like (n, n)
+        Initial covariance, in the order of :data:`atomnav.filter.INS15`, then the
+        sensor's extra states where the sensor does not supply them; SI units of the
+        states, squared.
+    accel_psd : float
+        Accelerometer white-noise PSD, (m/s²)²/Hz.
+    gyro_psd : float
+        Gyro white-noise PSD, rad²/s.
+    accel_bias, gyro_bias : BiasModel, default BiasModel()
+        Bias processes (default random constant).
+    ba0 : array_like (3,), default (0, 0, 0)
+        Initial accelerometer bias estimate, m/s².
+    bg0 : array_like (3,), default (0, 0, 0)
+        Initial gyro bias estimate, rad/s.
+    predict_every : int, default 1
+        The filter predicts every ``predict_every`` IMU steps and at every measurement.
+    method : {"van_loan", "first_order"}, default "van_loan"
+        Discretisation (:func:`atomnav.filter.engine.discretize`).
+    mode : {"closed", "open"}, default "closed"
+        Closed loop (feedback) or open loop (estimation).
+    sequential : bool, default False
+        Scalar (decorrelated) updates.
+    gate : float, optional
+        χ² threshold on the NIS (default: no gate).
+    ellipsoid : str, default "WGS84"
+        Earth ellipsoid.
+    vertical : str, default "free"
+        One of :data:`VERTICAL`: "free" or "damped" (see Notes).
+    zeta : float, optional
+        Damping ratio ζ of the baro loop (default None: the core's 0.707).
+    omega : float, optional
+        Natural frequency ω of the baro loop, rad/s (default None: the core's 0.01 rad/s).
+    baro_psd : float, default 0.0
+        PSD of the white part n of the reference-altitude error, m²·s.
+    baro_bias : BiasModel, optional
+        Process of the reference-altitude bias b, m (default: b = 0).
+    baro_bias_sigma0 : float, optional
+        Initial σ of ``baro_bias``, m.
+    smooth : bool, default False
+        Store the forward pass for the smoother (see Notes).
+    smooth_chunk : int, default 1000
+        Epochs per chunk of the stored forward pass (≥ 1).
+    smooth_memory : int, default 2**30
+        Bytes of the forward pass held in memory (≥ 0); beyond, written to disk.
+    smooth_dir : str or path-like, optional
+        Directory for the on-disk forward pass (default: the system's temporary
+        directory).
 
+    Raises
+    ------
+    atomnav.InputError
+        Naming the invalid field.
+
+    Notes
+    -----
     Vertical channel: ``vertical`` one of :data:`VERTICAL` — "free" (default) or
     "damped", then :meth:`AidedIns.run` needs ``h_ref``, the reference (barometric)
     altitude (m) per IMU sample; ``zeta``, ``omega`` (rad/s) of the baro loop (default None:
@@ -68,6 +126,15 @@ class InsSetup(Config):
     ``smooth_dir`` (the system's temporary directory when None) and deleted with the
     engine.
 
+    References
+    ----------
+    H. E. Rauch, F. Tung and C. T. Striebel, "Maximum likelihood estimates of linear
+    dynamic systems", *AIAA Journal* 3 (1965). P. D. Groves, *Principles of GNSS,
+    Inertial, and Multisensor Integrated Navigation Systems*, 2nd ed. (2013), ch. 14.
+    Demidov 2009 (gains of the baro loop).
+
+    Examples
+    --------
     >>> s = InsSetup(t0=0.0, lla0=(0.8, 0.2, 100.0), vel0=(0, 0, 0), q0=(1, 0, 0, 0),
     ...              kind="rates", p0=np.eye(15), accel_psd=1e-8, gyro_psd=1e-12)  # doctest: +SKIP
     >>> InsSetup.from_json(s.to_json()) == s                                      # doctest: +SKIP
@@ -162,6 +229,17 @@ class AidedResult:
     innovations of all measurements, concatenated in order (``measurements.rows`` each).
     ``smoothed``: the smoothed solution when the engine was built with ``smooth=True``
     (:meth:`AidedIns.run`), else None.
+
+    Attributes
+    ----------
+    nav : pandas.DataFrame
+        One row per prediction epoch (as above).
+    measurements : pandas.DataFrame
+        One row per applied measurement: time_s (s), rows, nis, rejected_rows, source.
+    innovation : numpy.ndarray (K,)
+        Innovations of all measurements, concatenated (units of the measurement rows).
+    smoothed : SmoothedResult or None
+        The smoothed solution, or None.
     """
 
     nav: pd.DataFrame
@@ -195,7 +273,15 @@ class SmoothedResult:
 class AidedIns:
     """A running aided INS; build it with a sensor's factory function. It may be pickled
     or deep-copied between chunks (a checkpoint, or a Dask task): the copy, fed the rest of
-    the record, continues bit for bit like the original."""
+    the record, continues bit for bit like the original.
+
+    Parameters
+    ----------
+    core : atomnav._core.AidedIns
+        The core engine a sensor's factory built.
+    setup : InsSetup
+        The INS configuration it was built with.
+    """
 
     def __init__(self, core: _core.AidedIns, setup: InsSetup):
         self._core = instance(core, _core.AidedIns, "core")
@@ -257,14 +343,40 @@ class AidedIns:
         rates (rad/s, m/s²) or increments (rad, m/s) per the ``kind`` given at
         construction, ``h_ref`` (N,) m the reference altitude of a damped vertical
         channel (required then, refused with a free one); time must keep increasing
-        across chunks. A chunk whose accelerations look like g, gyro rates like °/s or
-        time stamps like ms warns (:class:`atomnav.UnitWarning`, naming ``accel``,
-        ``gyro`` or ``time``; :meth:`run` checks the whole record once). Returns the epochs
-        and measurements of this chunk. Bad samples
-        (non-finite, time not increasing) raise ``ValueError`` naming their index in the
-        whole streamed record. If it stops on an error (bad sample, divergence, loss of
-        positive definiteness), the exception's ``partial`` attribute is the
-        :class:`AidedResult` of the epochs computed before it."""
+        across chunks.
+
+        Parameters
+        ----------
+        time : array_like (N,)
+            Sample times, s, increasing across chunks.
+        gyro : array_like (N, 3)
+            Angular rate, rad/s (rates) or angle increment, rad (increments).
+        accel : array_like (N, 3)
+            Specific force, m/s² (rates) or velocity increment, m/s (increments).
+        h_ref : array_like (N,), optional
+            Reference (barometric) altitude, m; required with a damped vertical channel,
+            refused with a free one.
+
+        Returns
+        -------
+        AidedResult
+            The epochs and measurements of this chunk.
+
+        Raises
+        ------
+        ValueError
+            Bad samples (non-finite, time not increasing), naming their index in the
+            whole streamed record. If it stops on an error (bad sample, divergence, loss
+            of positive definiteness), the exception's ``partial`` attribute is the
+            :class:`AidedResult` of the epochs computed before it.
+
+        Warns
+        -----
+        atomnav.UnitWarning
+            A chunk whose accelerations look like g, gyro rates like °/s or time stamps
+            like ms, naming ``accel``, ``gyro`` or ``time`` (:meth:`run` checks the whole
+            record once).
+        """
         t, g, a, h = _imu(time, gyro, accel, h_ref)
         self._plausible(t, g, a)
         return self._call(self._core.process, t, g, a, h)
@@ -355,7 +467,13 @@ class AidedIns:
         return SmoothedResult(nav, np.concatenate(covs[::-1]) if covariance else None)
 
     def finish(self) -> AidedResult:
-        """End of the record: a last epoch at the last sample if steps are left over."""
+        """End of the record: a last epoch at the last sample if steps are left over.
+
+        Returns
+        -------
+        AidedResult
+            The last epoch and its measurements (empty tables if none).
+        """
         return self._call(self._core.finish)
 
     def run(self, time, gyro, accel, h_ref=None, chunk_s: float = 60.0, progress: bool = True) -> AidedResult:
@@ -366,7 +484,44 @@ class AidedIns:
         their index in the record (the Rust engine checks them chunk by chunk). On an
         error the exception's ``partial`` attribute holds every epoch computed before it.
         With ``smooth=True`` the result's ``smoothed`` is :meth:`smooth` over the record
-        (the progress bar then also covers its chunks)."""
+        (the progress bar then also covers its chunks).
+
+        Parameters
+        ----------
+        time : array_like (N,)
+            Sample times, s (N ≥ 2); every measurement must lie inside [time[0], time[-1]].
+        gyro : array_like (N, 3)
+            Angular rate, rad/s (rates) or angle increment, rad (increments).
+        accel : array_like (N, 3)
+            Specific force, m/s² (rates) or velocity increment, m/s (increments).
+        h_ref : array_like (N,), optional
+            Reference (barometric) altitude, m, with a damped vertical channel.
+        chunk_s : float, default 60.0
+            Approximate chunk length, s.
+        progress : bool, default True
+            Show a progress bar.
+
+        Returns
+        -------
+        AidedResult
+            Every epoch and measurement of the record (and ``smoothed`` with
+            ``smooth=True``).
+
+        Raises
+        ------
+        ValueError
+            Bad samples, naming their index in the record; ``partial`` holds every epoch
+            computed before the error.
+        atomnav.InputError
+            Naming ``time`` (fewer than 2 samples, or a measurement outside the record)
+            or ``chunk_s``.
+
+        Warns
+        -----
+        atomnav.UnitWarning
+            Accelerations in g, gyro rates in °/s or time stamps in ms, naming ``accel``,
+            ``gyro`` or ``time``.
+        """
         t, g, a, h = _imu(time, gyro, accel, h_ref)
         self._plausible(t, g, a)  # once, on the whole record (a chunk may look static while the record moves)
         positive(chunk_s, "chunk_s")
@@ -430,13 +585,51 @@ def position_aided_ins(t0: float, lla0, vel0, q0, kind: str, fix_time, fix_lla, 
                        gyro_psd: float, **options) -> AidedIns:
     """A position-aided 15-state INS.
 
-    Fixes at ``fix_time`` (M,) s with ``fix_lla`` (M, 3) and NED covariance ``fix_cov``
-    (M, 3, 3) m², applied at the first IMU epoch at or after their time. The INS
-    arguments (initial state ``t0``, ``lla0``, ``vel0``, ``q0``, IMU ``kind``, ``p0``
-    (15, 15), noise PSDs and the keyword ``options``: bias models, ``ba0``/``bg0``,
-    ``predict_every``, ``method``, ``mode``, ``sequential``, ``gate``, ``ellipsoid`` and the
-    vertical channel) are the fields of :class:`InsSetup`.
+    Fixes are applied at the first IMU epoch at or after their time. The INS arguments
+    are the fields of :class:`InsSetup`.
 
+    Parameters
+    ----------
+    t0 : float
+        Time of the initial state, s.
+    lla0 : array_like (3,)
+        Initial latitude, longitude (rad) and height (m).
+    vel0 : array_like (3,)
+        Initial NED velocity, m/s.
+    q0 : array_like (4,)
+        Initial attitude q_nb (scalar first).
+    kind : {"rates", "increments"}
+        IMU output.
+    fix_time : array_like (M,)
+        Times of the fixes, s.
+    fix_lla : array_like (M, 3)
+        Fixed positions: latitude, longitude (rad) and height (m).
+    fix_cov : array_like (M, 3, 3)
+        NED covariance of each fix, m².
+    p0 : array_like (15, 15)
+        Initial covariance, SI units of the states squared.
+    accel_psd : float
+        Accelerometer white-noise PSD, (m/s²)²/Hz.
+    gyro_psd : float
+        Gyro white-noise PSD, rad²/s.
+    **options
+        The other fields of :class:`InsSetup`: bias models, ``ba0``/``bg0``,
+        ``predict_every``, ``method``, ``mode``, ``sequential``, ``gate``, ``ellipsoid``,
+        the vertical channel and the smoother.
+
+    Returns
+    -------
+    AidedIns
+        The engine; feed it with :meth:`AidedIns.run`.
+
+    Raises
+    ------
+    atomnav.InputError
+        Naming the bad argument (``fix_time``, ``fix_lla``, ``fix_cov`` or a field of
+        :class:`InsSetup`).
+
+    Examples
+    --------
     >>> ins = position_aided_ins(...)              # doctest: +SKIP
     >>> result = ins.run(time, gyro, accel)        # doctest: +SKIP
     >>> truth.errors(result.nav)                   # doctest: +SKIP
