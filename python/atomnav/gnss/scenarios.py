@@ -40,8 +40,37 @@ BARO_ZETA, BARO_OMEGA, BARO_SIGMA = 0.707, 0.01, 1.0
 
 @dataclass(frozen=True)
 class Scenario:
-    """One experiment. ``n_sats``: None = every satellite above the mask, else the fixed
-    n highest at the start (0 = free INS); ``outage``: (start s, length s) without GNSS."""
+    """One experiment of the thesis (Demidov 2009, §4) on the tightly coupled filter.
+
+    Parameters
+    ----------
+    imu_class : {"precise", "medium", "coarse"}, default "precise"
+        INS accuracy class: IMU error preset and initial attitude σ
+        (:data:`INITIAL_ATTITUDE`). The only positional field; the others are
+        keyword-only.
+    motion : {"MOVE", "STAT"}, default "MOVE"
+        "MOVE": level drive at 100 m/s whose heading swings with yaw rate
+        3 °/s·sin(2πt/600 s); "STAT": stationary at 55.75°N, 37.6°E, 200 m, heading 30°.
+    duration_s : float, default 1200.0
+        Length of the run, s.
+    n_sats : int, optional
+        None = every satellite above the mask, else the fixed n highest at the start
+        (0 = free INS).
+    outage : (float, float), optional
+        (start s, length s) without GNSS.
+    mode : {"closed", "open"}, default "closed"
+        Closed- or open-loop error correction.
+    formulation : str, default "first_difference"
+        Tight-coupling formulation, one of :data:`atomnav.gnss.FORMULATIONS`.
+    rate_hz : float, default 50.0
+        IMU sampling rate, Hz.
+    seed : int, default 0
+        Seed of the IMU errors, satellite clocks, observation noise, initial error and
+        barometer noise.
+    vertical : {"damped", "free"}, default "damped"
+        Vertical channel: damped by a 1 Hz barometric altitude (white error σ = 1 m;
+        loop ζ = 0.707, ω_v = 0.01 rad/s), or free.
+    """
 
     imu_class: str = "precise"
     _: KW_ONLY
@@ -89,10 +118,30 @@ def _scenario(sc) -> Scenario:
 
 
 def build(sc: Scenario | str, clock=(0.0, 0.0)) -> dict:
-    """Truth trajectory, corrupted IMU increments with their bias truth, ephemerides and
-    observations (receiver clock ``clock`` = (bias s, drift s/s)), the barometric
-    reference altitude per IMU sample (``h_ref``, m), and the filter factory arguments
-    with an initial error drawn from P0."""
+    """Everything a scenario run needs, simulated.
+
+    Parameters
+    ----------
+    sc : Scenario or str
+        The scenario, or the name of one of :data:`SCENARIOS`.
+    clock : array_like, shape (2,), default (0, 0)
+        True receiver clock (bias s, drift s/s).
+
+    Returns
+    -------
+    dict
+        ``scenario`` (:class:`Scenario`); ``trajectory`` (truth,
+        :class:`atomnav.trajectory.Trajectory`); ``imu``: corrupted IMU increments with
+        their bias truth (DataFrame); ``eph`` (:class:`Ephemerides`) and ``obs``
+        (observation table); ``args``: the keyword arguments of :func:`tight_ins`, with an
+        initial error drawn from P0; ``h_ref``: the barometric reference altitude per IMU
+        sample (m), None unless ``vertical="damped"``.
+
+    Raises
+    ------
+    atomnav.InputError
+        Naming ``sc`` for an unknown scenario name, or ``motion`` for an unknown motion.
+    """
     sc = _scenario(sc)
     clock = vector(clock, 2, "clock")
     rng = np.random.default_rng(sc.seed)
@@ -134,10 +183,33 @@ def build(sc: Scenario | str, clock=(0.0, 0.0)) -> dict:
 
 
 def errors_and_nees(setup: dict, result) -> pd.DataFrame:
-    """Errors of every output epoch (NED position/velocity, ψ, bias errors) and the NEES
-    over the 15 INS states from the reported σ: Σ(e_i/σ_i)². The engine reports σ, not the
-    full covariance, so cross-correlations are ignored (the mean is still 15 for a
-    consistent filter; the spread is wider than χ²₁₅)."""
+    """Errors of every output epoch and the NEES over the 15 INS states from the reported
+    σ: Σ(e_i/σ_i)².
+
+    Parameters
+    ----------
+    setup : dict
+        The dict of :func:`build` (its ``trajectory`` and ``imu``).
+    result : atomnav.filter.aided.AidedResult
+        The filter's result on that setup.
+
+    Returns
+    -------
+    pandas.DataFrame
+        ``time_s`` (s) and the errors of :meth:`atomnav.trajectory.Trajectory.errors`
+        (NED position m, NED velocity m/s, attitude ψ rad), ``nees`` over position,
+        velocity, ψ and the accelerometer/gyro bias errors, and ``horizontal_m`` (m).
+
+    Raises
+    ------
+    TypeError
+        When ``setup`` is not the dict of :func:`build`.
+
+    Notes
+    -----
+    The engine reports σ, not the full covariance, so cross-correlations are ignored
+    (the mean is still 15 for a consistent filter; the spread is wider than χ²₁₅).
+    """
     if not isinstance(setup, dict) or any(k not in setup for k in ("trajectory", "imu")):
         raise TypeError("setup: expected the dict of build()")
     instance(result, AidedResult, "result")
@@ -157,8 +229,26 @@ def errors_and_nees(setup: dict, result) -> pd.DataFrame:
 
 
 def run(sc: Scenario | str, progress: bool = False, clock=(0.0, 0.0), **overrides) -> dict:
-    """Build and run a scenario; ``overrides`` replace Scenario fields. Returns the setup,
-    the :class:`AidedResult` and the error/NEES table."""
+    """Build and run a scenario.
+
+    Parameters
+    ----------
+    sc : Scenario or str
+        The scenario, or the name of one of :data:`SCENARIOS`.
+    progress : bool, default False
+        Show a progress bar.
+    clock : array_like, shape (2,), default (0, 0)
+        True receiver clock (bias s, drift s/s).
+    **overrides
+        Fields of :class:`Scenario` to replace (e.g. ``seed=3``).
+
+    Returns
+    -------
+    dict
+        ``setup`` (the dict of :func:`build`), ``result`` (the
+        :class:`atomnav.filter.aided.AidedResult`) and ``errors`` (the table of
+        :func:`errors_and_nees`).
+    """
     sc = replace(_scenario(sc), **overrides)
     setup = build(sc, clock)
     ins = tight_ins(setup["eph"], setup["obs"], **setup["args"])
@@ -184,10 +274,31 @@ def _horizontal(err) -> tuple[np.ndarray, np.ndarray]:
 
 
 def outage_summary(err: pd.DataFrame, start: float, length: float) -> dict:
-    """Horizontal error around an outage [start, start + length) s: RMS over the 5 min
-    before (``pre``), the error at its end (``end``), RMS 60–600 s after reacquisition
-    (``post``) and RMS over 240–300 s after it (``at5``, the 5-minute recovery check).
-    An RMS over a window without epochs is NaN: the output may be non-finite."""
+    """Horizontal error around an outage [start, start + length) s.
+
+    Parameters
+    ----------
+    err : pandas.DataFrame
+        A table of :func:`errors_and_nees` (``time_s`` s, ``horizontal_m`` m).
+    start : float
+        Start of the outage, s.
+    length : float
+        Length of the outage, s.
+
+    Returns
+    -------
+    dict
+        Horizontal errors, m: RMS over the 5 min before (``pre``), the error at its end
+        (``end``), RMS 60–600 s after reacquisition (``post``) and RMS over 240–300 s after
+        it (``at5``, the 5-minute recovery check). An RMS over a window without epochs is
+        NaN: the output may be non-finite.
+
+    Raises
+    ------
+    atomnav.InputError
+        Naming ``err`` for a table without those columns or epochs, ``start`` when no
+        epoch precedes the end of the outage.
+    """
     t, e = _horizontal(err)
     start, length = finite_scalar(start, "start"), finite_scalar(length, "length")
     b = start + length
@@ -198,7 +309,20 @@ def outage_summary(err: pd.DataFrame, start: float, length: float) -> dict:
 
 
 def last_rms(err: pd.DataFrame, window: float = 600.0) -> float:
-    """Horizontal RMS error over the last ``window`` seconds (NaN when no epoch falls in
-    it: the output may be non-finite)."""
+    """Horizontal RMS error over the last ``window`` seconds.
+
+    Parameters
+    ----------
+    err : pandas.DataFrame
+        A table of :func:`errors_and_nees` (``time_s`` s, ``horizontal_m`` m).
+    window : float, default 600.0
+        Length of the final window, s.
+
+    Returns
+    -------
+    float
+        RMS horizontal error, m (NaN when no epoch falls in the window: the output may be
+        non-finite).
+    """
     t, e = _horizontal(err)
     return _rms(e[t > t.max() - finite_scalar(window, "window")])

@@ -18,19 +18,40 @@ from .options import GnssOptions, split_options
 
 def tight_ins(eph: Ephemerides, obs: pd.DataFrame, options: GnssOptions | None = None, setup: InsSetup | None = None,
               **fields) -> AidedIns:
-    """A tightly coupled aided INS.
+    """A tightly coupled GPS + GLONASS / INS aided INS (Demidov 2009, §2.12).
 
-    ``obs``: observation table (``time_s, sat, channel, code_m, rate_mps``, GPS time; see
-    :func:`atomnav.gnss.simulate` or :func:`atomnav.gnss.rinex.read`). GNSS: ``options``
-    (:class:`GnssOptions`: formulation, lever arm, noise, corrections, τ_GPS and clock
-    models). INS: ``setup`` (:class:`atomnav.filter.aided.InsSetup`, ``p0`` the 15 × 15
-    INS block; the extra states' initial σ come from the options). Every field of either
-    may instead be given as a keyword (``p0_ins`` for the INS ``p0``); here
-    ``sequential`` defaults to True and ``gate`` to 10.83 (χ²₁ at 0.999 per decorrelated
-    row; sequential scalar updates as in Demidov 2009). Extra states are carried in metres: ``c_tau_gps`` =
-    c·τ_GPS and ``clock`` = (c·δt_r, c·δṫ_r); the nominal clock bias follows the drift
-    between epochs. A barometric altimeter damps the vertical channel through the
-    ``vertical`` fields of :class:`InsSetup` (then ``run(..., h_ref=...)``)."""
+    Extra states are carried in metres: ``c_tau_gps`` = c·τ_GPS and ``clock`` =
+    (c·δt_r, c·δṫ_r); the nominal clock bias follows the drift between epochs. A
+    barometric altimeter damps the vertical channel through the ``vertical`` fields of
+    :class:`InsSetup` (then ``run(..., h_ref=...)``).
+
+    Parameters
+    ----------
+    eph : Ephemerides
+        Broadcast ephemerides.
+    obs : pandas.DataFrame
+        Observation table (``time_s`` GPS s, ``sat``, ``channel``, ``code_m`` m,
+        ``rate_mps`` m/s; see :func:`atomnav.gnss.simulate` or
+        :func:`atomnav.gnss.rinex.read_obs`).
+    options : GnssOptions, optional
+        GNSS options: formulation, lever arm, noise, corrections, τ_GPS and clock models
+        (default ``GnssOptions()``).
+    setup : atomnav.filter.aided.InsSetup, optional
+        The INS: initial state, IMU kind and noise, ``p0`` the 15 × 15 INS block (the
+        extra states' initial σ come from the options).
+    **fields
+        Any field of :class:`GnssOptions` or :class:`InsSetup` as a keyword (``p0_ins``
+        for the INS ``p0``), replacing those of ``options``/``setup``. Without ``setup``,
+        ``sequential`` defaults to True and ``gate`` to 10.83 (χ²₁ at 0.999 per
+        decorrelated row; sequential scalar updates as in Demidov 2009).
+
+    Returns
+    -------
+    atomnav.filter.sources.SourcedIns
+        The filter (an :class:`atomnav.filter.AidedIns`), built by
+        :func:`atomnav.filter.aided_ins` from one :class:`GnssObservations` source; its
+        ``options`` attribute holds the GNSS options used.
+    """
     instance(eph, Ephemerides, "eph")
     opts, ins_fields = split_options(options, fields)
     if "p0_ins" in ins_fields:
@@ -48,14 +69,24 @@ def tight_ins(eph: Ephemerides, obs: pd.DataFrame, options: GnssOptions | None =
 
 class GnssObservations(Source):
     """GNSS code and pseudorange-rate observations as one measurement source of
-    :func:`atomnav.filter.aided_ins`, the tightly coupled model of :func:`tight_ins`.
+    :func:`atomnav.filter.aided_ins`, the tightly coupled model of :func:`tight_ins`
+    (Demidov 2009, §2.12).
 
-    ``eph``: broadcast ephemerides; ``obs``: observation table as for :func:`tight_ins`;
-    ``options``: :class:`GnssOptions` (default ``GnssOptions()``), which also give the
-    initial values and σ of the extra states (``c_tau_gps``, and ``clock`` with
-    ``formulation="clock_states"``). The table is checked here; the sensor is made for
-    each INS built from it (it needs the IMU kind of the setup). Two GNSS sources in one
-    INS would share those state names: an :class:`atomnav.InputError` naming ``sources``.
+    The table is checked here; the sensor is made for each INS built from it (it needs
+    the IMU kind of the setup). Two GNSS sources in one INS would share the extra states'
+    names: an :class:`atomnav.InputError` naming ``sources``.
+
+    Parameters
+    ----------
+    eph : Ephemerides
+        Broadcast ephemerides.
+    obs : pandas.DataFrame
+        Observation table as for :func:`tight_ins` (``time_s`` GPS s, ``sat``,
+        ``channel``, ``code_m`` m, ``rate_mps`` m/s).
+    options : GnssOptions, optional
+        GNSS options (default ``GnssOptions()``), which also give the initial values and σ
+        of the extra states (``c_tau_gps`` m, and ``clock`` (m, m/s) with
+        ``formulation="clock_states"``).
     """
 
     def __init__(self, eph: Ephemerides, obs: pd.DataFrame, options: GnssOptions | None = None):
