@@ -102,6 +102,29 @@ class PositionFixes(_Fixes):
     with latitudes within ±π/2, covariances symmetric positive definite; a bad one raises
     :class:`atomnav.InputError` naming ``time``, ``lla`` or ``cov`` and its row.
     Longitudes in degrees warn (:class:`atomnav.UnitWarning`).
+
+    Parameters
+    ----------
+    time : array_like (M,) or pandas.DataFrame
+        Times of the fixes, s; or a table with the columns above.
+    lla : array_like (M, 3), optional
+        Latitude, longitude (rad) and height (m) of each fix; not with a table.
+    cov : array_like (M, 3, 3) or (3, 3), optional
+        NED covariance of each fix, m² (one (3, 3) for every fix); required unless the
+        table has the σ columns.
+    epoch : datetime-like, optional
+        Epoch of the IMU record's time: a ``time_s`` column of datetimes counts seconds
+        from it (datetimes without an epoch are a ``TypeError``).
+
+    Raises
+    ------
+    atomnav.InputError
+        Naming ``time``, ``lla`` or ``cov`` and the bad row.
+
+    Warns
+    -----
+    atomnav.UnitWarning
+        Longitudes that look like degrees.
     """
 
     COLUMNS = ("time_s", "lat_rad", "lon_rad", "h_m")
@@ -136,6 +159,24 @@ class VelocityFixes(_Fixes):
     fix is checked here (time finite and strictly increasing, velocities finite,
     covariances symmetric positive definite); a bad one raises :class:`atomnav.InputError`
     naming ``time``, ``vel_ned`` or ``cov`` and its row.
+
+    Parameters
+    ----------
+    time : array_like (M,) or pandas.DataFrame
+        Times of the fixes, s; or a table with the columns above.
+    vel_ned : array_like (M, 3), optional
+        NED velocity of each fix, m/s; not with a table.
+    cov : array_like (M, 3, 3) or (3, 3), optional
+        Covariance of each fix, m²/s² (one (3, 3) for every fix); required unless the
+        table has the σ columns.
+    epoch : datetime-like, optional
+        Epoch of the IMU record's time: a ``time_s`` column of datetimes counts seconds
+        from it (datetimes without an epoch are a ``TypeError``).
+
+    Raises
+    ------
+    atomnav.InputError
+        Naming ``time``, ``vel_ned`` or ``cov`` and the bad row.
     """
 
     COLUMNS = ("time_s", "vn_mps", "ve_mps", "vd_mps")
@@ -153,7 +194,20 @@ class ZeroVelocity(Source):
     """Zero-velocity updates (ZUPT; Groves 2013, *Principles of GNSS, Inertial, and
     Multisensor Integrated Navigation Systems*, 2nd ed., §15.3) at ``time`` (M,) s, with
     velocity noise σ ``sigma`` (m/s): z = v̂ − 0 on the velocity error states. A bad
-    ``time`` or ``sigma`` raises :class:`atomnav.InputError` naming it (and the row)."""
+    ``time`` or ``sigma`` raises :class:`atomnav.InputError` naming it (and the row).
+
+    Parameters
+    ----------
+    time : array_like (M,)
+        Times of the updates, s.
+    sigma : float
+        Velocity noise σ, m/s (> 0).
+
+    Raises
+    ------
+    atomnav.InputError
+        Naming ``time`` (and the row) or ``sigma``.
+    """
 
     def __init__(self, time, sigma: float):
         #: Times of the updates (M,), s.
@@ -174,7 +228,27 @@ class ZeroRate(Source):
     Earth-relative body rate ω̂_ib − Ĉ_n^b ω_ie^n, from the mean bias-compensated gyro
     output since the previous update, is zero. Noise: the gyro white-noise PSD
     ``gyro_psd`` (rad²/s, ARW²) over the time averaged, plus ``sigma`` (rad/s) for motion
-    the record may hold. It reads the IMU kind of the INS it feeds."""
+    the record may hold. It reads the IMU kind of the INS it feeds.
+
+    Parameters
+    ----------
+    time : array_like (M,)
+        Times of the updates, s.
+    gyro_psd : float
+        Gyro white-noise PSD, rad²/s (ARW², ≥ 0).
+    sigma : float, default 0.0
+        Allowance for motion, σ in rad/s (≥ 0).
+
+    Raises
+    ------
+    atomnav.InputError
+        Naming ``time`` (and the row), ``gyro_psd`` or ``sigma``.
+
+    References
+    ----------
+    P. D. Groves, *Principles of GNSS, Inertial, and Multisensor Integrated Navigation
+    Systems*, 2nd ed. (2013), §15.3.
+    """
 
     def __init__(self, time, gyro_psd: float, sigma: float = 0.0):
         #: Times of the updates (M,), s.
@@ -265,7 +339,17 @@ class SourcedIns(AidedIns):
     """The aided INS of :func:`aided_ins`: an :class:`AidedIns` whose sources check the IMU
     record before it starts — :class:`atomnav.cai.CaiShots` reports the shots the record
     cannot complete. When a source leaves measurements out, ``run`` rebuilds the filter
-    without them."""
+    without them.
+
+    Parameters
+    ----------
+    core : atomnav._core.AidedIns
+        The core engine built from ``setup`` and ``sources``.
+    setup : InsSetup
+        The INS configuration.
+    sources : list of Source
+        The measurement sources, in order.
+    """
 
     def __init__(self, core: _core.AidedIns, setup: InsSetup, sources: list):
         super().__init__(core, setup)
@@ -290,11 +374,46 @@ class SourcedIns(AidedIns):
 
     def process(self, time, gyro, accel, *args, **kwargs):
         """See :meth:`AidedIns.process`; the first chunk is the record start, which the
-        sources check."""
+        sources check.
+
+        Parameters
+        ----------
+        time : array_like (N,)
+            Sample times, s.
+        gyro : array_like (N, 3)
+            Angular rate, rad/s (rates) or angle increment, rad (increments).
+        accel : array_like (N, 3)
+            Specific force, m/s² (rates) or velocity increment, m/s (increments).
+        *args, **kwargs
+            The other arguments of :meth:`AidedIns.process` (``h_ref``).
+
+        Returns
+        -------
+        AidedResult
+            The epochs and measurements of this chunk.
+        """
         self._start(time, whole=False)
         return super().process(time, gyro, accel, *args, **kwargs)
 
     def run(self, time, gyro, accel, *args, **kwargs):
-        """See :meth:`AidedIns.run`; the sources check the whole record before it starts."""
+        """See :meth:`AidedIns.run`; the sources check the whole record before it starts.
+
+        Parameters
+        ----------
+        time : array_like (N,)
+            Sample times, s.
+        gyro : array_like (N, 3)
+            Angular rate, rad/s (rates) or angle increment, rad (increments).
+        accel : array_like (N, 3)
+            Specific force, m/s² (rates) or velocity increment, m/s (increments).
+        *args, **kwargs
+            The other arguments of :meth:`AidedIns.run` (``h_ref``, ``chunk_s``,
+            ``progress``).
+
+        Returns
+        -------
+        AidedResult
+            Every epoch and measurement of the record.
+        """
         self._start(time, whole=True)
         return super().run(time, gyro, accel, *args, **kwargs)
