@@ -165,7 +165,7 @@ def chi2_band(dof: int, runs: int, p: float = 0.95) -> tuple[float, float]:
     runs : int
         Number of runs averaged.
     p : float, default 0.95
-        Probability of the band, in (0, 1).
+        Probability of the band, 0 < p < 1.
 
     Returns
     -------

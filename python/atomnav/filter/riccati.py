@@ -59,6 +59,8 @@ class SteadyState:
 def dare(phi, q, h, r) -> SteadyState:
     """Solve the filter-form DARE (Tennstedt et al. 2021, Eq. 31).
 
+    Scalars are accepted as 1×1.
+
     Parameters
     ----------
     phi : (n, n) array_like
@@ -69,8 +71,6 @@ def dare(phi, q, h, r) -> SteadyState:
         Observation matrix.
     r : (m, m) array_like
         Measurement noise covariance (symmetric PD), squared measurement units.
-
-    Scalars are accepted as 1×1.
 
     Returns
     -------
