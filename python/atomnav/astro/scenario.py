@@ -3,8 +3,8 @@
 73 epochs 21.0007 s apart, 3 cameras (12° half-angle) on the mount β̆ = (10°, −25°, 2°),
 ~108 stars per epoch from the synthetic catalog (docs/departures.md#synthetic-star-catalog) to
 m = 5.6, σ_s = 16″, refraction at 150 m,
-200 Hz gyro with the paper's error budget, on main's two-axis stand
-(``trajectory.vasilyuk2024_stand``, converted from NED/FRD to ENU/right-forward-up).
+200 Hz gyro with the paper's error budget, on the two-axis stand of
+:func:`atomnav.trajectory.vasilyuk2024_stand` (converted from NED/FRD to ENU/right-forward-up).
 """
 
 from __future__ import annotations
