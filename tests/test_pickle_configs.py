@@ -11,6 +11,7 @@ from __future__ import annotations
 import copy
 import dataclasses
 import pickle
+from pathlib import Path
 
 import numpy as np
 import pandas as pd
@@ -23,6 +24,7 @@ from atomnav.filter import (BiasModel, InsSetup, Layout, MonteCarlo, PositionFix
 from atomnav.filter.analysis import Scenario
 from atomnav.filter.riccati import dare
 from atomnav.gnss import GnssOptions, tight_ins
+from atomnav.gnss.solution import read_pos
 from atomnav.gnss.tight import GnssObservations
 from atomnav.gnss import scenarios as gnss_scenarios
 from atomnav.imu import ImuErrors
@@ -369,6 +371,7 @@ CASES = {
     "Stationarity": lambda: stationarity(_series()),
     "ArmaFit": lambda: fit_arma(_series(), order=(1, 1)),
     "ArimaStateSpace": lambda: ArimaStateSpace(ar=PAPER_AR, ma=PAPER_MA, sigma2=PAPER_SIGMA2),
+    "PosSolution": lambda: read_pos(Path(__file__).parent / "data" / "real_walk" / "gnss_1730_sf.pos.gz"),
     "CoarseAlignment": lambda: _alignment()[0],
     "FineAlignment": lambda: _alignment()[1],
     "KalmanResult": lambda: kalman(_series(), ArimaStateSpace(ar=PAPER_AR, ma=PAPER_MA, sigma2=PAPER_SIGMA2)),
