@@ -398,6 +398,8 @@ def test_every_public_class_is_covered():
         "Trajectory", "Ephemerides", "GnssEphemerides", "AllanStream",
         # test_io.py
         "ImuLog", "SamplingReport",
+        # test_outages.py
+        "OutageResult",
         # test_cai_own_data.py (and its warning, an exception)
         "IncompleteShotWarning",
         # test_cai_source.py (and the aided INS of aided_ins, with test_cai_own_data.py)

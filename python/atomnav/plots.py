@@ -33,6 +33,7 @@ from . import _core, plausibility, units
 from ._validate import flag, input_error, instance, integer, locate, positive, probability, renamed, table as read_table
 from .filter.aided import AidedResult
 from .filter.analysis import chi2_band
+from .filter.outages import OutageResult
 from .imu import BIAS_COLUMNS
 from .trajectory import Trajectory
 
@@ -452,3 +453,38 @@ def _allan_axes(ax, unit: str) -> None:
     ax.set_ylabel(f"Allan deviation ({unit})")
     ax.grid(True, which="both", alpha=0.3)
     ax.legend(fontsize=8)
+
+
+# ---- GNSS outages ------------------------------------------------------------------
+
+def outages(result):
+    """GNSS outages bridged by the INS: the 3-D position error and 3σ of the forward filter
+    and of the smoother at every withheld fix, against time, the windows shaded.
+
+    Parameters
+    ----------
+    result : atomnav.filter.outages.OutageResult
+        The result of :func:`atomnav.filter.outages.outage_analysis`.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        One axis: time (s) against the 3-D error (m), solid with dots, and 3σ (m), dashed,
+        per solution; the outage windows shaded grey.
+    """
+    instance(result, OutageResult, "result")
+    plt = _pyplot()
+    fig, ax = plt.subplots(figsize=(10, 4), layout="constrained")
+    for k, (start, end) in enumerate(result.windows):
+        ax.axvspan(start, end, color="0.9", label="GNSS withheld" if k == 0 else "_nolegend_")
+    for i, (solution, rows) in enumerate(result.errors.groupby("solution", sort=False)):
+        for k, (_, w) in enumerate(rows.groupby("window")):
+            first = k == 0
+            ax.plot(w["time_s"], w["error_m"], "-o", ms=2, color=f"C{i}", label=f"{solution} error" if first else "_nolegend_")
+            ax.plot(w["time_s"], 3.0 * w["sigma_m"], "--", lw=0.8, color=f"C{i}", label=f"{solution} 3σ" if first else "_nolegend_")
+    ax.set_xlabel("time (s)")
+    ax.set_ylabel("3-D position error (m)")
+    ax.set_title("Drift in the GNSS outages, against the withheld fixes")
+    ax.grid(True, alpha=0.3)
+    ax.legend(fontsize=8)
+    return fig

@@ -16,6 +16,8 @@ states (clock, lever arm, ...) follow the 15 INS states in source order.
 
 from __future__ import annotations
 
+import copy
+
 import numpy as np
 import pandas as pd
 
@@ -81,6 +83,26 @@ class _Fixes(Source):
 
     def _plausible(self, value: np.ndarray) -> np.ndarray:
         return value
+
+    def select(self, keep) -> "_Fixes":
+        """These fixes at the rows where ``keep`` is True, every other field kept.
+
+        Parameters
+        ----------
+        keep : array_like of bool (M,)
+            One flag per fix.
+
+        Returns
+        -------
+        PositionFixes or VelocityFixes
+            A new source of the same class with the kept fixes.
+        """
+        mask = np.asarray(keep)
+        if mask.dtype != bool or mask.shape != self.time.shape:
+            raise input_error("keep", f"expected {len(self.time)} booleans, one per fix, got {mask.dtype} {mask.shape}")
+        out = copy.copy(self)
+        out.time, out.value, out.cov = self.time[mask], self.value[mask], self.cov[mask]
+        return out
 
     def __len__(self) -> int:
         return len(self.time)

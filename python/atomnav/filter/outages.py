@@ -1,0 +1,199 @@
+"""GNSS outages on a recorded or simulated run: withhold the position fixes over chosen
+windows, run the aided INS (forward filter and Rauch–Tung–Striebel smoother, Rauch, Tung &
+Striebel 1965) on the rest, and score the solution against the withheld fixes — how far
+the INS drifts while it bridges each gap, and what σ it states at the end of it.
+
+>>> windows = outage_windows(fixes.time, length=15.0, first=25.0)          # doctest: +SKIP
+>>> out = outage_analysis(setup, fixes, (time, gyro, accel), windows)      # doctest: +SKIP
+>>> print(out.table)                     # per window: forward and smoothed, max and end error
+>>> atomnav.plots.outages(out)           # error and 3σ against time, the windows shaded
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import pandas as pd
+
+from .. import earth, rotation
+from .._validate import as_floats, finite_scalar, input_error, instance, positive
+from .aided import AidedResult, InsSetup
+from .sources import PositionFixes, aided_ins
+
+#: Columns of :attr:`OutageResult.table`.
+TABLE_COLUMNS = ("window", "start_s", "end_s", "solution", "fixes", "max_error_m", "end_error_m", "end_sigma_m")
+#: Columns of :attr:`OutageResult.errors`.
+ERROR_COLUMNS = ("time_s", "window", "solution", "error_n_m", "error_e_m", "error_d_m", "error_m", "sigma_m")
+_SIGMA = [f"sigma_position[{i}]" for i in range(3)]
+
+
+@dataclass(frozen=True)
+class OutageResult:
+    """What :func:`outage_analysis` found.
+
+    Attributes
+    ----------
+    windows : ndarray (K, 2)
+        The outage windows [start, end), s, on the IMU clock.
+    table : DataFrame
+        One row per window and solution (``"forward"``, ``"smoothed"``): the window's
+        number, start and end (s), the number of withheld fixes scored, the largest and the
+        end-of-window 3-D error (m) against them, and the solution's 3-D position σ (m,
+        √(σ_N² + σ_E² + σ_D²)) at the last scored fix.
+    errors : DataFrame
+        One row per scored fix and solution: time (s), window, solution, NED error and its
+        3-D norm (m), and the 3-D σ (m), for plots (:func:`atomnav.plots.outages`).
+    result : AidedResult
+        The aided-INS run without the withheld fixes (its ``smoothed`` holds the smoother).
+    """
+
+    windows: np.ndarray
+    table: pd.DataFrame
+    errors: pd.DataFrame
+    result: AidedResult
+
+
+def outage_windows(time, *, length: float, first: float, spacing: float | None = None) -> np.ndarray:
+    """Outage windows over a fix record: ``length`` s each, the first starting ``first`` s
+    after the first fix, then one every ``spacing`` s (start to start) while a whole window
+    still ends before the last fix.
+
+    Parameters
+    ----------
+    time : array_like (M,)
+        Times of the fixes, s.
+    length : float
+        Length of each window, s.
+    first : float
+        Start of the first window after the first fix, s.
+    spacing : float, optional
+        Start-to-start distance between windows, s (≥ ``length``); default: one window.
+
+    Returns
+    -------
+    ndarray (K, 2)
+        [start, end) of each window, s.
+
+    Raises
+    ------
+    atomnav.InputError
+        Naming ``length``, ``first`` or ``spacing`` when no whole window fits in the record
+        or windows would overlap.
+    """
+    t = as_floats(time, "time").reshape(-1)
+    length, first = positive(length, "length"), finite_scalar(first, "first")
+    if first < 0:
+        raise input_error("first", f"must be >= 0 s after the first fix, got {first}")
+    start = t[0] + first
+    if spacing is None:
+        starts = np.array([start])
+    else:
+        spacing = positive(spacing, "spacing")
+        if spacing < length:
+            raise input_error("spacing", f"{spacing} s is shorter than the window length {length} s: windows would overlap")
+        starts = start + spacing * np.arange(int(np.floor((t[-1] - length - start) / spacing)) + 1)
+    windows = np.column_stack([starts, starts + length])
+    if not len(windows) or windows[-1, 1] > t[-1]:
+        raise input_error("length" if spacing is None else "first",
+                          f"a {length} s window from {first} s after the first fix ends after the last fix "
+                          f"({t[-1] - t[0]:g} s after the first)")
+    return windows
+
+
+def outage_analysis(setup: InsSetup, fixes: PositionFixes, imu, windows, *, sources=(), reference: PositionFixes | None = None,
+                    progress: bool = True) -> OutageResult:
+    """Withhold ``fixes`` over ``windows``, run the aided INS and its smoother on the rest,
+    and score both against the withheld fixes.
+
+    Parameters
+    ----------
+    setup : InsSetup
+        The INS; smoothing is switched on for this run whatever ``setup.smooth`` says.
+    fixes : PositionFixes
+        The GNSS positions (at the antenna: their lever arm, if any, applies).
+    imu : tuple (time, gyro, accel)
+        The IMU record as :meth:`AidedIns.run` takes it: time (N,) s, gyro and accel (N, 3)
+        of ``setup.kind``.
+    windows : array_like (K, 2)
+        Outage windows [start, end), s on the IMU clock, in time order and not
+        overlapping (e.g. from :func:`outage_windows`).
+    sources : sequence of sources, optional
+        Other measurement sources kept throughout (velocity fixes, zero-velocity updates).
+    reference : PositionFixes, optional
+        The positions to score against (e.g. only the fixed-ambiguity epochs); default: the
+        withheld fixes themselves.
+    progress : bool
+        Show a progress bar over the IMU record.
+
+    Returns
+    -------
+    OutageResult
+        Per window and solution, the largest and end-of-window 3-D error (m) and the 3-D σ
+        (m) at the window's end; the errors at every scored fix; the run.
+
+    Raises
+    ------
+    atomnav.InputError
+        Naming ``windows`` and its row for a window outside the fixes, overlapping the one
+        before, or holding no fix to score.
+    TypeError
+        For a ``setup`` that is no :class:`InsSetup` or ``fixes`` that are no
+        :class:`PositionFixes`.
+    """
+    instance(setup, InsSetup, "setup")
+    instance(fixes, PositionFixes, "fixes")
+    scored = fixes if reference is None else instance(reference, PositionFixes, "reference")
+    w = _windows(windows, fixes.time)
+    inside = _inside(fixes.time, w)
+    smoothing = InsSetup.from_dict({**setup.to_dict(), "smooth": True})
+    result = aided_ins(smoothing, [fixes.select(~inside), *sources]).run(*imu, progress=progress)
+    rows, errors = [], []
+    for solution, nav in (("forward", result.nav), ("smoothed", result.smoothed.nav)):
+        for k, (start, end) in enumerate(w):
+            pick = (scored.time >= start) & (scored.time < end)
+            if not pick.any():
+                raise input_error("windows", f"window {k} [{start:g}, {end:g}) s holds no fix of the reference to score", k)
+            t = scored.time[pick]
+            err = _errors(nav, t, scored.value[pick], getattr(scored, "lever_arm", None))
+            sigma = np.sqrt(sum(np.interp(t, nav["time_s"], nav[c]) ** 2 for c in _SIGMA))
+            norm = np.linalg.norm(err, axis=1)
+            rows.append((k, start, end, solution, len(t), norm.max(), norm[-1], sigma[-1]))
+            errors.append(pd.DataFrame({"time_s": t, "window": k, "solution": solution, "error_n_m": err[:, 0],
+                                        "error_e_m": err[:, 1], "error_d_m": err[:, 2], "error_m": norm, "sigma_m": sigma}))
+    return OutageResult(w, pd.DataFrame(rows, columns=list(TABLE_COLUMNS)), pd.concat(errors, ignore_index=True), result)
+
+
+def _windows(windows, fix_time: np.ndarray) -> np.ndarray:
+    w = as_floats(windows, "windows")
+    if w.ndim != 2 or w.shape[1] != 2 or not len(w):
+        raise input_error("windows", f"expected shape (K, 2) of [start, end) in s, got {w.shape}")
+    for k, (start, end) in enumerate(w):
+        if not (np.isfinite(start) and np.isfinite(end) and start < end):
+            raise input_error("windows", f"window {k} [{start}, {end}) s is not an interval", k)
+        if start < fix_time[0] or end > fix_time[-1]:
+            raise input_error("windows", f"window {k} [{start:g}, {end:g}) s lies outside the fixes "
+                              f"({fix_time[0]:g} to {fix_time[-1]:g} s)", k)
+        if k and start < w[k - 1, 1]:
+            raise input_error("windows", f"window {k} starts at {start:g} s, before window {k - 1} ends", k)
+    return w
+
+
+def _inside(t: np.ndarray, windows: np.ndarray) -> np.ndarray:
+    return np.any((t[:, None] >= windows[:, 0]) & (t[:, None] < windows[:, 1]), axis=1)
+
+
+def _errors(nav: pd.DataFrame, t: np.ndarray, lla_ref: np.ndarray, lever_arm) -> np.ndarray:
+    """NED error (m) of the solution ``nav`` (interpolated to ``t``, at the point
+    ``lever_arm`` from the IMU in the body frame) against the positions ``lla_ref``."""
+    nt = nav["time_s"].to_numpy()
+    lla = np.column_stack([np.interp(t, nt, nav[c]) for c in ("lat_rad", "lon_rad", "h_m")])
+    ecef = earth.lla_to_ecef(lla)
+    if lever_arm is not None and np.any(lever_arm):
+        q = np.column_stack([np.interp(t, nt, nav[c]) for c in ("qw", "qx", "qy", "qz")])
+        c_bn = rotation.dcm_from_quat(q / np.linalg.norm(q, axis=1, keepdims=True))
+        c_ne = np.stack([earth.dcm_ned_to_ecef(la, lo) for la, lo in lla[:, :2]])
+        ecef = ecef + np.einsum("kij,kjl,l->ki", c_ne, c_bn, np.asarray(lever_arm, float))
+    d = ecef - earth.lla_to_ecef(lla_ref)
+    c_ne_ref = np.stack([earth.dcm_ned_to_ecef(la, lo) for la, lo in lla_ref[:, :2]])
+    return np.einsum("kji,kj->ki", c_ne_ref, d)
