@@ -312,13 +312,18 @@ def angular_rate(w, name: str, scale: float = 1.0, *, static: bool = False):
     array_like
         ``w``, unchanged.
 
+    Raises
+    ------
+    TypeError
+        A ``w`` that is not numbers (strings included), naming ``name``.
+
     Warns
     -----
     UnitWarning
         The rate is likely in °/s.
     """
     scale = _value(scale)
-    peak = _max_abs(_rows_sample(w)) * scale
+    peak = _max_abs(_rows_sample(as_floats(w, name))) * scale
     if _converts(peak, MAX_ANGULAR_RATE, _DEG):
         _warn(name, "angular rate", "deg/s", "rad/s", f"max |ω| = {peak:.4g}, beyond {MAX_ANGULAR_RATE} rad/s", _DEG)
     elif static is True and (s := _columns(w)).size:
@@ -368,12 +373,17 @@ def time_steps(t, name: str):
     array_like
         ``t``, unchanged.
 
+    Raises
+    ------
+    TypeError
+        A ``t`` that is not numbers (strings included), naming ``name``.
+
     Warns
     -----
     UnitWarning
         The time stamps are likely in ms.
     """
-    _step(_median_step(t), name)
+    _step(_median_step(as_floats(t, name)), name)
     return t
 
 
