@@ -56,6 +56,7 @@ from collections import Counter
 
 import numpy as np
 import pandas as pd
+from numpydoc.docscrape import NumpyDocString
 
 import fuzz
 
@@ -73,8 +74,9 @@ copy does not continue bit for bit; an ``InputError``/``TypeError`` that names n
 parameter of the called function; a harmless mutation rejected; numeric strings taken
 as numbers; ``pd.NA`` handled unlike ``NaN``; a clean call of the catalogue that raises
 or warns (a false unit warning on good data); a public callable that takes a table or an
-array with no clean call in the catalogue and no entry in ``EXEMPT`` (or an entry of
-``EXEMPT`` that no longer names such a callable, or one that has a clean call)."""
+array with no clean call in the catalogue and no entry in ``EXEMPT`` or
+``NOT_YET_CATALOGUED`` (or an entry of either that no longer names such a callable, or one
+that has a clean call)."""
 
 NOT_JUDGED = "not judged"
 """A unit mistake no documented plausibility rule can see (e.g. a gyro in °/s on a vehicle
@@ -216,6 +218,10 @@ ZUPT = ('time = still.time[50::100]\n'
         'still_imu = [still_meas["time_s"].to_numpy(), still_meas[["dtheta_x_rad", "dtheta_y_rad", "dtheta_z_rad"]].to_numpy(), '
         'still_meas[["dv_x_mps", "dv_y_mps", "dv_z_mps"]].to_numpy()]\n'
         'still_aided = lambda source: an.filter.aided_ins(still_setup, source).run(*still_imu, progress=False)')
+FRINGE = ("rng = np.random.default_rng(5)\npsi = rng.uniform(-np.pi, np.pi, 400)\n"
+          "p = 0.5 + 0.02 * rng.standard_normal(400) + 0.3 * np.cos(0.4 + psi + 0.2 * rng.standard_normal(400))")
+ROTVEC = "rotvec = np.array([[0.1, -0.2, 0.3], [0.0, 0.0, 0.0], [2.0, 1.0, -1.5]])"
+ORIGIN = (Unit("origin_lla", "lat", "[0]"), Unit("origin_lla", "lon", "[1]"))
 FIX_TABLE = ('fix_table = pd.DataFrame({"time_s": fixes["fix_time"], "lat_rad": fixes["fix_lla"][:, 0], '
              '"lon_rad": fixes["fix_lla"][:, 1], "h_m": fixes["fix_lla"][:, 2], "sigma_n_m": 1.0, "sigma_e_m": 1.0, '
              '"sigma_d_m": 1.0})')
@@ -432,22 +438,68 @@ CATALOGUE: tuple[Clean, ...] = (
        ["nis", "nees"]),
     _c("atomnav.plots.allan", "drawn(an.plots.allan(table, fit, unit=an.units.DEG_PER_HOUR))",
        PLOTS + "\ntable, fit = allan, an.noise.allan.fit_allan(omega, 1.0)", ["table"]),
+    # atom-interferometer readout noise (Tennstedt et al. 2021: a fringe scanned by a known phase)
+    _c("atomnav.cai.noise_id.fringe_track", "an.cai.noise_id.fringe_track(p, psi)", FRINGE),
+    _c("atomnav.cai.noise_id.residuals", "an.cai.noise_id.residuals(p, psi, track)",
+       FRINGE + "\ntrack = an.cai.noise_id.fringe_track(p, psi)", ["track"]),
+    _c("atomnav.cai.noise_id.identify_noise", "an.cai.noise_id.identify_noise(x, phi, amplitude)",
+       FRINGE + "\nx, phi, amplitude = an.cai.noise_id.residuals(p, psi, an.cai.noise_id.fringe_track(p, psi))"),
+    # atom-interferometer sensitivity functions (Tennstedt et al. 2023)
+    _c("atomnav.cai.predictor.phase_jacobian",
+       "an.cai.predictor.phase_jacobian(t, f, w, shots, T, an.cai.Channels.cyclic())", SINE_IMU, (), SINE_UNITS),
+    _c("atomnav.cai.sensitivity.convolution_phase",
+       "an.cai.convolution_phase(t, acceleration, centres, t_dark=t_dark, tau=1e-5, k=1.61e7)",
+       "t = np.arange(1000) / 1000.0\nacceleration, centres, t_dark = 0.1 * np.sin(6 * np.pi * t), np.array([0.3, 0.6]), 0.05",
+       (), (Unit("t", "time"), Unit("t_dark", "T"))),
+    _c("atomnav.cai.sensitivity.ideal_transfer", "an.cai.ideal_transfer(T, omega)",
+       "T, omega = 0.05, np.array([1.0, 10.0, 100.0])", (), (Unit("T", "T"),)),
+    _c("atomnav.cai.sensitivity.sensitivity", "an.cai.sensitivity(t, t_dark, 1e-5)",
+       "t, t_dark = np.linspace(-0.06, 0.06, 7), 0.05", (), (Unit("t_dark", "T"),)),
+    _c("atomnav.cai.sensor.CaiShots.incomplete",
+       "an.cai.CaiShots(an.cai.seed003_sensor(), np.array([0.0, 0.5, 1.9]), phase=cai_phase[:3], noise=cai_noise[:3])"
+       ".incomplete(time)",
+       "time = slalom.time", (), (Unit("time", "time"),)),
+    # rotations between representations (the attitudes of the 10 s trajectory)
+    _c("atomnav.rotation.euler_from_quat", "an.rotation.euler_from_quat(q)", "q = traj.q_nb"),
+    _c("atomnav.rotation.euler_from_dcm", "an.rotation.euler_from_dcm(dcm)", "dcm = an.rotation.dcm_from_quat(traj.q_nb)"),
+    _c("atomnav.rotation.rotvec_from_quat", "an.rotation.rotvec_from_quat(q)", "q = traj.q_nb"),
+    _c("atomnav.rotation.rotvec_from_dcm", "an.rotation.rotvec_from_dcm(dcm)", "dcm = an.rotation.dcm_from_quat(traj.q_nb)"),
+    _c("atomnav.rotation.quat_from_rotvec", "an.rotation.quat_from_rotvec(rotvec)", ROTVEC),
+    _c("atomnav.rotation.dcm_from_rotvec", "an.rotation.dcm_from_rotvec(rotvec)", ROTVEC),
+    _c("atomnav.rotation.quat_multiply", "an.rotation.quat_multiply(a, b)", "a, b = traj.q_nb[1:], traj.q_nb[:-1]"),
+    _c("atomnav.rotation.quat_normalize", "an.rotation.quat_normalize(q)", "q = 2.0 * traj.q_nb"),
+    _c("atomnav.rotation.skew", "an.rotation.skew(v)", "v = imu_gyro"),
+    # Earth: frames and local parameters along the trajectory
+    _c("atomnav.earth.ecef_to_lla", "an.earth.ecef_to_lla(ecef)", "ecef = an.earth.lla_to_ecef(traj.lla)"),
+    _c("atomnav.earth.ecef_to_ned", "an.earth.ecef_to_ned(ecef, origin_lla)",
+       "ecef, origin_lla = an.earth.lla_to_ecef(traj.lla), init['lla']", (), ORIGIN),
+    _c("atomnav.earth.ned_to_ecef", "an.earth.ned_to_ecef(ned, origin_lla)",
+       "ned, origin_lla = an.earth.lla_to_ned(traj.lla, init['lla']), init['lla']", (), ORIGIN),
+    _c("atomnav.earth.lla_to_ned", "an.earth.lla_to_ned(lla, origin_lla)", "lla, origin_lla = traj.lla, init['lla']", (),
+       LLA_ROWS + ORIGIN),
+    _c("atomnav.earth.navigation_rates", "an.earth.navigation_rates(lla, vel_ned)", "lla, vel_ned = traj.lla, traj.vel_ned",
+       (), LLA_ROWS),
+    _c("atomnav.earth.parameters", "an.earth.parameters(lla)", "lla = traj.lla", (), LLA_ROWS),
+    _c("atomnav.earth.radii", "an.earth.radii(lat)", "lat = traj.lla[:, 0]", (), (Unit("lat", "lat"),)),
+    # the plausibility rules themselves, on an IMU record in SI
+    # (a check returns its argument unchanged: it is judged by its warning)
+    _c("atomnav.plausibility.angular_rate", 'an.plausibility.angular_rate(w, "w") is w', "w = imu_gyro", (),
+       (Unit("w", "gyro"),)),
+    _c("atomnav.plausibility.time_steps", 'an.plausibility.time_steps(t, "t") is t', "t = imu_t", (),
+       (Unit("t", "imu_time"),)),
+    # diagnostics
+    _c("atomnav.diagnostics.zero_crossing_periods", "an.diagnostics.zero_crossing_periods(t, v)",
+       "t = np.linspace(0.0, 10.0, 1001)\nv = np.sin(2 * np.pi * 0.7 * t + 0.1)", (), (Unit("t", "time"),)),
 )
 
 
 EXEMPT = {
-    # its argument is a file path; the arrays it names are the calibration's own
-    "atomnav.astro.results.Calibration.save": "takes a file path, not a table or an array",
-    # a seed and option names in, the arrays of its docstring out
-    "atomnav.astro.scenario.Vasilyuk2024.run": "takes a seed and option names; the arrays are its output",
     # an option name in, the table of its docstring out
     "atomnav.trajectory.Trajectory.ideal_imu": "takes an option name; the table is its output",
     # result containers: the library builds them from its own checked arrays and returns them
     "atomnav.astro.Increments": "the result of astro.gyro_increments",
-    "atomnav.cai.predictor.PhasePrediction": "the result of cai.predict_phase",
     "atomnav.cai.results.HybridResult": "the result of a CAI hybrid Monte Carlo",
     "atomnav.noise.filters.KalmanResult": "the result of noise.filters.kalman",
-    "atomnav.alignment.CoarseAlignment": "the result of alignment.coarse",
     "atomnav.alignment.FineAlignment": "the result of alignment.fine",
     "atomnav.filter.aided.SmoothedResult": "the result of smoothing an aided INS",
     # its constructor takes an error model and options; the arrays are those of its corrupt()
@@ -456,6 +508,13 @@ EXEMPT = {
 """Public callables whose docstring mentions a table or an array but that take none from
 the user, each with the reason it has no clean call (``table_or_array_callables`` finds
 them by their docstrings)."""
+
+NOT_YET_CATALOGUED: dict[str, str] = {
+}
+"""Table- or array-taking callables whose clean call found a defect of atomnav that needs
+more than a local fix: the defect and the outcome of its reproducer. ``check_coverage``
+accepts them like ``EXEMPT``; each leaves when its defect is mended and its clean call
+lands."""
 
 
 @dataclasses.dataclass(frozen=True)
@@ -923,10 +982,12 @@ class Campaign:
             lines += [f"### `{target}` — {cls} ({n}×)", "", fuzz._md(rec.message), "", "```python", rec.call, "```", ""]
         lines += ["## Unit mistakes not judged", ""]
         lines += [f"- `{t}`: {name}" for t, name in self.not_judged] or ["none"]
-        missing = sorted(table_or_array_callables() - self.covered - set(EXEMPT))
+        missing = sorted(table_or_array_callables() - self.covered - set(EXEMPT) - set(NOT_YET_CATALOGUED))
         lines += ["", f"## Table- or array-taking callables without a clean call ({len(missing)})", "",
                   ", ".join(f"`{n}`" for n in missing) or "none", "",
-                  f"## Exempt ({len(EXEMPT)})", ""] + [f"- `{n}`: {why}" for n, why in sorted(EXEMPT.items())] + [""]
+                  f"## Exempt ({len(EXEMPT)})", ""] + [f"- `{n}`: {why}" for n, why in sorted(EXEMPT.items())] + [
+                  "", f"## Not yet catalogued: a defect to mend first ({len(NOT_YET_CATALOGUED)})", ""] + [
+                  f"- `{n}`: {why}" for n, why in sorted(NOT_YET_CATALOGUED.items())] + [""]
         return "\n".join(lines)
 
 
@@ -1074,14 +1135,15 @@ def campaign(thread_rounds: int = THREAD_ROUNDS, only: list[str] | None = None) 
 def check_coverage(camp: Campaign) -> None:
     """A public table- or array-taking callable without a clean call, and a stale ``EXEMPT``
     entry, are each a ``no-clean-call`` outcome."""
-    found = table_or_array_callables()
-    for name in sorted(found - camp.covered - set(EXEMPT)):
+    found, excused = table_or_array_callables(), {**EXEMPT, **NOT_YET_CATALOGUED}
+    for name in sorted(found - camp.covered - set(excused)):
         camp.add(name, "no-clean-call", "takes a table or an array (its docstring says so) and has no clean call in "
-                 "CATALOGUE nor an entry in EXEMPT", 0.0, "")
-    for name in sorted(set(EXEMPT) - found):
-        camp.add(name, "no-clean-call", "is in EXEMPT but is no longer a public table- or array-taking callable", 0.0, "")
-    for name in sorted(set(EXEMPT) & camp.covered):
-        camp.add(name, "no-clean-call", "is in EXEMPT but has a clean call", 0.0, "")
+                 "CATALOGUE nor an entry in EXEMPT or NOT_YET_CATALOGUED", 0.0, "")
+    for name in sorted(set(excused) - found):
+        camp.add(name, "no-clean-call", "is in EXEMPT or NOT_YET_CATALOGUED but is no longer a public table- or "
+                 "array-taking callable", 0.0, "")
+    for name in sorted(set(excused) & camp.covered):
+        camp.add(name, "no-clean-call", "is in EXEMPT or NOT_YET_CATALOGUED but has a clean call", 0.0, "")
 
 
 def table_or_array_callables() -> set[str]:
@@ -1093,10 +1155,26 @@ def table_or_array_callables() -> set[str]:
         if t.module.startswith("atomnav._core") or t.kind == "property" or not t.params:
             continue
         obj = fuzz.resolve(t.module, t.qualname)
-        doc = " ".join((inspect.getdoc(obj) or "").split())
-        if re.search(r"DataFrame|\barray|\(N\b|\(N,|\(M,|\(\d+,\s*\d*\)", doc):
+        if any(TAKES_TABLE_OR_ARRAY.search(text) for text in parameter_docs(obj)):
             out.add(t.name)
     return out
+
+
+TAKES_TABLE_OR_ARRAY = re.compile(r"DataFrame|\bSeries\b|\((N|M)\b")
+"""What a parameter's documented type or description says when it is a table or an array."""
+
+
+def parameter_docs(obj) -> list[str]:
+    """The documented type and description of each parameter of ``obj`` (its numpydoc
+    ``Parameters``; a class's constructor parameters are in its own docstring), or the
+    whole docstring where it has no such section."""
+    doc = inspect.getdoc(obj) or ""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # numpydoc warns of sections it does not know
+        params = NumpyDocString(doc)["Parameters"]
+    if not params:
+        return [" ".join(doc.split())]
+    return [" ".join([p.type, *p.desc]) for p in params]
 
 
 def main(argv=None) -> int:
