@@ -490,6 +490,33 @@ CATALOGUE: tuple[Clean, ...] = (
     # diagnostics
     _c("atomnav.diagnostics.zero_crossing_periods", "an.diagnostics.zero_crossing_periods(t, v)",
        "t = np.linspace(0.0, 10.0, 1001)\nv = np.sin(2 * np.pi * 0.7 * t + 0.1)", (), (Unit("t", "time"),)),
+    # sensor noise: Allan statistics, ARMA modelling and filters of the gyro noise series (Niu et al. 2025)
+    _c("atomnav.noise.allan.bias", "an.noise.allan.bias(series)", "series = omega"),
+    _c("atomnav.noise.allan.bias_stability", "an.noise.allan.bias_stability(series, window=3)", "series = omega"),
+    _c("atomnav.noise.allan.fit_allan", "an.noise.allan.fit_allan(series, 1.0)", "series = omega"),
+    _c("atomnav.noise.allan.fit_allan", "an.noise.allan.fit_allan(series, 1.0)", "series = pd.Series(omega)", ["series"]),
+    _c("atomnav.noise.arma.fit_arma", "an.noise.arma.fit_arma(series)", "series = pd.Series(omega[:500])", ["series"]),
+    _c("atomnav.noise.baselines.butterworth_lowpass", "an.noise.baselines.butterworth_lowpass(series, 1.0, fc=0.01)",
+       "series = pd.Series(omega)", ["series"]),
+    _c("atomnav.noise.allan.long_term_stability", "an.noise.allan.long_term_stability(series, 1.0)", "series = omega"),
+    _c("atomnav.noise.allan.short_term_sensitivity", "an.noise.allan.short_term_sensitivity(series, 1.0)",
+       "series = omega"),
+    _c("atomnav.noise.arma.difference", "an.noise.arma.difference(series)", "series = omega"),
+    _c("atomnav.noise.arma.undifference", "an.noise.arma.undifference(diffs, initial)",
+       "diffs, initial = np.diff(omega), omega[0]"),
+    _c("atomnav.noise.arma.acf_pacf", "an.noise.arma.acf_pacf(z, nlags=20)", "z = omega"),
+    _c("atomnav.noise.arma.durbin_watson", "an.noise.arma.durbin_watson(e)", "e = np.diff(omega)"),
+    _c("atomnav.noise.arma.ljung_box", "an.noise.arma.ljung_box(e)", "e = np.diff(omega)"),
+    _c("atomnav.noise.arma.stationarity", "an.noise.arma.stationarity(z)", "z = omega[:500]"),
+    _c("atomnav.noise.arma.fit_arma", "an.noise.arma.fit_arma(series)", "series = omega[:500]"),
+    _c("atomnav.noise.arma.select_arma", "an.noise.arma.select_arma(d, max_p=1, max_q=1)", "d = np.diff(omega[:500])"),
+    _c("atomnav.noise.baselines.butterworth_lowpass", "an.noise.baselines.butterworth_lowpass(series, 1.0, fc=0.01)",
+       "series = omega"),
+    _c("atomnav.noise.baselines.wavelet_denoise", "an.noise.baselines.wavelet_denoise(series)", "series = omega"),
+    _c("atomnav.noise.filters.filter_series", "an.noise.filters.filter_series(series, config)",
+       "series = omega[:500]\nconfig = an.noise.filters.ArmaFilterConfig(arima.ar, arima.ma, arima.sigma2)"),
+    _c("atomnav.noise.filters.sage_husa", "an.noise.filters.sage_husa(series, arima)", "series = omega[:500]"),
+    _c("atomnav.noise.report.compare", "an.noise.report.compare(series)", "series = omega"),
 )
 
 
@@ -500,6 +527,9 @@ EXEMPT = {
     "atomnav.astro.Increments": "the result of astro.gyro_increments",
     "atomnav.cai.results.HybridResult": "the result of a CAI hybrid Monte Carlo",
     "atomnav.noise.filters.KalmanResult": "the result of noise.filters.kalman",
+    "atomnav.noise.allan.AllanFit": "the result of noise.allan.fit_allan",
+    "atomnav.noise.arma.ArmaFit": "the result of noise.arma.fit_arma",
+    "atomnav.noise.report.Comparison": "the result of noise.report.compare",
     "atomnav.alignment.FineAlignment": "the result of alignment.fine",
     "atomnav.filter.aided.SmoothedResult": "the result of smoothing an aided INS",
     # its constructor takes an error model and options; the arrays are those of its corrupt()
