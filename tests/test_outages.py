@@ -154,3 +154,16 @@ def test_result_pickles(analysis):
     pd.testing.assert_frame_equal(back.table, out.table, check_exact=True)
     pd.testing.assert_frame_equal(back.errors, out.errors, check_exact=True)
     pd.testing.assert_frame_equal(back.result.smoothed.nav, out.result.smoothed.nav, check_exact=True)
+
+
+def test_velocity_fixes_of_the_receiver_are_withheld_too(run):
+    f = run["fixes"]
+    truth = run["truth"]
+    vel = an.filter.VelocityFixes(f.time, truth.vel_ned[np.searchsorted(truth.time, f.time)], np.eye(3) * 1e-4)
+    windows = [[30.0, 45.0]]
+    out = outage_analysis(run["setup"], f, run["imu"], windows, withhold=[vel], progress=False)
+    applied = out.result.measurements
+    assert not ((applied["time_s"] >= 30.0) & (applied["time_s"] < 45.0)).any()
+    assert (applied["source"] == "velocity_fixes").sum() == len(f) - 15
+    with pytest.raises(TypeError, match="withhold"):
+        outage_analysis(run["setup"], f, run["imu"], windows, withhold=[an.filter.ZeroVelocity([10.0], 0.01)], progress=False)

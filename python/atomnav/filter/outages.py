@@ -19,7 +19,7 @@ import pandas as pd
 from .. import earth, rotation
 from .._validate import as_floats, finite_scalar, input_error, instance, positive
 from .aided import AidedResult, InsSetup
-from .sources import PositionFixes, aided_ins
+from .sources import PositionFixes, _Fixes, aided_ins
 
 #: Columns of :attr:`OutageResult.table`.
 TABLE_COLUMNS = ("window", "start_s", "end_s", "solution", "fixes", "max_error_m", "end_error_m", "end_sigma_m")
@@ -101,8 +101,8 @@ def outage_windows(time, *, length: float, first: float, spacing: float | None =
     return windows
 
 
-def outage_analysis(setup: InsSetup, fixes: PositionFixes, imu, windows, *, sources=(), reference: PositionFixes | None = None,
-                    progress: bool = True) -> OutageResult:
+def outage_analysis(setup: InsSetup, fixes: PositionFixes, imu, windows, *, withhold=(), sources=(),
+                    reference: PositionFixes | None = None, progress: bool = True) -> OutageResult:
     """Withhold ``fixes`` over ``windows``, run the aided INS and its smoother on the rest,
     and score both against the withheld fixes.
 
@@ -118,8 +118,10 @@ def outage_analysis(setup: InsSetup, fixes: PositionFixes, imu, windows, *, sour
     windows : array_like (K, 2)
         Outage windows [start, end), s on the IMU clock, in time order and not
         overlapping (e.g. from :func:`outage_windows`).
+    withhold : sequence of PositionFixes or VelocityFixes, optional
+        Other fixes of the same receiver, withheld over the windows too (its velocities).
     sources : sequence of sources, optional
-        Other measurement sources kept throughout (velocity fixes, zero-velocity updates).
+        Other measurement sources kept throughout (zero-velocity updates, constraints).
     reference : PositionFixes, optional
         The positions to score against (e.g. only the fixed-ambiguity epochs); default: the
         withheld fixes themselves.
@@ -143,11 +145,14 @@ def outage_analysis(setup: InsSetup, fixes: PositionFixes, imu, windows, *, sour
     """
     instance(setup, InsSetup, "setup")
     instance(fixes, PositionFixes, "fixes")
+    for k, other in enumerate(withhold):
+        if not isinstance(other, _Fixes):
+            raise TypeError(f"withhold: item {k} is a {type(other).__name__}, not PositionFixes or VelocityFixes")
     scored = fixes if reference is None else instance(reference, PositionFixes, "reference")
     w = _windows(windows, fixes.time)
-    inside = _inside(fixes.time, w)
     smoothing = InsSetup.from_dict({**setup.to_dict(), "smooth": True})
-    result = aided_ins(smoothing, [fixes.select(~inside), *sources]).run(*imu, progress=progress)
+    kept = [f.select(~_inside(f.time, w)) for f in (fixes, *withhold)]
+    result = aided_ins(smoothing, [*kept, *sources]).run(*imu, progress=progress)
     rows, errors = [], []
     for solution, nav in (("forward", result.nav), ("smoothed", result.smoothed.nav)):
         for k, (start, end) in enumerate(w):
