@@ -16,7 +16,7 @@ import pandas as pd
 
 from .._validate import input_error, instance, path as checked_path
 from .ephemeris import GLONASS_COLUMNS, GPS_COLUMNS, Ephemerides
-from .observations import C_LIGHT, doppler_to_rate, obs_arrays
+from .observations import C_LIGHT, _gps_week_start, doppler_to_rate, obs_arrays
 
 WEEK_START = datetime(2017, 1, 1)   # a Sunday: GPS week 1930
 
@@ -84,9 +84,11 @@ def write_obs(path, obs: pd.DataFrame, week_start: datetime = WEEK_START) -> Pat
         Output file.
     obs : pandas.DataFrame
         Observation table (``time_s`` GPS s, ``sat``, ``channel``, ``code_m`` m,
-        ``rate_mps`` m/s), as :func:`atomnav.gnss.simulate` gives it.
+        ``rate_mps`` m/s), as :func:`atomnav.gnss.simulate` gives it, read by column
+        name as by :func:`atomnav.gnss.observations.obs_arrays` (``time_s`` may be naive
+        GPS-time datetime64, which then dates the file itself).
     week_start : datetime.datetime, default 2017-01-01
-        Start (a Sunday, GPS time) of the GPS week of ``time_s``.
+        Start (a Sunday, GPS time) of the GPS week of ``time_s`` in seconds.
 
     Returns
     -------
@@ -99,18 +101,20 @@ def write_obs(path, obs: pd.DataFrame, week_start: datetime = WEEK_START) -> Pat
         Naming ``obs`` for an empty or malformed table.
     """
     path, week_start = checked_path(path), _week_start(week_start)
-    obs_arrays(obs)
+    time, sats, channel, code, rate = obs_arrays(obs)
     if not len(obs):
         raise input_error("obs", "no observations to write")
+    dated = _gps_week_start(obs)  # a datetime time column, read as seconds of its own GPS week
+    week_start = week_start if dated is None else dated.to_pydatetime()
     lines = [f"{3.04:9.2f}{'':11}{'OBSERVATION DATA':20}{'M: Mixed':20}RINEX VERSION / TYPE",
              f"{'atomnav':20}{'':20}{'':20}PGM / RUN BY / DATE",
              f"{'G    2 C1C D1C':60}SYS / # / OBS TYPES", f"{'R    2 C1C D1C':60}SYS / # / OBS TYPES"]
-    t0 = week_start + timedelta(seconds=float(obs["time_s"].iloc[0]))
+    t0 = week_start + timedelta(seconds=float(time[0]))
     lines += [f"  {t0.year:04d}    {t0.month:02d}    {t0.day:02d}    {t0.hour:02d}    {t0.minute:02d}"
               f"{t0.second + t0.microsecond / 1e6:13.7f}     GPS         TIME OF FIRST OBS", f"{'':60}END OF HEADER"]
-    lam = -doppler_to_rate(np.ones(len(obs)), obs["sat"], obs["channel"])
-    doppler = -obs["rate_mps"].to_numpy() / lam
-    for t, ep in obs.assign(doppler=doppler).groupby("time_s", sort=True):
+    lam = -doppler_to_rate(np.ones(len(obs)), sats, channel)
+    epochs = pd.DataFrame({"sat": sats, "code_m": code, "doppler": -rate / lam})
+    for t, ep in epochs.groupby(time, sort=True):
         s = week_start + timedelta(seconds=float(t))
         lines.append(f"> {s.year:04d} {s.month:02d} {s.day:02d} {s.hour:02d} {s.minute:02d}"
                      f"{s.second + s.microsecond / 1e6:11.7f}  0{len(ep):3d}")
