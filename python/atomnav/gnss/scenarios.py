@@ -20,7 +20,7 @@ import numpy as np
 import pandas as pd
 
 from .. import _core, imu, trajectory, units
-from .._validate import finite_scalar, input_error, instance, vector
+from .._validate import finite_scalar, input_error, instance, table, vector
 from ..filter.aided import AidedResult
 from ..filter.engine import BiasModel
 from .ephemeris import Ephemerides
@@ -265,12 +265,10 @@ def _rms(x) -> float:
 
 def _horizontal(err) -> tuple[np.ndarray, np.ndarray]:
     """Times (s) and horizontal errors (m) of a table of :func:`errors_and_nees`."""
-    instance(err, pd.DataFrame, "err")
-    if any(c not in err.columns for c in ("time_s", "horizontal_m")):
-        raise input_error("err", "expected a table of errors_and_nees (columns time_s, horizontal_m)")
-    if not len(err):
+    t, e = table(err, ("time_s", "horizontal_m"), "err", finite=False).T
+    if not len(t):
         raise input_error("err", "no epochs")
-    return (np.asarray(err["time_s"].to_numpy(), dtype=float), np.asarray(err["horizontal_m"].to_numpy(), dtype=float))
+    return t, e
 
 
 def outage_summary(err: pd.DataFrame, start: float, length: float) -> dict:
