@@ -213,6 +213,13 @@ def test_bad_lines_name_source_and_line(edit, line, words):
     assert e.value.parameter == "source" and e.value.index == len(header) + line
 
 
+def test_extra_trailing_fields_are_ignored(walk):
+    """Programs writing RTKLIB's format append their own columns (as the walk's source
+    filter does); RTKLIB reads the named fields and ignores the rest."""
+    got = _read(_broken(lambda b: b.__setitem__(6, b[6] + " 1.0 2.0")))
+    pd.testing.assert_frame_equal(got.data, walk.data, check_exact=True)
+
+
 def test_bad_header_and_epoch():
     _, body = _lines()
     with pytest.raises(an.InputError, match="no RTKLIB column header"):

@@ -209,12 +209,13 @@ def read_pos(source: str | PathLike | io.TextIOBase, *, epoch=None) -> PosSoluti
     dated = "/" in data_lines[0][1].split()[0]
     per_position = 3 if position is _DMS else 1
     fields = 2 + 2 * per_position + (len(names) - 2)  # date and time (or week and seconds), lat and lon
-    raw = pd.read_csv(io.StringIO("\n".join(ln for _, ln in data_lines)), sep=r"\s+", header=None, dtype=str,
-                      names=range(fields), engine="python")
-    for j, (number, line) in enumerate(data_lines):
-        if len(line.split()) != fields:
-            raise input_error("source", f"line {number} has {len(line.split())} fields, the header names {fields} "
-                              "(a truncated or joined line)", number)
+    split = [line.split() for _, line in data_lines]
+    for (number, _), f in zip(data_lines, split):
+        if len(f) < fields:
+            raise input_error("source", f"line {number} has {len(f)} fields, the header names {fields} (a truncated "
+                              "line)", number)
+    # fields beyond the named ones (some programs append their own) are ignored, as RTKLIB does
+    raw = pd.DataFrame([f[:fields] for f in split])
     time = _gps_time(raw, dated, scale, data_lines)
     values = _numbers(raw.iloc[:, 2:], data_lines)
     if per_position == 3:
