@@ -10,7 +10,7 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from .. import _core
+from .. import _core, plausibility
 from .._validate import as_floats, finite_scalar, instance, integer, rows, table, vector
 
 #: Columns of a GPS ephemeris table (angles rad, times GPS s, clock s, s/s, s/s²).
@@ -159,9 +159,14 @@ class Ephemerides:
         -------
         pandas.DataFrame
             One row per time: ``elevation_rad``, ``azimuth_rad`` (rad).
+
+        Warns
+        -----
+        atomnav.UnitWarning
+            Naming ``lla``: a longitude likely in degrees.
         """
         t = np.atleast_1d(as_floats(t, "t"))
-        a = self._core.look_angles(sat, vector(t, None, "t"), vector(lla, 3, "lla"))
+        a = self._core.look_angles(sat, vector(t, None, "t"), plausibility.lla(vector(lla, 3, "lla"), "lla"))
         return pd.DataFrame(a, columns=["elevation_rad", "azimuth_rad"])
 
     def top(self, n: int, t: float, lla, mask_deg: float = 10.0) -> list[str]:
@@ -183,7 +188,7 @@ class Ephemerides:
         list of str
             Up to ``n`` satellite names, highest first.
         """
-        n, t, lla = integer(n, "n", 0), finite_scalar(t, "t"), vector(lla, 3, "lla")
+        n, t, lla = integer(n, "n", 0), finite_scalar(t, "t"), plausibility.lla(vector(lla, 3, "lla"), "lla")
         mask = np.radians(finite_scalar(mask_deg, "mask_deg"))
         el = {s: self.look_angles(s, [t], lla)["elevation_rad"].iloc[0] for s in self.satellites}
         up = sorted((s for s in el if el[s] >= mask), key=lambda s: -el[s])
