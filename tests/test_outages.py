@@ -167,3 +167,20 @@ def test_velocity_fixes_of_the_receiver_are_withheld_too(run):
     assert (applied["source"] == "velocity_fixes").sum() == len(f) - 15
     with pytest.raises(TypeError, match="withhold"):
         outage_analysis(run["setup"], f, run["imu"], windows, withhold=[an.filter.ZeroVelocity([10.0], 0.01)], progress=False)
+
+
+def test_another_programs_solution_is_scored_the_same_way(run, analysis):
+    """A solution table of another program (positions, and σ as RTKLIB writes it: NED
+    covariance columns) is scored like atomnav's own."""
+    windows, out = analysis
+    nav = out.result.nav
+    other = pd.DataFrame({"time_s": nav["time_s"], "lat_rad": nav["lat_rad"], "lon_rad": nav["lon_rad"], "h_m": nav["h_m"],
+                          **{f"cov_{a}_m2": nav[f"sigma_position[{i}]"] ** 2 for i, a in enumerate(("nn", "ee", "dd"))}})
+    table, errors = an.filter.score_outages(other, run["fixes"], windows, solution="forward")
+    want = out.table[out.table["solution"] == "forward"].reset_index(drop=True)
+    pd.testing.assert_frame_equal(table, want, check_exact=False, rtol=1e-12)
+    bare, _ = an.filter.score_outages(other[["time_s", "lat_rad", "lon_rad", "h_m"]], run["fixes"], windows)
+    assert "end_sigma_m" not in bare and not bare.isna().any().any()
+    with pytest.raises(InputError) as e:
+        an.filter.score_outages(other[other["time_s"] < 50.0], run["fixes"], windows)
+    assert e.value.parameter == "nav"

@@ -153,20 +153,84 @@ def outage_analysis(setup: InsSetup, fixes: PositionFixes, imu, windows, *, with
     smoothing = InsSetup.from_dict({**setup.to_dict(), "smooth": True})
     kept = [f.select(~_inside(f.time, w)) for f in (fixes, *withhold)]
     result = aided_ins(smoothing, [*kept, *sources]).run(*imu, progress=progress)
+    scores = [score_outages(nav, scored, w, solution=name) for name, nav in (("forward", result.nav),
+                                                                            ("smoothed", result.smoothed.nav))]
+    return OutageResult(w, pd.concat([t for t, _ in scores], ignore_index=True),
+                        pd.concat([e for _, e in scores], ignore_index=True), result)
+
+
+def score_outages(nav: pd.DataFrame, reference: PositionFixes, windows, *, solution: str = "solution",
+                  lever_arm=None) -> tuple[pd.DataFrame, pd.DataFrame]:
+    """Score any navigation solution against reference positions inside outage windows:
+    atomnav's (``AidedResult.nav``) or another program's (e.g. an RTKLIB-format output
+    read by :func:`atomnav.gnss.read_pos`, whose ``data`` has the same position columns).
+
+    Parameters
+    ----------
+    nav : DataFrame
+        The solution: ``time_s`` (s, increasing), ``lat_rad``, ``lon_rad``, ``h_m`` and,
+        for a lever arm, ``qw, qx, qy, qz``; its 3-D σ is read from ``sigma_position[i]``
+        (m) or ``cov_nn_m2, cov_ee_m2, cov_dd_m2`` (m²) when it has them.
+    reference : PositionFixes
+        The positions scored against; its ``lever_arm`` (if any) places the solution's
+        point at the reference's antenna.
+    windows : array_like (K, 2)
+        Outage windows [start, end), s.
+    solution : str
+        The name of the solution in the tables.
+    lever_arm : array_like (3,), optional
+        Antenna position from the solution's point in the body frame, m (default: the
+        reference's own lever arm, else none).
+
+    Returns
+    -------
+    table : DataFrame
+        :data:`TABLE_COLUMNS`, one row per window (``end_sigma_m`` NaN-free: the column is
+        left out for a solution without σ).
+    errors : DataFrame
+        :data:`ERROR_COLUMNS` at every scored reference position.
+
+    Raises
+    ------
+    atomnav.InputError
+        Naming ``windows`` and its row for a window holding no reference position, or
+        ``nav`` for a solution that does not cover a window.
+    """
+    instance(nav, pd.DataFrame, "nav")
+    instance(reference, PositionFixes, "reference")
+    w = _windows(windows, reference.time)
+    lever = getattr(reference, "lever_arm", None) if lever_arm is None else as_floats(lever_arm, "lever_arm")
+    sigma_of = _sigma_source(nav)
     rows, errors = [], []
-    for solution, nav in (("forward", result.nav), ("smoothed", result.smoothed.nav)):
-        for k, (start, end) in enumerate(w):
-            pick = (scored.time >= start) & (scored.time < end)
-            if not pick.any():
-                raise input_error("windows", f"window {k} [{start:g}, {end:g}) s holds no fix of the reference to score", k)
-            t = scored.time[pick]
-            err = _errors(nav, t, scored.value[pick], getattr(scored, "lever_arm", None))
-            sigma = np.sqrt(sum(np.interp(t, nav["time_s"], nav[c]) ** 2 for c in _SIGMA))
-            norm = np.linalg.norm(err, axis=1)
-            rows.append((k, start, end, solution, len(t), norm.max(), norm[-1], sigma[-1]))
-            errors.append(pd.DataFrame({"time_s": t, "window": k, "solution": solution, "error_n_m": err[:, 0],
-                                        "error_e_m": err[:, 1], "error_d_m": err[:, 2], "error_m": norm, "sigma_m": sigma}))
-    return OutageResult(w, pd.DataFrame(rows, columns=list(TABLE_COLUMNS)), pd.concat(errors, ignore_index=True), result)
+    for k, (start, end) in enumerate(w):
+        pick = (reference.time >= start) & (reference.time < end)
+        if not pick.any():
+            raise input_error("windows", f"window {k} [{start:g}, {end:g}) s holds no fix of the reference to score", k)
+        t = reference.time[pick]
+        if t[0] < nav["time_s"].iloc[0] or t[-1] > nav["time_s"].iloc[-1]:
+            raise input_error("nav", f"the solution ({nav['time_s'].iloc[0]:g} to {nav['time_s'].iloc[-1]:g} s) does not "
+                              f"cover window {k} [{start:g}, {end:g}) s")
+        err = _errors(nav, t, reference.value[pick], lever)
+        norm = np.linalg.norm(err, axis=1)
+        frame = {"time_s": t, "window": k, "solution": solution, "error_n_m": err[:, 0], "error_e_m": err[:, 1],
+                 "error_d_m": err[:, 2], "error_m": norm}
+        row = {"window": k, "start_s": start, "end_s": end, "solution": solution, "fixes": len(t),
+               "max_error_m": norm.max(), "end_error_m": norm[-1]}
+        if sigma_of is not None:
+            frame["sigma_m"] = sigma_of(t)
+            row["end_sigma_m"] = frame["sigma_m"][-1]
+        rows.append(row)
+        errors.append(pd.DataFrame(frame))
+    return pd.DataFrame(rows), pd.concat(errors, ignore_index=True)
+
+
+def _sigma_source(nav: pd.DataFrame):
+    """A function of time giving the solution's 3-D position σ (m), or None without σ."""
+    nt = nav["time_s"].to_numpy()
+    for cols, power in ((_SIGMA, 2), (("cov_nn_m2", "cov_ee_m2", "cov_dd_m2"), 1)):
+        if set(cols) <= set(nav.columns):
+            return lambda t, cols=cols, power=power: np.sqrt(sum(np.interp(t, nt, nav[c]) ** power for c in cols))
+    return None
 
 
 def _windows(windows, fix_time: np.ndarray) -> np.ndarray:
