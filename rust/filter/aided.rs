@@ -21,6 +21,7 @@ use super::ins::{baro_loop_dynamics, error_dynamics, BaroModel, InsNoise};
 use super::initial_error::add_nav_error;
 use super::kf::{rts_chunk, Kf, LoopMode, StoredStep};
 use super::layout::{ins_size, Layout};
+use super::sources::Mounting;
 use crate::earth::Ellipsoid;
 use crate::error::{invalid, NavError, Result};
 use crate::imu::ImuKind;
@@ -48,6 +49,8 @@ pub struct AidingContext<'a> {
     /// Bias estimates currently removed from the IMU output (m/s², rad/s).
     pub accel_bias: Vec3,
     pub gyro_bias: Vec3,
+    /// Bias-compensated angular rate ω̂_ib^b of the last IMU sample (rad/s, body frame).
+    pub gyro_rate: Vec3,
     /// δx̂ (all zeros in closed loop).
     pub x: &'a DVector<f64>,
     /// Estimate of the extra blocks currently in use (layout order after the 15 INS states).
@@ -285,6 +288,10 @@ pub struct InsSetup {
     pub p0: DMatrix<f64>,
     pub cfg: AidedConfig,
     pub damped: Option<DampedVertical>,
+    /// The IMU mount C_imu^b (v_b = C v_imu; docs/mounting.md), applied to every IMU
+    /// sample before the strapdown; identity by default.
+    #[serde(default = "Mat3::identity")]
+    pub mount: Mat3,
 }
 
 impl InsSetup {
@@ -304,7 +311,14 @@ impl InsSetup {
         if let Some(d) = damped {
             d.baro.check()?;
         }
-        Ok(InsSetup { initial, kind, ell, accel_bias0, gyro_bias0, p0, cfg, damped })
+        Ok(InsSetup { initial, kind, ell, accel_bias0, gyro_bias0, p0, cfg, damped, mount: Mat3::identity() })
+    }
+
+    /// This setup with the IMU mounted by `mount` = C_imu^b (checked by [`check_mount`]).
+    pub fn with_mount(mut self, mount: Mat3) -> Result<InsSetup> {
+        check_mount(&mount)?;
+        self.mount = mount;
+        Ok(self)
     }
 
     /// P₀ of the whole layout: this P₀ over the INS blocks and `extra_var` on the
@@ -324,6 +338,15 @@ impl InsSetup {
         }
         Ok(p)
     }
+}
+
+/// An IMU mount C_imu^b must be a rotation (orthonormal within the tolerance of
+/// [`crate::math::check_rotation`], det = +1): otherwise an error naming `mount`.
+pub fn check_mount(mount: &Mat3) -> Result<()> {
+    crate::math::check_rotation("mount", 0, mount).map_err(|e| match e {
+        NavError::InvalidInput { field, reason, .. } => NavError::InvalidInput { field, reason: reason.replace(" at index 0", ""), index: None },
+        other => other,
+    })
 }
 
 /// The checks of the filter options that need no layout.
@@ -355,6 +378,12 @@ pub struct AidedIns<A: Aiding> {
     t_last_predict: f64,
     /// Time and compensated specific force (m/s²) of the last sample, for F.
     last_sample: Option<(f64, Vec3)>,
+    /// Compensated angular rate (rad/s) of the last sample, for the sensors' models.
+    #[serde(default)]
+    last_rate: Vec3,
+    /// The IMU mount C_imu^b applied to every sample (None: the identity, not applied).
+    #[serde(default)]
+    mount: Option<Mat3>,
     steps_since: usize,
     /// Samples processed so far (errors name the sample of the whole record).
     samples: usize,
@@ -411,6 +440,8 @@ impl<A: Aiding> AidedIns<A> {
             next_meas: 0,
             t_last_predict: initial.t,
             last_sample: None,
+            last_rate: Vec3::zeros(),
+            mount: None,
             steps_since: 0,
             samples: 0,
             baro: BaroModel { noise_psd: 0.0, bias: None },
@@ -423,7 +454,7 @@ impl<A: Aiding> AidedIns<A> {
     /// blocks and `p0` over the whole layout (`setup.p0` when None).
     pub fn from_setup(setup: &InsSetup, extra0: DVector<f64>, p0: Option<DMatrix<f64>>, aiding: A) -> Result<Self> {
         let p0 = p0.unwrap_or_else(|| setup.p0.clone());
-        let engine = AidedIns::new(setup.initial, setup.kind, setup.ell, setup.accel_bias0, setup.gyro_bias0, extra0, p0, setup.cfg, aiding)?;
+        let engine = AidedIns::new(setup.initial, setup.kind, setup.ell, setup.accel_bias0, setup.gyro_bias0, extra0, p0, setup.cfg, aiding)?.with_mount(setup.mount)?;
         match setup.damped {
             Some(d) => engine.with_damped_vertical(d.zeta, d.omega, d.baro),
             None => Ok(engine),
@@ -456,6 +487,18 @@ impl<A: Aiding> AidedIns<A> {
             self.extra = self.extra.clone().push(0.0);
         }
         self.baro = baro;
+        Ok(self)
+    }
+
+    /// Mount the IMU by `mount` = C_imu^b: every sample is turned to the body frame
+    /// (v_b = C v_imu) before the bias compensation and the strapdown, so the bias
+    /// estimates are body-frame biases. Only before the first sample.
+    pub fn with_mount(mut self, mount: Mat3) -> Result<Self> {
+        if self.samples > 0 {
+            return Err(invalid("mount", "must be set before the first sample"));
+        }
+        check_mount(&mount)?;
+        self.mount = (mount != Mat3::identity()).then_some(mount);
         Ok(self)
     }
 
@@ -586,9 +629,13 @@ impl<A: Aiding> AidedIns<A> {
         }
         for k in 0..n {
             let dt = t[k] - self.sd.state.t;
+            let (gyro_b, accel_b) = match self.mount {
+                Some(m) => (m * gyro[k], m * accel[k]),
+                None => (gyro[k], accel[k]),
+            };
             let (g, a) = match self.sd.kind() {
-                ImuKind::Rates => (gyro[k] - self.gyro_bias, accel[k] - self.accel_bias),
-                ImuKind::Increments => (gyro[k] - self.gyro_bias * dt, accel[k] - self.accel_bias * dt),
+                ImuKind::Rates => (gyro_b - self.gyro_bias, accel_b - self.accel_bias),
+                ImuKind::Increments => (gyro_b - self.gyro_bias * dt, accel_b - self.accel_bias * dt),
             };
             // reference altitude compensated by the baro bias estimate
             let hb = h_ref.map(|h| h[k] - baro_bias.map_or(0.0, |i| self.extra[i]));
@@ -596,11 +643,12 @@ impl<A: Aiding> AidedIns<A> {
             self.sd.check_diverged(self.samples)?;
             self.samples += 1;
             self.aiding.observe(t[k], dt, &g, &a, &self.sd.state);
-            let f_b = match self.sd.kind() {
-                ImuKind::Rates => a,
-                ImuKind::Increments => a / dt,
+            let (f_b, w_b) = match self.sd.kind() {
+                ImuKind::Rates => (a, g),
+                ImuKind::Increments => (a / dt, g / dt),
             };
             self.last_sample = Some((t[k], f_b));
+            self.last_rate = w_b;
             // A rate sample at the initial time only primes the integrator: not a step.
             if dt > 0.0 {
                 self.steps_since += 1;
@@ -655,6 +703,7 @@ impl<A: Aiding> AidedIns<A> {
                 nav: &self.sd.state,
                 accel_bias: self.accel_bias,
                 gyro_bias: self.gyro_bias,
+                gyro_rate: self.last_rate,
                 x: &self.kf.x,
                 extra: &self.extra,
                 layout: &self.layout,
@@ -754,11 +803,14 @@ pub struct PositionFix {
     pub cov_ned: Mat3,
 }
 
-/// Position fixes as an aiding sensor: z = NED(INS − fix), H = [I 0 ...].
+/// Position fixes as an aiding sensor: z = NED(INS + Ĉ_b^n l − fix) for the lever arm l
+/// of its [`Mounting`], H = [I 0 [(Ĉ_b^n l)×] 0 ...].
 #[derive(serde::Serialize, serde::Deserialize)]
 pub struct PositionAiding {
     times: Vec<f64>,
     fixes: Vec<PositionFix>,
+    #[serde(default)]
+    mounting: Mounting,
 }
 
 impl PositionFix {
@@ -777,7 +829,14 @@ impl PositionFix {
 impl PositionAiding {
     pub fn new(fixes: Vec<PositionFix>) -> Result<Self> {
         super::sources::check_fix_rows(["fixes", "fixes"], "position", fixes.iter().map(|f| (&f.lla, &f.cov_ned)))?;
-        Ok(PositionAiding { times: fixes.iter().map(|f| f.t).collect(), fixes })
+        Ok(PositionAiding { times: fixes.iter().map(|f| f.t).collect(), fixes, mounting: Mounting::default() })
+    }
+
+    /// These fixes measured at the lever arm and time offset of `mounting`.
+    pub fn with_mounting(mut self, mounting: Mounting) -> Self {
+        self.times = mounting.imu_times(&self.fixes.iter().map(|f| f.t).collect::<Vec<_>>());
+        self.mounting = mounting;
+        self
     }
 }
 
@@ -791,9 +850,14 @@ impl Aiding for PositionAiding {
     }
     fn measure(&mut self, j: usize, ctx: &AidingContext) -> Result<Option<Measurement>> {
         let fx = self.fixes.get(j).ok_or_else(|| invalid("position_fixes", format!("no fix {j} (of {})", self.fixes.len())))?;
-        let z = ned_diff(ctx.ell, &ctx.nav.lla, &fx.lla);
+        let mut z = ned_diff(ctx.ell, &ctx.nav.lla, &fx.lla);
         let mut h = DMatrix::<f64>::zeros(3, ctx.layout.size());
         h.view_mut((0, ctx.layout.range("position")?.start), (3, 3)).fill_with_identity();
+        if self.mounting.lever_arm != Vec3::zeros() {
+            let (lever_n, h_psi) = self.mounting.position(ctx.nav);
+            z += lever_n;
+            h.view_mut((0, ctx.layout.range("attitude")?.start), (3, 3)).copy_from(&h_psi);
+        }
         Ok(Some(Measurement { z: z.as_slice().to_vec(), h, r: DMatrix::from_column_slice(3, 3, fx.cov_ned.as_slice()) }))
     }
 }

@@ -25,6 +25,7 @@
 
 use super::aided::{Aiding, AidingContext, Measurement};
 use super::layout::Layout;
+use super::sources::Mounting;
 use crate::earth::Ellipsoid;
 use crate::error::{check_finite, invalid, Result};
 use crate::imu::errors::{ImuErrorModel, TriadErrors};
@@ -284,12 +285,16 @@ pub fn fine_p0(layout: &Layout, q_nb: &Quat, lat: f64, gravity: f64, omega: f64,
     Ok(p)
 }
 
-/// Zero-velocity update (ZUPT; Groves 2013, §15.3.1): the vehicle is at rest, so
-/// z = v̂ − 0 (predicted − measured), H = [0 I 0 …] on the velocity block, R = σ²I.
+/// Zero-velocity update (ZUPT; Groves 2013, §15.3.1): the point at the lever arm of its
+/// [`Mounting`] (the IMU by default) is at rest, so z = v̂_point − 0 (predicted −
+/// measured), H = [0 I 0 …] on the velocity block plus the lever-arm columns of
+/// [`Mounting::velocity`], R = σ²I.
 #[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
 pub struct ZeroVelocity {
     times: Vec<f64>,
     sigma: f64,
+    #[serde(default)]
+    mounting: Mounting,
 }
 
 impl ZeroVelocity {
@@ -297,13 +302,23 @@ impl ZeroVelocity {
     pub fn new(times: Vec<f64>, sigma: f64) -> Result<Self> {
         crate::error::check_positive("sigma", sigma)?;
         check_finite("zero_velocity", &times, 1)?;
-        Ok(ZeroVelocity { times, sigma })
+        Ok(ZeroVelocity { times, sigma, mounting: Mounting::default() })
+    }
+
+    /// These updates at the lever arm and time offset of `mounting` (the times given to
+    /// [`Self::new`] are the stamps).
+    pub fn with_mounting(mut self, mounting: Mounting) -> Self {
+        self.times = mounting.imu_times(&self.times);
+        self.mounting = mounting;
+        self
     }
 
     fn model(&self, ctx: &AidingContext) -> Result<Measurement> {
         let mut h = DMatrix::<f64>::zeros(3, ctx.layout.size());
         h.view_mut((0, ctx.layout.range("velocity")?.start), (3, 3)).fill_with_identity();
-        Ok(Measurement { z: ctx.nav.vel.as_slice().to_vec(), h, r: DMatrix::identity(3, 3) * (self.sigma * self.sigma) })
+        let mut z = ctx.nav.vel;
+        self.mounting.add_velocity_terms(ctx, &mut z, &mut h)?;
+        Ok(Measurement { z: z.as_slice().to_vec(), h, r: DMatrix::identity(3, 3) * (self.sigma * self.sigma) })
     }
 }
 

@@ -9,8 +9,9 @@
 use super::aided::{Aiding, AidingContext, InsSetup, Measurement};
 use super::layout::{ins_size, Layout};
 use super::matrix::check_covariance;
+use crate::earth::Ellipsoid;
 use crate::error::{check_increasing, invalid, invalid_at, NavError, Result};
-use crate::math::{Mat3, Vec3};
+use crate::math::{dcm_from_quat, skew, Mat3, Vec3};
 use crate::strapdown::NavState;
 use nalgebra::{DMatrix, DVector};
 
@@ -58,6 +59,65 @@ fn at_row(e: NavError, i: usize) -> NavError {
     }
 }
 
+/// Where and when a source measures relative to the IMU (docs/mounting.md): the lever
+/// arm l^b (m, body frame) from the IMU to the point the source measures (antenna, the
+/// point at rest), and the time offset (s) of its stamps: a measurement stamped t was
+/// made at t + `time_offset` in the IMU clock. The default (no lever arm, no offset)
+/// leaves a source's model as it was.
+#[derive(Debug, Clone, Copy, Default, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct Mounting {
+    pub lever_arm: Vec3,
+    pub time_offset: f64,
+}
+
+impl Mounting {
+    /// A finite lever arm and time offset (an error names `lever_arm` or `time_offset`).
+    pub fn new(lever_arm: Vec3, time_offset: f64) -> Result<Mounting> {
+        crate::error::check_finite("lever_arm", lever_arm.as_slice(), 1)?;
+        crate::error::check_finite("time_offset", &[time_offset], 1)?;
+        Ok(Mounting { lever_arm, time_offset })
+    }
+
+    /// Stamps `t` in the IMU clock: t + time_offset.
+    pub fn imu_times(&self, t: &[f64]) -> Vec<f64> {
+        t.iter().map(|&s| s + self.time_offset).collect()
+    }
+
+    /// The point's NED offset from the IMU and its attitude column: Ĉ_b^n l and ∂(Ĉ_b^n l)/∂ψ
+    /// = [(Ĉ_b^n l)×] (from Ĉ = (I − [ψ×])C: Ĉl = Cl + (Ĉl) × ψ to first order).
+    pub fn position(&self, nav: &NavState) -> (Vec3, Mat3) {
+        let lever_n = dcm_from_quat(&nav.q_nb) * self.lever_arm;
+        (lever_n, skew(&lever_n))
+    }
+
+    /// The point's NED velocity relative to the IMU, v_point − v = Ĉ(ω̂_ib × l) − ω_ie × Ĉl
+    /// (Groves 2013, Eq. 14.110 without the transport rate), with `omega` = ω̂_ib^b the
+    /// bias-compensated angular rate (rad/s); and its columns on ψ,
+    /// [(Ĉ(ω̂ × l))×] − [ω_ie×][(Ĉl)×], and on the gyro bias δb_g (ω̂ = ω − δb_g),
+    /// Ĉ[l×].
+    pub fn velocity(&self, ell: &Ellipsoid, nav: &NavState, omega: &Vec3) -> (Vec3, Mat3, Mat3) {
+        let cnb = dcm_from_quat(&nav.q_nb);
+        let w_ie = ell.earth_rate_ned(nav.lla.x);
+        let lever_n = cnb * self.lever_arm;
+        let turn = cnb * omega.cross(&self.lever_arm);
+        let dv = turn - w_ie.cross(&lever_n);
+        (dv, skew(&turn) - skew(&w_ie) * skew(&lever_n), cnb * skew(&self.lever_arm))
+    }
+
+    /// The lever-arm terms of a velocity model: `z` += v_point − v, and the ψ and gyro-bias
+    /// columns in `h` (3 rows); nothing without a lever arm.
+    pub fn add_velocity_terms(&self, ctx: &AidingContext, z: &mut Vec3, h: &mut DMatrix<f64>) -> Result<()> {
+        if self.lever_arm == Vec3::zeros() {
+            return Ok(());
+        }
+        let (dv, h_psi, h_bg) = self.velocity(ctx.ell, ctx.nav, &ctx.gyro_rate);
+        *z += dv;
+        h.view_mut((0, ctx.layout.range("attitude")?.start), (3, 3)).copy_from(&h_psi);
+        h.view_mut((0, ctx.layout.range("gyro_bias")?.start), (3, 3)).copy_from(&h_bg);
+        Ok(())
+    }
+}
+
 /// A velocity fix: time (s), NED velocity (m/s) and its covariance (m²/s²).
 #[derive(Debug, Clone, Copy, serde::Serialize, serde::Deserialize)]
 pub struct VelocityFix {
@@ -66,12 +126,15 @@ pub struct VelocityFix {
     pub cov: Mat3,
 }
 
-/// NED velocity fixes as an aiding sensor: z = v̂ − v_fix, H = [0 I 0 ...] on the velocity
-/// block (δv = estimate − true), R the fix's covariance.
+/// NED velocity fixes as an aiding sensor: z = v̂_point − v_fix, H = [0 I 0 ...] on the
+/// velocity block (δv = estimate − true) plus, with a lever arm, the ψ and gyro-bias
+/// columns of [`Mounting::velocity`]; R the fix's covariance.
 #[derive(serde::Serialize, serde::Deserialize)]
 pub struct VelocityFixes {
     times: Vec<f64>,
     fixes: Vec<VelocityFix>,
+    #[serde(default)]
+    mounting: Mounting,
 }
 
 impl VelocityFixes {
@@ -80,7 +143,14 @@ impl VelocityFixes {
     pub fn table(names: [&str; 3], t: &[f64], vel: &[Vec3], cov: &[DMatrix<f64>]) -> Result<Self> {
         let cov = fix_table(names, "velocity", t, vel, cov)?;
         let fixes = t.iter().zip(vel).zip(cov).map(|((&t, &vel_ned), cov)| VelocityFix { t, vel_ned, cov }).collect();
-        Ok(VelocityFixes { times: t.to_vec(), fixes })
+        Ok(VelocityFixes { times: t.to_vec(), fixes, mounting: Mounting::default() })
+    }
+
+    /// These fixes measured at the lever arm and time offset of `mounting`.
+    pub fn with_mounting(mut self, mounting: Mounting) -> Self {
+        self.times = mounting.imu_times(&self.fixes.iter().map(|f| f.t).collect::<Vec<_>>());
+        self.mounting = mounting;
+        self
     }
 }
 
@@ -94,9 +164,10 @@ impl Aiding for VelocityFixes {
     }
     fn measure(&mut self, j: usize, ctx: &AidingContext) -> Result<Option<Measurement>> {
         let fx = self.fixes.get(j).ok_or_else(|| invalid("velocity_fixes", format!("no fix {j} (of {})", self.fixes.len())))?;
-        let z = ctx.nav.vel - fx.vel_ned;
+        let mut z = ctx.nav.vel - fx.vel_ned;
         let mut h = DMatrix::<f64>::zeros(3, ctx.layout.size());
         h.view_mut((0, ctx.layout.range("velocity")?.start), (3, 3)).fill_with_identity();
+        self.mounting.add_velocity_terms(ctx, &mut z, &mut h)?;
         Ok(Some(Measurement { z: z.as_slice().to_vec(), h, r: DMatrix::from_column_slice(3, 3, fx.cov.as_slice()) }))
     }
 }
@@ -391,6 +462,82 @@ mod tests {
             Err(NavError::InvalidInput { field, index, .. }) => assert_eq!((field.as_str(), index), ("sources", Some(1))),
             other => panic!("expected an invalid sources, got {:?}", other.map(|s| s.times.len())),
         }
+    }
+
+    /// Central finite difference of `z(δx)` (3 rows) over the 15 INS error states, step
+    /// `h` (1 cm for the position states: a smaller step in latitude drowns in rounding).
+    fn finite_difference(mut z: impl FnMut(&DVector<f64>) -> Vec3, h: f64) -> DMatrix<f64> {
+        let n = ins_size();
+        let mut jac = DMatrix::zeros(3, n);
+        for i in 0..n {
+            let h = if i < 3 { 1e-2 } else { h };
+            let mut dx = DVector::zeros(n);
+            dx[i] = h;
+            jac.set_column(i, &((z(&dx) - z(&-dx)) / (2.0 * h)));
+        }
+        jac
+    }
+
+    /// The lever-arm models' z at the estimate whose error against a moving, turning
+    /// truth is δx (position, velocity, ψ and gyro bias: ω̂ = ω − δb_g), and their H at
+    /// the truth: H equals the finite difference of z, column by column.
+    #[test]
+    fn lever_arm_jacobians_match_finite_differences() {
+        let ell = crate::earth::WGS84;
+        let truth = NavState { t: 1.0, lla: Vec3::new(0.8, 0.2, 100.0), vel: Vec3::new(12.0, -3.0, 0.5), q_nb: crate::math::quat_from_euler(0.1, -0.3, 2.0) };
+        let omega = Vec3::new(0.2, -0.35, 0.5);
+        let mounting = Mounting::new(Vec3::new(0.4, -0.3, -0.65), 0.0).unwrap();
+        let layout = Layout::ins_with(&[]).unwrap();
+        let (x, extra) = (DVector::zeros(layout.size()), DVector::zeros(0));
+        let fix_cov = vec![DMatrix::identity(3, 3); 1];
+        let position = PositionAiding::new(vec![PositionFix { t: 1.0, lla: truth.lla, cov_ned: Mat3::identity() }]).unwrap().with_mounting(mounting);
+        let velocity = VelocityFixes::table(["time", "vel_ned", "cov"], &[1.0], &[Vec3::new(1.0, 2.0, 3.0)], &fix_cov).unwrap().with_mounting(mounting);
+        let mut sensors: [Box<dyn Aiding>; 2] = [Box::new(position), Box::new(velocity)];
+        for sensor in &mut sensors {
+            let mut model = |dx: &DVector<f64>| {
+                let at = |i: usize| Vec3::new(dx[i], dx[i + 1], dx[i + 2]);
+                let nav = crate::filter::initial_error::add_nav_error(&ell, &truth, &at(0), &at(3), &at(6));
+                let ctx = AidingContext { t: 1.0, nav: &nav, accel_bias: at(9), gyro_bias: at(12), gyro_rate: omega - at(12), x: &x, extra: &extra, layout: &layout, ell: &ell };
+                sensor.measure(0, &ctx).unwrap().unwrap()
+            };
+            let h = model(&DVector::zeros(15)).h;
+            let z = |dx: &DVector<f64>| Vec3::from_column_slice(&model(dx).z);
+            let fd = finite_difference(z, 1e-5);
+            let worst = (&h - &fd).abs().max();
+            // the lever-arm columns are ~0.1–1: a wrong sign or a missing term errs by that
+            assert!(h.columns(6, 3).abs().max() > 0.1, "{}: no attitude column", sensor.name());
+            assert!(worst < 1e-6, "{}: |H − finite difference| = {worst:e}\nH = {h:.6}\nFD = {fd:.6}", sensor.name());
+        }
+    }
+
+    /// A stamp plus the time offset is the measurement time in the IMU clock; a NaN lever
+    /// arm or offset is an error naming it.
+    #[test]
+    fn time_offset_shifts_and_bad_mountings_are_named() {
+        let (_, lla, _, _, _) = record(LoopMode::Closed);
+        let shifted = fixes(lla, [1.0, 2.0].into_iter()).with_mounting(Mounting::new(Vec3::zeros(), 0.125).unwrap());
+        assert_eq!(shifted.times(), [1.125, 2.125]);
+        for (lever, offset, name) in [(Vec3::new(0.0, f64::NAN, 0.0), 0.0, "lever_arm"), (Vec3::zeros(), f64::INFINITY, "time_offset")] {
+            match Mounting::new(lever, offset) {
+                Err(NavError::InvalidInput { field, .. }) => assert_eq!(field, name),
+                other => panic!("expected an invalid {name}, got {other:?}"),
+            }
+        }
+    }
+
+    /// A mount that is no rotation (a reflection, a scaled matrix) is an error naming
+    /// `mount`; a rotation is kept, and the identity leaves the samples untouched.
+    #[test]
+    fn mount_must_be_a_rotation() {
+        let (setup, _, _, _, _) = record(LoopMode::Closed);
+        for bad in [Mat3::from_diagonal(&Vec3::new(1.0, 1.0, -1.0)), Mat3::identity() * 1.01] {
+            match setup.clone().with_mount(bad) {
+                Err(NavError::InvalidInput { field, index, .. }) => assert_eq!((field.as_str(), index), ("mount", None)),
+                other => panic!("expected an invalid mount, got {:?}", other.map(|s| s.mount)),
+            }
+        }
+        let turned = crate::math::dcm_from_euler(std::f64::consts::PI, 0.0, -std::f64::consts::FRAC_PI_2);
+        assert_eq!(setup.with_mount(turned).unwrap().mount, turned);
     }
 
     /// A sensor's own times must increase: the error names the sensor.

@@ -351,7 +351,7 @@ mod tests {
         let (x, extra) = (DVector::zeros(layout.size()), DVector::zeros(3));
         let q = quat_from_euler(0.1, -0.05, 1.2);
         let z_of = |a: &mut TightAiding, nav: &NavState| {
-            let ctx = AidingContext { t: 100.0, nav, accel_bias: Vec3::zeros(), gyro_bias: Vec3::zeros(), x: &x, extra: &extra, layout: &layout, ell: &WGS84 };
+            let ctx = AidingContext { t: 100.0, nav, accel_bias: Vec3::zeros(), gyro_bias: Vec3::zeros(), gyro_rate: Vec3::zeros(), x: &x, extra: &extra, layout: &layout, ell: &WGS84 };
             a.measure(0, &ctx).unwrap().unwrap()
         };
         let nav0 = NavState { t: 100.0, lla, vel, q_nb: q };

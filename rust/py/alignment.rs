@@ -104,10 +104,13 @@ fn alignment_euler_sigma<'py>(py: Python<'py>, euler: numpy::PyReadonlyArray1<'p
     Ok(numpy::IntoPyArray::into_pyarray(s.as_slice().to_vec(), py))
 }
 
-/// Zero-velocity updates at `time` (M,) s with velocity noise σ `sigma` (m/s).
+/// Zero-velocity updates at `time` (M,) s with velocity noise σ `sigma` (m/s) of the
+/// point at the lever arm (m; None: the IMU), stamps offset by `time_offset` (s).
 #[pyfunction]
-fn zero_velocity(time: numpy::PyReadonlyArray1<'_, f64>, #[pyo3(from_py_with = real)] sigma: f64) -> PyResult<AidingSource> {
-    Ok(AidingSource::new(Box::new(ZeroVelocity::new(vector(&time, "time")?, sigma)?)))
+#[pyo3(signature = (time, sigma, *, lever_arm=None, time_offset=0.0))]
+fn zero_velocity(time: numpy::PyReadonlyArray1<'_, f64>, #[pyo3(from_py_with = real)] sigma: f64, lever_arm: Option<&Bound<'_, PyAny>>, #[pyo3(from_py_with = real)] time_offset: f64) -> PyResult<AidingSource> {
+    let mounting = super::sources::mounting(lever_arm, time_offset)?;
+    Ok(AidingSource::new(Box::new(ZeroVelocity::new(vector(&time, "time")?, sigma)?.with_mounting(mounting))))
 }
 
 /// Zero-angular-rate updates at `time` (M,) s: gyro white-noise PSD `gyro_psd` (rad²/s)

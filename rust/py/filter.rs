@@ -127,9 +127,9 @@ impl AidedSetup {
     /// `vertical` "free" (default) or "damped" with the baro loop's ζ, ω_v (rad/s) and the
     /// reference-altitude error model: white-noise PSD `baro_psd` (m²·s) and optionally a
     /// bias state `baro_bias` = (model, p1, p2) as for the IMU biases with initial σ
-    /// `baro_bias_sigma0` (m).
+    /// `baro_bias_sigma0` (m). `mount` the IMU mount C_imu^b (3, 3) (None: identity).
     #[new]
-    #[pyo3(signature = (*, t0, lla0, vel0, q0, kind, p0, accel_psd, gyro_psd, accel_bias, gyro_bias, ba0, bg0, predict_every, method, mode, sequential=false, gate=None, ellipsoid=Wrap(crate::earth::WGS84), vertical=Wrap(Vertical::Free), zeta=None, omega=None, baro_psd=0.0, baro_bias=None, baro_bias_sigma0=None))]
+    #[pyo3(signature = (*, t0, lla0, vel0, q0, kind, p0, accel_psd, gyro_psd, accel_bias, gyro_bias, ba0, bg0, predict_every, method, mode, sequential=false, gate=None, ellipsoid=Wrap(crate::earth::WGS84), vertical=Wrap(Vertical::Free), zeta=None, omega=None, baro_psd=0.0, baro_bias=None, baro_bias_sigma0=None, mount=None))]
     #[allow(clippy::too_many_arguments)]
     fn new(
         #[pyo3(from_py_with = real)] t0: f64,
@@ -156,6 +156,7 @@ impl AidedSetup {
         #[pyo3(from_py_with = real)] baro_psd: f64,
         baro_bias: Option<(String, f64, f64)>,
         #[pyo3(from_py_with = real_opt)] baro_bias_sigma0: Option<f64>,
+        mount: Option<PyReadonlyArray2<'_, f64>>,
     ) -> PyResult<Self> {
         let (lla0, vel0, q0) = (floats::<3>(lla0, "lla0")?, floats::<3>(vel0, "vel0")?, floats::<4>(q0, "q0")?);
         let (ba0, bg0) = (floats::<3>(ba0, "ba0")?, floats::<3>(bg0, "bg0")?);
@@ -173,7 +174,13 @@ impl AidedSetup {
             Vertical::Free => None,
             Vertical::Damped { zeta, omega } => Some(DampedVertical { zeta, omega, baro: BaroModel { noise_psd: baro_psd, bias } }),
         };
-        let setup = InsSetup::new(initial, kind.0, ellipsoid.0, ba0.into(), bg0.into(), mat(&p0, "p0")?, cfg, damped)?;
+        let mut setup = InsSetup::new(initial, kind.0, ellipsoid.0, ba0.into(), bg0.into(), mat(&p0, "p0")?, cfg, damped)?;
+        if let Some(m) = mount.map(|m| mat(&m, "mount")).transpose()? {
+            if m.shape() != (3, 3) {
+                return Err(invalid("mount", format!("expected shape (3, 3), got {:?}", m.shape())).into());
+            }
+            setup = setup.with_mount(crate::math::Mat3::from_iterator(m.iter().copied()))?;
+        }
         Ok(AidedSetup { setup })
     }
 }

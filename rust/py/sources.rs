@@ -2,11 +2,11 @@
 //! constructor (`position_fixes`, `velocity_fixes`, and those of other modules) returns an
 //! `AidingSource`; `aided_ins_from_sources` builds one `AidedIns` from a list of them.
 
-use super::convert::{vec3_rows, vector};
-use super::filter::{mats, AidedSetup, PyAidedIns};
+use super::convert::{real, vec3_rows, vector};
+use super::filter::{floats, mats, AidedSetup, PyAidedIns};
 use crate::error::{invalid_at, Result};
 use crate::filter::aided::{Aiding, InsSetup, PositionAiding, PositionFix};
-use crate::filter::sources::{combine, Source, VelocityFixes};
+use crate::filter::sources::{combine, Mounting, Source, VelocityFixes};
 use numpy::{PyReadonlyArray1, PyReadonlyArray2, PyReadonlyArray3};
 use pyo3::prelude::*;
 use std::sync::Mutex;
@@ -50,21 +50,31 @@ impl AidingSource {
     }
 }
 
+/// The lever arm (3 values, m, body frame; None: none) and time offset (s) of a source.
+pub(crate) fn mounting(lever_arm: Option<&Bound<'_, PyAny>>, time_offset: f64) -> PyResult<Mounting> {
+    let lever_arm = lever_arm.map(|l| floats::<3>(l, "lever_arm")).transpose()?.unwrap_or_default();
+    Ok(Mounting::new(lever_arm.into(), time_offset)?)
+}
+
 /// Position fixes: times (M,) s, (lat, lon, h) (M, 3) rad, rad, m and NED covariances
-/// (M, 3, 3) m².
+/// (M, 3, 3) m², measured at the lever arm (m) and time offset (s) of the source.
 #[pyfunction]
-fn position_fixes(time: PyReadonlyArray1<'_, f64>, lla: PyReadonlyArray2<'_, f64>, cov: PyReadonlyArray3<'_, f64>) -> PyResult<AidingSource> {
+#[pyo3(signature = (time, lla, cov, *, lever_arm=None, time_offset=0.0))]
+fn position_fixes(time: PyReadonlyArray1<'_, f64>, lla: PyReadonlyArray2<'_, f64>, cov: PyReadonlyArray3<'_, f64>, lever_arm: Option<&Bound<'_, PyAny>>, #[pyo3(from_py_with = real)] time_offset: f64) -> PyResult<AidingSource> {
     let (t, lla, cov) = (vector(&time, "time")?, vec3_rows(&lla, "lla")?, mats(&cov, "cov")?);
     let fixes = PositionFix::table(["time", "lla", "cov"], &t, &lla, &cov)?;
-    Ok(AidingSource::new(Box::new(PositionAiding::new(fixes)?)))
+    let mounting = mounting(lever_arm, time_offset)?;
+    Ok(AidingSource::new(Box::new(PositionAiding::new(fixes)?.with_mounting(mounting))))
 }
 
 /// NED velocity fixes: times (M,) s, velocities (M, 3) m/s and covariances (M, 3, 3)
-/// m²/s².
+/// m²/s², measured at the lever arm (m) and time offset (s) of the source.
 #[pyfunction]
-fn velocity_fixes(time: PyReadonlyArray1<'_, f64>, vel_ned: PyReadonlyArray2<'_, f64>, cov: PyReadonlyArray3<'_, f64>) -> PyResult<AidingSource> {
+#[pyo3(signature = (time, vel_ned, cov, *, lever_arm=None, time_offset=0.0))]
+fn velocity_fixes(time: PyReadonlyArray1<'_, f64>, vel_ned: PyReadonlyArray2<'_, f64>, cov: PyReadonlyArray3<'_, f64>, lever_arm: Option<&Bound<'_, PyAny>>, #[pyo3(from_py_with = real)] time_offset: f64) -> PyResult<AidingSource> {
     let (t, vel, cov) = (vector(&time, "time")?, vec3_rows(&vel_ned, "vel_ned")?, mats(&cov, "cov")?);
-    Ok(AidingSource::new(Box::new(VelocityFixes::table(["time", "vel_ned", "cov"], &t, &vel, &cov)?)))
+    let mounting = mounting(lever_arm, time_offset)?;
+    Ok(AidingSource::new(Box::new(VelocityFixes::table(["time", "vel_ned", "cov"], &t, &vel, &cov)?.with_mounting(mounting))))
 }
 
 /// The aided INS of `setup` fed by every source of `sources` (a list of `AidingSource`,
