@@ -222,6 +222,8 @@ FRINGE = ("rng = np.random.default_rng(5)\npsi = rng.uniform(-np.pi, np.pi, 400)
           "p = 0.5 + 0.02 * rng.standard_normal(400) + 0.3 * np.cos(0.4 + psi + 0.2 * rng.standard_normal(400))")
 ROTVEC = "rotvec = np.array([[0.1, -0.2, 0.3], [0.0, 0.0, 0.0], [2.0, 1.0, -1.5]])"
 ORIGIN = (Unit("origin_lla", "lat", "[0]"), Unit("origin_lla", "lon", "[1]"))
+ERR_TABLE = ('err = pd.DataFrame({"time_s": np.arange(0.0, 1500.0), '
+             '"horizontal_m": 1.0 + 0.01 * np.arange(1500.0) + np.sin(np.arange(1500.0) / 7.0)})')
 FIX_TABLE = ('fix_table = pd.DataFrame({"time_s": fixes["fix_time"], "lat_rad": fixes["fix_lla"][:, 0], '
              '"lon_rad": fixes["fix_lla"][:, 1], "h_m": fixes["fix_lla"][:, 2], "sigma_n_m": 1.0, "sigma_e_m": 1.0, '
              '"sigma_d_m": 1.0})')
@@ -517,6 +519,25 @@ CATALOGUE: tuple[Clean, ...] = (
        "series = omega[:500]\nconfig = an.noise.filters.ArmaFilterConfig(arima.ar, arima.ma, arima.sigma2)"),
     _c("atomnav.noise.filters.sage_husa", "an.noise.filters.sage_husa(series, arima)", "series = omega[:500]"),
     _c("atomnav.noise.report.compare", "an.noise.report.compare(series)", "series = omega"),
+    # GNSS: satellites, Doppler, RINEX writing and the thesis scenarios' error summaries
+    _c("atomnav.gnss.ephemeris.Ephemerides.state", 'eph.state("G01", t)', "t = np.arange(0.0, 600.0, 30.0)", (),
+       (Unit("t", "time"),)),
+    _c("atomnav.gnss.ephemeris.Ephemerides.look_angles", 'eph.look_angles("G01", t, lla)',
+       "t, lla = np.arange(0.0, 600.0, 30.0), init['lla']", (), (Unit("t", "time"),) + LLA),
+    _c("atomnav.gnss.observations.doppler_to_rate", "an.gnss.observations.doppler_to_rate(doppler_hz, sat, channel)",
+       'doppler_hz, sat, channel = np.array([1000.0, -2500.0, 300.0]), ["G01", "R05", "R07"], np.array([0, 1, -7])'),
+    _c("atomnav.gnss.rinex.write_obs", "an.gnss.rinex.write_obs(path, obs, week_start).read_text()",
+       "import datetime, os, tempfile\npath = os.path.join(tempfile.mkdtemp(), 'obs.rnx')\n"
+       f"week_start = datetime.datetime.fromisoformat({GPS_WEEK_START!r})", ["obs"], epoch=GPS_WEEK_START),
+    _c("atomnav.gnss.scenarios.last_rms", "an.gnss.scenarios.last_rms(err, 600.0)", ERR_TABLE, ["err"]),
+    _c("atomnav.gnss.scenarios.outage_summary", "an.gnss.scenarios.outage_summary(err, 600.0, 60.0)", ERR_TABLE,
+       ["err"]),
+    # the tightly coupled INS on the 10 s record (the GNSS observations of a receiver at its start)
+    _c("atomnav.gnss.tight.GnssObservations",
+       "an.filter.aided_ins(setup, [an.gnss.tight.GnssObservations(eph, obs)]).run(time, gyro, accel, progress=False)",
+       AIDED + "\nsetup = ins.setup", ["obs"], AIDED_UNITS, epoch=GPS_WEEK_START),
+    _c("atomnav.gnss.tight.tight_ins", "an.gnss.tight.tight_ins(eph, obs, setup=setup).run(time, gyro, accel, progress=False)",
+       AIDED + "\nsetup = ins.setup", ["obs"], AIDED_UNITS, epoch=GPS_WEEK_START),
 )
 
 
@@ -530,6 +551,9 @@ EXEMPT = {
     "atomnav.noise.allan.AllanFit": "the result of noise.allan.fit_allan",
     "atomnav.noise.arma.ArmaFit": "the result of noise.arma.fit_arma",
     "atomnav.noise.report.Comparison": "the result of noise.report.compare",
+    "atomnav.gnss.solution.PosSolution": "the result of gnss.read_pos",
+    "atomnav.io.ImuLog": "the result of io.read_imu",
+    "atomnav.io.SamplingReport": "the sampling report of an io.ImuLog",
     "atomnav.alignment.FineAlignment": "the result of alignment.fine",
     "atomnav.filter.aided.SmoothedResult": "the result of smoothing an aided INS",
     # its constructor takes an error model and options; the arrays are those of its corrupt()
@@ -868,11 +892,14 @@ def _eq(a, b) -> bool:
 
 FORWARDS = {"atomnav.cai.predictor.check_jacobian": "atomnav.cai.predictor.phase_jacobian",
             "atomnav.astro.star_attitudes": "atomnav.astro.results.Observations",
-            "atomnav.filter.sources.aided_ins": "atomnav.filter.aided.AidedIns.run"}
+            "atomnav.filter.sources.aided_ins": "atomnav.filter.aided.AidedIns.run",
+            "atomnav.gnss.tight.tight_ins": "atomnav.filter.aided.AidedIns.run",
+            "atomnav.gnss.tight.GnssObservations": "atomnav.filter.sources.aided_ins"}
 """Callables that pass ``*args``/``**kwargs`` on to another public callable, or whose clean
 call builds its argument with one (``star_attitudes(Observations(epoch, camera, s_cf, g),
 ...)``: a mutated ``s_cf`` is rejected by ``Observations``) or runs what it returns
-(``aided_ins(setup, sources).run(time, gyro, accel)``), whose parameters are then the
+(``aided_ins(setup, sources).run(time, gyro, accel)``, ``tight_ins(eph, obs, ...).run(...)``,
+``aided_ins(setup, [GnssObservations(eph, obs)]).run(...)``), whose parameters are then the
 names of the call's arguments."""
 
 
