@@ -224,6 +224,11 @@ ROTVEC = "rotvec = np.array([[0.1, -0.2, 0.3], [0.0, 0.0, 0.0], [2.0, 1.0, -1.5]
 ORIGIN = (Unit("origin_lla", "lat", "[0]"), Unit("origin_lla", "lon", "[1]"))
 ERR_TABLE = ('err = pd.DataFrame({"time_s": np.arange(0.0, 1500.0), '
              '"horizontal_m": 1.0 + 0.01 * np.arange(1500.0) + np.sin(np.arange(1500.0) / 7.0)})')
+MOUNT = ("mount = an.rotation.dcm_from_euler(np.array([1e-3, 2e-3, -1e-3]))\n"
+         "ds_imu, ds_avu = ring, mount.T @ ring @ mount")  # six increments seen through a small mount
+BETA = "beta = np.array([[0.1, 0.2, 0.3], [1.0, -0.5, 2.0]])"
+SOURCED = (AIDED + '\nsetup = ins.setup\nsources = [an.filter.PositionFixes(fixes["fix_time"], fixes["fix_lla"], '
+           'fixes["fix_cov"])]')
 FIX_TABLE = ('fix_table = pd.DataFrame({"time_s": fixes["fix_time"], "lat_rad": fixes["fix_lla"][:, 0], '
              '"lon_rad": fixes["fix_lla"][:, 1], "h_m": fixes["fix_lla"][:, 2], "sigma_n_m": 1.0, "sigma_e_m": 1.0, '
              '"sigma_d_m": 1.0})')
@@ -538,6 +543,27 @@ CATALOGUE: tuple[Clean, ...] = (
        AIDED + "\nsetup = ins.setup", ["obs"], AIDED_UNITS, epoch=GPS_WEEK_START),
     _c("atomnav.gnss.tight.tight_ins", "an.gnss.tight.tight_ins(eph, obs, setup=setup).run(time, gyro, accel, progress=False)",
        AIDED + "\nsetup = ins.setup", ["obs"], AIDED_UNITS, epoch=GPS_WEEK_START),
+    # star cameras: the mount calibration of Vasilyuk et al. 2024 on six rotations
+    _c("atomnav.astro.astro_increments", "an.astro.astro_increments(s_vf, p_avu)",
+       "s_vf, p_avu = ring, np.tile(1e-10 * np.eye(3), (6, 1, 1))"),
+    _c("atomnav.astro.calibrate", "an.astro.calibrate(ds_imu, ds_avu)", MOUNT),
+    _c("atomnav.astro.observability", "an.astro.observability(ds_avu)", MOUNT),
+    _c("atomnav.astro.d1", "an.astro.d1(beta)", BETA, (), (Unit("beta", "euler"),)),
+    _c("atomnav.astro.d2", "an.astro.d2(beta)", BETA, (), (Unit("beta", "euler"),)),
+    _c("atomnav.astro.euler_from_dcm", "an.astro.euler_from_dcm(c)", "c = ring"),
+    _c("atomnav.astro.refraction_apply", "an.astro.refraction_apply(s, up, 1.0003)",
+       "s, up = stars, np.tile([0.0, 0.0, 1.0], (3, 1))"),
+    _c("atomnav.astro.simulate_observations",
+       "an.astro.simulate_observations(catalog, s_gcrs_vf, up_gcrs, cameras, fov_half_rad=0.5, m_lim=6.0, "
+       "sigma_s_rad=1e-5, n_refr=1.0003, seed=1)",
+       "sky = np.random.default_rng(2).normal(size=(400, 3))\n"
+       "catalog = an.astro.Catalog(sky / np.linalg.norm(sky, axis=1)[:, None], np.linspace(0.0, 6.5, 400), np.arange(400))\n"
+       "s_gcrs_vf, up_gcrs, cameras = ring[:3], np.tile([0.0, 0.0, 1.0], (3, 1)), np.eye(3)[None]"),
+    # the aided INS built from sources (SourcedIns), fed chunk by chunk or whole
+    _c("atomnav.filter.sources.SourcedIns.process", "an.filter.aided_ins(setup, sources).process(time, gyro, accel)",
+       SOURCED, (), AIDED_UNITS),
+    _c("atomnav.filter.sources.SourcedIns.run", "an.filter.aided_ins(setup, sources).run(time, gyro, accel, progress=False)",
+       SOURCED, (), AIDED_UNITS),
 )
 
 
@@ -552,6 +578,9 @@ EXEMPT = {
     "atomnav.noise.arma.ArmaFit": "the result of noise.arma.fit_arma",
     "atomnav.noise.report.Comparison": "the result of noise.report.compare",
     "atomnav.gnss.solution.PosSolution": "the result of gnss.read_pos",
+    "atomnav.astro.results.Calibration": "the result of astro.calibrate",
+    "atomnav.filter.aided.AidedResult": "the result of an aided INS run",
+    "atomnav.filter.analysis.MonteCarlo": "the result of a filter Monte-Carlo campaign",
     "atomnav.io.ImuLog": "the result of io.read_imu",
     "atomnav.io.SamplingReport": "the sampling report of an io.ImuLog",
     "atomnav.alignment.FineAlignment": "the result of alignment.fine",
