@@ -116,8 +116,9 @@ def outage_analysis(setup: InsSetup, fixes: PositionFixes, imu, windows, *, with
         The IMU record as :meth:`AidedIns.run` takes it: time (N,) s, gyro and accel (N, 3)
         of ``setup.kind``.
     windows : array_like (K, 2)
-        Outage windows [start, end), s on the IMU clock, in time order and not
-        overlapping (e.g. from :func:`outage_windows`).
+        Outage windows [start, end), s on the IMU clock (a fix stamped t is at t plus its
+        ``time_offset``), in time order and not overlapping (e.g. from
+        :func:`outage_windows`).
     withhold : sequence of PositionFixes or VelocityFixes, optional
         Other fixes of the same receiver, withheld over the windows too (its velocities).
     sources : sequence of sources, optional
@@ -149,9 +150,9 @@ def outage_analysis(setup: InsSetup, fixes: PositionFixes, imu, windows, *, with
         if not isinstance(other, _Fixes):
             raise TypeError(f"withhold: item {k} is a {type(other).__name__}, not PositionFixes or VelocityFixes")
     scored = fixes if reference is None else instance(reference, PositionFixes, "reference")
-    w = _windows(windows, fixes.time)
+    w = _windows(windows, fixes.time + getattr(fixes, "time_offset", 0.0))
     smoothing = InsSetup.from_dict({**setup.to_dict(), "smooth": True})
-    kept = [f.select(~_inside(f.time, w)) for f in (fixes, *withhold)]
+    kept = [f.select(~_inside(f.time + getattr(f, "time_offset", 0.0), w)) for f in (fixes, *withhold)]
     result = aided_ins(smoothing, [*kept, *sources]).run(*imu, progress=progress)
     scores = [score_outages(nav, scored, w, solution=name) for name, nav in (("forward", result.nav),
                                                                             ("smoothed", result.smoothed.nav))]
@@ -173,7 +174,8 @@ def score_outages(nav: pd.DataFrame, reference: PositionFixes, windows, *, solut
         (m) or ``cov_nn_m2, cov_ee_m2, cov_dd_m2`` (m²) when it has them.
     reference : PositionFixes
         The positions scored against; its ``lever_arm`` (if any) places the solution's
-        point at the reference's antenna.
+        point at the reference's antenna, and its ``time_offset`` (if any) puts its stamps
+        on the solution's (IMU) clock.
     windows : array_like (K, 2)
         Outage windows [start, end), s.
     solution : str
@@ -198,15 +200,16 @@ def score_outages(nav: pd.DataFrame, reference: PositionFixes, windows, *, solut
     """
     instance(nav, pd.DataFrame, "nav")
     instance(reference, PositionFixes, "reference")
-    w = _windows(windows, reference.time)
+    ref_time = reference.time + getattr(reference, "time_offset", 0.0)  # on the IMU clock
+    w = _windows(windows, ref_time)
     lever = getattr(reference, "lever_arm", None) if lever_arm is None else as_floats(lever_arm, "lever_arm")
     sigma_of = _sigma_source(nav)
     rows, errors = [], []
     for k, (start, end) in enumerate(w):
-        pick = (reference.time >= start) & (reference.time < end)
+        pick = (ref_time >= start) & (ref_time < end)
         if not pick.any():
             raise input_error("windows", f"window {k} [{start:g}, {end:g}) s holds no fix of the reference to score", k)
-        t = reference.time[pick]
+        t = ref_time[pick]
         if t[0] < nav["time_s"].iloc[0] or t[-1] > nav["time_s"].iloc[-1]:
             raise input_error("nav", f"the solution ({nav['time_s'].iloc[0]:g} to {nav['time_s'].iloc[-1]:g} s) does not "
                               f"cover window {k} [{start:g}, {end:g}) s")
