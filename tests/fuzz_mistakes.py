@@ -564,6 +564,12 @@ CATALOGUE: tuple[Clean, ...] = (
        SOURCED, (), AIDED_UNITS),
     _c("atomnav.filter.sources.SourcedIns.run", "an.filter.aided_ins(setup, sources).run(time, gyro, accel, progress=False)",
        SOURCED, (), AIDED_UNITS),
+    # GNSS outages withheld from the aided INS and scored (windows [2, 3.5) and [5, 6.5) s over the five fixes)
+    _c("atomnav.filter.outages.outage_windows", "an.filter.outages.outage_windows(time, length=1.5, first=1.0, spacing=3.0)",
+       'time = fixes["fix_time"]', (), (Unit("time", "time"),)),
+    _c("atomnav.filter.outages.outage_analysis",
+       "an.filter.outages.outage_analysis(setup, sources[0], (time, gyro, accel), windows, progress=False)",
+       SOURCED + "\nwindows = np.array([[2.0, 3.5], [5.0, 6.5]])", (), AIDED_UNITS + (Unit("windows", "time"),)),
 )
 
 
@@ -581,6 +587,7 @@ EXEMPT = {
     "atomnav.astro.results.Calibration": "the result of astro.calibrate",
     "atomnav.filter.aided.AidedResult": "the result of an aided INS run",
     "atomnav.filter.analysis.MonteCarlo": "the result of a filter Monte-Carlo campaign",
+    "atomnav.filter.outages.OutageResult": "the result of filter.outage_analysis",
     "atomnav.io.ImuLog": "the result of io.read_imu",
     "atomnav.io.SamplingReport": "the sampling report of an io.ImuLog",
     "atomnav.alignment.FineAlignment": "the result of alignment.fine",
@@ -593,6 +600,11 @@ the user, each with the reason it has no clean call (``table_or_array_callables`
 them by their docstrings)."""
 
 NOT_YET_CATALOGUED: dict[str, str] = {
+    "atomnav.filter.outages.score_outages":
+        "reads nav's columns raw (nav['time_s'], np.interp of nav[c]): with nav = pd.concat([nav, nav[['time_s']]], "
+        "axis=1) it raises ValueError 'The truth value of a Series is ambiguous', with time_s as datetime64 a TypeError "
+        "naming no argument ('<' not supported between 'numpy.float64' and 'Timestamp'); nav wants reading through "
+        "_validate.table",
 }
 """Table- or array-taking callables whose clean call found a defect of atomnav that needs
 more than a local fix: the defect and the outcome of its reproducer. ``check_coverage``
@@ -923,12 +935,14 @@ FORWARDS = {"atomnav.cai.predictor.check_jacobian": "atomnav.cai.predictor.phase
             "atomnav.astro.star_attitudes": "atomnav.astro.results.Observations",
             "atomnav.filter.sources.aided_ins": "atomnav.filter.aided.AidedIns.run",
             "atomnav.gnss.tight.tight_ins": "atomnav.filter.aided.AidedIns.run",
-            "atomnav.gnss.tight.GnssObservations": "atomnav.filter.sources.aided_ins"}
+            "atomnav.gnss.tight.GnssObservations": "atomnav.filter.sources.aided_ins",
+            "atomnav.filter.outages.outage_analysis": "atomnav.filter.aided.AidedIns.run"}
 """Callables that pass ``*args``/``**kwargs`` on to another public callable, or whose clean
 call builds its argument with one (``star_attitudes(Observations(epoch, camera, s_cf, g),
 ...)``: a mutated ``s_cf`` is rejected by ``Observations``) or runs what it returns
 (``aided_ins(setup, sources).run(time, gyro, accel)``, ``tight_ins(eph, obs, ...).run(...)``,
-``aided_ins(setup, [GnssObservations(eph, obs)]).run(...)``), whose parameters are then the
+``aided_ins(setup, [GnssObservations(eph, obs)]).run(...)``, ``outage_analysis``'s ``imu``
+passed on as ``run(*imu)``), whose parameters are then the
 names of the call's arguments."""
 
 
