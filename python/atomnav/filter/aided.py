@@ -126,6 +126,14 @@ class InsSetup(Config):
     ``smooth_dir`` (the system's temporary directory when None) and deleted with the
     engine.
 
+    IMU mount: ``mount`` the rotation C_imu^b from the IMU's axes to the body axes
+    (v_b = C v_imu), a (3, 3) DCM or (roll, pitch, yaw) in rad as for
+    :func:`atomnav.rotation.dcm_from_euler`, kept as its DCM; None (default) is the
+    identity. Every IMU sample is turned by it before the strapdown, so ``ba0``, ``bg0``
+    and the estimated biases are in the body frame. The conventions are in
+    ``docs/mounting.md``; a matrix that is no rotation raises :class:`atomnav.InputError`
+    naming ``mount``.
+
     References
     ----------
     H. E. Rauch, F. Tung and C. T. Striebel, "Maximum likelihood estimates of linear
@@ -171,6 +179,7 @@ class InsSetup(Config):
     smooth_chunk: int = 1000
     smooth_memory: int = 1 << 30
     smooth_dir: str | None = None
+    mount: tuple | None = None
 
     def __post_init__(self):
         flag(self.smooth, "smooth")
@@ -194,6 +203,8 @@ class InsSetup(Config):
             instance(getattr(self, name), BiasModel, name)
         opt = {name: None if getattr(self, name) is None else finite_scalar(getattr(self, name), name)
                for name in ("gate", "zeta", "omega", "baro_bias_sigma0")}
+        if self.mount is not None:
+            object.__setattr__(self, "mount", _floats(_mount_dcm(self.mount)))
         with renamed(lla="lla0", vel_ned="vel0", q_nb="q0"):  # the core checks the initial state as a strapdown state
             native = _core.AidedSetup(
                 t0=finite_scalar(self.t0, "t0"), lla0=list(self.lla0), vel0=list(self.vel0), q0=list(self.q0), kind=self.kind, p0=p0,
@@ -202,13 +213,28 @@ class InsSetup(Config):
                 predict_every=integer(self.predict_every, "predict_every", 1, 2**63 - 1),
                 method=self.method, mode=self.mode, sequential=flag(self.sequential, "sequential"), ellipsoid=self.ellipsoid, vertical=self.vertical,
                 baro_psd=finite_scalar(self.baro_psd, "baro_psd"),
-                baro_bias=None if self.baro_bias is None else self.baro_bias._parts(), **opt)
+                baro_bias=None if self.baro_bias is None else self.baro_bias._parts(),
+                mount=None if self.mount is None else np.array(self.mount), **opt)
         object.__setattr__(self, "_native", native)
 
     @property
     def native(self) -> _core.AidedSetup:
         """The checked core object the sensor factories take."""
         return self._native
+
+def _mount_dcm(mount) -> np.ndarray:
+    """The IMU mount C_imu^b (3, 3) from a DCM or (roll, pitch, yaw) in rad (docs/mounting.md);
+    whether it is a rotation is the core's check."""
+    from ..rotation import dcm_from_euler
+
+    m = as_floats(mount, "mount")
+    if m.shape == (3,):
+        with renamed(euler="mount"):
+            return dcm_from_euler(m)
+    if m.shape != (3, 3):
+        raise input_error("mount", f"expected a (3, 3) DCM or the (3,) Euler angles (roll, pitch, yaw) in rad, got shape {m.shape}")
+    return m
+
 
 _AXES = "xyz"
 

@@ -22,8 +22,9 @@ import numpy as np
 import pandas as pd
 
 from .. import _core, plausibility
-from .._validate import as_floats, input_error, instance, nonnegative, positive, rows, table, vector
+from .._validate import as_floats, input_error, instance, nonnegative, positive, rows, scalar, table, vector
 from .aided import AidedIns, InsSetup
+from .engine import _floats
 
 
 class Source:
@@ -41,7 +42,32 @@ class Source:
         return self
 
 
-class _Fixes(Source):
+class _Mounted(Source):
+    """A source that measures at a lever arm from the IMU and stamps its measurements in
+    its own clock (the conventions are in ``docs/mounting.md``).
+
+    ``lever_arm`` (3,) m, body frame, from the IMU to the point measured (an antenna, the
+    point at rest; None: the IMU itself); ``time_offset`` (s): a measurement stamped t
+    was made at t + ``time_offset`` in the IMU's clock (IMU stamps that lag the true time
+    by 0.125 s, with measurements stamped in true time: ``time_offset=0.125``). A
+    non-finite value raises :class:`atomnav.InputError` naming it, and so does an offset
+    longer than the IMU record run."""
+
+    def _mount(self, lever_arm, time_offset) -> None:
+        #: Lever arm (3,) m in the body frame, or None.
+        self.lever_arm: tuple | None = None if lever_arm is None else _floats(as_floats(lever_arm, "lever_arm"))
+        #: Time offset of the stamps, s (IMU time = stamp + time_offset).
+        self.time_offset: float = scalar(time_offset, "time_offset")
+
+    def _check_record(self, time: np.ndarray, whole: bool) -> "Source":
+        span = time[-1] - time[0]
+        if whole and abs(self.time_offset) > span:
+            raise input_error("time_offset", f"{self.time_offset:g} s is longer than the IMU record ({span:g} s): "
+                                             "is it in seconds?")
+        return self
+
+
+class _Fixes(_Mounted):
     """Fixes of a 3-vector: times (M,) s, values (M, 3) and covariances (M, 3, 3), or a
     table with :attr:`COLUMNS` and, without ``cov``, :attr:`SIGMA_COLUMNS`."""
 
@@ -52,7 +78,8 @@ class _Fixes(Source):
     #: Name of the 3-vector argument.
     VALUE = ""
 
-    def __init__(self, time, value=None, cov=None, *, epoch=None):
+    def __init__(self, time, value=None, cov=None, *, epoch=None, lever_arm=None, time_offset=0.0):
+        self._mount(lever_arm, time_offset)
         if isinstance(time, pd.DataFrame):
             if value is not None:
                 raise input_error(self.VALUE, f"given together with a table: the table's columns {list(self.COLUMNS[1:])} are the {self.VALUE}")
@@ -153,14 +180,14 @@ class PositionFixes(_Fixes):
     SIGMA_COLUMNS = ("sigma_n_m", "sigma_e_m", "sigma_d_m")
     VALUE = "lla"
 
-    def __init__(self, time, lla=None, cov=None, *, epoch=None):
-        super().__init__(time, lla, cov, epoch=epoch)
+    def __init__(self, time, lla=None, cov=None, *, epoch=None, lever_arm=None, time_offset=0.0):
+        super().__init__(time, lla, cov, epoch=epoch, lever_arm=lever_arm, time_offset=time_offset)
 
     def _plausible(self, value):
         return plausibility.lla(value, self.VALUE)
 
     def _native(self) -> _core.AidingSource:
-        return _core.position_fixes(self.time, self.value, self.cov)
+        return _core.position_fixes(self.time, self.value, self.cov, lever_arm=self.lever_arm, time_offset=self.time_offset)
 
 
 class _PositionFixArguments(PositionFixes):
@@ -205,14 +232,14 @@ class VelocityFixes(_Fixes):
     SIGMA_COLUMNS = ("sigma_vn_mps", "sigma_ve_mps", "sigma_vd_mps")
     VALUE = "vel_ned"
 
-    def __init__(self, time, vel_ned=None, cov=None, *, epoch=None):
-        super().__init__(time, vel_ned, cov, epoch=epoch)
+    def __init__(self, time, vel_ned=None, cov=None, *, epoch=None, lever_arm=None, time_offset=0.0):
+        super().__init__(time, vel_ned, cov, epoch=epoch, lever_arm=lever_arm, time_offset=time_offset)
 
     def _native(self) -> _core.AidingSource:
-        return _core.velocity_fixes(self.time, self.value, self.cov)
+        return _core.velocity_fixes(self.time, self.value, self.cov, lever_arm=self.lever_arm, time_offset=self.time_offset)
 
 
-class ZeroVelocity(Source):
+class ZeroVelocity(_Mounted):
     """Zero-velocity updates (ZUPT; Groves 2013, *Principles of GNSS, Inertial, and
     Multisensor Integrated Navigation Systems*, 2nd ed., §15.3) at ``time`` (M,) s, with
     velocity noise σ ``sigma`` (m/s): z = v̂ − 0 on the velocity error states. A bad
@@ -231,15 +258,16 @@ class ZeroVelocity(Source):
         Naming ``time`` (and the row) or ``sigma``.
     """
 
-    def __init__(self, time, sigma: float):
+    def __init__(self, time, sigma: float, *, lever_arm=None, time_offset=0.0):
         #: Times of the updates (M,), s.
         self.time: np.ndarray = vector(time, None, "time")
         #: Velocity noise σ, m/s.
         self.sigma: float = positive(sigma, "sigma")
+        self._mount(lever_arm, time_offset)
         self._native()  # the core checks every time now
 
     def _native(self) -> _core.AidingSource:
-        return _core.zero_velocity(self.time, self.sigma)
+        return _core.zero_velocity(self.time, self.sigma, lever_arm=self.lever_arm, time_offset=self.time_offset)
 
     def __repr__(self) -> str:
         return f"ZeroVelocity({len(self.time)} updates, sigma={self.sigma:g} m/s)"
