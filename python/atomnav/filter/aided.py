@@ -99,6 +99,9 @@ class InsSetup(Config):
     smooth_dir : str or path-like, optional
         Directory for the on-disk forward pass (default: the system's temporary
         directory).
+    mount : array_like (3, 3) or (3,), optional
+        The IMU mount C_imu^b, as a DCM or (roll, pitch, yaw) in rad (see Notes; default
+        None: the identity).
 
     Raises
     ------

@@ -55,7 +55,7 @@ class _Mounted(Source):
 
     def _mount(self, lever_arm, time_offset) -> None:
         #: Lever arm (3,) m in the body frame, or None.
-        self.lever_arm: tuple | None = None if lever_arm is None else _floats(as_floats(lever_arm, "lever_arm"))
+        self.lever_arm: tuple | None = None if lever_arm is None else _floats(_lever(lever_arm))
         #: Time offset of the stamps, s (IMU time = stamp + time_offset).
         self.time_offset: float = scalar(time_offset, "time_offset")
 
@@ -141,7 +141,8 @@ class _Fixes(_Mounted):
 
 class PositionFixes(_Fixes):
     """Position fixes: ``time`` (M,) s, ``lla`` (M, 3) (lat rad, lon rad, h m) and their NED
-    covariances ``cov`` (M, 3, 3) m² (or one (3, 3) for every fix), z = NED(INS − fix).
+    covariances ``cov`` (M, 3, 3) m² (or one (3, 3) for every fix), z = NED(INS + C_b^n l −
+    fix) for the ``lever_arm`` l from the IMU to the antenna.
 
     ``time`` may instead be a DataFrame with the columns ``time_s, lat_rad, lon_rad, h_m``
     and, unless ``cov`` is given, ``sigma_n_m, sigma_e_m, sigma_d_m`` (σ of the north,
@@ -164,11 +165,20 @@ class PositionFixes(_Fixes):
     epoch : datetime-like, optional
         Epoch of the IMU record's time: a ``time_s`` column of datetimes counts seconds
         from it (datetimes without an epoch are a ``TypeError``).
+    lever_arm : array_like (3,), optional
+        From the IMU to the antenna (the point the fixes locate), m, body frame (``docs/mounting.md``); None
+        (default): the IMU itself.
+    time_offset : float
+        Offset of the stamps, s: a fix stamped t was made at t + ``time_offset`` in
+        the IMU clock (IMU stamps that lag the true time by 0.125 s:
+        ``time_offset=0.125``); default 0.
 
     Raises
     ------
     atomnav.InputError
-        Naming ``time``, ``lla`` or ``cov`` and the bad row.
+        Naming ``time``, ``lla`` or ``cov`` and the bad row; ``lever_arm`` or
+        ``time_offset`` for a non-finite value, and ``time_offset`` when it is longer than
+        the IMU record run.
 
     Warns
     -----
@@ -199,8 +209,8 @@ class _PositionFixArguments(PositionFixes):
 
 class VelocityFixes(_Fixes):
     """NED velocity fixes: ``time`` (M,) s, ``vel_ned`` (M, 3) m/s and their covariances
-    ``cov`` (M, 3, 3) m²/s² (or one (3, 3) for every fix), z = v̂ − v_fix on the velocity
-    error states.
+    ``cov`` (M, 3, 3) m²/s² (or one (3, 3) for every fix), z = v̂_l − v_fix with v̂_l the
+    velocity at the ``lever_arm`` l, v + C_b^n(ω_ib^b × l) − ω_ie^n × C_b^n l.
 
     ``time`` may instead be a DataFrame with the columns ``time_s, vn_mps, ve_mps,
     vd_mps`` and, unless ``cov`` is given, ``sigma_vn_mps, sigma_ve_mps, sigma_vd_mps``
@@ -221,11 +231,19 @@ class VelocityFixes(_Fixes):
     epoch : datetime-like, optional
         Epoch of the IMU record's time: a ``time_s`` column of datetimes counts seconds
         from it (datetimes without an epoch are a ``TypeError``).
+    lever_arm : array_like (3,), optional
+        From the IMU to the point whose velocity the fixes give, m, body frame (``docs/mounting.md``); None
+        (default): the IMU itself.
+    time_offset : float
+        Offset of the stamps, s: a fix stamped t was made at t + ``time_offset`` in
+        the IMU clock (IMU stamps that lag the true time by 0.125 s:
+        ``time_offset=0.125``); default 0.
 
     Raises
     ------
     atomnav.InputError
-        Naming ``time``, ``vel_ned`` or ``cov`` and the bad row.
+        Naming ``time``, ``vel_ned`` or ``cov`` and the bad row; ``lever_arm`` or
+        ``time_offset`` as for :class:`PositionFixes`.
     """
 
     COLUMNS = ("time_s", "vn_mps", "ve_mps", "vd_mps")
@@ -242,8 +260,9 @@ class VelocityFixes(_Fixes):
 class ZeroVelocity(_Mounted):
     """Zero-velocity updates (ZUPT; Groves 2013, *Principles of GNSS, Inertial, and
     Multisensor Integrated Navigation Systems*, 2nd ed., §15.3) at ``time`` (M,) s, with
-    velocity noise σ ``sigma`` (m/s): z = v̂ − 0 on the velocity error states. A bad
-    ``time`` or ``sigma`` raises :class:`atomnav.InputError` naming it (and the row).
+    velocity noise σ ``sigma`` (m/s): z = v̂_l − 0 for the point at rest at the
+    ``lever_arm`` l (v̂_l as for :class:`VelocityFixes`). A bad ``time`` or ``sigma``
+    raises :class:`atomnav.InputError` naming it (and the row).
 
     Parameters
     ----------
@@ -251,11 +270,19 @@ class ZeroVelocity(_Mounted):
         Times of the updates, s.
     sigma : float
         Velocity noise σ, m/s (> 0).
+    lever_arm : array_like (3,), optional
+        From the IMU to the point at rest, m, body frame (``docs/mounting.md``); None
+        (default): the IMU itself.
+    time_offset : float
+        Offset of the stamps, s: a update stamped t was made at t + ``time_offset`` in
+        the IMU clock (IMU stamps that lag the true time by 0.125 s:
+        ``time_offset=0.125``); default 0.
 
     Raises
     ------
     atomnav.InputError
-        Naming ``time`` (and the row) or ``sigma``.
+        Naming ``time`` (and the row) or ``sigma``; ``lever_arm`` or ``time_offset`` as
+        for :class:`PositionFixes`.
     """
 
     def __init__(self, time, sigma: float, *, lever_arm=None, time_offset=0.0):
@@ -314,6 +341,14 @@ class ZeroRate(Source):
 
     def __repr__(self) -> str:
         return f"ZeroRate({len(self.time)} updates, gyro_psd={self.gyro_psd:g} rad²/s, sigma={self.sigma:g} rad/s)"
+
+
+def _lever(lever_arm) -> np.ndarray:
+    """A lever arm as a vector; its length and values are the core's checks."""
+    a = as_floats(lever_arm, "lever_arm")
+    if a.ndim != 1:
+        raise input_error("lever_arm", f"expected the 3 values (m, body frame), got shape {a.shape}")
+    return a
 
 
 def _covariances(cov, m: int) -> np.ndarray:
