@@ -6,6 +6,8 @@ IMU's own position without delay is the ideal run; configured with the mount, th
 arm and the time offset, the turned, offset and delayed installation must navigate as
 well as it, and leaving the lever arm (or the offset) out must visibly cost accuracy."""
 
+import pickle
+
 import numpy as np
 import pytest
 
@@ -133,6 +135,20 @@ def test_mount_is_saved_with_the_setup():
     assert InsSetup.from_dict(s.to_dict()) == s
     assert InsSetup.from_json(s.to_json()) == s
     assert InsSetup.from_json(s.to_json()).mount == s.mount
+    assert pickle.loads(pickle.dumps(s)) == s
+    assert _setup(an.trajectory.stationary(1.0)).to_dict()["mount"] is None  # the identity, saved as no mount
+
+
+def test_the_core_turns_the_samples_by_the_saved_mount(scene):
+    """An INS rebuilt from the saved (JSON) setup and a pickled copy of the native setup
+    both turn the samples: each gives the configured run's solution bit for bit."""
+    fixes = _fixes(scene, "fix_antenna", lever_arm=LEVER, time_offset=DELAY)
+    s = _setup(scene["truth"], DELAY, mount=MOUNT)
+    record = (scene["t"] + DELAY, *scene["imu"])
+    want = aided_ins(s, fixes).run(*record, progress=False).nav
+    for copy in (InsSetup.from_json(s.to_json()), pickle.loads(pickle.dumps(s))):
+        assert copy.native is not s.native
+        np.testing.assert_array_equal(aided_ins(copy, fixes).run(*record, progress=False).nav.to_numpy(), want.to_numpy())
 
 
 # ---- bad input names the field -------------------------------------------------------

@@ -302,16 +302,26 @@ def _sources():
         "VelocityFixes": VelocityFixes(fix_t, np.zeros((len(fix_t), 3)), 1e-4 * cov),
         "ZeroVelocity": ZeroVelocity(fix_t, 0.01),
         "ZeroRate": ZeroRate(fix_t, 1e-16),
+        # measured away from the IMU, stamped in another clock (docs/mounting.md)
+        "PositionFixes mounted": PositionFixes(fix_t, fix_lla, cov, lever_arm=(0.5, -0.2, -1.0), time_offset=-0.25),
+        "VelocityFixes mounted": VelocityFixes(fix_t, np.zeros((len(fix_t), 3)), 1e-4 * cov, lever_arm=(0.3, 0.1, -0.6),
+                                               time_offset=-0.125),
+        "ZeroVelocity mounted": ZeroVelocity(fix_t, 0.01, lever_arm=(0.0, 0.4, 0.2), time_offset=-0.5),
     }
 
 
-@pytest.mark.parametrize("name", ["PositionFixes", "VelocityFixes", "ZeroVelocity", "ZeroRate"])
+@pytest.mark.parametrize("name", ["PositionFixes", "VelocityFixes", "ZeroVelocity", "ZeroRate", "PositionFixes mounted",
+                                  "VelocityFixes mounted", "ZeroVelocity mounted"])
 def test_source_copies_feed_the_same_ins(name):
     source = _sources()[name]
     setup = _position_ins().setup
     record = _static_record()[:3]
     want = aided_ins(setup, source).run(*record, progress=False)
     assert len(want.measurements) >= 20
+    if name.endswith("mounted"):  # the lever arm and the offset act, so a copy must carry them
+        plain = aided_ins(setup, _sources()[name.split()[0]]).run(*record, progress=False)
+        assert not np.array_equal(plain.nav.to_numpy(), want.nav.to_numpy())
+        assert np.array_equal(want.measurements["time_s"], plain.measurements["time_s"] + source.time_offset)
     for c in _copies(source):
         assert_same(source, c, name)
         assert_result_equal(want, aided_ins(setup, c).run(*record, progress=False))

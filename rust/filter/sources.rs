@@ -90,8 +90,8 @@ impl Mounting {
         (lever_n, skew(&lever_n))
     }
 
-    /// The point's NED velocity relative to the IMU, v_point − v = Ĉ(ω̂_ib × l) − ω_ie × Ĉl
-    /// (Groves 2013, Eq. 14.110 without the transport rate), with `omega` = ω̂_ib^b the
+    /// The point's NED velocity relative to the IMU, v_point − v = Ĉ(ω̂_eb × l) =
+    /// Ĉ(ω̂_ib × l) − ω_ie × Ĉl (Groves 2013, ch. 14), with `omega` = ω̂_ib^b the
     /// bias-compensated angular rate (rad/s); and its columns on ψ,
     /// [(Ĉ(ω̂ × l))×] − [ω_ie×][(Ĉl)×], and on the gyro bias δb_g (ω̂ = ω − δb_g),
     /// Ĉ[l×].
