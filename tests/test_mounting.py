@@ -15,7 +15,8 @@ import atomnav as an
 from atomnav import InputError
 from atomnav.filter import BiasModel, InsSetup, PositionFixes, VelocityFixes, ZeroVelocity, aided_ins
 
-RATE, DURATION, FIX_HZ, SIGMA_FIX = 100.0, 300.0, 2.0, 1.0  # Hz, s, Hz, m
+RATE, DURATION, FIX_HZ, SIGMA_FIX, SIGMA_VEL = 100.0, 300.0, 2.0, 1.0, 0.02  # Hz, s, Hz, m, m/s
+OMEGA_IE = 7.292115e-5  # rad/s (WGS-84)
 DELAY = 0.125  # s: the IMU stamps a sample measured at true time T with T + DELAY
 LEVER = 0.65 * np.array([0.45, -0.3, -0.84]) / np.linalg.norm([0.45, -0.3, -0.84])  # m, body frame
 POS, VEL, ATT = (["dpos_n_m", "dpos_e_m", "dpos_d_m"], ["dvel_n_mps", "dvel_e_mps", "dvel_d_mps"],
@@ -46,7 +47,9 @@ def scene(request):
     """The truth, the turned IMU's tactical-grade output (seeded) in its own axes, and the
     same samples turned to body axes (the ideal mount: the same sensor, the same error
     realisation); 2 Hz fixes with 1 m noise (seeded) of the IMU's position and of the
-    antenna's, p_ant = p + C_b^n l."""
+    antenna's, p_ant = p + C_b^n l; and velocity fixes with 2 cm/s noise (seeded) of the
+    IMU's and the antenna's velocity, v_ant = v + C_b^n(ω_eb^b × l) from the truth's
+    ω_ib^b and the Earth rate."""
     truth = _truth(request.param)
     ideal = truth.ideal_imu("rates")
     g_b = ideal[[f"gyro_{a}_rad_s" for a in "xyz"]].to_numpy()
@@ -65,9 +68,14 @@ def scene(request):
     def lla_of(ned):  # the NED offset ned (m) from the IMU's truth, in lat/lon/h
         return lla + np.c_[ned[:, 0] / (rm + lla[:, 2]), ned[:, 1] / ((rn + lla[:, 2]) * np.cos(lla[:, 0])), -ned[:, 2]]
 
-    lever_n = np.einsum("kij,j->ki", an.rotation.dcm_from_quat(truth.q_nb[k]), LEVER)
+    c_bn = an.rotation.dcm_from_quat(truth.q_nb[k])
+    lever_n = np.einsum("kij,j->ki", c_bn, LEVER)
+    w_ie = OMEGA_IE * np.c_[np.cos(lla[:, 0]), np.zeros(len(k)), -np.sin(lla[:, 0])]
+    v_turn = np.einsum("kij,kj->ki", c_bn, np.cross(g_b[k], LEVER)) - np.cross(w_ie, lever_n)
+    v_noise = np.random.default_rng(12).standard_normal((len(t_fix), 3)) * SIGMA_VEL
     return dict(truth=truth, t=ideal["time_s"].to_numpy(), imu=(g_imu, f_imu), body=(g_imu @ MOUNT.T, f_imu @ MOUNT.T),
-                t_fix=t_fix, fix_imu=lla_of(noise), fix_antenna=lla_of(noise + lever_n))
+                t_fix=t_fix, fix_imu=lla_of(noise), fix_antenna=lla_of(noise + lever_n),
+                vel_imu=truth.vel_ned[k] + v_noise, vel_antenna=truth.vel_ned[k] + v_turn + v_noise)
 
 
 def _setup(truth, offset=0.0, **kw):
@@ -120,6 +128,23 @@ def test_the_lever_arm_and_the_time_offset_each_act(table):
     # left out, the 0.65 m lever arm biases every fix; 0.125 s of lag at speed misplaces it
     assert table["no lever arm"][0] > 1.2 * table["configured"][0], table
     assert table["no time offset"][0] > 1.2 * table["configured"][0], table
+
+
+def test_velocity_fixes_at_the_antenna_need_their_lever_arm(scene):
+    """Velocity fixes of the antenna (next to its position fixes): configured, the errors
+    equal the ideal installation's; without the velocity fixes' lever arm, the turning
+    antenna's ω × l biases them and the velocity error grows."""
+    imu, cov = scene["imu"], np.eye(3) * SIGMA_VEL**2
+    position = _fixes(scene, "fix_antenna", lever_arm=LEVER, time_offset=DELAY)
+
+    def velocity(**kw):
+        return VelocityFixes(scene["t_fix"], scene["vel_antenna"], cov, time_offset=DELAY, **kw)
+
+    ideal = _rms(scene, scene["body"], [_fixes(scene, "fix_imu"), VelocityFixes(scene["t_fix"], scene["vel_imu"], cov)])
+    configured = _rms(scene, imu, [position, velocity(lever_arm=LEVER)], DELAY, MOUNT)
+    left_out = _rms(scene, imu, [position, velocity()], DELAY, MOUNT)
+    assert np.all(np.abs(configured / ideal - 1) < 0.05), (configured, ideal)
+    assert left_out[1] > 1.2 * configured[1], (left_out, configured)
 
 
 def test_mount_as_euler_angles_is_the_same_dcm():
