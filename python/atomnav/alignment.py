@@ -1,4 +1,5 @@
-"""Initial alignment of a strapdown INS at rest (Rust core, ``rust/filter/alignment.rs``).
+"""Initial alignment of a strapdown INS: at rest (Rust core, ``rust/filter/alignment.rs``),
+and in motion from GNSS velocity.
 
 :func:`coarse` levels from the mean specific force (roll, pitch) and gyrocompasses from
 the mean angular rate (heading) of a static IMU record, and states the accuracy the
@@ -19,6 +20,15 @@ the correlation between the coarse attitude error and the biases that caused it.
 updates as measurement sources for any aided INS built with
 :func:`atomnav.filter.aided_ins`.
 
+:func:`in_motion` is for gyros that cannot find north at rest (MEMS: a gyro bias above
+the horizontal Earth rate Ω cos φ ≤ 15 °/h leaves :func:`coarse` a heading of any value;
+it does not refuse, and its stated heading σ shows it): it keeps the levelling of
+:func:`coarse` alone, takes the heading from the direction of the GNSS velocity once the
+vehicle moves faster than a threshold (Groves 2013, §5.6.2), and starts the aided INS
+there with that heading's σ in its initial covariance — a coarse-heading step before the
+Kalman filter, so the filter's small-angle attitude error model never sees the large
+initial heading error (Groves 2013, §14.4.3).
+
 >>> c = coarse(imu, lla, errors="tactical")                  # doctest: +SKIP
 >>> print(c)                                                 # attitude and its accuracy
 >>> f = fine(later_imu, lla, c)                              # doctest: +SKIP
@@ -27,16 +37,17 @@ updates as measurement sources for any aided INS built with
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass
 
 import numpy as np
 import pandas as pd
 
-from . import _core, plausibility, units
-from ._validate import choice, finite, flag, input_error, instance, positive, renamed, vector
+from . import _core, earth, plausibility, rotation, units
+from ._validate import choice, finite, flag, input_error, instance, nonnegative, positive, renamed, vector
 from .filter.aided import AidedResult, InsSetup, _concat
 from .filter.engine import BiasModel
-from .filter.sources import ZeroRate, ZeroVelocity, aided_ins
+from .filter.sources import PositionFixes, VelocityFixes, ZeroRate, ZeroVelocity, aided_ins
 from .imu import KINDS, ImuErrors
 from .strapdown import _imu_arrays, _imu_errors
 from .trajectory import imu_kind
@@ -44,6 +55,13 @@ from .trajectory import imu_kind
 _ARCMIN = np.pi / (180.0 * 60.0)
 #: Most update epochs at which :func:`fine` keeps the filter covariance (spread evenly).
 COVARIANCE_EPOCHS = 50
+#: Index of the heading error ψ_D (``attitude[2]``) in :data:`atomnav.filter.INS15`.
+_HEADING = 8
+#: σ of the velocity at the end of the rest (m/s) for carrying the attitude to the
+#: heading fix, and of the placeholder heading there (rad), which the fix replaces.
+_REST_SIGMA = 0.01
+#: Two time stamps within this (s) are the same epoch.
+_TIME_TOLERANCE = 1e-6
 
 
 def _errors(errors) -> ImuErrors:
@@ -273,6 +291,24 @@ class FineAlignment:
         p.text(str(self))
 
 
+def _setup(level: CoarseAlignment, model: ImuErrors, q_nb, *, t0: float, lla, horizon: float, step: float,
+           predict_s: float, pos_sigma: float, vel_sigma: float) -> InsSetup:
+    """The aided INS at rest at ``t0`` with attitude ``q_nb`` after the levelling (and
+    gyrocompassing) ``level``: the initial covariance keeps the correlation of the
+    attitude error with the biases that caused it (``rust/filter/alignment.rs``,
+    ``fine_p0``), and the noise of ``model`` over ``horizon`` s sets the process noise."""
+    accel_errors, gyro_errors = model._to_core()
+    p0, (accel_psd, accel_walk, gyro_psd, gyro_walk) = _core.fine_alignment_p0(
+        lla, q_nb, psi_cov_noise=level.psi_cov_noise, mean_f=level.mean_f, mean_w=level.mean_w,
+        gravity=level.gravity, horizon=horizon, accel_errors=accel_errors, gyro_errors=gyro_errors,
+        pos_sigma=pos_sigma, vel_sigma=vel_sigma, ellipsoid=level.ellipsoid)
+    with renamed(lla0="lla"):
+        return InsSetup(t0=t0, lla0=lla, vel0=(0.0, 0.0, 0.0), q0=q_nb, kind=level.kind, p0=p0, accel_psd=accel_psd,
+                        gyro_psd=gyro_psd, accel_bias=BiasModel(kind="random_walk", psd=accel_walk),
+                        gyro_bias=BiasModel(kind="random_walk", psd=gyro_walk),
+                        predict_every=max(1, int(round(predict_s / step))), ellipsoid=level.ellipsoid)
+
+
 def fine(imu, lla, coarse: CoarseAlignment, *, errors=None, interval: float = 1.0, zupt_sigma: float = 0.01,
          rate_updates: bool = True, rate_sigma: float = 0.0, pos_sigma: float = 1.0, vel_sigma: float = 0.01,
          predict_s: float = 0.1) -> FineAlignment:
@@ -341,17 +377,9 @@ def fine(imu, lla, coarse: CoarseAlignment, *, errors=None, interval: float = 1.
     times = t0 + interval * np.arange(1, int(np.floor(span / interval * (1 + 1e-12))) + 1)
     if not len(times):
         raise input_error("interval", f"{interval} s leaves no update inside the record of {span:g} s")
-    accel_errors, gyro_errors = model._to_core()
-    p0, (accel_psd, accel_walk, gyro_psd, gyro_walk) = _core.fine_alignment_p0(
-        site, coarse.q_nb, psi_cov_noise=coarse.psi_cov_noise, mean_f=coarse.mean_f, mean_w=coarse.mean_w,
-        gravity=coarse.gravity, horizon=span, accel_errors=accel_errors, gyro_errors=gyro_errors,
-        pos_sigma=positive(pos_sigma, "pos_sigma"), vel_sigma=positive(vel_sigma, "vel_sigma"), ellipsoid=coarse.ellipsoid)
-    with renamed(lla0="lla"):
-        setup = InsSetup(t0=t0, lla0=site, vel0=(0.0, 0.0, 0.0), q0=coarse.q_nb, kind=kind, p0=p0, accel_psd=accel_psd,
-                         gyro_psd=gyro_psd, accel_bias=BiasModel(kind="random_walk", psd=accel_walk),
-                         gyro_bias=BiasModel(kind="random_walk", psd=gyro_walk),
-                         predict_every=max(1, int(round(predict_s / step))), ellipsoid=coarse.ellipsoid)
-    sources = [ZeroVelocity(times, zupt_sigma)] + ([ZeroRate(times, gyro_psd, rate_sigma)] if rate_updates else [])
+    setup = _setup(coarse, model, coarse.q_nb, t0=t0, lla=site, horizon=span, step=step, predict_s=predict_s,
+                   pos_sigma=positive(pos_sigma, "pos_sigma"), vel_sigma=positive(vel_sigma, "vel_sigma"))
+    sources = [ZeroVelocity(times, zupt_sigma)] + ([ZeroRate(times, setup.gyro_psd, rate_sigma)] if rate_updates else [])
     ins = aided_ins(setup, sources)
     # feed the record up to the updates where the covariance is kept, reading it after each
     kept = np.unique(np.linspace(0, len(times) - 1, min(len(times), COVARIANCE_EPOCHS)).round().astype(int))
@@ -385,3 +413,273 @@ def fine(imu, lla, coarse: CoarseAlignment, *, errors=None, interval: float = 1.
         gyro_bias=last[[f"gyro_bias_{x}_rad_s" for x in "xyz"]].to_numpy(dtype=float),
         accel_bias_sigma=sigma("accel_bias"), gyro_bias_sigma=sigma("gyro_bias"),
         covariance_time=times[kept], covariance=cov, labels=labels, result=result, coarse=coarse)
+
+
+@dataclass(frozen=True, kw_only=True)
+class MotionAlignment:
+    """The result of :func:`in_motion`: the start of an aided INS at the first GNSS
+    velocity fix fast enough to give the heading. Angles in rad; ``print`` it for a
+    summary.
+
+    Attributes
+    ----------
+    t0 : float
+        The IMU time stamp at that fix, or the last one before it (s): the aided INS
+        starts here.
+    fix_time : float
+        Time of the heading fix (s); the fixes up to it are in the start state
+        (:meth:`later` leaves them out).
+    lla : ndarray (3,)
+        Position at ``t0``: latitude (rad), longitude (rad), height (m).
+    vel_ned : ndarray (3,)
+        NED velocity at ``t0`` (m/s): the velocity fix.
+    q_nb : ndarray (4,)
+        Attitude at ``t0``, scalar first: roll and pitch levelled at rest and carried to
+        ``t0`` by the gyros, yaw along the track.
+    euler, euler_sigma : ndarray (3,)
+        (roll, pitch, yaw) at ``t0`` and their σ (rad).
+    speed : float
+        Horizontal speed of the fix (m/s).
+    heading_sigma : float
+        σ of the heading from the velocity fix alone (rad): the cross-track velocity σ over
+        ``speed``; ``euler_sigma[2]`` adds ``slip_sigma``.
+    p0 : ndarray (15, 15)
+        Initial covariance in the order of :data:`atomnav.filter.INS15` (m, m/s, rad,
+        m/s², rad/s).
+    psi_cov : ndarray (3, 3)
+        Its attitude block: covariance (rad²) of the attitude error ψ (north, east, down;
+        Ĉ = (I − [ψ×])C).
+    setup : InsSetup
+        The aided INS from this state (``p0``, the process noise of the IMU error model),
+        for :func:`atomnav.filter.aided_ins` with the fixes after the heading fix
+        (:meth:`later`) and the IMU record from ``t0`` (:meth:`after`); change a field
+        with :func:`dataclasses.replace`.
+    level : CoarseAlignment
+        The levelling at rest it started from (its heading is not used).
+    """
+
+    t0: float
+    fix_time: float
+    lla: np.ndarray
+    vel_ned: np.ndarray
+    q_nb: np.ndarray
+    euler: np.ndarray
+    euler_sigma: np.ndarray
+    speed: float
+    heading_sigma: float
+    p0: np.ndarray
+    psi_cov: np.ndarray
+    setup: InsSetup
+    level: CoarseAlignment
+
+    @property
+    def state(self) -> dict:
+        """The start state as keyword arguments of :func:`atomnav.strapdown.integrate`."""
+        return {"t0": self.t0, "lla": self.lla.copy(), "vel_ned": self.vel_ned.copy(), "q_nb": self.q_nb.copy()}
+
+    def after(self, imu):
+        """The rows of an IMU record the aided INS of :attr:`setup` takes: those after
+        ``t0`` (increments), or from ``t0`` on (rates).
+
+        Parameters
+        ----------
+        imu : DataFrame or array (N, 7)
+            The record, time in the first column of an array or in ``time_s``.
+
+        Returns
+        -------
+        DataFrame or ndarray
+            The same type, the rows from the start on.
+        """
+        t, _, _ = _imu_arrays(imu, self.level.kind)
+        keep = t > self.t0 if self.level.kind == "increments" else t >= self.t0
+        return imu[keep]
+
+    def later(self, fixes):
+        """The fixes after the heading fix, for the aided INS of :attr:`setup` (those up
+        to it are in the start state: used again, they would count twice).
+
+        Parameters
+        ----------
+        fixes : PositionFixes or VelocityFixes
+            The GNSS fixes.
+
+        Returns
+        -------
+        PositionFixes or VelocityFixes
+            A copy with the later fixes.
+        """
+        instance(fixes, (PositionFixes, VelocityFixes), "fixes")
+        return fixes.select(fixes.time > self.fix_time + _TIME_TOLERANCE)
+
+    def __str__(self) -> str:
+        lat, lon = np.rad2deg(self.lla[:2])
+        return "\n".join([
+            f"Alignment in motion: heading from the GNSS velocity at {self.t0:.3f} s ({self.speed:.2f} m/s), "
+            f"levelled at rest until {self.level.time_s:.3f} s; at {lat:.6f}° {lon:.6f}°, {self.lla[2]:.1f} m",
+            *_attitude_lines(self.euler, self.euler_sigma),
+        ])
+
+    def _repr_pretty_(self, p, cycle) -> None:
+        p.text(str(self))
+
+
+def _heading(vel: np.ndarray) -> tuple[float, np.ndarray]:
+    """Track angle atan2(v_E, v_N) (rad) of a NED velocity and its gradient
+    (−v_E, v_N, 0)/s² with respect to the velocity (s the horizontal speed)."""
+    vn, ve = vel[0], vel[1]
+    s2 = vn * vn + ve * ve
+    return float(np.arctan2(ve, vn)), np.array([-ve / s2, vn / s2, 0.0])
+
+
+def _predict(setup: InsSetup, t, g, a, end: int) -> tuple[pd.Series, np.ndarray]:
+    """Run the free inertial solution of ``setup`` (no aiding) over the IMU rows before
+    ``end``; the last navigation row and the covariance there."""
+    ins = aided_ins(setup, [])
+    first = int(np.searchsorted(t, setup.t0, side="right" if setup.kind == "increments" else "left"))
+    with _imu_errors(setup.kind, g, a, 0):
+        res = _concat([ins.process(t[first:end], g[first:end], a[first:end]), ins.finish()])
+    return res.nav.iloc[-1], ins._core.covariance
+
+
+def in_motion(imu, position, velocity, level: CoarseAlignment, *, speed: float = 1.0, slip_sigma: float = np.deg2rad(1.0),
+              errors=None, predict_s: float = 0.1) -> MotionAlignment:
+    """Alignment in motion: levelling at rest, heading from the GNSS velocity once the
+    vehicle moves, then the aided INS from that epoch.
+
+    For an IMU whose gyros cannot find north at rest (a MEMS gyro's bias exceeds the
+    horizontal Earth rate of at most 15 °/h), heading comes from the direction of travel
+    (Groves 2013, §5.6.2; a coarse-heading step before the Kalman filter, one of the
+    remedies for large heading errors of §14.4.3):
+
+    1. Levelling: roll and pitch from the mean specific force at rest, the levelling of
+       :func:`coarse` (its gyrocompassed heading is not used, whatever the gyro).
+    2. Carrying: the free inertial solution from the end of the rest to the first
+       velocity fix whose horizontal speed exceeds ``speed``, which carries roll and pitch
+       (and their error, growing with the gyro noise and bias) to that fix.
+    3. Heading: the yaw is set to the track angle atan2(v_E, v_N) of that fix, with
+       σ² = (v_N² σ_E² + v_E² σ_N² − 2 v_N v_E σ_NE)/s⁴ (the cross-track velocity σ over the
+       horizontal speed s), plus ``slip_sigma``².
+    4. The start: position (the last position fix up to then, moved by the fix velocity
+       to the fix time) and velocity (the fix) with their covariances, the attitude error
+       covariance of the levelling carried to the fix, the heading σ, and the
+       correlation of the heading error with the velocity error of the same fix.
+
+    The fixes are taken as measured at the IMU, at the IMU's time stamps (a lever arm or
+    time offset of the receiver is not applied in this step; it is the aided INS's).
+    It assumes the body x axis points along the track at that fix: forward motion of a
+    vehicle without side slip, or a walker holding the IMU pointing ahead. Otherwise the
+    heading is off by the angle between them (180° when reversing, 90° for an IMU whose
+    x axis points sideways): give the mount so that the record is in body axes, and
+    ``slip_sigma`` for the angle that remains.
+
+    Parameters
+    ----------
+    imu : DataFrame or array (N, 7)
+        The IMU record of the kind of ``level``, covering the rest that ``level`` used and
+        the motion after it up to the heading fix (read as by :func:`coarse`; it may go
+        on beyond).
+    position : PositionFixes
+        GNSS position fixes (rad, rad, m) with NED covariances (m²).
+    velocity : VelocityFixes
+        GNSS NED velocity fixes (m/s) with covariances (m²/s²).
+    level : CoarseAlignment
+        The levelling at rest: :func:`coarse` on the part of ``imu`` at rest (any gyro
+        grade; a site within 1° of a pole, where :func:`coarse` refuses to gyrocompass, is
+        refused), whatever heading it found.
+    speed : float
+        Horizontal speed (m/s) above which a velocity fix gives the heading; default 1 m/s.
+    slip_sigma : float
+        σ of the angle between the body x axis and the track at that fix (rad): side slip,
+        a crab angle, a walker's sway; default 1°, a vehicle driving straight.
+    errors : ImuErrors or str, optional
+        The sensor error model of the filter; by default the one ``level`` used.
+    predict_s : float
+        Time between filter predictions (s; at least one IMU step).
+
+    Returns
+    -------
+    MotionAlignment
+        The start state at the heading fix, its covariance, and an :class:`InsSetup` of
+        the aided INS from there.
+
+    Raises
+    ------
+    InputError
+        Naming ``speed`` or ``slip_sigma`` out of range (``speed`` ≤ 0, ``slip_sigma`` < 0);
+        ``velocity`` when no fix after the rest is faster than ``speed``; ``position`` when
+        it has no fix up to that one; ``imu`` for a bad row or a record that does not span the end of the
+        rest to the heading fix.
+    TypeError
+        For ``position``, ``velocity`` or ``level`` of another type.
+
+    Examples
+    --------
+    >>> level = coarse(imu_at_rest, lla, errors="mems")          # doctest: +SKIP
+    >>> a = in_motion(imu, position, velocity, level)            # doctest: +SKIP
+    >>> ins = aided_ins(a.setup, [a.later(position), a.later(velocity)])  # doctest: +SKIP
+    >>> rest = a.after(imu)                                      # doctest: +SKIP
+    >>> result = ins.run(rest.time_s, rest[gyro_columns], rest[accel_columns])  # doctest: +SKIP
+    """
+    instance(position, PositionFixes, "position")
+    instance(velocity, VelocityFixes, "velocity")
+    instance(level, CoarseAlignment, "level")
+    speed, predict_s = positive(speed, "speed"), positive(predict_s, "predict_s")
+    slip_sigma = nonnegative(slip_sigma, "slip_sigma")
+    model = level.errors if errors is None else _errors(errors)
+    horizontal = np.hypot(velocity.value[:, 0], velocity.value[:, 1])
+    fast = np.nonzero((velocity.time > level.time_s) & (horizontal > speed))[0]
+    if not fast.size:
+        later = horizontal[velocity.time > level.time_s]
+        raise input_error("velocity", f"no fix after the rest (which ends at {level.time_s:g} s) is faster than speed={speed:g} m/s "
+                                      f"horizontally (the fastest: {later.max() if later.size else 0.0:g} m/s), so the track gives no heading")
+    j = fast[0]
+    t_h, vel, vel_cov = float(velocity.time[j]), velocity.value[j].copy(), velocity.cov[j]
+    t, g, a = _read(imu, level.kind)
+    if not len(t) or t[-1] < t_h - _TIME_TOLERANCE:
+        raise input_error("imu", f"the record ends {f'at {t[-1]:g} s' if len(t) else 'empty'}, before the heading fix at {t_h:g} s")
+    if t[0] > level.time_s + _TIME_TOLERANCE:
+        raise input_error("imu", f"the record starts at {t[0]:g} s, after the end of the rest at {level.time_s:g} s")
+    end = int(np.searchsorted(t, t_h + _TIME_TOLERANCE, side="right"))
+    t0 = float(t[end - 1])  # the IMU stamp at the fix, or the last one before it
+    horizon = max(float(t[-1] - level.time_s), t0 - level.time_s)
+    step = (t[-1] - t[0]) / max(len(t) - 1, 1)
+    track, grad = _heading(vel)
+
+    def carry(euler_rest: np.ndarray) -> tuple[InsSetup, pd.Series, np.ndarray]:
+        """The free inertial solution from the end of the rest with this attitude there."""
+        setup = _setup(level, model, rotation.quat_from_euler(euler_rest), t0=level.time_s, lla=level.lla, horizon=horizon,
+                       step=step, predict_s=predict_s, pos_sigma=1.0, vel_sigma=_REST_SIGMA)
+        p = np.array(setup.p0)
+        p[_HEADING, :], p[:, _HEADING] = 0.0, 0.0  # the heading at rest is not known: set at the fix
+        p[_HEADING, _HEADING] = _REST_SIGMA ** 2
+        return (setup, *_predict(dataclasses.replace(setup, p0=p), t, g, a, end))
+
+    # carry the levelled attitude to the fix; turn it at rest by the difference of its yaw
+    # there to the track, and carry it again, so its error is propagated in the right axes
+    _, last, _ = carry(level.euler)
+    setup, last, cov = carry(level.euler + [0.0, 0.0, np.angle(np.exp(1j * (track - last["yaw_rad"])))])
+    euler = np.array([last["roll_rad"], last["pitch_rad"], track])
+    # the start: fixes for position and velocity, the carried tilt, the track heading
+    k = int(np.searchsorted(position.time, t_h + _TIME_TOLERANCE, side="right")) - 1
+    if k < 0:
+        raise input_error("position", f"no fix at or before the heading fix at {t_h:g} s (the first at {position.time[0]:g} s)")
+    dt = t0 - position.time[k]
+    lla = earth.ecef_to_lla(earth.ned_to_ecef(vel * dt, position.value[k], level.ellipsoid), level.ellipsoid).reshape(3)
+    pos, vel_block, att = (slice(3 * i, 3 * i + 3) for i in range(3))
+    cov[pos, :], cov[:, pos], cov[vel_block, :], cov[:, vel_block] = 0.0, 0.0, 0.0, 0.0
+    cov[_HEADING, :], cov[:, _HEADING] = 0.0, 0.0
+    cov[pos, pos] = position.cov[k] + dt * dt * vel_cov
+    cov[vel_block, vel_block] = vel_cov
+    heading_var = float(grad @ vel_cov @ grad)
+    cov[_HEADING, _HEADING] = heading_var + slip_sigma ** 2
+    cov[_HEADING, vel_block] = -grad @ vel_cov  # ψ_D = −δyaw, δyaw = ∇yaw · δv
+    cov[vel_block, _HEADING] = cov[_HEADING, vel_block]
+    q0 = rotation.quat_from_euler(euler)
+    psi_cov = cov[att, att].copy()
+    with renamed(lla0="position"):
+        start = dataclasses.replace(setup, t0=t0, lla0=lla, vel0=vel, q0=q0, p0=cov)
+    return MotionAlignment(t0=t0, fix_time=t_h, lla=lla, vel_ned=vel, q_nb=q0, euler=euler,
+                           euler_sigma=np.asarray(_core.alignment_euler_sigma(euler, np.ascontiguousarray(psi_cov))),
+                           speed=float(horizontal[j]), heading_sigma=float(np.sqrt(heading_var)), p0=cov, psi_cov=psi_cov,
+                           setup=start, level=level)

@@ -1,0 +1,204 @@
+"""Alignment in motion (atomnav.alignment.in_motion) on a simulated car run with known
+truth: the car profile of atomnav.trajectory (5 s at rest, then along-track acceleration,
+a sliding turn with 50° of side slip, a left turn, a shock), a MEMS-grade IMU at 100 Hz
+whose gyro bias (10 °/h) exceeds the horizontal Earth rate, and 1 Hz GNSS position and
+velocity fixes drawn from the truth with their stated σ.
+
+The levelling at rest is given a heading 90° off the truth, and nothing but the GNSS
+velocity gives heading. Oracles, independent of the code under test: the simulator's
+attitude, velocity and position truth (``Trajectory.errors``), the χ² quantiles of scipy,
+and the cross-track geometry of the heading σ."""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+import pandas as pd
+import pytest
+from scipy.stats import chi2
+
+import atomnav as an
+from atomnav import alignment
+from atomnav.filter import PositionFixes, VelocityFixes, aided_ins
+
+RATE_HZ = 100.0
+GRADE = "mems"
+REST_END = 4.0  # s: the car profile is at rest, without vibration, until 4 s
+FIX_SIGMA_POS = np.array([0.5, 0.5, 1.0])  # m, NED
+FIX_SIGMA_VEL = np.array([0.05, 0.05, 0.1])  # m/s, NED
+HEADING_LIMIT = np.deg2rad(2.0)
+MOTION_WINDOW = 30.0  # s of motion after which the heading is within HEADING_LIMIT
+GYRO = [f"dtheta_{a}_rad" for a in "xyz"]
+ACCEL = [f"dv_{a}_mps" for a in "xyz"]
+NAV_DOF, ATT_DOF = 9, 3
+IN_BAND = 0.90  # fraction of epochs whose NEES lies in its 95 % χ² band
+
+
+@pytest.fixture(scope="module")
+def truth():
+    traj = an.trajectory.car(rate_hz=RATE_HZ)
+    return traj, traj.ideal_imu("increments")
+
+
+def fixes(traj, seed: int):
+    """1 Hz GNSS position and velocity fixes: the truth plus white noise of the stated σ."""
+    rng = np.random.default_rng(10_000 + seed)
+    t = np.arange(1.0, traj.time[-1] + 1e-9, 1.0)
+    i = np.searchsorted(traj.time, t - 1e-9)
+    ned = rng.normal(size=(len(t), 3)) * FIX_SIGMA_POS
+    lla = np.array([an.earth.ecef_to_lla(an.earth.ned_to_ecef(n, traj.lla[k])).reshape(3) for n, k in zip(ned, i)])
+    vel = traj.vel_ned[i] + rng.normal(size=(len(t), 3)) * FIX_SIGMA_VEL
+    return PositionFixes(t, lla, np.diag(FIX_SIGMA_POS**2)), VelocityFixes(t, vel, np.diag(FIX_SIGMA_VEL**2))
+
+
+def aligned(traj, ideal, seed: int):
+    """The IMU record, the fixes and the alignment in motion from a levelling whose
+    heading is 90° off the truth."""
+    imu = an.imu.corrupt(ideal, errors=GRADE, dt=1.0 / RATE_HZ, seed=seed)
+    pos, vel = fixes(traj, seed)
+    level = alignment.coarse(imu[imu.time_s <= REST_END], traj.lla[0], errors=GRADE)
+    true_yaw = an.rotation.euler_from_quat(traj.q_nb[0])[2]
+    euler = np.array([level.euler[0], level.euler[1], true_yaw + np.pi / 2])
+    level = dataclasses.replace(level, euler=euler, q_nb=an.rotation.quat_from_euler(euler))
+    return imu, pos, vel, alignment.in_motion(imu, pos, vel, level)
+
+
+def run(traj, ideal, seed: int):
+    """Per seed: the largest heading error after MOTION_WINDOW s of motion (rad), and the
+    NEES of the 9 navigation states and of the attitude at every GNSS update from the
+    alignment on (the filter's covariance against the truth's errors)."""
+    imu, pos, vel, a = aligned(traj, ideal, seed)
+    ins = aided_ins(a.setup, [a.later(pos), a.later(vel)])
+    rec = a.after(imu)
+    t, g, f = rec.time_s.to_numpy(), rec[GYRO].to_numpy(), rec[ACCEL].to_numpy()
+    updates = a.later(pos).time
+    ends = np.searchsorted(t, updates - 1e-9) + 1
+    parts, cov, lo = [], [], 0
+    for hi in ends:
+        parts.append(ins.process(t[lo:hi], g[lo:hi], f[lo:hi]))
+        cov.append(ins._core.covariance[:NAV_DOF, :NAV_DOF])
+        lo = hi
+    parts.append(ins.finish())
+    err = traj.errors(pd.concat([p.nav for p in parts], ignore_index=True))
+    psi_d = err["psi_d_rad"].to_numpy()
+    moving = traj.time[np.argmax(np.hypot(traj.vel_ned[:, 0], traj.vel_ned[:, 1]) > 0.1)]
+    late = err["time_s"].to_numpy() >= moving + MOTION_WINDOW
+    at = np.searchsorted(err["time_s"].to_numpy(), updates - 1e-9)
+    x = err.iloc[at][[c for c in err.columns if c != "time_s"]].to_numpy()
+    nees = np.array([e @ np.linalg.solve(p, e) for e, p in zip(x, cov)])
+    nees_att = np.array([e[6:9] @ np.linalg.solve(p[6:9, 6:9], e[6:9]) for e, p in zip(x, cov)])
+    return np.max(np.abs(psi_d[late])), np.abs(psi_d[np.argmax(late)]), nees, nees_att, a
+
+
+def band(dof: int) -> tuple[float, float]:
+    return chi2.ppf(0.025, dof), chi2.ppf(0.975, dof)
+
+
+def in_band(nees: np.ndarray, dof: int) -> float:
+    lo, hi = band(dof)
+    return float(np.mean((nees >= lo) & (nees <= hi)))
+
+
+def check_seeds(truth, seeds):
+    traj, ideal = truth
+    worst, at30, nees, nees_att = [], [], [], []
+    for seed in seeds:
+        w, h, n, na, _ = run(traj, ideal, seed)
+        worst.append(w)
+        at30.append(h)
+        nees.append(n)
+        nees_att.append(na)
+    worst, at30 = np.rad2deg(worst), np.rad2deg(at30)
+    nav_frac, att_frac = in_band(np.concatenate(nees), NAV_DOF), in_band(np.concatenate(nees_att), ATT_DOF)
+    print(f"\n{len(seeds)} seeds, {GRADE} IMU, heading given 90° off: heading error after {MOTION_WINDOW:g} s of motion "
+          f"{np.median(at30):.3f}° median, {at30.max():.3f}° largest; largest from then on {worst.max():.3f}°")
+    print(f"NEES in its 95 % χ² band (per epoch, per run): 9 navigation states {nav_frac:.1%} "
+          f"[{band(NAV_DOF)[0]:.2f}, {band(NAV_DOF)[1]:.2f}], attitude {att_frac:.1%} [{band(ATT_DOF)[0]:.2f}, {band(ATT_DOF)[1]:.2f}]; "
+          f"mean NEES {np.mean(np.concatenate(nees)):.2f} (9 expected), {np.mean(np.concatenate(nees_att)):.2f} (3 expected)")
+    assert worst.max() < np.rad2deg(HEADING_LIMIT)
+    assert nav_frac >= IN_BAND
+    assert att_frac >= IN_BAND
+
+
+def test_converges_from_a_heading_90_degrees_off_over_50_seeds(truth):
+    check_seeds(truth, range(50))
+
+
+def test_the_given_heading_is_not_used(truth):
+    traj, ideal = truth
+    imu, pos, vel, a = aligned(traj, ideal, 3)
+    turned = dataclasses.replace(a.level, euler=a.level.euler - [0, 0, 2.0], q_nb=an.rotation.quat_from_euler(a.level.euler - [0, 0, 2.0]))
+    b = alignment.in_motion(imu, pos, vel, turned)
+    assert np.allclose(an.rotation.dcm_from_quat(a.q_nb), an.rotation.dcm_from_quat(b.q_nb), atol=1e-6)
+    assert np.allclose(a.p0, b.p0, rtol=1e-6, atol=1e-12)
+
+
+def test_start_state_and_heading_sigma(truth):
+    traj, ideal = truth
+    imu, pos, vel, a = aligned(traj, ideal, 5)
+    # the first fix faster than 1 m/s after the rest, and its time in the IMU record
+    speeds = np.hypot(vel.value[:, 0], vel.value[:, 1])
+    j = np.nonzero((vel.time > REST_END) & (speeds > 1.0))[0][0]
+    assert a.fix_time == vel.time[j] and a.t0 == pytest.approx(vel.time[j], abs=1e-9)
+    assert np.array_equal(a.vel_ned, vel.value[j])
+    # heading σ: the cross-track velocity σ over the speed, with the side-slip allowance
+    track = np.arctan2(vel.value[j, 1], vel.value[j, 0])
+    across = np.array([-np.sin(track), np.cos(track), 0.0])
+    expected = np.sqrt(across @ vel.cov[j] @ across) / speeds[j]
+    assert a.heading_sigma == pytest.approx(expected, rel=1e-9)
+    assert np.sqrt(a.p0[8, 8]) == pytest.approx(np.hypot(expected, np.deg2rad(1.0)), rel=1e-9)
+    assert a.euler[2] == pytest.approx(track, abs=1e-12)
+    # the levelled tilt against the truth, within 4σ of the stated attitude covariance
+    k = np.searchsorted(traj.time, a.t0 - 1e-9)
+    true_roll_pitch = an.rotation.euler_from_quat(traj.q_nb[k])[:2]
+    assert np.all(np.abs(a.euler[:2] - true_roll_pitch) < 4 * a.euler_sigma[:2])
+    # the later fixes leave out the one used
+    assert a.later(vel).time[0] > a.fix_time and len(a.later(pos)) == np.sum(pos.time > a.fix_time)
+
+
+@pytest.mark.parametrize("value", [0.0, -1.0])
+def test_non_positive_speed_is_an_input_error(truth, value):
+    traj, ideal = truth
+    imu, pos, vel, a = aligned(traj, ideal, 0)
+    with pytest.raises(an.InputError) as e:
+        alignment.in_motion(imu, pos, vel, a.level, speed=value)
+    assert e.value.parameter == "speed"
+
+
+def test_negative_slip_sigma_is_an_input_error(truth):
+    traj, ideal = truth
+    imu, pos, vel, a = aligned(traj, ideal, 0)
+    with pytest.raises(an.InputError) as e:
+        alignment.in_motion(imu, pos, vel, a.level, slip_sigma=-0.01)
+    assert e.value.parameter == "slip_sigma"
+
+
+def test_a_record_that_never_exceeds_the_speed_is_an_input_error(truth):
+    traj, ideal = truth
+    imu, pos, vel, a = aligned(traj, ideal, 0)
+    fastest = np.hypot(traj.vel_ned[:, 0], traj.vel_ned[:, 1]).max()
+    with pytest.raises(an.InputError) as e:
+        alignment.in_motion(imu, pos, vel, a.level, speed=fastest + 1.0)
+    assert e.value.parameter == "velocity"
+    slow = vel.select(vel.time <= REST_END + 1.0)
+    with pytest.raises(an.InputError) as e:
+        alignment.in_motion(imu, pos, slow, a.level)
+    assert e.value.parameter == "velocity"
+
+
+def test_a_record_that_stops_before_the_heading_fix_is_an_input_error(truth):
+    traj, ideal = truth
+    imu, pos, vel, a = aligned(traj, ideal, 0)
+    with pytest.raises(an.InputError) as e:
+        alignment.in_motion(imu[imu.time_s <= a.fix_time - 0.5], pos, vel, a.level)
+    assert e.value.parameter == "imu"
+
+
+def test_wrong_types_name_the_argument(truth):
+    traj, ideal = truth
+    imu, pos, vel, a = aligned(traj, ideal, 0)
+    for kwargs, name in ((dict(position=vel), "position"), (dict(velocity=pos), "velocity"), (dict(level=a), "level")):
+        args = dict(imu=imu, position=pos, velocity=vel, level=a.level) | kwargs
+        with pytest.raises(TypeError, match=name):
+            alignment.in_motion(**args)
