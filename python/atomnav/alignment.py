@@ -490,8 +490,13 @@ class MotionAlignment:
         -------
         DataFrame or ndarray
             The same type, the rows from the start on.
+
+        Warns
+        -----
+        atomnav.UnitWarning
+            Naming ``imu``: time stamps, rates or specific forces likely in another unit.
         """
-        t, _, _ = _imu_arrays(imu, self.level.kind)
+        t, _, _ = _read(imu, self.level.kind)
         keep = t > self.t0 if self.level.kind == "increments" else t >= self.t0
         return imu[keep]
 
