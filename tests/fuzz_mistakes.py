@@ -136,6 +136,9 @@ ring = ring * np.sign(np.linalg.det(ring))[:, None, None]  # six rotations
 stars = np.array([[0.6, 0.0, 0.8], [0.0, 0.6, 0.8], [0.0, 0.0, 1.0]])
 kf_phi, kf_q = np.array([[1.0, 0.5], [0.0, 0.9]]), np.array([[0.02, 0.01], [0.01, 0.05]])
 kf_h, kf_r = np.array([[1.0, 0.0]]), np.array([[0.3]])
+car = an.trajectory.car(rate_hz=100.0)
+car_imu = an.imu.corrupt(car.ideal_imu("increments"), errors="mems", dt=0.01, seed=7)
+car_fix_t = np.arange(1.0, 16.0)
 """
 
 
@@ -229,6 +232,11 @@ MOUNT = ("mount = an.rotation.dcm_from_euler(np.array([1e-3, 2e-3, -1e-3]))\n"
 BETA = "beta = np.array([[0.1, 0.2, 0.3], [1.0, -0.5, 2.0]])"
 SOURCED = (AIDED + '\nsetup = ins.setup\nsources = [an.filter.PositionFixes(fixes["fix_time"], fixes["fix_lla"], '
            'fixes["fix_cov"])]')
+MOTION = ("i = np.searchsorted(car.time, car_fix_t - 1e-9)\n"
+          "position = an.filter.PositionFixes(car_fix_t, car.lla[i], np.diag([0.25, 0.25, 1.0]))\n"
+          "velocity = an.filter.VelocityFixes(car_fix_t, car.vel_ned[i], np.diag([0.0025, 0.0025, 0.01]))\n"
+          'imu = car_imu[car_imu["time_s"] <= 15.0]\n'
+          'level = an.alignment.coarse(imu[imu["time_s"] <= 4.0], car.lla[0], errors="mems")')
 FIX_TABLE = ('fix_table = pd.DataFrame({"time_s": fixes["fix_time"], "lat_rad": fixes["fix_lla"][:, 0], '
              '"lon_rad": fixes["fix_lla"][:, 1], "h_m": fixes["fix_lla"][:, 2], "sigma_n_m": 1.0, "sigma_e_m": 1.0, '
              '"sigma_d_m": 1.0})')
@@ -570,6 +578,11 @@ CATALOGUE: tuple[Clean, ...] = (
     _c("atomnav.filter.outages.outage_analysis",
        "an.filter.outages.outage_analysis(setup, sources[0], (time, gyro, accel), windows, progress=False)",
        SOURCED + "\nwindows = np.array([[2.0, 3.5], [5.0, 6.5]])", (), AIDED_UNITS + (Unit("windows", "time"),)),
+    # alignment in motion: the car levelled at rest until 4 s, heading from its GNSS velocity (15 s of 1 Hz fixes)
+    _c("atomnav.alignment.in_motion", "an.alignment.in_motion(imu, position, velocity, level)", MOTION, ["imu"]),
+    # (it returns the rows of the record it is given as they are: it is judged by the rows it keeps)
+    _c("atomnav.alignment.MotionAlignment.after", "a.after(imu).index",
+       MOTION + "\na = an.alignment.in_motion(imu, position, velocity, level)\nimu = car_imu", ["imu"]),
 )
 
 
