@@ -350,6 +350,17 @@ def _alignment():
     return coarse, an.alignment.fine(meas.iloc[1000:], lla, coarse)
 
 
+def _motion_alignment():
+    car = an.trajectory.car(rate_hz=50.0, vibration=False)
+    meas = an.imu.corrupt(car.ideal_imu("rates"), errors="mems", dt=0.02, kind="rates", seed=3)
+    t = np.arange(1.0, 21.0)
+    k = np.searchsorted(car.time, t - 1e-9)
+    position = an.filter.PositionFixes(t, car.lla[k], np.eye(3))
+    velocity = an.filter.VelocityFixes(t, car.vel_ned[k], 0.01 * np.eye(3))
+    level = an.alignment.coarse(meas[meas.time_s <= 4.0], car.lla[0], errors="mems")
+    return an.alignment.in_motion(meas, position, velocity, level)
+
+
 CASES = {
     "Channels": lambda: cai.Channels.cyclic(),
     "CaiSensor": lambda: cai.seed003_sensor(),
@@ -384,6 +395,7 @@ CASES = {
     "PosSolution": lambda: read_pos(Path(__file__).parent / "data" / "real_walk" / "gnss_1730_sf.pos.gz"),
     "CoarseAlignment": lambda: _alignment()[0],
     "FineAlignment": lambda: _alignment()[1],
+    "MotionAlignment": _motion_alignment,
     "KalmanResult": lambda: kalman(_series(), ArimaStateSpace(ar=PAPER_AR, ma=PAPER_MA, sigma2=PAPER_SIGMA2)),
 }
 

@@ -477,28 +477,24 @@ class MotionAlignment:
         """The start state as keyword arguments of :func:`atomnav.strapdown.integrate`."""
         return {"t0": self.t0, "lla": self.lla.copy(), "vel_ned": self.vel_ned.copy(), "q_nb": self.q_nb.copy()}
 
-    def after(self, imu):
-        """The rows of an IMU record the aided INS of :attr:`setup` takes: those after
-        ``t0`` (increments), or from ``t0`` on (rates).
+    def after(self, imu) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The part of an IMU record the aided INS of :attr:`setup` takes: the rows after
+        ``t0`` (increments, whose first interval then starts at ``t0``), or from ``t0`` on
+        (rates).
 
         Parameters
         ----------
         imu : DataFrame or array (N, 7)
-            The record, time in the first column of an array or in ``time_s``.
+            The record, of the kind of the levelling (read as by :func:`coarse`).
 
         Returns
         -------
-        DataFrame or ndarray
-            The same type, the rows from the start on.
-
-        Warns
-        -----
-        atomnav.UnitWarning
-            Naming ``imu``: time stamps, rates or specific forces likely in another unit.
+        time, gyro, accel : ndarray (M,), (M, 3), (M, 3)
+            Those rows, as ``run`` and ``process`` of the aided INS take them.
         """
-        t, _, _ = _read(imu, self.level.kind)
-        keep = t > self.t0 if self.level.kind == "increments" else t >= self.t0
-        return imu[keep]
+        t, g, a = _read(imu, self.level.kind)
+        first = _first_row(t, self.t0, self.level.kind)
+        return t[first:], g[first:], a[first:]
 
     def later(self, fixes):
         """The fixes after the heading fix, for the aided INS of :attr:`setup` (those up
@@ -537,11 +533,18 @@ def _heading(vel: np.ndarray) -> tuple[float, np.ndarray]:
     return float(np.arctan2(ve, vn)), np.array([-ve / s2, vn / s2, 0.0])
 
 
+def _first_row(t: np.ndarray, t0: float, kind: str) -> int:
+    """The first row of an IMU record (times ``t``, s) that an INS starting at ``t0`` takes:
+    the first after ``t0`` (increments: its interval starts at ``t0``), or the first from
+    ``t0`` on (rates)."""
+    return int(np.searchsorted(t, t0, side="right" if kind == "increments" else "left"))
+
+
 def _predict(setup: InsSetup, t, g, a, end: int) -> tuple[pd.Series, np.ndarray]:
     """Run the free inertial solution of ``setup`` (no aiding) over the IMU rows before
     ``end``; the last navigation row and the covariance there."""
     ins = aided_ins(setup, [])
-    first = int(np.searchsorted(t, setup.t0, side="right" if setup.kind == "increments" else "left"))
+    first = _first_row(t, setup.t0, setup.kind)
     with _imu_errors(setup.kind, g, a, 0):
         res = _concat([ins.process(t[first:end], g[first:end], a[first:end]), ins.finish()])
     return res.nav.iloc[-1], ins._core.covariance
@@ -623,8 +626,7 @@ def in_motion(imu, position, velocity, level: CoarseAlignment, *, speed: float =
     >>> level = coarse(imu_at_rest, lla, errors="mems")          # doctest: +SKIP
     >>> a = in_motion(imu, position, velocity, level)            # doctest: +SKIP
     >>> ins = aided_ins(a.setup, [a.later(position), a.later(velocity)])  # doctest: +SKIP
-    >>> rest = a.after(imu)                                      # doctest: +SKIP
-    >>> result = ins.run(rest.time_s, rest[gyro_columns], rest[accel_columns])  # doctest: +SKIP
+    >>> result = ins.run(*a.after(imu))                          # doctest: +SKIP
     """
     instance(position, PositionFixes, "position")
     instance(velocity, VelocityFixes, "velocity")
