@@ -853,11 +853,7 @@ impl Aiding for PositionAiding {
         let mut z = ned_diff(ctx.ell, &ctx.nav.lla, &fx.lla);
         let mut h = DMatrix::<f64>::zeros(3, ctx.layout.size());
         h.view_mut((0, ctx.layout.range("position")?.start), (3, 3)).fill_with_identity();
-        if self.mounting.lever_arm != Vec3::zeros() {
-            let (lever_n, h_psi) = self.mounting.position(ctx.nav);
-            z += lever_n;
-            h.view_mut((0, ctx.layout.range("attitude")?.start), (3, 3)).copy_from(&h_psi);
-        }
+        self.mounting.add_position_terms(ctx, &mut z, &mut h)?;
         Ok(Some(Measurement { z: z.as_slice().to_vec(), h, r: DMatrix::from_column_slice(3, 3, fx.cov_ned.as_slice()) }))
     }
 }

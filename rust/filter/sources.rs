@@ -104,6 +104,18 @@ impl Mounting {
         (dv, skew(&turn) - skew(&w_ie) * skew(&lever_n), cnb * skew(&self.lever_arm))
     }
 
+    /// The lever-arm terms of a position model: `z` += Ĉ_b^n l, and the ψ columns in `h`
+    /// (3 rows); nothing without a lever arm.
+    pub fn add_position_terms(&self, ctx: &AidingContext, z: &mut Vec3, h: &mut DMatrix<f64>) -> Result<()> {
+        if self.lever_arm == Vec3::zeros() {
+            return Ok(());
+        }
+        let (lever_n, h_psi) = self.position(ctx.nav);
+        *z += lever_n;
+        h.view_mut((0, ctx.layout.range("attitude")?.start), (3, 3)).copy_from(&h_psi);
+        Ok(())
+    }
+
     /// The lever-arm terms of a velocity model: `z` += v_point − v, and the ψ and gyro-bias
     /// columns in `h` (3 rows); nothing without a lever arm.
     pub fn add_velocity_terms(&self, ctx: &AidingContext, z: &mut Vec3, h: &mut DMatrix<f64>) -> Result<()> {
