@@ -207,6 +207,17 @@ def test_a_record_that_stops_before_the_heading_fix_is_an_input_error(truth):
     assert e.value.parameter == "imu"
 
 
+def test_a_nan_row_before_the_heading_fix_names_imu_and_the_row(truth):
+    traj, ideal = truth
+    imu, pos, vel, a = aligned(traj, ideal, 0)
+    bad = imu.copy()
+    row = int(np.searchsorted(bad.time_s.to_numpy(), a.fix_time - 1.0))
+    bad.loc[bad.index[row], "dv_y_mps"] = np.nan
+    with pytest.raises(an.InputError) as e:
+        alignment.in_motion(bad, pos, vel, a.level)
+    assert e.value.parameter == "imu" and e.value.index == row
+
+
 def test_wrong_types_name_the_argument(truth):
     traj, ideal = truth
     imu, pos, vel, a = aligned(traj, ideal, 0)

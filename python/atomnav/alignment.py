@@ -44,7 +44,7 @@ import numpy as np
 import pandas as pd
 
 from . import _core, earth, plausibility, rotation, units
-from ._validate import choice, finite, flag, input_error, instance, nonnegative, positive, renamed, vector
+from ._validate import choice, finite, flag, increasing, input_error, instance, nonnegative, positive, renamed, vector
 from .filter.aided import AidedResult, InsSetup, _concat
 from .filter.engine import BiasModel
 from .filter.sources import PositionFixes, VelocityFixes, ZeroRate, ZeroVelocity, aided_ins
@@ -594,7 +594,9 @@ def in_motion(imu, position, velocity, level: CoarseAlignment, *, speed: float =
     level : CoarseAlignment
         The levelling at rest: :func:`coarse` on the part of ``imu`` at rest (any gyro
         grade; a site within 1° of a pole, where :func:`coarse` refuses to gyrocompass, is
-        refused), whatever heading it found.
+        refused), whatever heading it found. Its static test holds a hand-held device to
+        the sensor noise: give it a few quiet seconds (on a recorded walk, 3 s of the 10 s
+        the walker stood still passed).
     speed : float
         Horizontal speed (m/s) above which a velocity fix gives the heading; default 1 m/s.
     slip_sigma : float
@@ -643,11 +645,14 @@ def in_motion(imu, position, velocity, level: CoarseAlignment, *, speed: float =
     j = fast[0]
     t_h, vel, vel_cov = float(velocity.time[j]), velocity.value[j].copy(), velocity.cov[j]
     t, g, a = _read(imu, level.kind)
+    finite(t, "imu")
+    increasing(t, "imu", "time")
     if not len(t) or t[-1] < t_h - _TIME_TOLERANCE:
         raise input_error("imu", f"the record ends {f'at {t[-1]:g} s' if len(t) else 'empty'}, before the heading fix at {t_h:g} s")
     if t[0] > level.time_s + _TIME_TOLERANCE:
         raise input_error("imu", f"the record starts at {t[0]:g} s, after the end of the rest at {level.time_s:g} s")
     end = int(np.searchsorted(t, t_h + _TIME_TOLERANCE, side="right"))
+    finite(np.column_stack([g[:end], a[:end]]), "imu")  # the rows carried (the core would count from the rest)
     t0 = float(t[end - 1])  # the IMU stamp at the fix, or the last one before it
     horizon = max(float(t[-1] - level.time_s), t0 - level.time_s)
     step = (t[-1] - t[0]) / max(len(t) - 1, 1)
