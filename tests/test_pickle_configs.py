@@ -19,7 +19,7 @@ import pytest
 
 import atomnav as an
 from atomnav import _core, astro, cai
-from atomnav.filter import (BiasModel, InsSetup, Layout, MonteCarlo, PositionFixes, VelocityFixes, ZeroRate, ZeroVelocity,
+from atomnav.filter import (BiasModel, InsSetup, Layout, MonteCarlo, NonHolonomic, PositionFixes, VelocityFixes, ZeroRate, ZeroVelocity,
                             aided_ins, monte_carlo, position_aided_ins)
 from atomnav.filter.analysis import Scenario
 from atomnav.filter.riccati import dare
@@ -307,11 +307,12 @@ def _sources():
         "VelocityFixes mounted": VelocityFixes(fix_t, np.zeros((len(fix_t), 3)), 1e-4 * cov, lever_arm=(0.3, 0.1, -0.6),
                                                time_offset=-0.125),
         "ZeroVelocity mounted": ZeroVelocity(fix_t, 0.01, lever_arm=(0.0, 0.4, 0.2), time_offset=-0.5),
+        "NonHolonomic": NonHolonomic(fix_t, 0.05, lever_arm=(-1.0, 0.2, 0.5)),
     }
 
 
 @pytest.mark.parametrize("name", ["PositionFixes", "VelocityFixes", "ZeroVelocity", "ZeroRate", "PositionFixes mounted",
-                                  "VelocityFixes mounted", "ZeroVelocity mounted"])
+                                  "VelocityFixes mounted", "ZeroVelocity mounted", "NonHolonomic"])
 def test_source_copies_feed_the_same_ins(name):
     source = _sources()[name]
     setup = _position_ins().setup
@@ -428,7 +429,9 @@ def test_every_public_class_is_covered():
         "CaiShots", "SourcedIns",
         # tests above (sources); AidingSource is the core's single-use hand-over that a
         # source makes afresh for every INS (Source._native), never held by a user
-        "PositionFixes", "VelocityFixes", "ZeroVelocity", "ZeroRate", "GnssObservations", "Source", "AidingSource",
+        "PositionFixes", "VelocityFixes", "ZeroVelocity", "ZeroRate", "NonHolonomic", "GnssObservations", "Source", "AidingSource",
+        # test_constraints.py
+        "StillPeriods",
         # tests above
         "AidedIns", "AidedSetup", "CaiChannels", "CaiSetup", "CaiGravity", "CaiMotion", "CaiHybrid", "AstroScenario",
         "Vasilyuk2024", "Scenario", "Calibration", "Observations",

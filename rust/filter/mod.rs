@@ -14,3 +14,4 @@ pub mod aided;
 pub mod sources;
 pub mod initial_error;
 pub mod alignment;
+pub mod constraints;

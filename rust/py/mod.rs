@@ -5,6 +5,7 @@ use pyo3::prelude::*;
 mod alignment;
 mod astro;
 mod cai;
+mod constraints;
 mod convert;
 mod earth;
 mod filter;
@@ -67,5 +68,6 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     gnss::register(m)?;
     sources::register(m)?;
     alignment::register(m)?;
+    constraints::register(m)?;
     Ok(())
 }
