@@ -491,6 +491,11 @@ class MotionAlignment:
         -------
         time, gyro, accel : ndarray (M,), (M, 3), (M, 3)
             Those rows, as ``run`` and ``process`` of the aided INS take them.
+
+        Warns
+        -----
+        atomnav.UnitWarning
+            Naming ``imu``: time stamps, rates or specific forces likely in another unit.
         """
         t, g, a = _read(imu, self.level.kind)
         first = _first_row(t, self.t0, self.level.kind)
