@@ -580,9 +580,11 @@ CATALOGUE: tuple[Clean, ...] = (
        SOURCED + "\nwindows = np.array([[2.0, 3.5], [5.0, 6.5]])", (), AIDED_UNITS + (Unit("windows", "time"),)),
     # alignment in motion: the car levelled at rest until 4 s, heading from its GNSS velocity (15 s of 1 Hz fixes)
     _c("atomnav.alignment.in_motion", "an.alignment.in_motion(imu, position, velocity, level)", MOTION, ["imu"]),
-    # (it returns the rows of the record it is given as they are: it is judged by the rows it keeps)
-    _c("atomnav.alignment.MotionAlignment.after", "a.after(imu).index",
+    _c("atomnav.alignment.MotionAlignment.after", "a.after(imu)",
        MOTION + "\na = an.alignment.in_motion(imu, position, velocity, level)\nimu = car_imu", ["imu"]),
+    # vehicle and pedestrian constraints on the 10 s static record
+    _c("atomnav.filter.constraints.NonHolonomic", "still_aided(an.filter.constraints.NonHolonomic(time, 0.05))", ZUPT, (),
+       (Unit("time", "time"),)),
 )
 
 
@@ -601,6 +603,7 @@ EXEMPT = {
     "atomnav.filter.aided.AidedResult": "the result of an aided INS run",
     "atomnav.filter.analysis.MonteCarlo": "the result of a filter Monte-Carlo campaign",
     "atomnav.filter.outages.OutageResult": "the result of filter.outage_analysis",
+    "atomnav.filter.constraints.StillPeriods": "the result of filter.constraints.detect_still",
     "atomnav.io.ImuLog": "the result of io.read_imu",
     "atomnav.io.SamplingReport": "the sampling report of an io.ImuLog",
     "atomnav.alignment.FineAlignment": "the result of alignment.fine",
@@ -618,6 +621,10 @@ NOT_YET_CATALOGUED: dict[str, str] = {
         "axis=1) it raises ValueError 'The truth value of a Series is ambiguous', with time_s as datetime64 a TypeError "
         "naming no argument ('<' not supported between 'numpy.float64' and 'Timestamp'); nav wants reading through "
         "_validate.table",
+    "atomnav.filter.constraints.detect_still":
+        "a site latitude in degrees is refused naming 'lat', earth.gravity's parameter, not the user's lla: "
+        "detect_still(time, gyro, accel, kind='increments', lla=np.array([55.75, 37.6, 200.0])) -> "
+        "InputError(parameter='lat', index=0)",
 }
 """Table- or array-taking callables whose clean call found a defect of atomnav that needs
 more than a local fix: the defect and the outcome of its reproducer. ``check_coverage``
