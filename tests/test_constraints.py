@@ -291,3 +291,20 @@ def test_still_periods_pickle(stand):
         np.testing.assert_array_equal(c.still, still.still)
         np.testing.assert_array_equal(c.update_times(), still.update_times())
         assert (c.window, c.gravity) == (still.window, still.gravity)
+
+
+def test_zero_rate_of_still_periods_copies_feed_the_same_ins(stand):
+    """The ZARU of the still periods, pickled or deep-copied, gives the run of the original."""
+    t, g, a = _imu(stand, "rates", "tactical")
+    s0 = stand.initial_state()
+    still = detect_still(t, g, a, kind="rates", lla=s0["lla"])
+    source = still.zero_rate(1e-9, 1e-5)
+    p0 = np.diag(np.r_[[1e-4] * 3, [1e-6] * 3, [1e-6] * 3, [1e-4] * 3, [1e-10] * 3])
+    setup = InsSetup(t0=s0["t0"], lla0=s0["lla"], vel0=s0["vel_ned"], q0=s0["q_nb"], kind="rates", p0=p0,
+                     accel_psd=1e-6, gyro_psd=1e-9, predict_every=10)
+    want = aided_ins(setup, source).run(t, g, a, progress=False)
+    assert len(want.measurements) >= 100
+    for c in (pickle.loads(pickle.dumps(source)), copy.deepcopy(source)):
+        got = aided_ins(setup, c).run(t, g, a, progress=False)
+        np.testing.assert_array_equal(got.nav.to_numpy(), want.nav.to_numpy())
+        np.testing.assert_array_equal(got.measurements["time_s"], want.measurements["time_s"])

@@ -2,12 +2,12 @@
 //! zero-angular-rate updates ([`StillDetector`], [`ZeroRateWhileStill`]), and the
 //! non-holonomic constraint of a wheeled vehicle ([`NonHolonomic`]).
 //!
-//! Still detection (Groves 2013, §15.3; the windowed test of Skog et al. 2010, IEEE
+//! Still detection (Groves 2013, ch. 15; the windowed test of Skog et al. 2010, IEEE
 //! Trans. Biomed. Eng. 57(11)): a sample passes when | |f| − g | < `accel_threshold` and
 //! |ω| < `gyro_threshold`; a sample is still when it lies in a window of `window`
 //! consecutive passing samples, i.e. in a run of at least `window` passing samples (the
-//! rule of the loosely coupled filter of Groves 2013 as published with the walk of
-//! `tests/data/real_walk`).
+//! rule of the loosely coupled filter after Groves 2013 published in rtklibexplorer's
+//! GNSS_IMU, 2025).
 
 use super::aided::{Aiding, AidingContext, Measurement};
 use super::alignment::ZeroRate;
@@ -156,7 +156,8 @@ impl Aiding for ZeroRateWhileStill {
     }
 }
 
-/// Non-holonomic constraint of a wheeled vehicle (Groves 2013, §15.4.1; Sukkarieh 2000):
+/// Non-holonomic constraint of a wheeled vehicle (Groves 2013, ch. 15; Dissanayake et al.
+/// 2001, IEEE Trans. Robot. Autom. 17(5)):
 /// the point at the lever arm l^b (m, body frame, from the IMU; e.g. the middle of the
 /// rear axle) moves neither sideways nor vertically in the body frame.
 ///
@@ -176,9 +177,10 @@ pub struct NonHolonomic {
 }
 
 impl NonHolonomic {
-    /// Updates at `times` (s, finite and strictly increasing), noise σ `sigma` (m/s,
-    /// > 0) of both rows, at `lever_arm` (m, finite), above `min_speed` (m/s, finite,
-    /// ≥ 0). Errors name `time`, `sigma`, `lever_arm` or `min_speed`.
+    /// Updates at `times` (s, finite and strictly increasing) with noise σ `sigma` of
+    /// both rows (m/s, positive), at `lever_arm` (m, finite), at speeds of `min_speed`
+    /// and above (m/s, finite, not negative). Errors name `time`, `sigma`, `lever_arm` or
+    /// `min_speed`.
     pub fn new(times: Vec<f64>, sigma: f64, lever_arm: Vec3, min_speed: f64) -> Result<Self> {
         check_increasing("time", &times)?;
         check_positive("sigma", sigma)?;

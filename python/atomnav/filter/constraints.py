@@ -13,9 +13,12 @@ Both feed :func:`atomnav.filter.aided_ins` like any other source.
 References
 ----------
 P. D. Groves, *Principles of GNSS, Inertial, and Multisensor Integrated Navigation
-Systems*, 2nd ed. (2013), §15.3 (zero updates) and §15.4.1 (vehicle motion constraints).
+Systems*, 2nd ed. (2013), ch. 15 (zero updates and motion constraints).
 I. Skog, P. Händel, J.-O. Nilsson, J. Rantakokko, "Zero-velocity detection — an
 algorithm evaluation", IEEE Trans. Biomed. Eng. 57(11), 2657–2666 (2010).
+G. Dissanayake, S. Sukkarieh, E. Nebot, H. Durrant-Whyte, "The aiding of a low-cost
+strapdown inertial measurement unit using vehicle model constraints for land vehicle
+applications", IEEE Trans. Robot. Autom. 17(5), 731–747 (2001).
 """
 
 from __future__ import annotations
@@ -77,7 +80,7 @@ class StillPeriods:
         ----------
         every : int, optional
             Samples between updates (≥ 1); default :attr:`window` (one update per window,
-            as the filter of Groves 2013 applies them).
+            as the GNSS_IMU filter applies them).
 
         Returns
         -------
@@ -126,7 +129,10 @@ class StillPeriods:
         gyro_psd : float
             Gyro white-noise PSD, rad²/s (ARW², ≥ 0).
         sigma : float, default 0.0
-            Allowance for motion, σ in rad/s (≥ 0; > 0 when ``gyro_psd`` is 0).
+            Allowance for motion, σ in rad/s (≥ 0; > 0 when ``gyro_psd`` is 0). The edges
+            of a still period may hold slow motion under :attr:`gyro_threshold` (the
+            start and end of a move): an allowance of that order keeps such an update
+            consistent.
         every : int, optional
             Samples between updates; default :attr:`window`.
 
@@ -167,10 +173,10 @@ def detect_still(time, gyro, accel, *, kind: str, lla=None, gravity: float | Non
     A sample passes when | |f| − g | < ``accel_threshold`` and |ω| < ``gyro_threshold``
     (increments are divided by their interval t_k − t_{k−1}; the first row by t_1 − t_0);
     a sample is still when it lies in a window of ``window`` consecutive passing samples,
-    i.e. in a run of at least ``window`` passing samples (Groves 2013, §15.3; the windowed
-    test of Skog et al. 2010). The defaults are those of the loosely coupled filter of
-    Groves 2013 as published with the walk of ``tests/data/real_walk``: 50 samples,
-    0.25 m/s², 0.25 °/s.
+    i.e. in a run of at least ``window`` passing samples (Groves 2013, ch. 15; the windowed
+    test of Skog et al. 2010). The defaults are those of the loosely coupled filter after
+    Groves 2013 published in rtklibexplorer's GNSS_IMU (2025): 50 samples, 0.25 m/s²,
+    0.25 °/s.
 
     Parameters
     ----------
@@ -238,7 +244,7 @@ def detect_still(time, gyro, accel, *, kind: str, lla=None, gravity: float | Non
 
 
 class NonHolonomic(Source):
-    """Non-holonomic constraint of a wheeled vehicle (Groves 2013, §15.4.1): the point at
+    """Non-holonomic constraint of a wheeled vehicle (Dissanayake et al. 2001): the point at
     ``lever_arm`` from the IMU (body frame; e.g. the rear axle's middle) moves neither
     sideways nor vertically in the body frame.
 
