@@ -291,22 +291,37 @@ class FineAlignment:
         p.text(str(self))
 
 
-def _setup(level: CoarseAlignment, model: ImuErrors, q_nb, *, t0: float, lla, horizon: float, step: float,
-           predict_s: float, pos_sigma: float, vel_sigma: float) -> InsSetup:
-    """The aided INS at rest at ``t0`` with attitude ``q_nb`` after the levelling (and
-    gyrocompassing) ``level``: the initial covariance keeps the correlation of the
-    attitude error with the biases that caused it (``rust/filter/alignment.rs``,
-    ``fine_p0``), and the noise of ``model`` over ``horizon`` s sets the process noise."""
+def _setup(level: CoarseAlignment, model: ImuErrors, q_imu, *, t0: float, lla, horizon: float, step: float,
+           predict_s: float, pos_sigma: float, vel_sigma: float, mount=None) -> InsSetup:
+    """The aided INS at rest at ``t0`` after the levelling (and gyrocompassing) ``level``
+    of an IMU with attitude ``q_imu`` (C_imu^n) mounted as ``mount`` (C_imu^b,
+    ``docs/mounting.md``; None: the IMU axes are the body axes): the body attitude
+    C_imu^n (C_imu^b)ᵀ; an initial covariance that keeps the correlation of the attitude
+    error with the biases that caused it (``rust/filter/alignment.rs``, ``fine_p0``, in the
+    IMU axes, then turned to the body axes of the bias states); and the process noise of
+    ``model`` over ``horizon`` s."""
+    with renamed(lla0="lla"):  # the core checks the state and the mount before they are used
+        setup = InsSetup(t0=t0, lla0=lla, vel0=(0.0, 0.0, 0.0), q0=q_imu, kind=level.kind, p0=np.eye(15), accel_psd=0.0,
+                         gyro_psd=0.0, predict_every=max(1, int(round(predict_s / step))), ellipsoid=level.ellipsoid,
+                         mount=mount)
+    c_ib = _mount_of(setup)
     accel_errors, gyro_errors = model._to_core()
     p0, (accel_psd, accel_walk, gyro_psd, gyro_walk) = _core.fine_alignment_p0(
-        lla, q_nb, psi_cov_noise=level.psi_cov_noise, mean_f=level.mean_f, mean_w=level.mean_w,
+        lla, np.asarray(setup.q0), psi_cov_noise=level.psi_cov_noise, mean_f=level.mean_f, mean_w=level.mean_w,
         gravity=level.gravity, horizon=horizon, accel_errors=accel_errors, gyro_errors=gyro_errors,
         pos_sigma=pos_sigma, vel_sigma=vel_sigma, ellipsoid=level.ellipsoid)
-    with renamed(lla0="lla"):
-        return InsSetup(t0=t0, lla0=lla, vel0=(0.0, 0.0, 0.0), q0=q_nb, kind=level.kind, p0=p0, accel_psd=accel_psd,
-                        gyro_psd=gyro_psd, accel_bias=BiasModel(kind="random_walk", psd=accel_walk),
-                        gyro_bias=BiasModel(kind="random_walk", psd=gyro_walk),
-                        predict_every=max(1, int(round(predict_s / step))), ellipsoid=level.ellipsoid)
+    turn = np.eye(15)
+    turn[9:12, 9:12] = c_ib  # the bias states (INS15 order) in body axes: δb_b = C_imu^b δb_imu
+    turn[12:15, 12:15] = c_ib
+    return dataclasses.replace(setup, q0=rotation.quat_from_dcm(rotation.dcm_from_quat(setup.q0) @ c_ib.T),
+                               p0=turn @ p0 @ turn.T, accel_psd=accel_psd, gyro_psd=gyro_psd,
+                               accel_bias=BiasModel(kind="random_walk", psd=accel_walk),
+                               gyro_bias=BiasModel(kind="random_walk", psd=gyro_walk))
+
+
+def _mount_of(setup: InsSetup) -> np.ndarray:
+    """The IMU mount C_imu^b of ``setup`` (3, 3); the identity without one."""
+    return np.eye(3) if setup.mount is None else np.array(setup.mount)
 
 
 def fine(imu, lla, coarse: CoarseAlignment, *, errors=None, interval: float = 1.0, zupt_sigma: float = 0.01,
@@ -427,15 +442,16 @@ class MotionAlignment:
         The IMU time stamp at that fix, or the last one before it (s): the aided INS
         starts here.
     fix_time : float
-        Time of the heading fix (s); the fixes up to it are in the start state
-        (:meth:`later` leaves them out).
+        Time of the heading fix (s) in the IMU's clock (its stamp plus the fixes'
+        ``time_offset``); the fixes up to it are in the start state (:meth:`later` leaves
+        them out).
     lla : ndarray (3,)
-        Position at ``t0``: latitude (rad), longitude (rad), height (m).
+        Position of the IMU at ``t0``: latitude (rad), longitude (rad), height (m).
     vel_ned : ndarray (3,)
-        NED velocity at ``t0`` (m/s): the velocity fix.
+        NED velocity of the IMU at ``t0`` (m/s): the velocity fix, less its lever-arm term.
     q_nb : ndarray (4,)
-        Attitude at ``t0``, scalar first: roll and pitch levelled at rest and carried to
-        ``t0`` by the gyros, yaw along the track.
+        Body attitude at ``t0``, scalar first: roll and pitch levelled at rest and carried
+        to ``t0`` by the gyros, yaw along the track.
     euler, euler_sigma : ndarray (3,)
         (roll, pitch, yaw) at ``t0`` and their σ (rad).
     speed : float
@@ -516,7 +532,7 @@ class MotionAlignment:
             A copy with the later fixes.
         """
         instance(fixes, (PositionFixes, VelocityFixes), "fixes")
-        return fixes.select(fixes.time > self.fix_time + _TIME_TOLERANCE)
+        return fixes.select(_imu_clock(fixes) > self.fix_time + _TIME_TOLERANCE)
 
     def __str__(self) -> str:
         lat, lon = np.rad2deg(self.lla[:2])
@@ -538,6 +554,21 @@ def _heading(vel: np.ndarray) -> tuple[float, np.ndarray]:
     return float(np.arctan2(ve, vn)), np.array([-ve / s2, vn / s2, 0.0])
 
 
+def _imu_clock(fixes) -> np.ndarray:
+    """Times (s) of GNSS fixes in the IMU's clock: stamp + ``time_offset``
+    (``docs/mounting.md``)."""
+    return fixes.time + fixes.time_offset
+
+
+def _lever_velocity(fixes, c_bn: np.ndarray, body_rate: np.ndarray) -> np.ndarray:
+    """The velocity (m/s, NED) of the point at ``fixes.lever_arm`` relative to the IMU,
+    C_b^n (ω_ib^b × l), for the body rate ``body_rate`` (rad/s; the Earth-rate term, below
+    1e-4 m/s per metre of lever arm, is left out)."""
+    if fixes.lever_arm is None:
+        return np.zeros(3)
+    return c_bn @ np.cross(body_rate, np.asarray(fixes.lever_arm))
+
+
 def _first_row(t: np.ndarray, t0: float, kind: str) -> int:
     """The first row of an IMU record (times ``t``, s) that an INS starting at ``t0`` takes:
     the first after ``t0`` (increments: its interval starts at ``t0``), or the first from
@@ -555,8 +586,8 @@ def _predict(setup: InsSetup, t, g, a, end: int) -> tuple[pd.Series, np.ndarray]
     return res.nav.iloc[-1], ins._core.covariance
 
 
-def in_motion(imu, position, velocity, level: CoarseAlignment, *, speed: float = 1.0, slip_sigma: float = np.deg2rad(1.0),
-              errors=None, predict_s: float = 0.1) -> MotionAlignment:
+def in_motion(imu, position, velocity, level: CoarseAlignment, *, mount=None, speed: float = 1.0,
+              slip_sigma: float = np.deg2rad(1.0), errors=None, predict_s: float = 0.1) -> MotionAlignment:
     """Alignment in motion: levelling at rest, heading from the GNSS velocity once the
     vehicle moves, then the aided INS from that epoch.
 
@@ -578,13 +609,14 @@ def in_motion(imu, position, velocity, level: CoarseAlignment, *, speed: float =
        covariance of the levelling carried to the fix, the heading σ, and the
        correlation of the heading error with the velocity error of the same fix.
 
-    The fixes are taken as measured at the IMU, at the IMU's time stamps (a lever arm or
-    time offset of the receiver is not applied in this step; it is the aided INS's).
+    The fixes' lever arms and time offsets are applied as the aided INS applies them
+    (``docs/mounting.md``): the heading is the track of the IMU's velocity, the antenna's
+    less C_b^n (ω × l) at the last IMU sample, and the position the antenna's less C_b^n l.
     It assumes the body x axis points along the track at that fix: forward motion of a
     vehicle without side slip, or a walker holding the IMU pointing ahead. Otherwise the
     heading is off by the angle between them (180° when reversing, 90° for an IMU whose
-    x axis points sideways): give the mount so that the record is in body axes, and
-    ``slip_sigma`` for the angle that remains.
+    x axis points sideways and no ``mount`` says so): give the mount, and ``slip_sigma``
+    for the angle that remains.
 
     Parameters
     ----------
@@ -599,9 +631,13 @@ def in_motion(imu, position, velocity, level: CoarseAlignment, *, speed: float =
     level : CoarseAlignment
         The levelling at rest: :func:`coarse` on the part of ``imu`` at rest (any gyro
         grade; a site within 1° of a pole, where :func:`coarse` refuses to gyrocompass, is
-        refused), whatever heading it found. Its static test holds a hand-held device to
+        refused), whatever heading it found, in the IMU's axes. Its static test holds a hand-held device to
         the sensor noise: give it a few quiet seconds (on a recorded walk, 3 s of the 10 s
         the walker stood still passed).
+    mount : array_like (3, 3) or (3,), optional
+        The IMU mount C_imu^b from the IMU's axes to the body axes, a DCM or (roll, pitch,
+        yaw) in rad (``docs/mounting.md``); None (default): the IMU's axes are the body's.
+        It goes into :attr:`MotionAlignment.setup`.
     speed : float
         Horizontal speed (m/s) above which a velocity fix gives the heading; default 1 m/s.
     slip_sigma : float
@@ -621,7 +657,7 @@ def in_motion(imu, position, velocity, level: CoarseAlignment, *, speed: float =
     Raises
     ------
     InputError
-        Naming ``speed`` or ``slip_sigma`` out of range (``speed`` ≤ 0, ``slip_sigma`` < 0);
+        Naming ``mount`` for a matrix that is no rotation; ``speed`` or ``slip_sigma`` out of range (``speed`` ≤ 0, ``slip_sigma`` < 0);
         ``velocity`` when no fix after the rest is faster than ``speed``; ``position`` when
         it has no fix up to that one; ``imu`` for a bad row or a record that does not span the end of the
         rest to the heading fix.
@@ -641,14 +677,15 @@ def in_motion(imu, position, velocity, level: CoarseAlignment, *, speed: float =
     speed, predict_s = positive(speed, "speed"), positive(predict_s, "predict_s")
     slip_sigma = nonnegative(slip_sigma, "slip_sigma")
     model = level.errors if errors is None else _errors(errors)
+    v_time, p_time = _imu_clock(velocity), _imu_clock(position)
     horizontal = np.hypot(velocity.value[:, 0], velocity.value[:, 1])
-    fast = np.nonzero((velocity.time > level.time_s) & (horizontal > speed))[0]
+    fast = np.nonzero((v_time > level.time_s) & (horizontal > speed))[0]
     if not fast.size:
-        later = horizontal[velocity.time > level.time_s]
+        later = horizontal[v_time > level.time_s]
         raise input_error("velocity", f"no fix after the rest (which ends at {level.time_s:g} s) is faster than speed={speed:g} m/s "
                                       f"horizontally (the fastest: {later.max() if later.size else 0.0:g} m/s), so the track gives no heading")
     j = fast[0]
-    t_h, vel, vel_cov = float(velocity.time[j]), velocity.value[j].copy(), velocity.cov[j]
+    t_h, vel_cov = float(v_time[j]), velocity.cov[j]
     t, g, a = _read(imu, level.kind)
     finite(t, "imu")
     increasing(t, "imu", "time")
@@ -661,28 +698,42 @@ def in_motion(imu, position, velocity, level: CoarseAlignment, *, speed: float =
     t0 = float(t[end - 1])  # the IMU stamp at the fix, or the last one before it
     horizon = max(float(t[-1] - level.time_s), t0 - level.time_s)
     step = (t[-1] - t[0]) / max(len(t) - 1, 1)
-    track, grad = _heading(vel)
 
-    def carry(euler_rest: np.ndarray) -> tuple[InsSetup, pd.Series, np.ndarray]:
-        """The free inertial solution from the end of the rest with this attitude there."""
-        setup = _setup(level, model, rotation.quat_from_euler(euler_rest), t0=level.time_s, lla=level.lla, horizon=horizon,
-                       step=step, predict_s=predict_s, pos_sigma=1.0, vel_sigma=_REST_SIGMA)
+    def carry(turn: float) -> tuple[InsSetup, pd.Series, np.ndarray]:
+        """The free inertial solution from the end of the rest, with the levelled attitude
+        turned there by ``turn`` (rad) about the down axis."""
+        q_turn = np.array([np.cos(turn / 2), 0.0, 0.0, np.sin(turn / 2)])
+        setup = _setup(level, model, rotation.quat_multiply(q_turn, level.q_nb), t0=level.time_s, lla=level.lla,
+                       horizon=horizon, step=step, predict_s=predict_s, pos_sigma=1.0, vel_sigma=_REST_SIGMA, mount=mount)
         p = np.array(setup.p0)
         p[_HEADING, :], p[:, _HEADING] = 0.0, 0.0  # the heading at rest is not known: set at the fix
         p[_HEADING, _HEADING] = _REST_SIGMA ** 2
         return (setup, *_predict(dataclasses.replace(setup, p0=p), t, g, a, end))
 
+    def track_at(roll: float, pitch: float, yaw: float) -> tuple[np.ndarray, float, np.ndarray]:
+        """The IMU's velocity at the fix (the antenna's less the lever-arm term at this
+        attitude), its track angle and the gradient of that angle."""
+        v = velocity.value[j] - _lever_velocity(velocity, rotation.dcm_from_euler([roll, pitch, yaw]), body_rate)
+        return (v, *_heading(v))
+
     # carry the levelled attitude to the fix; turn it at rest by the difference of its yaw
     # there to the track, and carry it again, so its error is propagated in the right axes
-    _, last, _ = carry(level.euler)
-    setup, last, cov = carry(level.euler + [0.0, 0.0, np.angle(np.exp(1j * (track - last["yaw_rad"])))])
+    setup, last, _ = carry(0.0)
+    body_rate = _mount_of(setup) @ (g[end - 1] if level.kind == "rates" else g[end - 1] / step)
+    _, track, _ = track_at(last["roll_rad"], last["pitch_rad"], last["yaw_rad"])
+    setup, last, cov = carry(np.angle(np.exp(1j * (track - last["yaw_rad"]))))
+    vel, track, grad = track_at(last["roll_rad"], last["pitch_rad"], track)
     euler = np.array([last["roll_rad"], last["pitch_rad"], track])
-    # the start: fixes for position and velocity, the carried tilt, the track heading
-    k = int(np.searchsorted(position.time, t_h + _TIME_TOLERANCE, side="right")) - 1
+    q0 = rotation.quat_from_euler(euler)
+    c_bn = rotation.dcm_from_quat(q0)
+    # the start: fixes for position and velocity (moved from the antenna to the IMU), the
+    # carried tilt, the track heading
+    k = int(np.searchsorted(p_time, t_h + _TIME_TOLERANCE, side="right")) - 1
     if k < 0:
-        raise input_error("position", f"no fix at or before the heading fix at {t_h:g} s (the first at {position.time[0]:g} s)")
-    dt = t0 - position.time[k]
-    lla = earth.ecef_to_lla(earth.ned_to_ecef(vel * dt, position.value[k], level.ellipsoid), level.ellipsoid).reshape(3)
+        raise input_error("position", f"no fix at or before the heading fix at {t_h:g} s (the first at {p_time[0]:g} s)")
+    dt = t0 - p_time[k]
+    arm = np.zeros(3) if position.lever_arm is None else c_bn @ np.asarray(position.lever_arm)
+    lla = earth.ecef_to_lla(earth.ned_to_ecef(vel * dt - arm, position.value[k], level.ellipsoid), level.ellipsoid).reshape(3)
     pos, vel_block, att = (slice(3 * i, 3 * i + 3) for i in range(3))
     cov[pos, :], cov[:, pos], cov[vel_block, :], cov[:, vel_block] = 0.0, 0.0, 0.0, 0.0
     cov[_HEADING, :], cov[:, _HEADING] = 0.0, 0.0
@@ -692,7 +743,11 @@ def in_motion(imu, position, velocity, level: CoarseAlignment, *, speed: float =
     cov[_HEADING, _HEADING] = heading_var + slip_sigma ** 2
     cov[_HEADING, vel_block] = -grad @ vel_cov  # ψ_D = −δyaw, δyaw = ∇yaw · δv
     cov[vel_block, _HEADING] = cov[_HEADING, vel_block]
-    q0 = rotation.quat_from_euler(euler)
+    # the position error from the lever arm turned by the attitude error: p = p_fix − Ĉ l,
+    # so δp = n_p − [(C l)×] ψ (to first order)
+    lever = np.eye(len(cov))
+    lever[pos, att] = -rotation.skew(arm)
+    cov = lever @ cov @ lever.T
     psi_cov = cov[att, att].copy()
     with renamed(lla0="position"):
         start = dataclasses.replace(setup, t0=t0, lla0=lla, vel0=vel, q0=q0, p0=cov)
