@@ -275,6 +275,14 @@ def test_a_nan_row_before_the_heading_fix_names_imu_and_the_row(truth):
     assert e.value.parameter == "imu" and e.value.index == row
 
 
+def test_a_mount_that_is_no_rotation_is_an_input_error(truth):
+    traj, ideal = truth
+    imu, pos, vel, a = aligned(traj, ideal, 0)
+    with pytest.raises(an.InputError) as e:
+        alignment.in_motion(imu, pos, vel, a.level, mount=np.diag([1.0, 1.0, -1.0]))  # a reflection
+    assert e.value.parameter == "mount"
+
+
 def test_wrong_types_name_the_argument(truth):
     traj, ideal = truth
     imu, pos, vel, a = aligned(traj, ideal, 0)
