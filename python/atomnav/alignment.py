@@ -313,8 +313,8 @@ def _setup(level: CoarseAlignment, model: ImuErrors, q_imu, *, t0: float, lla, h
     turn = np.eye(15)
     turn[9:12, 9:12] = c_ib  # the bias states (INS15 order) in body axes: δb_b = C_imu^b δb_imu
     turn[12:15, 12:15] = c_ib
-    return dataclasses.replace(setup, q0=rotation.quat_from_dcm(rotation.dcm_from_quat(setup.q0) @ c_ib.T),
-                               p0=turn @ p0 @ turn.T, accel_psd=accel_psd, gyro_psd=gyro_psd,
+    q_nb = setup.q0 if setup.mount is None else rotation.quat_from_dcm(rotation.dcm_from_quat(setup.q0) @ c_ib.T)
+    return dataclasses.replace(setup, q0=q_nb, p0=turn @ p0 @ turn.T, accel_psd=accel_psd, gyro_psd=gyro_psd,
                                accel_bias=BiasModel(kind="random_walk", psd=accel_walk),
                                gyro_bias=BiasModel(kind="random_walk", psd=gyro_walk))
 
