@@ -631,9 +631,9 @@ def in_motion(imu, position, velocity, level: CoarseAlignment, *, mount=None, sp
     level : CoarseAlignment
         The levelling at rest: :func:`coarse` on the part of ``imu`` at rest (any gyro
         grade; a site within 1° of a pole, where :func:`coarse` refuses to gyrocompass, is
-        refused), whatever heading it found, in the IMU's axes. Its static test holds a hand-held device to
-        the sensor noise: give it a few quiet seconds (on a recorded walk, 3 s of the 10 s
-        the walker stood still passed).
+        refused), whatever heading it found, in the IMU's axes. Its static test holds a
+        hand-held device to the sensor noise: give it a few quiet seconds (on a recorded
+        walk, 3 s of the 10 s the walker stood still passed).
     mount : array_like (3, 3) or (3,), optional
         The IMU mount C_imu^b from the IMU's axes to the body axes, a DCM or (roll, pitch,
         yaw) in rad (``docs/mounting.md``); None (default): the IMU's axes are the body's.
@@ -657,9 +657,10 @@ def in_motion(imu, position, velocity, level: CoarseAlignment, *, mount=None, sp
     Raises
     ------
     InputError
-        Naming ``mount`` for a matrix that is no rotation; ``speed`` or ``slip_sigma`` out of range (``speed`` ≤ 0, ``slip_sigma`` < 0);
-        ``velocity`` when no fix after the rest is faster than ``speed``; ``position`` when
-        it has no fix up to that one; ``imu`` for a bad row or a record that does not span the end of the
+        Naming ``mount`` for a matrix that is no rotation; ``speed`` or ``slip_sigma`` out
+        of range (``speed`` ≤ 0, ``slip_sigma`` < 0); ``velocity`` when no fix after the
+        rest is faster than ``speed``; ``position`` when it has no fix up to that one;
+        ``imu`` for a bad row (``.index``) or a record that does not span the end of the
         rest to the heading fix.
     TypeError
         For ``position``, ``velocity`` or ``level`` of another type.
@@ -667,7 +668,7 @@ def in_motion(imu, position, velocity, level: CoarseAlignment, *, mount=None, sp
     Examples
     --------
     >>> level = coarse(imu_at_rest, lla, errors="mems")          # doctest: +SKIP
-    >>> a = in_motion(imu, position, velocity, level)            # doctest: +SKIP
+    >>> a = in_motion(imu, position, velocity, level, mount=(np.pi, 0.0, -np.pi / 2))  # doctest: +SKIP
     >>> ins = aided_ins(a.setup, [a.later(position), a.later(velocity)])  # doctest: +SKIP
     >>> result = ins.run(*a.after(imu))                          # doctest: +SKIP
     """
