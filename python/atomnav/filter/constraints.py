@@ -28,7 +28,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .. import _core, earth, plausibility
-from .._validate import choice, input_error, integer, nonnegative, positive, rows, vector
+from .._validate import choice, input_error, integer, nonnegative, positive, renamed, rows, vector
 from .sources import Source, ZeroRate, ZeroVelocity
 
 #: The IMU output kinds: rates (rad/s, m/s²) or increments (rad, m/s).
@@ -232,7 +232,8 @@ def detect_still(time, gyro, accel, *, kind: str, lla=None, gravity: float | Non
         if lla is None:
             raise input_error("lla", "required (the site, for its normal gravity) unless gravity is given")
         site = plausibility.lla(vector(lla, 3, "lla"), "lla")
-        gravity = earth.gravity(site[0], site[2], ellipsoid)
+        with renamed(lat="lla", h="lla"):  # earth.gravity's arguments are the site's elements
+            gravity = earth.gravity(site[0], site[2], ellipsoid)
     g0 = positive(gravity, "gravity")
     if len(g) == len(t) == len(a) and len(t) >= 2:
         plausibility.imu(t, g, a, kind, "accel", gyro_name="gyro", time_name="time")
