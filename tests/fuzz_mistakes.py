@@ -583,6 +583,10 @@ CATALOGUE: tuple[Clean, ...] = (
     _c("atomnav.alignment.MotionAlignment.after", "a.after(imu)",
        MOTION + "\na = an.alignment.in_motion(imu, position, velocity, level)\nimu = car_imu", ["imu"]),
     # vehicle and pedestrian constraints on the 10 s static record
+    _c("atomnav.filter.constraints.detect_still",
+       'an.filter.constraints.detect_still(time, gyro, accel, kind="increments", lla=lla, window=20)',
+       ZUPT + '\ntime, gyro, accel = still_imu\nlla = still_init["lla"]', (),
+       (Unit("time", "imu_time"), Unit("gyro", "gyro"), Unit("accel", "accel")) + LLA),
     _c("atomnav.filter.constraints.NonHolonomic", "still_aided(an.filter.constraints.NonHolonomic(time, 0.05))", ZUPT, (),
        (Unit("time", "time"),)),
 )
@@ -621,10 +625,6 @@ NOT_YET_CATALOGUED: dict[str, str] = {
         "axis=1) it raises ValueError 'The truth value of a Series is ambiguous', with time_s as datetime64 a TypeError "
         "naming no argument ('<' not supported between 'numpy.float64' and 'Timestamp'); nav wants reading through "
         "_validate.table",
-    "atomnav.filter.constraints.detect_still":
-        "a site latitude in degrees is refused naming 'lat', earth.gravity's parameter, not the user's lla: "
-        "detect_still(time, gyro, accel, kind='increments', lla=np.array([55.75, 37.6, 200.0])) -> "
-        "InputError(parameter='lat', index=0)",
 }
 """Table- or array-taking callables whose clean call found a defect of atomnav that needs
 more than a local fix: the defect and the outcome of its reproducer. ``check_coverage``
