@@ -14,7 +14,7 @@ import numpy as np
 import pandas as pd
 
 from . import _core, plausibility
-from ._validate import (FIRST_SAMPLE, finite_scalar, increasing, input_error, instance, locate, path as checked_path,
+from ._validate import (FIRST_SAMPLE, finite_scalar, increasing, input_error, instance, integer, locate, path as checked_path,
                         positive, renamed, rows, table, timestamp, vector)
 from .rotation import euler_from_quat
 
@@ -658,6 +658,63 @@ def car(rate_hz: float = 200.0, origin=MOSCOW, heading: float = 0.0, vibration: 
         Sampled at ``rate_hz``, with its motion model (exact :meth:`Trajectory.ideal_imu`).
     """
     return Trajectory.from_motion(_core.Motion.car(_origin(origin), plausibility.angles(finite_scalar(heading, "heading"), "heading", "heading"), bool(instance(vibration, (bool, np.bool_), "vibration"))), rate_hz, ellipsoid)
+
+
+def stop_and_go(rate_hz: float = 200.0, origin=MOSCOW, *, heading: float = 0.0, speed: float = 5.0, ramp: float = 3.0,
+                cruise: float = 5.0, stop: float = 10.0, cycles: int = 3, squat: float = 0.005,
+                vibration: float = 0.02, ellipsoid: str = "WGS84") -> Trajectory:
+    """Level stop-and-go drive along a constant course: at rest ``stop`` s, then ``cycles``
+    times: speed up to ``speed`` over a raised-cosine ramp of ``ramp`` s, cruise ``cruise``
+    s, slow to rest over ``ramp`` s, stand ``stop`` s.
+
+    The body pitches with the longitudinal acceleration a (squat and dive on the
+    suspension): a raised-cosine pulse over each ramp peaking at ``squat``·a_max (a_max =
+    π·``speed``/(2·``ramp``)), nose up while speeding up. While moving it also rolls in a
+    12 Hz oscillation of angular-rate amplitude ``vibration`` times speed/``speed`` (road
+    vibration; without it a smooth cruise looks like rest to any IMU).
+
+    Parameters
+    ----------
+    rate_hz : float
+        Sample rate (Hz), default 200 Hz.
+    origin : array_like (3,)
+        Site: latitude (rad), longitude (rad), height (m); default :data:`MOSCOW`.
+    heading : float
+        Course and heading (rad).
+    speed : float
+        Cruise speed (m/s, > 0).
+    ramp : float
+        Length of each speed-up and slow-down (s, > 0).
+    cruise : float
+        Time at ``speed`` in each cycle (s, ≥ 0).
+    stop : float
+        Time at rest before the first and after every cycle (s, > 0).
+    cycles : int
+        Number of go-and-stop cycles (1 to 10 000).
+    squat : float
+        Pitch per longitudinal acceleration (rad per m/s², ≥ 0).
+    vibration : float
+        Roll-rate amplitude of the road vibration at ``speed`` (rad/s, ≥ 0).
+    ellipsoid : str
+        Earth model, one of ``atomnav._core.OPTIONS["Ellipsoid"]`` (default ``"WGS84"``).
+
+    Returns
+    -------
+    Trajectory
+        Sampled at ``rate_hz``, with its motion model (exact :meth:`Trajectory.ideal_imu`);
+        ``stop + cycles·(2·ramp + cruise + stop)`` s long.
+
+    Raises
+    ------
+    InputError
+        Naming the argument out of its range.
+    """
+    m = _core.Motion.stop_and_go(_origin(origin), heading=plausibility.angles(finite_scalar(heading, "heading"), "heading", "heading"),
+                                 speed=finite_scalar(speed, "speed"), ramp=finite_scalar(ramp, "ramp"),
+                                 cruise=finite_scalar(cruise, "cruise"), stop=finite_scalar(stop, "stop"),
+                                 cycles=integer(cycles, "cycles", 1, 10_000), squat=finite_scalar(squat, "squat"),
+                                 vibration=finite_scalar(vibration, "vibration"))
+    return Trajectory.from_motion(m, rate_hz, ellipsoid)
 
 
 def rotary_stand(states, move_starts, move_duration: float, duration: float, rate_hz: float = 200.0, origin=MOSCOW, ellipsoid: str = "WGS84") -> Trajectory:

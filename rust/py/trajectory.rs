@@ -90,6 +90,24 @@ impl Motion {
     }
 
     #[staticmethod]
+    #[pyo3(signature = (origin, *, heading, speed, ramp, cruise, stop, cycles, squat, vibration))]
+    #[allow(clippy::too_many_arguments)]
+    fn stop_and_go(
+        origin: PyReadonlyArray1<'_, f64>,
+        #[pyo3(from_py_with = real)] heading: f64,
+        #[pyo3(from_py_with = real)] speed: f64,
+        #[pyo3(from_py_with = real)] ramp: f64,
+        #[pyo3(from_py_with = real)] cruise: f64,
+        #[pyo3(from_py_with = real)] stop: f64,
+        cycles: &Bound<'_, PyAny>,
+        #[pyo3(from_py_with = real)] squat: f64,
+        #[pyo3(from_py_with = real)] vibration: f64,
+    ) -> PyResult<Motion> {
+        let cycles = super::convert::count(cycles, "cycles", 1, 10_000)?;
+        Ok(wrap(generators::stop_and_go(checked_origin(&origin)?, heading, speed, ramp, cruise, stop, cycles, squat, vibration)?))
+    }
+
+    #[staticmethod]
     fn car(origin: PyReadonlyArray1<'_, f64>, #[pyo3(from_py_with = real)] heading: f64, vibration: bool) -> PyResult<Motion> {
         Ok(wrap(generators::car(checked_origin(&origin)?, heading, vibration)))
     }

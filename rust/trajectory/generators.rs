@@ -179,6 +179,48 @@ pub fn car(origin: Vec3, heading: f64, vibration: bool) -> Motion {
     Motion { name: "car".into(), origin, duration: 40.0, speed, course, displacement: disp, attitude: euler_chain(roll, pitch, yaw) }
 }
 
+/// Level stop-and-go drive along the constant course `heading` (rad): at rest for `stop`
+/// s, then `cycles` times: speed up to `speed` (m/s) over a raised-cosine ramp of `ramp`
+/// s, cruise `cruise` s, slow to rest over `ramp` s, stand `stop` s. The body pitches with
+/// the longitudinal acceleration a (squat and dive on the suspension): a raised-cosine
+/// pulse over each ramp peaking at `squat`·a_max (rad per m/s², a_max = π·speed/(2·ramp)),
+/// nose up while speeding up. While moving the body also rolls in a 12 Hz oscillation of
+/// angular-rate amplitude `vibration` (rad/s) times speed/`speed` (road vibration: an IMU
+/// cannot tell a smooth cruise from rest).
+#[allow(clippy::too_many_arguments)]
+pub fn stop_and_go(origin: Vec3, heading: f64, speed: f64, ramp: f64, cruise: f64, stop: f64, cycles: usize, squat: f64, vibration: f64) -> Result<Motion> {
+    check_positive("speed", speed)?;
+    check_positive("ramp", ramp)?;
+    check_positive("stop", stop)?;
+    crate::error::check_count("cycles", cycles, 1, 10_000)?;
+    for (field, x) in [("cruise", cruise), ("squat", squat), ("vibration", vibration)] {
+        if !(x.is_finite() && x >= 0.0) {
+            return Err(invalid(field, format!("must be finite and >= 0, got {x}")));
+        }
+    }
+    crate::error::check_finite("heading", &[heading], 1)?;
+    let rc = StepShape::RaisedCosine;
+    let period = 2.0 * ramp + cruise + stop;
+    let starts = (0..cycles).map(|k| stop + k as f64 * period);
+    // the speed profile with height 1: the vibration's envelope
+    let envelope = starts.clone().fold(Profile::zero(), |p, s| pulse(p, s, ramp, cruise, 1.0, rc));
+    let speed_profile = starts.clone().fold(Profile::zero(), |p, s| pulse(p, s, ramp, cruise, speed, rc));
+    let tilt = squat * PI * speed / (2.0 * ramp);
+    let pitch = starts.fold(Profile::zero(), |p, s| pulse(pulse(p, s, ramp / 2.0, 0.0, tilt, rc), s + ramp + cruise, ramp / 2.0, 0.0, -tilt, rc));
+    let f = 12.0;
+    let carrier = Profile::zero().with(sine(vibration / (2.0 * PI * f), 1.0 / f));
+    let roll = Profile::zero().with(Term::Product(Box::new(envelope), Box::new(carrier)));
+    Ok(Motion {
+        name: "stop_and_go".into(),
+        origin,
+        duration: stop + cycles as f64 * period,
+        speed: speed_profile,
+        course: Profile::constant(heading),
+        displacement: zero3(),
+        attitude: euler_chain(roll, pitch, Profile::constant(heading)),
+    })
+}
+
 /// Two-axis rotary stand (as in Vasilyuk et al. 2024) in NED/FRD:
 /// C_nb = R_y(tilt) R_z(turntable) — tilt about the East axis, turntable about body z.
 /// `states` are (tilt, turntable) in rad; the stand holds each state and moves to the
