@@ -17,7 +17,7 @@ import numpy as np
 import pandas as pd
 
 from .. import earth, rotation
-from .._validate import as_floats, finite_scalar, input_error, instance, positive
+from .._validate import as_floats, finite_scalar, input_error, instance, positive, renamed, table
 from .aided import AidedResult, InsSetup
 from .sources import PositionFixes, _Fixes, aided_ins
 
@@ -25,7 +25,10 @@ from .sources import PositionFixes, _Fixes, aided_ins
 TABLE_COLUMNS = ("window", "start_s", "end_s", "solution", "fixes", "max_error_m", "end_error_m", "end_sigma_m")
 #: Columns of :attr:`OutageResult.errors`.
 ERROR_COLUMNS = ("time_s", "window", "solution", "error_n_m", "error_e_m", "error_d_m", "error_m", "sigma_m")
-_SIGMA = [f"sigma_position[{i}]" for i in range(3)]
+_SIGMA_GROUPS = (tuple(f"sigma_position[{i}]" for i in range(3)),  # a solution's position σ (m) or variances (m²)
+                 ("cov_nn_m2", "cov_ee_m2", "cov_dd_m2"))
+_POSITION = ("time_s", "lat_rad", "lon_rad", "h_m")
+_QUATERNION = ("qw", "qx", "qy", "qz")
 
 
 @dataclass(frozen=True)
@@ -196,13 +199,18 @@ def score_outages(nav: pd.DataFrame, reference: PositionFixes, windows, *, solut
     ------
     atomnav.InputError
         Naming ``windows`` and its row for a window holding no reference position, or
-        ``nav`` for a solution that does not cover a window.
+        ``nav`` for a solution that does not cover a window, a missing, duplicated or
+        ambiguous column (``qw, qx, qy, qz`` are needed with a lever arm) or a latitude
+        beyond ±π/2.
+    TypeError
+        Naming ``nav`` for a column that holds no numbers, or a ``time_s`` of
+        datetimes (it is seconds on the IMU clock).
     """
-    instance(nav, pd.DataFrame, "nav")
     instance(reference, PositionFixes, "reference")
     ref_time = reference.time + getattr(reference, "time_offset", 0.0)  # on the IMU clock
     w = _windows(windows, ref_time)
     lever = getattr(reference, "lever_arm", None) if lever_arm is None else as_floats(lever_arm, "lever_arm")
+    nav = _solution(nav, lever is not None and np.any(lever))
     sigma_of = _sigma_source(nav)
     rows, errors = [], []
     for k, (start, end) in enumerate(w):
@@ -213,7 +221,8 @@ def score_outages(nav: pd.DataFrame, reference: PositionFixes, windows, *, solut
         if t[0] < nav["time_s"].iloc[0] or t[-1] > nav["time_s"].iloc[-1]:
             raise input_error("nav", f"the solution ({nav['time_s'].iloc[0]:g} to {nav['time_s'].iloc[-1]:g} s) does not "
                               f"cover window {k} [{start:g}, {end:g}) s")
-        err = _errors(nav, t, reference.value[pick], lever)
+        with renamed(lla="nav"):  # the solution's positions, the reference's being checked already
+            err = _errors(nav, t, reference.value[pick], lever)
         norm = np.linalg.norm(err, axis=1)
         frame = {"time_s": t, "window": k, "solution": solution, "error_n_m": err[:, 0], "error_e_m": err[:, 1],
                  "error_d_m": err[:, 2], "error_m": norm}
@@ -227,10 +236,22 @@ def score_outages(nav: pd.DataFrame, reference: PositionFixes, windows, *, solut
     return pd.DataFrame(rows), pd.concat(errors, ignore_index=True)
 
 
+def _solution(nav, attitude: bool) -> pd.DataFrame:
+    """The columns of the solution ``nav`` that the score reads, by name, as floats: time
+    in seconds, position, the attitude when ``attitude`` (a lever arm) and σ when it has
+    them (extra columns ignored; a missing, duplicated or non-number column, or datetimes,
+    name ``nav``)."""
+    instance(nav, pd.DataFrame, "nav")
+    groups = [_QUATERNION] if attitude else []
+    groups += [g for g in _SIGMA_GROUPS if set(g) <= set(map(str, nav.columns))][:1]
+    names = [*_POSITION, *(c for g in groups for c in g)]
+    return pd.DataFrame(table(nav, names, "nav", epoch=None, finite=False), columns=names)
+
+
 def _sigma_source(nav: pd.DataFrame):
     """A function of time giving the solution's 3-D position σ (m), or None without σ."""
     nt = nav["time_s"].to_numpy()
-    for cols, power in ((_SIGMA, 2), (("cov_nn_m2", "cov_ee_m2", "cov_dd_m2"), 1)):
+    for cols, power in zip(_SIGMA_GROUPS, (2, 1)):
         if set(cols) <= set(nav.columns):
             return lambda t, cols=cols, power=power: np.sqrt(sum(np.interp(t, nt, nav[c]) ** power for c in cols))
     return None
@@ -262,7 +283,7 @@ def _errors(nav: pd.DataFrame, t: np.ndarray, lla_ref: np.ndarray, lever_arm) ->
     lla = np.column_stack([np.interp(t, nt, nav[c]) for c in ("lat_rad", "lon_rad", "h_m")])
     ecef = earth.lla_to_ecef(lla)
     if lever_arm is not None and np.any(lever_arm):
-        q = np.column_stack([np.interp(t, nt, nav[c]) for c in ("qw", "qx", "qy", "qz")])
+        q = np.column_stack([np.interp(t, nt, nav[c]) for c in _QUATERNION])
         c_bn = rotation.dcm_from_quat(q / np.linalg.norm(q, axis=1, keepdims=True))
         c_ne = np.stack([earth.dcm_ned_to_ecef(la, lo) for la, lo in lla[:, :2]])
         ecef = ecef + np.einsum("kij,kjl,l->ki", c_ne, c_bn, np.asarray(lever_arm, float))
