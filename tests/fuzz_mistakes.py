@@ -414,6 +414,7 @@ CATALOGUE: tuple[Clean, ...] = (
        "time, gyro, accel = imu_t, imu_gyro, imu_accel"),
     # initial alignment on the 10 s static record
     _c("atomnav.alignment.coarse", 'an.alignment.coarse(imu, lla, errors="tactical")', ALIGN, ["imu"], LLA),
+    _c("atomnav.alignment.level", 'an.alignment.level(imu, lla, errors="tactical")', ALIGN, ["imu"], LLA),
     _c("atomnav.alignment.fine", "an.alignment.fine(imu, lla, start)",
        ALIGN + '\nstart = an.alignment.coarse(imu, lla, errors="tactical")', ["imu"], LLA),
     _c("atomnav.filter.sources.ZeroVelocity", "still_aided(an.filter.ZeroVelocity(time, 0.01))", ZUPT, (),
@@ -578,6 +579,14 @@ CATALOGUE: tuple[Clean, ...] = (
     _c("atomnav.filter.outages.outage_analysis",
        "an.filter.outages.outage_analysis(setup, sources[0], (time, gyro, accel), windows, progress=False)",
        SOURCED + "\nwindows = np.array([[2.0, 3.5], [5.0, 6.5]])", (), AIDED_UNITS + (Unit("windows", "time"),)),
+    _c("atomnav.filter.outages.score_outages", "an.filter.outages.score_outages(solution, reference, windows)",
+       'solution = nav[["time_s", "lat_rad", "lon_rad", "h_m"]]\n'
+       'reference = an.filter.PositionFixes(fixes["fix_time"], fixes["fix_lla"], fixes["fix_cov"])\n'
+       "windows = np.array([[2.0, 3.5], [5.0, 6.5]])", ["solution"], (Unit("windows", "time"),), time_origin="windows"),
+    _c("atomnav.filter.outages.score_outages", "an.filter.outages.score_outages(solution, reference, windows)",
+       AIDED + '\nres = ins.run(time, gyro, accel, progress=False)\nsolution = res.nav[["time_s", "lat_rad", "lon_rad", "h_m", "qw", "qx", "qy", "qz"]]\n'
+       'reference = an.filter.PositionFixes(fixes["fix_time"], fixes["fix_lla"], fixes["fix_cov"], lever_arm=[0.5, 0.0, -0.3])\n'
+       "windows = np.array([[2.0, 3.5], [5.0, 6.5]])", ["solution"], (Unit("windows", "time"),), time_origin="windows"),
     # alignment in motion: the car levelled at rest until 4 s, heading from its GNSS velocity (15 s of 1 Hz fixes)
     _c("atomnav.alignment.in_motion", "an.alignment.in_motion(imu, position, velocity, level)", MOTION, ["imu"]),
     _c("atomnav.alignment.MotionAlignment.after", "a.after(imu)",
@@ -620,11 +629,6 @@ the user, each with the reason it has no clean call (``table_or_array_callables`
 them by their docstrings)."""
 
 NOT_YET_CATALOGUED: dict[str, str] = {
-    "atomnav.filter.outages.score_outages":
-        "reads nav's columns raw (nav['time_s'], np.interp of nav[c]): with nav = pd.concat([nav, nav[['time_s']]], "
-        "axis=1) it raises ValueError 'The truth value of a Series is ambiguous', with time_s as datetime64 a TypeError "
-        "naming no argument ('<' not supported between 'numpy.float64' and 'Timestamp'); nav wants reading through "
-        "_validate.table",
 }
 """Table- or array-taking callables whose clean call found a defect of atomnav that needs
 more than a local fix: the defect and the outcome of its reproducer. ``check_coverage``
