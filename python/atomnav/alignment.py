@@ -133,6 +133,9 @@ class CoarseAlignment:
         The sensor error model the accuracy is computed from.
     ellipsoid : str
         Earth model.
+    gyrocompassed : bool
+        True for :func:`coarse` (heading from the Earth rate); False for :func:`level`
+        (yaw 0, heading not determined).
     """
 
     t0: float
@@ -152,6 +155,7 @@ class CoarseAlignment:
     spread: tuple
     errors: ImuErrors
     ellipsoid: str
+    gyrocompassed: bool = True
 
     @property
     def state(self) -> dict:
@@ -164,16 +168,19 @@ class CoarseAlignment:
         noise = np.sqrt(np.diag(self.psi_cov_noise))
         lat, lon = np.rad2deg(self.lla[:2])
         lines = [
-            f"Coarse alignment: {self.time_s - self.t0:.1f} s at rest, {self.samples} samples ({self.kind}), "
-            f"at {lat:.4f}° {lon:.4f}°, {self.lla[2]:.1f} m",
+            f"{'Coarse alignment' if self.gyrocompassed else 'Levelling'}: {self.time_s - self.t0:.1f} s at rest, "
+            f"{self.samples} samples ({self.kind}), at {lat:.4f}° {lon:.4f}°, {self.lla[2]:.1f} m",
             *_attitude_lines(self.euler, self.euler_sigma),
             "  attainable accuracy (1σ), from the sensor biases | noise (white and faster than the record):",
             f"    levelling north/east  {_angle(bias[0])}, {_angle(bias[1])} | {_angle(noise[0])}, {_angle(noise[1])}"
             f"   (accel bias / g = {self.gravity:.4f} m/s²)",
-            f"    heading               {_angle(bias[2])} | {_angle(noise[2])}"
-            f"   (gyro bias / Ω cos φ = {self.earth_rate_h / units.DEG_PER_HOUR:.3f} °/h)",
-            f"  static test: spread {self.spread[0]:.2f} (specific force), {self.spread[1]:.2f} (angular rate); limit 5",
         ]
+        if self.gyrocompassed:
+            lines += [f"    heading               {_angle(bias[2])} | {_angle(noise[2])}"
+                      f"   (gyro bias / Ω cos φ = {self.earth_rate_h / units.DEG_PER_HOUR:.3f} °/h)",
+                      f"  static test: spread {self.spread[0]:.2f} (specific force), {self.spread[1]:.2f} (angular rate); limit 5"]
+        else:
+            lines += ["    heading               not determined (levelling only: take it from elsewhere, e.g. in_motion)"]
         return "\n".join(lines)
 
     def _repr_pretty_(self, p, cycle) -> None:
@@ -222,16 +229,68 @@ def coarse(imu, lla, *, errors, kind: str | None = None, ellipsoid: str = "WGS84
     TypeError
         For a column that does not hold numbers, or ``errors`` of another type.
     """
+    return _align(_core.coarse_alignment, imu, lla, errors, kind, ellipsoid)
+
+
+def level(imu, lla, *, errors, kind: str | None = None, ellipsoid: str = "WGS84") -> CoarseAlignment:
+    """Levelling alone: roll and pitch from the mean specific force of a record held still,
+    for any gyro and at any latitude, when the heading comes from elsewhere
+    (:func:`in_motion`: the GNSS track).
+
+    :func:`coarse` also gyrocompasses, which needs a record static to within the sensor
+    noise; a device held by hand, or a vehicle at a stop with its engine running, moves
+    more than that. Levelling needs only that the mean specific force is gravity: the
+    record's ten window means may scatter up to 0.25 m/s² per axis (the accelerometer
+    threshold of a zero-velocity detector, Skog et al. 2010), and their measured scatter
+    is added to the stated tilt σ (Titterton & Weston 2004, §10.3: a horizontal specific
+    force error δf tilts the levelled frame by δf/g).
+
+    Parameters
+    ----------
+    imu : DataFrame or array (N, 7)
+        A record held still, as for :func:`coarse`.
+    lla : array (3,)
+        The site: latitude (rad), longitude (rad), height (m).
+    errors : ImuErrors or str
+        The sensor error model (or a preset name): its accelerometer bias and noise give
+        the tilt accuracy.
+    kind : str, optional
+        ``"rates"`` or ``"increments"``; None (default): the kind of the table's columns.
+    ellipsoid : str
+        Earth model, one of ``atomnav._core.OPTIONS["Ellipsoid"]``.
+
+    Returns
+    -------
+    CoarseAlignment
+        Roll and pitch with their σ; yaw 0 (the body x axis's horizontal projection taken
+        as north) with σ π/√3 (rad), a heading uniform over ±180°: not determined.
+
+    Raises
+    ------
+    InputError
+        Naming ``imu``: a bad row, fewer than 100 samples, window means that scatter by
+        more than 0.25 m/s², a mean specific force that is not gravity, or a body x axis
+        that is vertical (no yaw reference). Naming ``kind``: an unknown kind.
+    TypeError
+        For a column that does not hold numbers, or ``errors`` of another type.
+    """
+    return _align(_core.level_alignment, imu, lla, errors, kind, ellipsoid)
+
+
+def _align(core, imu, lla, errors, kind, ellipsoid) -> CoarseAlignment:
+    """The alignment ``core`` (the core's coarse or levelling function) of ``imu``."""
+    gyrocompassed = core is _core.coarse_alignment
     kind = choice(imu_kind(kind, imu, "imu"), KINDS, "kind")
     model = _errors(errors)
     site = vector(lla, 3, "lla")
     plausibility.lla(site, "lla")
     t, g, a = _read(imu, kind)
     with _imu_errors(kind, g, a, 0):
-        d = _core.coarse_alignment(t, g, a, kind, site, *model._to_core(), ellipsoid=ellipsoid)
+        d = core(t, g, a, kind, site, *model._to_core(), ellipsoid=ellipsoid)
     arr = {k: np.asarray(d[k], dtype=float) for k in ("q_nb", "euler", "euler_sigma", "psi_cov", "psi_cov_noise", "mean_f", "mean_w")}
     return CoarseAlignment(t0=d["t0"], time_s=d["t1"], samples=d["samples"], kind=kind, lla=site, gravity=d["gravity"],
-                           earth_rate_h=d["earth_rate_h"], spread=tuple(d["spread"]), errors=model, ellipsoid=ellipsoid, **arr)
+                           earth_rate_h=d["earth_rate_h"], spread=tuple(d["spread"]), errors=model, ellipsoid=ellipsoid,
+                           gyrocompassed=gyrocompassed, **arr)
 
 
 @dataclass(frozen=True, kw_only=True)

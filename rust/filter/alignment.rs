@@ -49,6 +49,24 @@ pub const MAX_LATITUDE: f64 = 89.0 * std::f64::consts::PI / 180.0;
 /// The mean specific force of a static record is local gravity: a relative difference
 /// beyond this is no static record (accelerations in g, increments read as rates).
 pub const GRAVITY_TOLERANCE: f64 = 0.1;
+/// Levelling alone ([`level`]) accepts a record held still by hand or on a vehicle at a
+/// stop: the window means of its specific force may scatter up to this (m/s², per axis),
+/// the accelerometer threshold of a zero-velocity detector (Skog et al. 2010); their
+/// measured scatter enters the stated tilt accuracy.
+pub const LEVEL_SPREAD: f64 = 0.25;
+/// Variance of a heading that levelling alone leaves undetermined (rad²): uniform over
+/// ±π, π²/3.
+pub const UNKNOWN_HEADING_VAR: f64 = std::f64::consts::PI * std::f64::consts::PI / 3.0;
+
+/// What the coarse alignment takes the heading from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Heading {
+    /// Gyrocompassing: north from the mean angular rate (the Earth rate).
+    Gyrocompass,
+    /// None: yaw 0 (the body x axis's horizontal projection taken as north), its variance
+    /// [`UNKNOWN_HEADING_VAR`]; for gyros that cannot find north, heading from elsewhere.
+    Unknown,
+}
 
 /// The error budget of one sensor triad over a record of `horizon` s: each bias process
 /// (Gauss–Markov, and the Gauss–Markov poles that realise flicker, `imu::noise::Flicker`)
@@ -155,6 +173,16 @@ fn window_mean(t: &[f64], x: &[Vec3], kind: ImuKind, lo: usize, hi: usize) -> Ve
 /// rounding is static whatever the noise model.
 fn spread(t: &[f64], x: &[Vec3], kind: ImuKind, first: usize, budget: &TriadBudget, step: f64) -> f64 {
     let n = x.len() - first;
+    let var = window_scatter(t, x, kind, first);
+    let window = (n / STATIC_WINDOWS) as f64 * step;
+    let expected = (budget.white_psd / window + budget.drift_var).sqrt();
+    let floor = 1e-12 * window_mean(t, x, kind, first, x.len()).norm() + f64::MIN_POSITIVE;
+    var.iter().map(|v| v.sqrt() / expected.max(floor)).fold(0.0, f64::max)
+}
+
+/// Per-axis variance (m²/s⁴) of the [`STATIC_WINDOWS`] window means of `x` about their mean.
+fn window_scatter(t: &[f64], x: &[Vec3], kind: ImuKind, first: usize) -> Vec3 {
+    let n = x.len() - first;
     let bounds: Vec<usize> = (0..=STATIC_WINDOWS).map(|k| first + n * k / STATIC_WINDOWS).collect();
     let means: Vec<Vec3> = bounds.windows(2).filter_map(|w| match *w {
         [lo, hi] => Some(window_mean(t, x, kind, lo, hi)),
@@ -162,11 +190,7 @@ fn spread(t: &[f64], x: &[Vec3], kind: ImuKind, first: usize, budget: &TriadBudg
     }).collect();
     let k = means.len() as f64;
     let mid: Vec3 = means.iter().sum::<Vec3>() / k;
-    let var = means.iter().map(|m| (m - mid).component_mul(&(m - mid))).sum::<Vec3>() / (k - 1.0);
-    let window = (n / STATIC_WINDOWS) as f64 * step;
-    let expected = (budget.white_psd / window + budget.drift_var).sqrt();
-    let floor = 1e-12 * mid.norm() + f64::MIN_POSITIVE;
-    var.iter().map(|v| v.sqrt() / expected.max(floor)).fold(0.0, f64::max)
+    means.iter().map(|m| (m - mid).component_mul(&(m - mid))).sum::<Vec3>() / (k - 1.0)
 }
 
 /// Coarse alignment of a static record: time stamps `t` (s, strictly increasing), gyro
@@ -177,10 +201,23 @@ fn spread(t: &[f64], x: &[Vec3], kind: ImuKind, first: usize, budget: &TriadBudg
 /// for a record too short, not static, or whose mean specific force is not gravity, and
 /// `lla` for a site beyond ±[`MAX_LATITUDE`].
 pub fn coarse(t: &[f64], gyro: &[Vec3], accel: &[Vec3], kind: ImuKind, lla: &Vec3, ell: &Ellipsoid, errors: &ImuErrorModel) -> Result<CoarseAlignment> {
+    align(t, gyro, accel, kind, lla, ell, errors, Heading::Gyrocompass)
+}
+
+/// Levelling alone: roll and pitch from the mean specific force of a record held still
+/// (by hand, or a vehicle at a stop; its window means may scatter up to [`LEVEL_SPREAD`],
+/// and the measured scatter enters the stated tilt σ), yaw 0 with variance
+/// [`UNKNOWN_HEADING_VAR`], for any gyro and any latitude. Errors as [`coarse`].
+pub fn level(t: &[f64], gyro: &[Vec3], accel: &[Vec3], kind: ImuKind, lla: &Vec3, ell: &Ellipsoid, errors: &ImuErrorModel) -> Result<CoarseAlignment> {
+    align(t, gyro, accel, kind, lla, ell, errors, Heading::Unknown)
+}
+
+#[allow(clippy::too_many_arguments)]
+fn align(t: &[f64], gyro: &[Vec3], accel: &[Vec3], kind: ImuKind, lla: &Vec3, ell: &Ellipsoid, errors: &ImuErrorModel, heading: Heading) -> Result<CoarseAlignment> {
     errors.validate()?;
     check_finite("lla", lla.as_slice(), 1)?;
     crate::earth::check_latitude("lla", lla.x, 0)?;
-    if lla.x.abs() > MAX_LATITUDE {
+    if heading == Heading::Gyrocompass && lla.x.abs() > MAX_LATITUDE {
         return Err(invalid("lla", format!(
             "latitude {:.4}° is within 1° of a pole: the horizontal Earth rate Ω cos φ = {:.3} °/h is too small to find north by gyrocompassing",
             lla.x.to_degrees(), (ell.omega * lla.x.cos()).to_degrees() * 3600.0)));
@@ -208,15 +245,30 @@ pub fn coarse(t: &[f64], gyro: &[Vec3], accel: &[Vec3], kind: ImuKind, lla: &Vec
     }
     let (ba, bg) = (TriadBudget::of(&errors.accel, &mean_f, horizon), TriadBudget::of(&errors.gyro, &mean_w, horizon));
     let spread = (spread(t, accel, kind, first, &ba, step), spread(t, gyro, kind, first, &bg, step));
-    if spread.0 > STATIC_RATIO || spread.1 > STATIC_RATIO {
-        let (what, r) = if spread.0 >= spread.1 { ("specific force", spread.0) } else { ("angular rate", spread.1) };
-        return Err(invalid("imu", format!(
-            "not static: the {what} varies between the {STATIC_WINDOWS} windows of the record {r:.1} times more than the sensor noise and bias drift of `errors` explain (at most {STATIC_RATIO})")));
+    let scatter = window_scatter(t, accel, kind, first);
+    match heading {
+        Heading::Gyrocompass if spread.0 > STATIC_RATIO || spread.1 > STATIC_RATIO => {
+            let (what, r) = if spread.0 >= spread.1 { ("specific force", spread.0) } else { ("angular rate", spread.1) };
+            return Err(invalid("imu", format!(
+                "not static: the {what} varies between the {STATIC_WINDOWS} windows of the record {r:.1} times more than the sensor noise and bias drift of `errors` explain (at most {STATIC_RATIO}); \
+                 a record held by hand can only be levelled (alignment.level)")));
+        }
+        Heading::Unknown if scatter.max() > LEVEL_SPREAD * LEVEL_SPREAD => {
+            return Err(invalid("imu", format!(
+                "not held still: the specific force's window means scatter by {:.3} m/s² (σ), more than {LEVEL_SPREAD} m/s²", scatter.max().sqrt())));
+        }
+        _ => {}
     }
     let down = -mean_f.normalize();
-    let east_raw = down.cross(&mean_w);
-    if east_raw.norm() <= f64::MIN_POSITIVE {
-        return Err(invalid("imu", "the mean angular rate is parallel to gravity: no horizontal Earth rate to find north from"));
+    let east_raw = match heading {
+        Heading::Gyrocompass => down.cross(&mean_w),
+        Heading::Unknown => down.cross(&Vec3::x()),  // yaw 0: north along the body x axis's horizontal projection
+    };
+    if east_raw.norm() <= 1e-6 {
+        return Err(invalid("imu", match heading {
+            Heading::Gyrocompass => "the mean angular rate is parallel to gravity: no horizontal Earth rate to find north from",
+            Heading::Unknown => "the body x axis is vertical: its horizontal projection gives no yaw reference",
+        }));
     }
     let east = east_raw.normalize();
     let north = east.cross(&down);
@@ -228,7 +280,18 @@ pub fn coarse(t: &[f64], gyro: &[Vec3], accel: &[Vec3], kind: ImuKind, lla: &Vec
     let psi_cov_noise = la * la.transpose() * (ba.white_psd / horizon) + lg * lg.transpose() * (bg.white_psd / horizon);
     // the bias seen by the means: its value at the start, plus a random walk's mean drift (variance qT/3)
     let bias_cov = |b: &TriadBudget| Mat3::from_diagonal(&b.bias_var.add_scalar(b.walk_psd * horizon / 3.0));
-    let psi_cov = ma * bias_cov(&ba) * ma.transpose() + mg * bias_cov(&bg) * mg.transpose() + psi_cov_noise;
+    let mut psi_cov = ma * bias_cov(&ba) * ma.transpose() + mg * bias_cov(&bg) * mg.transpose() + psi_cov_noise;
+    let mut psi_cov_noise = psi_cov_noise;
+    if heading == Heading::Unknown {
+        // the motion the record held: the scatter of its window means, averaged over them
+        let motion = ma * Mat3::from_diagonal(&(scatter / STATIC_WINDOWS as f64)) * ma.transpose();
+        for p in [&mut psi_cov, &mut psi_cov_noise] {
+            *p += motion;
+            p.row_mut(2).fill(0.0);
+            p.column_mut(2).fill(0.0);
+            p[(2, 2)] = UNKNOWN_HEADING_VAR;
+        }
+    }
     let euler_sigma = euler_sigma(&euler, &psi_cov);
     Ok(CoarseAlignment { t0, t1, samples: n, q_nb, euler, mean_f, mean_w, gravity, earth_rate_h: ell.omega * lla.x.cos(), psi_cov, psi_cov_noise, euler_sigma, spread })
 }

@@ -6,7 +6,7 @@ use super::convert::{mat, mat_to_py, real, vec3, vec3_rows, vector, Wrap};
 use super::imu::triad_from_dict;
 use super::sources::AidingSource;
 use crate::earth::Ellipsoid;
-use crate::filter::alignment::{coarse, euler_sigma, fine_p0, TriadBudget, ZeroRate, ZeroVelocity};
+use crate::filter::alignment::{coarse, euler_sigma, fine_p0, level, CoarseAlignment, TriadBudget, ZeroRate, ZeroVelocity};
 use crate::filter::layout::Layout;
 use crate::filter::sources::Source;
 use crate::imu::errors::ImuErrorModel;
@@ -32,9 +32,41 @@ fn coarse_alignment<'py>(
     gyro_errors: &Bound<'py, PyDict>,
     ellipsoid: Wrap<Ellipsoid>,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let model = ImuErrorModel { accel: triad_from_dict(accel_errors, "accel")?, gyro: triad_from_dict(gyro_errors, "gyro")? };
-    let (t, g, a, lla) = (vector(&time, "time")?, vec3_rows(&gyro, "gyro")?, vec3_rows(&accel, "accel")?, vec3(&lla, "lla")?);
+    let (t, g, a, lla, model) = alignment_inputs(&time, &gyro, &accel, &lla, accel_errors, gyro_errors)?;
     let c = py.detach(|| coarse(&t, &g, &a, kind.0, &lla, &ellipsoid.0, &model))?;
+    coarse_dict(py, &c)
+}
+
+/// Levelling alone (any gyro, any latitude; yaw 0 with an undetermined heading's
+/// variance): arguments and result as `coarse_alignment`.
+#[pyfunction]
+#[pyo3(signature = (time, gyro, accel, kind, lla, accel_errors, gyro_errors, ellipsoid=Wrap(crate::earth::WGS84)))]
+#[allow(clippy::too_many_arguments)]
+fn level_alignment<'py>(
+    py: Python<'py>,
+    time: numpy::PyReadonlyArray1<'py, f64>,
+    gyro: numpy::PyReadonlyArray2<'py, f64>,
+    accel: numpy::PyReadonlyArray2<'py, f64>,
+    kind: Wrap<ImuKind>,
+    lla: numpy::PyReadonlyArray1<'py, f64>,
+    accel_errors: &Bound<'py, PyDict>,
+    gyro_errors: &Bound<'py, PyDict>,
+    ellipsoid: Wrap<Ellipsoid>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let (t, g, a, lla, model) = alignment_inputs(&time, &gyro, &accel, &lla, accel_errors, gyro_errors)?;
+    let c = py.detach(|| level(&t, &g, &a, kind.0, &lla, &ellipsoid.0, &model))?;
+    coarse_dict(py, &c)
+}
+
+type AlignmentInputs = (Vec<f64>, Vec<crate::math::Vec3>, Vec<crate::math::Vec3>, crate::math::Vec3, ImuErrorModel);
+
+fn alignment_inputs(time: &numpy::PyReadonlyArray1<'_, f64>, gyro: &numpy::PyReadonlyArray2<'_, f64>, accel: &numpy::PyReadonlyArray2<'_, f64>,
+                    lla: &numpy::PyReadonlyArray1<'_, f64>, accel_errors: &Bound<'_, PyDict>, gyro_errors: &Bound<'_, PyDict>) -> PyResult<AlignmentInputs> {
+    let model = ImuErrorModel { accel: triad_from_dict(accel_errors, "accel")?, gyro: triad_from_dict(gyro_errors, "gyro")? };
+    Ok((vector(time, "time")?, vec3_rows(gyro, "gyro")?, vec3_rows(accel, "accel")?, vec3(lla, "lla")?, model))
+}
+
+fn coarse_dict<'py>(py: Python<'py>, c: &CoarseAlignment) -> PyResult<Bound<'py, PyDict>> {
     let d = PyDict::new(py);
     d.set_item("t0", c.t0)?;
     d.set_item("t1", c.t1)?;
@@ -125,6 +157,7 @@ fn zero_rate(time: numpy::PyReadonlyArray1<'_, f64>, #[pyo3(from_py_with = real)
 
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(coarse_alignment, m)?)?;
+    m.add_function(wrap_pyfunction!(level_alignment, m)?)?;
     m.add_function(wrap_pyfunction!(fine_alignment_p0, m)?)?;
     m.add_function(wrap_pyfunction!(alignment_euler_sigma, m)?)?;
     m.add_function(wrap_pyfunction!(zero_velocity, m)?)?;
