@@ -123,6 +123,10 @@ def test_bad_schedules_name_the_argument(run):
         with pytest.raises(InputError) as e:
             outage_windows(t, **kw)
         assert e.value.parameter == name
+    for bad in (np.zeros(0), np.zeros((0, 1, 1)), [5.0], [[1.0, 2.0]]):
+        with pytest.raises(InputError) as e:
+            outage_windows(bad, length=15.0, first=0.0)
+        assert e.value.parameter == "time"
 
 
 def test_plot_draws_every_scored_fix_and_shades_the_windows(analysis):

@@ -84,7 +84,9 @@ def outage_windows(time, *, length: float, first: float, spacing: float | None =
         Naming ``length``, ``first`` or ``spacing`` when no whole window fits in the record
         or windows would overlap.
     """
-    t = as_floats(time, "time").reshape(-1)
+    t = as_floats(time, "time")
+    if t.ndim != 1 or len(t) < 2 or not np.all(np.isfinite(t[[0, -1]])):
+        raise input_error("time", f"expected the (M,) finite times of at least two fixes, got shape {t.shape}")
     length, first = positive(length, "length"), finite_scalar(first, "first")
     if first < 0:
         raise input_error("first", f"must be >= 0 s after the first fix, got {first}")
