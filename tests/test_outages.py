@@ -188,3 +188,6 @@ def test_another_programs_solution_is_scored_the_same_way(run, analysis):
     with pytest.raises(InputError) as e:
         an.filter.score_outages(other[other["time_s"] < 50.0], run["fixes"], windows)
     assert e.value.parameter == "nav"
+    with pytest.raises(InputError, match="every axis") as e:
+        an.filter.score_outages(other.drop(columns=["cov_dd_m2"]), run["fixes"], windows)
+    assert e.value.parameter == "nav"
