@@ -245,7 +245,12 @@ def _solution(nav, attitude: bool) -> pd.DataFrame:
     name ``nav``)."""
     instance(nav, pd.DataFrame, "nav")
     groups = [_QUATERNION] if attitude else []
-    groups += [g for g in _SIGMA_GROUPS if set(g) <= set(map(str, nav.columns))][:1]
+    columns = set(map(str, nav.columns))
+    for g in _SIGMA_GROUPS:
+        if columns & set(g) and not set(g) <= columns:
+            raise input_error("nav", f"has {sorted(columns & set(g))} but not {sorted(set(g) - columns)}: "
+                              "give every axis's σ or none")
+    groups += [g for g in _SIGMA_GROUPS if set(g) <= columns][:1]
     names = [*_POSITION, *(c for g in groups for c in g)]
     return pd.DataFrame(table(nav, names, "nav", epoch=None, finite=False), columns=names)
 
@@ -253,11 +258,6 @@ def _solution(nav, attitude: bool) -> pd.DataFrame:
 def _sigma_source(nav: pd.DataFrame):
     """A function of time giving the solution's 3-D position σ (m), or None without σ."""
     nt = nav["time_s"].to_numpy()
-    for cols in _SIGMA_GROUPS:
-        present = [c for c in cols if c in nav.columns]
-        if present and len(present) < len(cols):
-            raise input_error("nav", f"has {present} but not {[c for c in cols if c not in present]}: "
-                              "give every axis's σ or none")
     for cols, power in zip(_SIGMA_GROUPS, (2, 1)):
         if set(cols) <= set(nav.columns):
             return lambda t, cols=cols, power=power: np.sqrt(sum(np.interp(t, nt, nav[c]) ** power for c in cols))
