@@ -229,7 +229,7 @@ def coarse(imu, lla, *, errors, kind: str | None = None, ellipsoid: str = "WGS84
     TypeError
         For a column that does not hold numbers, or ``errors`` of another type.
     """
-    return _align(_core.coarse_alignment, imu, lla, errors, kind, ellipsoid)
+    return _align(True, imu, lla, errors, kind, ellipsoid)
 
 
 def level(imu, lla, *, errors, kind: str | None = None, ellipsoid: str = "WGS84") -> CoarseAlignment:
@@ -274,19 +274,18 @@ def level(imu, lla, *, errors, kind: str | None = None, ellipsoid: str = "WGS84"
     TypeError
         For a column that does not hold numbers, or ``errors`` of another type.
     """
-    return _align(_core.level_alignment, imu, lla, errors, kind, ellipsoid)
+    return _align(False, imu, lla, errors, kind, ellipsoid)
 
 
-def _align(core, imu, lla, errors, kind, ellipsoid) -> CoarseAlignment:
-    """The alignment ``core`` (the core's coarse or levelling function) of ``imu``."""
-    gyrocompassed = core is _core.coarse_alignment
+def _align(gyrocompassed: bool, imu, lla, errors, kind, ellipsoid) -> CoarseAlignment:
+    """The coarse alignment of ``imu``, or its levelling alone (``gyrocompassed`` False)."""
     kind = choice(imu_kind(kind, imu, "imu"), KINDS, "kind")
     model = _errors(errors)
     site = vector(lla, 3, "lla")
     plausibility.lla(site, "lla")
     t, g, a = _read(imu, kind)
     with _imu_errors(kind, g, a, 0):
-        d = core(t, g, a, kind, site, *model._to_core(), ellipsoid=ellipsoid)
+        d = _core.coarse_alignment(t, g, a, kind, site, *model._to_core(), ellipsoid=ellipsoid, gyrocompass=gyrocompassed)
     arr = {k: np.asarray(d[k], dtype=float) for k in ("q_nb", "euler", "euler_sigma", "psi_cov", "psi_cov_noise", "mean_f", "mean_w")}
     return CoarseAlignment(t0=d["t0"], time_s=d["t1"], samples=d["samples"], kind=kind, lla=site, gravity=d["gravity"],
                            earth_rate_h=d["earth_rate_h"], spread=tuple(d["spread"]), errors=model, ellipsoid=ellipsoid,

@@ -296,6 +296,22 @@ fn align(t: &[f64], gyro: &[Vec3], accel: &[Vec3], kind: ImuKind, lla: &Vec3, el
     Ok(CoarseAlignment { t0, t1, samples: n, q_nb, euler, mean_f, mean_w, gravity, earth_rate_h: ell.omega * lla.x.cos(), psi_cov, psi_cov_noise, euler_sigma, spread })
 }
 
+/// The start of a fine alignment after a coarse one at `lla` (attitude `q_nb`, the coarse
+/// white-noise attitude covariance `psi_cov_noise` and static means `mean_f`, `mean_w`,
+/// normal gravity `gravity`), over a record of `horizon` s with the sensor error model
+/// `errors`: the initial covariance over the 15 INS states ([`fine_p0`], position σ
+/// `pos_sigma` m, velocity σ `vel_sigma` m/s) and the filter's noise model (accel white
+/// PSD, accel bias random-walk PSD, gyro white PSD, gyro bias random-walk PSD).
+#[allow(clippy::too_many_arguments)]
+pub fn fine_start(lla: &Vec3, q_nb: &Quat, psi_cov_noise: &Mat3, mean_f: &Vec3, mean_w: &Vec3, gravity: f64, horizon: f64,
+                  errors: &ImuErrorModel, pos_sigma: f64, vel_sigma: f64, ell: &Ellipsoid) -> Result<(DMatrix<f64>, [f64; 4])> {
+    errors.validate()?;
+    crate::error::check_positive("horizon", horizon)?;
+    let (ba, bg) = (TriadBudget::of(&errors.accel, mean_f, horizon), TriadBudget::of(&errors.gyro, mean_w, horizon));
+    let p0 = fine_p0(&Layout::ins_with(&[])?, q_nb, lla.x, gravity, ell.omega, psi_cov_noise, &ba, &bg, pos_sigma, vel_sigma)?;
+    Ok((p0, [ba.white_psd, ba.walk_psd, bg.white_psd, bg.walk_psd]))
+}
+
 /// σ of (roll, pitch, yaw) from the covariance of ψ: a small rotation δθ of the
 /// navigation frame changes the Euler angles by δe with δθ = A δe,
 /// A = [R_z(yaw) R_y(pitch) x̂, R_z(yaw) ŷ, ẑ], and Ĉ = (I − [ψ×])C means δθ = −ψ.

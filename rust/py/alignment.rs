@@ -2,24 +2,24 @@
 //! covariance of a fine alignment, and the zero-velocity / zero-angular-rate updates as
 //! measurement sources (`AidingSource`) of an aided INS.
 
-use super::convert::{mat, mat_to_py, real, vec3, vec3_rows, vector, Wrap};
+use super::convert::{mat3, mat_to_py, real, vec3, vec3_rows, vector, Wrap};
 use super::imu::triad_from_dict;
 use super::sources::AidingSource;
 use crate::earth::Ellipsoid;
-use crate::filter::alignment::{coarse, euler_sigma, fine_p0, level, CoarseAlignment, TriadBudget, ZeroRate, ZeroVelocity};
-use crate::filter::layout::Layout;
+use crate::filter::alignment::{coarse, euler_sigma, fine_start, level, CoarseAlignment, ZeroRate, ZeroVelocity};
 use crate::filter::sources::Source;
 use crate::imu::errors::ImuErrorModel;
 use crate::imu::ImuKind;
-use crate::math::{quat, Mat3};
+use crate::math::quat;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
 /// Coarse alignment of a static record: time (N,) s, gyro and accel (N, 3) of `kind`, the
-/// site `lla` (3,) and the sensor error model as the two triad dicts of `atomnav.imu`.
-/// Returns a dict of the core's `CoarseAlignment` fields (arrays, floats).
+/// site `lla` (3,) and the sensor error model as the two triad dicts of `atomnav.imu`;
+/// with `gyrocompass` False, levelling alone (the heading undetermined). Returns a dict
+/// of the core's `CoarseAlignment` fields (arrays, floats).
 #[pyfunction]
-#[pyo3(signature = (time, gyro, accel, kind, lla, accel_errors, gyro_errors, ellipsoid=Wrap(crate::earth::WGS84)))]
+#[pyo3(signature = (time, gyro, accel, kind, lla, accel_errors, gyro_errors, *, ellipsoid=Wrap(crate::earth::WGS84), gyrocompass=true))]
 #[allow(clippy::too_many_arguments)]
 fn coarse_alignment<'py>(
     py: Python<'py>,
@@ -31,39 +31,17 @@ fn coarse_alignment<'py>(
     accel_errors: &Bound<'py, PyDict>,
     gyro_errors: &Bound<'py, PyDict>,
     ellipsoid: Wrap<Ellipsoid>,
+    gyrocompass: bool,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let (t, g, a, lla, model) = alignment_inputs(&time, &gyro, &accel, &lla, accel_errors, gyro_errors)?;
-    let c = py.detach(|| coarse(&t, &g, &a, kind.0, &lla, &ellipsoid.0, &model))?;
+    let model = errors_model(accel_errors, gyro_errors)?;
+    let (t, g, a, lla) = (vector(&time, "time")?, vec3_rows(&gyro, "gyro")?, vec3_rows(&accel, "accel")?, vec3(&lla, "lla")?);
+    let align = if gyrocompass { coarse } else { level };
+    let c = py.detach(|| align(&t, &g, &a, kind.0, &lla, &ellipsoid.0, &model))?;
     coarse_dict(py, &c)
 }
 
-/// Levelling alone (any gyro, any latitude; yaw 0 with an undetermined heading's
-/// variance): arguments and result as `coarse_alignment`.
-#[pyfunction]
-#[pyo3(signature = (time, gyro, accel, kind, lla, accel_errors, gyro_errors, ellipsoid=Wrap(crate::earth::WGS84)))]
-#[allow(clippy::too_many_arguments)]
-fn level_alignment<'py>(
-    py: Python<'py>,
-    time: numpy::PyReadonlyArray1<'py, f64>,
-    gyro: numpy::PyReadonlyArray2<'py, f64>,
-    accel: numpy::PyReadonlyArray2<'py, f64>,
-    kind: Wrap<ImuKind>,
-    lla: numpy::PyReadonlyArray1<'py, f64>,
-    accel_errors: &Bound<'py, PyDict>,
-    gyro_errors: &Bound<'py, PyDict>,
-    ellipsoid: Wrap<Ellipsoid>,
-) -> PyResult<Bound<'py, PyDict>> {
-    let (t, g, a, lla, model) = alignment_inputs(&time, &gyro, &accel, &lla, accel_errors, gyro_errors)?;
-    let c = py.detach(|| level(&t, &g, &a, kind.0, &lla, &ellipsoid.0, &model))?;
-    coarse_dict(py, &c)
-}
-
-type AlignmentInputs = (Vec<f64>, Vec<crate::math::Vec3>, Vec<crate::math::Vec3>, crate::math::Vec3, ImuErrorModel);
-
-fn alignment_inputs(time: &numpy::PyReadonlyArray1<'_, f64>, gyro: &numpy::PyReadonlyArray2<'_, f64>, accel: &numpy::PyReadonlyArray2<'_, f64>,
-                    lla: &numpy::PyReadonlyArray1<'_, f64>, accel_errors: &Bound<'_, PyDict>, gyro_errors: &Bound<'_, PyDict>) -> PyResult<AlignmentInputs> {
-    let model = ImuErrorModel { accel: triad_from_dict(accel_errors, "accel")?, gyro: triad_from_dict(gyro_errors, "gyro")? };
-    Ok((vector(time, "time")?, vec3_rows(gyro, "gyro")?, vec3_rows(accel, "accel")?, vec3(lla, "lla")?, model))
+fn errors_model(accel_errors: &Bound<'_, PyDict>, gyro_errors: &Bound<'_, PyDict>) -> PyResult<ImuErrorModel> {
+    Ok(ImuErrorModel { accel: triad_from_dict(accel_errors, "accel")?, gyro: triad_from_dict(gyro_errors, "gyro")? })
 }
 
 fn coarse_dict<'py>(py: Python<'py>, c: &CoarseAlignment) -> PyResult<Bound<'py, PyDict>> {
@@ -107,32 +85,19 @@ fn fine_alignment_p0<'py>(
     #[pyo3(from_py_with = real)] vel_sigma: f64,
     ellipsoid: Wrap<Ellipsoid>,
 ) -> PyResult<(Bound<'py, numpy::PyArray2<f64>>, (f64, f64, f64, f64))> {
-    let model = ImuErrorModel { accel: triad_from_dict(accel_errors, "accel")?, gyro: triad_from_dict(gyro_errors, "gyro")? };
-    model.validate()?;
+    let model = errors_model(accel_errors, gyro_errors)?;
     let (lla, q) = (vec3(&lla, "lla")?, vector(&q_nb, "q_nb")?);
     let [w, x, y, z] = <[f64; 4]>::try_from(q).map_err(|q| crate::error::invalid("q_nb", format!("expected 4 values, got {}", q.len())))?;
-    let noise = mat(&psi_cov_noise, "psi_cov_noise")?;
-    if noise.shape() != (3, 3) {
-        return Err(crate::error::invalid("psi_cov_noise", format!("expected (3, 3), got {:?}", noise.shape())).into());
-    }
-    let noise = Mat3::from_iterator(noise.iter().copied());
-    crate::error::check_positive("horizon", horizon)?;
-    let ba = TriadBudget::of(&model.accel, &vec3(&mean_f, "mean_f")?, horizon);
-    let bg = TriadBudget::of(&model.gyro, &vec3(&mean_w, "mean_w")?, horizon);
-    let layout = Layout::ins_with(&[])?;
-    let p0 = fine_p0(&layout, &quat(w, x, y, z), lla.x, gravity, ellipsoid.0.omega, &noise, &ba, &bg, pos_sigma, vel_sigma)?;
-    Ok((mat_to_py(py, &p0), (ba.white_psd, ba.walk_psd, bg.white_psd, bg.walk_psd)))
+    let (noise, mean_f, mean_w) = (mat3(&psi_cov_noise, "psi_cov_noise")?, vec3(&mean_f, "mean_f")?, vec3(&mean_w, "mean_w")?);
+    let (p0, [aw, ar, gw, gr]) = fine_start(&lla, &quat(w, x, y, z), &noise, &mean_f, &mean_w, gravity, horizon, &model, pos_sigma, vel_sigma, &ellipsoid.0)?;
+    Ok((mat_to_py(py, &p0), (aw, ar, gw, gr)))
 }
 
 /// σ of (roll, pitch, yaw) (3,) rad from the Euler angles `euler` (3,) rad and the
 /// covariance `psi_cov` (3, 3) rad² of the attitude error ψ (NED).
 #[pyfunction]
 fn alignment_euler_sigma<'py>(py: Python<'py>, euler: numpy::PyReadonlyArray1<'py, f64>, psi_cov: numpy::PyReadonlyArray2<'py, f64>) -> PyResult<Bound<'py, numpy::PyArray1<f64>>> {
-    let p = mat(&psi_cov, "psi_cov")?;
-    if p.shape() != (3, 3) {
-        return Err(crate::error::invalid("psi_cov", format!("expected (3, 3), got {:?}", p.shape())).into());
-    }
-    let s = euler_sigma(&vec3(&euler, "euler")?, &Mat3::from_iterator(p.iter().copied()));
+    let s = euler_sigma(&vec3(&euler, "euler")?, &mat3(&psi_cov, "psi_cov")?);
     Ok(numpy::IntoPyArray::into_pyarray(s.as_slice().to_vec(), py))
 }
 
@@ -157,7 +122,6 @@ fn zero_rate(time: numpy::PyReadonlyArray1<'_, f64>, #[pyo3(from_py_with = real)
 
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(coarse_alignment, m)?)?;
-    m.add_function(wrap_pyfunction!(level_alignment, m)?)?;
     m.add_function(wrap_pyfunction!(fine_alignment_p0, m)?)?;
     m.add_function(wrap_pyfunction!(alignment_euler_sigma, m)?)?;
     m.add_function(wrap_pyfunction!(zero_velocity, m)?)?;

@@ -164,6 +164,15 @@ pub fn vector(a: &PyReadonlyArray1<'_, f64>, field: &str) -> Result<Vec<f64>, Na
     Ok(v)
 }
 
+/// A (3, 3) array as a matrix; another shape names `field`.
+pub fn mat3(a: &PyReadonlyArray2<'_, f64>, field: &str) -> Result<crate::math::Mat3, NavError> {
+    let r = rows::<3>(a, field)?;
+    match r.as_slice() {
+        [x, y, z] => Ok(crate::math::Mat3::new(x[0], x[1], x[2], y[0], y[1], y[2], z[0], z[1], z[2])),
+        _ => Err(crate::error::invalid(field, format!("expected (3, 3), got ({}, 3)", r.len()))),
+    }
+}
+
 /// A length-3 vector argument.
 // invariant: v has 3 elements (checked above).
 #[allow(clippy::indexing_slicing)]
