@@ -61,6 +61,11 @@ def _input_error(parameter, call, index=None):
     (lambda: arma.ljung_box(e=[0.0] * 13, lags=10), "e"),  # was 0/0 NaN
     (lambda: allan.bias_stability(omega=np.array([1.7e308, -1.7e308])), "omega"),  # σ = 1.7e308·√2 = 2.4e308
     (lambda: atomnav.trajectory.nav_table([0.0], [[0.5, 0.5, 0.0]], [[0.0, 0.0, 0.0]], [[0.0, 0.0, 0.0, 0.0]]), "q_nb"),  # was "q"
+    # a subnormal period or speed made the path's slope infinite; the NaN surfaced as "q_nb"
+    (lambda: atomnav.trajectory.slalom(10.0, period=TINY), "period"),
+    (lambda: atomnav.trajectory.slalom(10.0, speed=TINY), "speed"),
+    (lambda: atomnav.trajectory.slalom(10.0, amp=HUGE, period=1e-10), "amp"),
+    (lambda: atomnav.trajectory.sinusoidal(10.0, period_ned=(TINY, 1.0, 1.0)), "period_ned"),
     # a 1.2-million-sample stationary run took over 10 s
     (lambda: diagnostics.stationary_errors(lat=0.99999, hours=50.55306038528544, rate_hz=6.632903781541362), "hours"),
 ])

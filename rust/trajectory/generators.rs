@@ -10,6 +10,16 @@ fn zero3() -> [Profile; 3] {
     [Profile::zero(), Profile::zero(), Profile::zero()]
 }
 
+/// A period (s) whose angular frequency 2π/period is finite: a subnormal period is not.
+fn check_period(field: &str, period: f64) -> Result<()> {
+    check_positive(field, period)?;
+    if (2.0 * PI / period).is_finite() {
+        Ok(())
+    } else {
+        Err(invalid(field, format!("{period:e} s is too short: its angular frequency 2π/period is not finite")))
+    }
+}
+
 fn sine(amp: f64, period: f64) -> Term {
     Term::Sine { amp, period, phase: 0.0 }
 }
@@ -20,8 +30,8 @@ fn sine(amp: f64, period: f64) -> Term {
 #[allow(clippy::indexing_slicing)]
 pub fn sinusoidal(origin: Vec3, duration: f64, amp_ned: Vec3, period_ned: Vec3, amp_euler: Vec3, period_euler: Vec3, heading: f64) -> Result<Motion> {
     for i in 0..3 {
-        check_positive("period_ned", period_ned[i])?;
-        check_positive("period_euler", period_euler[i])?;
+        check_period("period_ned", period_ned[i])?;
+        check_period("period_euler", period_euler[i])?;
     }
     let disp = [0, 1, 2].map(|i| Profile::zero().with(sine(amp_ned[i], period_ned[i])));
     let att = [0, 1, 2].map(|i| Profile::zero().with(sine(amp_euler[i], period_euler[i])));
@@ -84,7 +94,7 @@ pub const HEXAPOD_MAX_TILT: f64 = 0.5;
 /// ω_z = `yaw_rate_amp`·sin(2πt/`period`) (Tennstedt et al. 2023 Fig. 7: 1 m/s, 0.05 rad/s, 50 s).
 /// The velocity follows the heading (no side slip).
 pub fn drive_with_yaw(origin: Vec3, speed: f64, yaw_rate_amp: f64, period: f64, duration: f64, heading: f64) -> Result<Motion> {
-    check_positive("period", period)?;
+    check_period("period", period)?;
     // ψ = ψ₀ + A·P/(2π)·(1 − cos(2πt/P))
     let k = yaw_rate_amp * period / (2.0 * PI);
     let yaw = Profile::constant(heading + k).with(Term::Sine { amp: -k, period, phase: PI / 2.0 });
@@ -103,8 +113,12 @@ pub fn drive_with_yaw(origin: Vec3, speed: f64, yaw_rate_amp: f64, period: f64, 
 /// east = `amp`·sin(2πt/`period`), heading = atan2(ė, ṅ). Defaults 5 m/s, 2 m, 10 s, 60 s.
 pub fn slalom(origin: Vec3, speed: f64, amp: f64, period: f64, duration: f64) -> Result<Motion> {
     check_positive("speed", speed)?;
-    check_positive("period", period)?;
+    check_period("period", period)?;
     let slope = amp * 2.0 * PI / period / speed; // ė/ṅ amplitude
+    if !slope.is_finite() {
+        let field = if (2.0 * PI / period / speed).is_finite() { "amp" } else { "speed" };
+        return Err(invalid(field, format!("amp={amp:e} m, period={period:e} s and speed={speed:e} m/s give a path slope that is not finite")));
+    }
     Ok(Motion {
         name: "slalom".into(),
         origin,
