@@ -102,7 +102,7 @@ MAX_POPULATION: float = 1.5
 
 #: Statistics of long records (means, spreads) are read from at most this many evenly
 #: spaced rows, so a check costs the same on any record length.
-SAMPLE_ROWS: int = 10_000
+SAMPLE_ROWS: int = 2000
 
 #: The sample interval of a record is the median of its first this many time steps (10 s
 #: at 100 Hz: any gap or jitter is outvoted).
