@@ -133,3 +133,50 @@ def test_summary_says_the_heading_is_not_determined(still):
     text = str(alignment.level(meas, lla, errors="tactical"))
     assert text.startswith("Levelling") and "not determined" in text and "static test" not in text
     assert "static test" in str(alignment.coarse(meas, lla, errors="tactical"))
+
+
+def _still_with_gyro_bias(seed: int, bias: np.ndarray, gyro_white: float, yaw: float):
+    """A static record at heading ``yaw`` whose gyro reads the Earth rate plus ``bias``
+    (rad/s) and white noise of density ``gyro_white`` (rad/s/√Hz), added here."""
+    traj = an.trajectory.stationary(20.0, rate_hz=RATE, euler=(0.02, -0.03, yaw))
+    meas = traj.ideal_imu("rates")
+    rng = np.random.default_rng(seed)
+    gyro = [f"gyro_{a}_rad_s" for a in "xyz"]
+    meas[gyro] = meas[gyro].to_numpy() + bias + gyro_white * np.sqrt(RATE) * rng.standard_normal((len(meas), 3))
+    meas[ACCEL] = meas[ACCEL].to_numpy() + 1e-3 * rng.standard_normal((len(meas), 3))
+    return meas, traj.lla[0]
+
+
+def test_the_rest_gyro_bias_is_the_mean_rate_less_the_earth_rate_within_its_sigma():
+    """Over 40 static records with known gyro biases of 0.1-0.3 °/s (a MEMS gyro's) and
+    random headings, the bias seen at rest is off from the truth by what its covariance
+    says (mean NEES within the 95 % band of χ²(120)/40), though the horizontal Earth rate
+    is unknown to a levelling; and the vertical Earth rate is taken out (a bias of zero
+    reads zero up to that covariance)."""
+    deg = np.pi / 180
+    errors = an.imu.ImuErrors(accel=an.imu.TriadErrors(white=1e-4, bias_sigma=0.05),
+                              gyro=an.imu.TriadErrors(white=0.004 * deg, bias_sigma=0.2 * deg))
+    rng = np.random.default_rng(11)
+    nees = []
+    for seed in range(40):
+        bias = rng.uniform(0.1, 0.3, 3) * deg * rng.choice([-1.0, 1.0], 3)
+        meas, lla = _still_with_gyro_bias(seed, bias, 0.004 * deg, rng.uniform(-np.pi, np.pi))
+        lv = alignment.level(meas, lla, errors=errors)
+        e = lv.gyro_bias - bias
+        nees.append(float(e @ np.linalg.solve(lv.gyro_bias_cov, e)))
+    assert 2.28 < np.mean(nees) < 3.80, np.mean(nees)
+    # noise-free and unbiased: what remains is the horizontal Earth rate, whose direction
+    # a levelling does not know; the vertical Earth rate is taken out
+    meas, lla = _still_with_gyro_bias(0, np.zeros(3), 0.0, 0.3)
+    lv = alignment.level(meas, lla, errors=errors)
+    w = meas[[f"gyro_{a}_rad_s" for a in "xyz"]].to_numpy().mean(axis=0)  # ω_ie^b
+    down = an.rotation.dcm_from_euler([0.02, -0.03, 0.3])[2]             # the down axis in the body frame
+    np.testing.assert_allclose(lv.gyro_bias, w - (w @ down) * down, rtol=1e-4, atol=1e-12)
+    assert abs(w @ down) > 3e-5  # the vertical Earth rate that was removed
+
+
+def test_a_gyrocompass_leaves_the_gyro_bias_to_the_error_model(still):
+    meas, lla = still
+    c = alignment.coarse(meas, lla, errors="tactical")
+    assert np.all(c.gyro_bias == 0.0)
+    assert np.all(np.diag(c.gyro_bias_cov) > 0) and np.all(c.gyro_bias_cov == np.diag(np.diag(c.gyro_bias_cov)))

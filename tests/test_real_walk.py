@@ -30,9 +30,5 @@ def test_smoothed_within_the_published_velocity_matching(walk):
     assert walk.loc["smoothed", "max_error_m"] <= real_walk.PUBLISHED["smoothed"]
 
 
-@pytest.mark.xfail(strict=True, reason=(
-    "forward filter 13.5 m against the published 6.13 m: in_motion's start covariance holds the "
-    "tilt error as carried gyro bias (0.46 deg, fully correlated); with an uncorrelated 2 deg tilt "
-    "and 10 deg heading P0 the same filter reaches 4.78 m, with +1 deg of uncorrelated tilt 5.1 m"))
 def test_forward_within_the_published_forward_filter(walk):
     assert walk.loc["forward", "max_error_m"] <= real_walk.PUBLISHED["forward"]

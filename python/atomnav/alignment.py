@@ -57,6 +57,8 @@ _ARCMIN = np.pi / (180.0 * 60.0)
 COVARIANCE_EPOCHS = 50
 #: Index of the heading error ψ_D (``attitude[2]``) in :data:`atomnav.filter.INS15`.
 _HEADING = 8
+#: The gyro bias states (``gyro_bias[0..2]``) of :data:`atomnav.filter.INS15`.
+_GYRO_BIAS = slice(12, 15)
 #: σ of the velocity at the end of the rest (m/s) for carrying the attitude to the
 #: heading fix, and of the placeholder heading there (rad), which the fix replaces.
 _REST_SIGMA = 0.01
@@ -123,6 +125,13 @@ class CoarseAlignment:
         from the biases).
     mean_f, mean_w : ndarray (3,)
         Mean specific force (m/s²) and angular rate (rad/s) in the body frame.
+    gyro_bias, gyro_bias_cov : ndarray (3,), (3, 3)
+        The gyro bias (rad/s, body frame) seen at rest and its covariance (rad²/s²). For
+        :func:`level`: the mean angular rate less the vertical Earth rate, with the noise
+        of the mean and the horizontal Earth rate of an unknown heading, combined with the
+        error model's bias σ (a zero-angular-rate update, Groves 2013, §15.3.3); it is
+        the start of :func:`in_motion`'s bias estimate. For :func:`coarse`: zero and the
+        error model's bias covariance (the bias and the heading are not separable there).
     gravity, earth_rate_h : float
         Normal gravity (m/s²) and horizontal Earth rate Ω cos φ (rad/s) at the site.
     spread : tuple of float
@@ -150,6 +159,8 @@ class CoarseAlignment:
     psi_cov_noise: np.ndarray
     mean_f: np.ndarray
     mean_w: np.ndarray
+    gyro_bias: np.ndarray
+    gyro_bias_cov: np.ndarray
     gravity: float
     earth_rate_h: float
     spread: tuple
@@ -286,7 +297,8 @@ def _align(gyrocompassed: bool, imu, lla, errors, kind, ellipsoid) -> CoarseAlig
     t, g, a = _read(imu, kind)
     with _imu_errors(kind, g, a, 0):
         d = _core.coarse_alignment(t, g, a, kind, site, *model._to_core(), ellipsoid=ellipsoid, gyrocompass=gyrocompassed)
-    arr = {k: np.asarray(d[k], dtype=float) for k in ("q_nb", "euler", "euler_sigma", "psi_cov", "psi_cov_noise", "mean_f", "mean_w")}
+    arr = {k: np.asarray(d[k], dtype=float) for k in ("q_nb", "euler", "euler_sigma", "psi_cov", "psi_cov_noise", "mean_f", "mean_w",
+                                                      "gyro_bias", "gyro_bias_cov")}
     return CoarseAlignment(t0=d["t0"], time_s=d["t1"], samples=d["samples"], kind=kind, lla=site, gravity=d["gravity"],
                            earth_rate_h=d["earth_rate_h"], spread=tuple(d["spread"]), errors=model, ellipsoid=ellipsoid,
                            gyrocompassed=gyrocompassed, **arr)
@@ -655,10 +667,13 @@ def in_motion(imu, position, velocity, level: CoarseAlignment, *, mount=None, sp
     remedies for large heading errors of §14.4.3):
 
     1. Levelling: roll and pitch from the mean specific force at rest, the levelling of
-       :func:`coarse` (its gyrocompassed heading is not used, whatever the gyro).
-    2. Carrying: the free inertial solution from the end of the rest to the first
-       velocity fix whose horizontal speed exceeds ``speed``, which carries roll and pitch
-       (and their error, growing with the gyro noise and bias) to that fix.
+       :func:`coarse` (its gyrocompassed heading is not used, whatever the gyro), and
+       the gyro bias the rest saw (:attr:`CoarseAlignment.gyro_bias`: the mean angular
+       rate less the Earth rate, a zero-angular-rate update; zero after :func:`coarse`).
+    2. Carrying: the free inertial solution, corrected by that bias, from the end of the
+       rest to the first velocity fix whose horizontal speed exceeds ``speed``, which
+       carries roll and pitch (and their error, growing with the gyro noise and the
+       bias's remaining error) to that fix.
     3. Heading: the yaw is set to the track angle atan2(v_E, v_N) of that fix, with
        σ² = (v_N² σ_E² + v_E² σ_N² − 2 v_N v_E σ_NE)/s⁴ (the cross-track velocity σ over the
        horizontal speed s), plus ``slip_sigma``².
@@ -767,6 +782,11 @@ def in_motion(imu, position, velocity, level: CoarseAlignment, *, mount=None, sp
         p = np.array(setup.p0)
         p[_HEADING, :], p[:, _HEADING] = 0.0, 0.0  # the heading at rest is not known: set at the fix
         p[_HEADING, _HEADING] = _REST_SIGMA ** 2
+        # the gyro bias the rest saw (the levelled tilt does not depend on it), in body axes
+        c_ib = _mount_of(setup)
+        p[_GYRO_BIAS, :], p[:, _GYRO_BIAS] = 0.0, 0.0
+        p[_GYRO_BIAS, _GYRO_BIAS] = c_ib @ level.gyro_bias_cov @ c_ib.T
+        setup = dataclasses.replace(setup, bg0=c_ib @ level.gyro_bias)
         return (setup, *_predict(dataclasses.replace(setup, p0=p), t, g, a, end))
 
     def track_at(roll: float, pitch: float, yaw: float) -> tuple[np.ndarray, float, np.ndarray]:

@@ -149,6 +149,35 @@ pub struct CoarseAlignment {
     /// Spread of the window means over what noise and drift explain, for the specific
     /// force and the angular rate (static while both are ≤ [`STATIC_RATIO`]).
     pub spread: (f64, f64),
+    /// The gyro bias seen at rest (rad/s, body axes) and its covariance (rad²/s²): for a
+    /// levelling ([`rest_gyro_bias`]); for a gyrocompass, where the bias and the heading
+    /// are not separable, zero and the error model's bias covariance.
+    pub gyro_bias: Vec3,
+    pub gyro_bias_cov: Mat3,
+}
+
+/// The gyro bias from a rest of unknown heading (a zero-angular-rate update, Groves 2013,
+/// §15.3.3, applied to the mean of the record): the mean rate `mean_w` (rad/s, body
+/// axes) less the vertical Earth rate, which the levelled attitude `c_nb` (C_b^n, any
+/// yaw) knows, measures the bias with noise: the white noise of the mean, `white_var`
+/// (rad²/s²), and the horizontal Earth rate Ω cos φ in an unknown direction (variance
+/// (Ω cos φ)²/2 per horizontal axis). Combined with the prior covariance `prior`
+/// (the error model's bias), it gives the estimate and its covariance (the Kalman update
+/// of a zero prior; the prior unchanged if the two together are singular).
+pub fn rest_gyro_bias(c_nb: &Mat3, lat: f64, omega: f64, mean_w: &Vec3, prior: &Mat3, white_var: f64) -> (Vec3, Mat3) {
+    let (s, c) = lat.sin_cos();
+    let c_bn = c_nb.transpose();
+    let vertical = c_bn * Vec3::new(0.0, 0.0, -omega * s);
+    let h2 = (omega * c).powi(2) / 2.0;
+    let noise = Mat3::identity() * white_var + c_bn * Mat3::from_diagonal(&Vec3::new(h2, h2, 0.0)) * c_nb;
+    match (prior + noise).try_inverse() {
+        Some(inv) => {
+            let gain = prior * inv;
+            let cov = (Mat3::identity() - gain) * prior;
+            (gain * (mean_w - vertical), (cov + cov.transpose()) / 2.0)
+        }
+        None => (Vec3::zeros(), *prior),
+    }
 }
 
 /// Mean of rows [lo, hi) of `x`: the arithmetic mean of rate samples, or the sum of
@@ -293,7 +322,12 @@ fn align(t: &[f64], gyro: &[Vec3], accel: &[Vec3], kind: ImuKind, lla: &Vec3, el
         }
     }
     let euler_sigma = euler_sigma(&euler, &psi_cov);
-    Ok(CoarseAlignment { t0, t1, samples: n, q_nb, euler, mean_f, mean_w, gravity, earth_rate_h: ell.omega * lla.x.cos(), psi_cov, psi_cov_noise, euler_sigma, spread })
+    let (gyro_bias, gyro_bias_cov) = match heading {
+        Heading::Unknown => rest_gyro_bias(&c_nb, lla.x, ell.omega, &mean_w, &bias_cov(&bg), bg.white_psd / horizon),
+        Heading::Gyrocompass => (Vec3::zeros(), bias_cov(&bg)),
+    };
+    Ok(CoarseAlignment { t0, t1, samples: n, q_nb, euler, mean_f, mean_w, gravity, earth_rate_h: ell.omega * lla.x.cos(), psi_cov, psi_cov_noise, euler_sigma,
+                         spread, gyro_bias, gyro_bias_cov })
 }
 
 /// The start of a fine alignment after a coarse one at `lla` (attitude `q_nb`, the coarse

@@ -59,6 +59,8 @@ fn coarse_dict<'py>(py: Python<'py>, c: &CoarseAlignment) -> PyResult<Bound<'py,
     d.set_item("psi_cov", mat_to_py(py, &c.psi_cov))?;
     d.set_item("psi_cov_noise", mat_to_py(py, &c.psi_cov_noise))?;
     d.set_item("spread", c.spread)?;
+    d.set_item("gyro_bias", c.gyro_bias.as_slice().to_vec())?;
+    d.set_item("gyro_bias_cov", mat_to_py(py, &c.gyro_bias_cov))?;
     Ok(d)
 }
 
