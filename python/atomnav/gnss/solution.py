@@ -25,7 +25,7 @@ from __future__ import annotations
 
 import gzip
 import io
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from os import PathLike
 from pathlib import Path
 from typing import Mapping
@@ -87,11 +87,20 @@ class PosSolution:
         Time 0 of ``time_s`` (GPS time scale).
     time_scale : str
         The file's time scale: ``"GPST"``, ``"UTC"`` or ``"JST"`` (converted to GPS time).
+    default_gains : mapping
+        Multiplier on the covariance columns' σ per quality when
+        :meth:`position_fixes` is given none: :data:`SIGMA_GAINS` for a ``.pos`` file
+        (formal σ's), 1 for an NMEA log (its σ's are already final, see
+        :func:`~atomnav.gnss.read_nmea`). A quality without a gain is not used.
+    skipped : int
+        Epochs left out because the receiver had no solution (NMEA quality 0, 7 or 8).
     """
 
     data: pd.DataFrame
     epoch: pd.Timestamp
     time_scale: str
+    default_gains: Mapping[str, float] = field(default_factory=lambda: dict(SIGMA_GAINS))
+    skipped: int = 0
 
     @property
     def has_velocity(self) -> bool:
@@ -115,7 +124,7 @@ class PosSolution:
         ----------
         gains : mapping, optional
             Multiplier on the file's σ per quality name (covariance × gain²); default
-            :data:`SIGMA_GAINS`. A quality without a gain is left out.
+            :attr:`default_gains`. A quality without a gain is left out.
         lever_arm : array_like (3,), optional
             Antenna position from the IMU in the body frame, m, passed to
             :class:`~atomnav.filter.PositionFixes` when given.
@@ -136,7 +145,7 @@ class PosSolution:
         Parameters
         ----------
         gains : mapping, optional
-            Multiplier on the file's velocity σ per quality name; default :data:`SIGMA_GAINS`.
+            Multiplier on the file's velocity σ per quality name; default :attr:`default_gains`.
         lever_arm : array_like (3,), optional
             Antenna position from the IMU in the body frame, m.
 
@@ -159,7 +168,7 @@ class PosSolution:
 
     def _kept(self, gains) -> tuple[pd.DataFrame, np.ndarray]:
         """The rows of a quality with a gain, and each row's covariance factor (gain²)."""
-        gains = dict(SIGMA_GAINS if gains is None else gains)
+        gains = dict(self.default_gains if gains is None else gains)
         for name, g in gains.items():
             if name not in SIGMA_GAINS and name != "dr":
                 raise input_error("gains", f"unknown quality {name!r}; one of {list(QUALITY.values())}")
@@ -195,7 +204,7 @@ def read_pos(source: str | PathLike | io.TextIOBase, *, epoch=None) -> PosSoluti
         with fewer fields than the header names (a truncated line), a field that is not a
         number, an unknown Q, or times that do not increase.
     """
-    lines = _text(source).splitlines()
+    lines = read_text(source).splitlines()
     header = [i for i, ln in enumerate(lines) if ln.startswith("%")]
     labels = lines[header[-1]].lstrip("%").split() if header else []
     if not labels or labels[0] not in _TIME_SCALES:
@@ -222,7 +231,7 @@ def read_pos(source: str | PathLike | io.TextIOBase, *, epoch=None) -> PosSoluti
         lat, lon = (_dms(values[:, k:k + 3]) for k in (0, 3))
         values = np.column_stack([lat, lon, values[:, 6:]])
     cols = dict(zip(names, values.T))
-    epoch0 = _epoch(epoch)
+    epoch0 = parse_epoch(epoch)
     time_s = (time - epoch0) / pd.Timedelta(seconds=1)
     bad = np.flatnonzero(np.diff(time_s) <= 0)
     if len(bad):
@@ -242,16 +251,16 @@ def read_pos(source: str | PathLike | io.TextIOBase, *, epoch=None) -> PosSoluti
     out.update(lat_rad=lla[:, 0], lon_rad=lla[:, 1], h_m=lla[:, 2], q=q.astype(np.int64),
                quality=pd.Series(q.astype(np.int64)).map(QUALITY).to_numpy(), n_sats=cols["ns"].astype(np.int64),
                age_s=cols["age(s)"], ratio=cols["ratio"])
-    out.update(_cov_columns(cov, NED_COV))
+    out.update(cov_columns(cov, NED_COV))
     if set(_NEU_VEL) <= set(cols):
         v = np.column_stack([cols["vn(m/s)"], cols["ve(m/s)"], -cols["vu(m/s)"]])
-        out.update(dict(zip(VEL_COLUMNS, v.T)), **_cov_columns(_neu_to_ned(_cov(cols, _NEU_VEL[3:])), VEL_COV))
+        out.update(dict(zip(VEL_COLUMNS, v.T)), **cov_columns(_neu_to_ned(_cov(cols, _NEU_VEL[3:])), VEL_COV))
     elif set(_XYZ_VEL) <= set(cols):
         v_e = np.column_stack([cols[c] for c in _XYZ_VEL[:3]])
         rot = np.stack([earth.dcm_ned_to_ecef(la, lo) for la, lo in lla[:, :2]])
         v = np.einsum("kji,kj->ki", rot, v_e)
         cov_v = np.einsum("kji,kjl,klm->kim", rot, _cov(cols, _XYZ_VEL[3:]), rot)
-        out.update(dict(zip(VEL_COLUMNS, v.T)), **_cov_columns(cov_v, VEL_COV))
+        out.update(dict(zip(VEL_COLUMNS, v.T)), **cov_columns(cov_v, VEL_COV))
     return PosSolution(pd.DataFrame(out), epoch0, scale)
 
 
@@ -271,7 +280,19 @@ def gps_minus_utc(when: pd.Timestamp) -> int:
     return max([n for date, n in LEAP_SECONDS if when >= pd.Timestamp(date)], default=0)
 
 
-def _text(source) -> str:
+def read_text(source) -> str:
+    """The whole text of a solution file.
+
+    Parameters
+    ----------
+    source : str, path-like or text stream
+        The file (``.gz``: read through gzip) or an open text stream.
+
+    Returns
+    -------
+    str
+        Its text.
+    """
     if hasattr(source, "read"):
         return source.read()
     path = Path(source)
@@ -316,7 +337,20 @@ def _gps_time(raw: pd.DataFrame, dated: bool, scale: str, data_lines) -> pd.Seri
     return utc + pd.to_timedelta(np.array([gps_minus_utc(x) for x in utc], dtype=float), unit="s")
 
 
-def _epoch(epoch) -> pd.Timestamp:
+def parse_epoch(epoch) -> pd.Timestamp:
+    """Time 0 of a solution's ``time_s``.
+
+    Parameters
+    ----------
+    epoch : datetime-like, "gps" or None
+        A time on the GPS time scale without a time zone, ``"gps"`` for 1980-01-06, or
+        None for 1970-01-01.
+
+    Returns
+    -------
+    Timestamp
+        The epoch (naive, GPS time scale).
+    """
     if epoch is None:
         return pd.Timestamp("1970-01-01")
     if isinstance(epoch, str) and epoch == "gps":
@@ -362,7 +396,21 @@ def _from_ecef(xyz: np.ndarray, cov_e: np.ndarray) -> tuple[np.ndarray, np.ndarr
     return lla, np.einsum("kji,kjl,klm->kim", rot, cov_e, rot)
 
 
-def _cov_columns(cov: np.ndarray, names: tuple[str, ...]) -> dict:
+def cov_columns(cov: np.ndarray, names: tuple[str, ...]) -> dict:
+    """The six distinct entries of (N, 3, 3) covariances as named columns.
+
+    Parameters
+    ----------
+    cov : ndarray (N, 3, 3)
+        Symmetric covariances.
+    names : tuple of str
+        Column names of the entries (0,0), (1,1), (2,2), (0,1), (1,2), (2,0).
+
+    Returns
+    -------
+    dict
+        Column name → (N,) array.
+    """
     idx = ((0, 0), (1, 1), (2, 2), (0, 1), (1, 2), (2, 0))
     return {n: cov[:, i, j] for n, (i, j) in zip(names, idx)}
 
