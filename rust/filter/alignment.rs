@@ -489,6 +489,12 @@ impl ZeroRate {
         Ok(ZeroRate { times, kind, gyro_psd, sigma, sum: Vec3::zeros(), span: 0.0 })
     }
 
+    /// The same updates on a record of `kind` (a source checked before the INS that
+    /// gives the kind is built).
+    pub fn on_record(self, kind: ImuKind) -> Self {
+        ZeroRate { kind, ..self }
+    }
+
     fn model(&mut self, ctx: &AidingContext) -> Result<Option<Measurement>> {
         if self.span <= 0.0 {
             return Ok(None);

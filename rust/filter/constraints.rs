@@ -128,6 +128,11 @@ impl ZeroRateWhileStill {
         Ok(ZeroRateWhileStill { rate, intervals })
     }
 
+    /// The same updates on a record of `kind` (see [`ZeroRate::on_record`]).
+    pub fn on_record(self, kind: ImuKind) -> Self {
+        ZeroRateWhileStill { rate: self.rate.on_record(kind), ..self }
+    }
+
     /// Whether (t0, t1] lies inside a still interval.
     fn inside(&self, t0: f64, t1: f64) -> bool {
         let i = self.intervals.partition_point(|iv| iv[1] < t1);

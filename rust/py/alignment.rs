@@ -116,10 +116,9 @@ fn zero_velocity(time: numpy::PyReadonlyArray1<'_, f64>, #[pyo3(from_py_with = r
 /// and a motion allowance σ `sigma` (rad/s); the IMU kind is the INS's.
 #[pyfunction]
 fn zero_rate(time: numpy::PyReadonlyArray1<'_, f64>, #[pyo3(from_py_with = real)] gyro_psd: f64, #[pyo3(from_py_with = real)] sigma: f64) -> PyResult<AidingSource> {
-    let t = vector(&time, "time")?;
-    // checked now, with the setup's IMU kind when the INS is built
-    ZeroRate::new(t.clone(), ImuKind::Rates, gyro_psd, sigma)?;
-    Ok(AidingSource::deferred("zero_rate".to_string(), Box::new(move |setup| Ok(Source::plain(Box::new(ZeroRate::new(t, setup.kind, gyro_psd, sigma)?))))))
+    // checked now; the IMU kind is the setup's, when the INS is built
+    let rate = ZeroRate::new(vector(&time, "time")?, ImuKind::Rates, gyro_psd, sigma)?;
+    Ok(AidingSource::deferred("zero_rate".to_string(), Box::new(move |setup| Ok(Source::plain(Box::new(rate.on_record(setup.kind)))))))
 }
 
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {

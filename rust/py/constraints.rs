@@ -37,10 +37,10 @@ fn detect_still<'py>(
 /// [start, end] s only; the IMU kind is the INS's.
 #[pyfunction]
 fn zero_rate_while_still(time: PyReadonlyArray1<'_, f64>, #[pyo3(from_py_with = real)] gyro_psd: f64, #[pyo3(from_py_with = real)] sigma: f64, intervals: PyReadonlyArray2<'_, f64>) -> PyResult<AidingSource> {
-    let (t, iv) = (vector(&time, "time")?, rows::<2>(&intervals, "intervals")?);
-    // checked now, with the setup's IMU kind when the INS is built
-    ZeroRateWhileStill::new(ZeroRate::new(t.clone(), ImuKind::Rates, gyro_psd, sigma)?, iv.clone())?;
-    Ok(AidingSource::deferred("zero_rate".to_string(), Box::new(move |setup| Ok(Source::plain(Box::new(ZeroRateWhileStill::new(ZeroRate::new(t, setup.kind, gyro_psd, sigma)?, iv)?))))))
+    // checked now; the IMU kind is the setup's, when the INS is built
+    let rate = ZeroRate::new(vector(&time, "time")?, ImuKind::Rates, gyro_psd, sigma)?;
+    let still = ZeroRateWhileStill::new(rate, rows::<2>(&intervals, "intervals")?)?;
+    Ok(AidingSource::deferred("zero_rate".to_string(), Box::new(move |setup| Ok(Source::plain(Box::new(still.on_record(setup.kind)))))))
 }
 
 /// The non-holonomic constraint at `time` (M,) s with noise σ `sigma` (m/s) at the lever
