@@ -42,8 +42,8 @@ rinex.write_obs("rover.obs.rnx", obs_true)
 
 # --- the README's walkthrough ---------------------------------------------------------
 eph = rinex.read_nav("brdc.nav.rnx")                  # GPS and GLONASS broadcast ephemerides
-obs = rinex.read_obs("rover.obs.rnx", eph)            # time_s (GPS s of week), sat, channel, code_m, rate_mps
-spp = an.gnss.solve(eph, obs)                         # per epoch: lat_rad, lon_rad, h_m, clock_m, tau_gps_s, DOP, ECEF velocity
+obs = rinex.read_obs("rover.obs.rnx", eph).table      # time_s (GPS s of week), sat, channel, code_m, rate_mps
+spp = an.gnss.solve(eph, obs).epochs                  # per epoch: lat_rad, lon_rad, h_m, clock_m, tau_gps_s, DOP, ECEF velocity
 print(spp[["time_s", "lat_rad", "lon_rad", "h_m", "tau_gps_s", "n_sats", "hdop"]].head().to_string())
 
 imu = pd.read_csv("imu_100hz.csv")                    # time_s (GPS s of week), gyro_*_rad_s, accel_*_mps2

@@ -612,6 +612,8 @@ EXEMPT = {
     "atomnav.noise.arma.ArmaFit": "the result of noise.arma.fit_arma",
     "atomnav.noise.report.Comparison": "the result of noise.report.compare",
     "atomnav.gnss.solution.PosSolution": "the result of gnss.read_pos",
+    "atomnav.gnss.spp.SppResult": "the result of gnss.solve",
+    "atomnav.gnss.rinex.RinexObservations": "the result of gnss.rinex.read_obs",
     "atomnav.astro.results.Calibration": "the result of astro.calibrate",
     "atomnav.filter.aided.AidedResult": "the result of an aided INS run",
     "atomnav.filter.analysis.MonteCarlo": "the result of a filter Monte-Carlo campaign",

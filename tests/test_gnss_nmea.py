@@ -157,3 +157,10 @@ def test_log_without_a_fix_names_source():
     with pytest.raises(an.InputError) as e:
         _read([_sentence("GPGGA,,,,,,,,,,,,,,"), "some text"])
     assert e.value.parameter == "source"
+
+
+def test_wrong_types_raise_type_error():
+    with pytest.raises(TypeError, match="sigma"):
+        read_nmea(DATA / "rtk_0759.nmea", sigma="fraction")
+    with pytest.raises(TypeError, match="source"):
+        read_nmea(3.0)

@@ -44,8 +44,8 @@ def test_keywords_and_options_object_agree():
     a = gnss.simulate(eph, t, np.tile(lla, (2, 1)), np.zeros((2, 3)), sigma_code=1.0, iono=False, seed=3)
     b = gnss.simulate(eph, t, np.tile(lla, (2, 1)), np.zeros((2, 3)), GnssOptions(sigma_code=1.0, iono=False), seed=3)
     assert a.equals(b)
-    s1 = gnss.solve(eph, a, use_tau=False, iono=False)
-    s2 = gnss.solve(eph, a, GnssOptions(use_tau=False, iono=False))
+    s1 = gnss.solve(eph, a, use_tau=False, iono=False).epochs
+    s2 = gnss.solve(eph, a, GnssOptions(use_tau=False, iono=False)).epochs
     assert s1.equals(s2) and list(s1.columns) == list(_core.SPP_COLUMNS)
     with pytest.raises(TypeError, match="sigma_kode"):
         gnss.solve(eph, a, sigma_kode=1.0)

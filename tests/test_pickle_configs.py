@@ -18,7 +18,7 @@ import pandas as pd
 import pytest
 
 import atomnav as an
-from atomnav import _core, astro, cai
+from atomnav import _core, astro, cai, gnss
 from atomnav.filter import (BiasModel, InsSetup, Layout, MonteCarlo, NonHolonomic, PositionFixes, VelocityFixes, ZeroRate, ZeroVelocity,
                             aided_ins, monte_carlo, position_aided_ins)
 from atomnav.filter.analysis import Scenario
@@ -351,6 +351,13 @@ def _alignment():
     return coarse, an.alignment.fine(meas.iloc[1000:], lla, coarse)
 
 
+def _spp_result():
+    eph = gnss.Ephemerides.nominal(0.0, 600.0, seed=1)
+    lla = np.array([np.radians(55.75), np.radians(37.6), 200.0])
+    obs = gnss.simulate(eph, [100.0, 101.0], np.tile(lla, (2, 1)), np.zeros((2, 3)), seed=3)
+    return gnss.solve(eph, obs)
+
+
 def _motion_alignment():
     car = an.trajectory.car(rate_hz=50.0, vibration=False)
     meas = an.imu.corrupt(car.ideal_imu("rates"), errors="mems", dt=0.02, kind="rates", seed=3)
@@ -394,6 +401,10 @@ CASES = {
     "ArmaFit": lambda: fit_arma(_series(), order=(1, 1)),
     "ArimaStateSpace": lambda: ArimaStateSpace(ar=PAPER_AR, ma=PAPER_MA, sigma2=PAPER_SIGMA2),
     "PosSolution": lambda: read_pos(Path(__file__).parent / "data" / "real_walk" / "gnss_1730_sf.pos.gz"),
+    "SppResult": _spp_result,
+    "RinexObservations": lambda: gnss.rinex.read_obs(
+        Path(__file__).parent / "data" / "rinex_stations" / "delf0010_cut.21o.gz",
+        gnss.rinex.read_nav(Path(__file__).parent / "data" / "rinex_stations" / "brdc0010_cut.21n.gz")),
     "CoarseAlignment": lambda: _alignment()[0],
     "FineAlignment": lambda: _alignment()[1],
     "MotionAlignment": _motion_alignment,

@@ -165,13 +165,14 @@ def _timedelta_seconds(d: np.ndarray) -> np.ndarray:
 
 
 def table(df, names, parameter: str, *, order: str = "C", epoch=FIRST_SAMPLE, epoch_name: str = "epoch",
-          time=("time_s",), finite: bool = True) -> np.ndarray:
+          time=("time_s",), finite=True) -> np.ndarray:
     """The columns ``names`` of DataFrame ``df`` (argument ``parameter``) as one float64
     array (N, len(names)) in memory ``order`` ("C" or "F"), read by name (module
     docstring: extra columns ignored; missing, duplicated or ambiguous columns an
     :class:`InputError`; non-numbers a ``TypeError``). Columns named in ``time`` convert
-    through :func:`seconds` with ``epoch``. With ``finite``, a NaN (also ``pd.NA``) or inf
-    is an :class:`InputError` naming the column, its row in ``.index``."""
+    through :func:`seconds` with ``epoch``. With ``finite`` True (or a collection of the
+    column names it applies to), a NaN (also ``pd.NA``) or inf is an :class:`InputError`
+    naming the column, its row in ``.index``."""
     instance(df, pd.DataFrame, parameter)
     where = locate(df, names, parameter)
     if all(df.dtypes.iloc[k] == np.float64 for k in where):  # plain floats: one block read, often without a copy
@@ -183,6 +184,8 @@ def table(df, names, parameter: str, *, order: str = "C", epoch=FIRST_SAMPLE, ep
             out[:, j] = seconds(values, parameter, name, epoch, epoch_name) if name in time else _numbers(values, parameter, name)
     if finite:
         for j, name in enumerate(names):
+            if finite is not True and name not in finite:
+                continue
             bad = np.flatnonzero(~np.isfinite(out[:, j]))
             if bad.size:
                 raise input_error(parameter, f"column {name!r}: non-finite value {out[bad[0], j]} at index {bad[0]}", bad[0])
@@ -258,7 +261,11 @@ def increasing(t: np.ndarray, name: str, what: str = "time") -> None:
 
 def scalar(x, name: str) -> float:
     """``x`` as a float; a non-number, a bool or an array is a ``TypeError`` naming ``name``."""
-    if isinstance(x, (str, bytes, bool, np.bool_)) or np.ndim(x) != 0:
+    try:
+        shaped = np.ndim(x) != 0
+    except ValueError:  # ragged nesting
+        shaped = True
+    if isinstance(x, (str, bytes, bool, np.bool_)) or shaped:
         raise TypeError(f"{name}: expected a number, got {type(x).__name__}")
     return float(as_floats(x, name))
 

@@ -2,6 +2,7 @@
 //! validity check, and satellite state in WGS-84 (GLONASS through the datum transformation
 //! of docs/departures.md#datum).
 
+use super::atmosphere::Klobuchar;
 use super::glonass_orbit::{GloEphemeris, DEFAULT_STEP};
 use super::gps_orbit::GpsEphemeris;
 use super::{SatId, System, TimeScales};
@@ -32,6 +33,9 @@ pub struct Ephemerides {
     pub time: TimeScales,
     pub datum: Helmert,
     pub glo_step: f64,
+    /// The broadcast ionosphere of the navigation message (GPS Klobuchar α, β).
+    #[serde(default)]
+    pub ionosphere: Klobuchar,
 }
 
 impl Ephemerides {
@@ -65,7 +69,14 @@ impl Ephemerides {
         }
         g.values_mut().for_each(|v| v.sort_by(|a, b| a.toe.total_cmp(&b.toe)));
         r.values_mut().for_each(|v| v.sort_by(|a, b| a.tb.total_cmp(&b.tb)));
-        Ok(Ephemerides { gps: g, glo: r, time, datum, glo_step: DEFAULT_STEP })
+        Ok(Ephemerides { gps: g, glo: r, time, datum, glo_step: DEFAULT_STEP, ionosphere: Klobuchar::default() })
+    }
+
+    /// The same sets with the navigation message's Klobuchar coefficients (finite).
+    pub fn with_ionosphere(self, ionosphere: Klobuchar) -> Result<Ephemerides> {
+        crate::error::check_finite("ionosphere", &ionosphere.alpha, 1)?;
+        crate::error::check_finite("ionosphere", &ionosphere.beta, 1)?;
+        Ok(Ephemerides { ionosphere, ..self })
     }
 
     /// Every GPS set, by satellite then reference time.

@@ -35,12 +35,6 @@ pub struct Atmosphere {
 }
 
 impl Atmosphere {
-    /// The broadcast models: Klobuchar with the fixed coefficient set of
-    /// [`Klobuchar::default`] when `iono`, Saastamoinen when `tropo`.
-    pub fn broadcast(iono: bool, tropo: bool) -> Atmosphere {
-        Atmosphere { iono: iono.then(Klobuchar::default), tropo }
-    }
-
     /// Ionosphere + troposphere delay (m) of one signal; 0 below the horizon.
     pub fn delay(&self, sat: SatId, channel: i8, lla: &Vec3, g: &Geometry, t: f64) -> f64 {
         if g.elevation <= 0.0 {
@@ -102,8 +96,9 @@ pub fn receiver_ecef(lla: &Vec3, vel_ned: &Vec3) -> (Vec3, Vec3) {
     (WGS84.lla_to_ecef(lla), dcm_ned_to_ecef(lla.x, lla.y) * vel_ned)
 }
 
-/// Observations at GPS times `t` of a receiver at `lla` moving with `vel_ned`, each with its
-/// true elevation (rad). Satellites are those with ephemerides, in the order of
+/// Observations stamped `t` by the receiver's clock (the signals arrive at GPS time
+/// t − δt_r) of a receiver at `lla` moving with `vel_ned`, each with its true elevation
+/// (rad). Satellites are those with ephemerides, in the order of
 /// `Ephemerides::satellites`.
 // invariant: lla and vel_ned have one row per epoch of t (checked above), k < t.len().
 #[allow(clippy::indexing_slicing)]
@@ -118,9 +113,11 @@ pub fn simulate(eph: &Ephemerides, t: &[f64], lla: &[Vec3], vel_ned: &[Vec3], cf
     for k in 0..t.len() {
         let (r, v) = receiver_ecef(&lla[k], &vel_ned[k]);
         let (dtr, dtr_dot) = (cfg.clock_bias + cfg.clock_drift * t[k], cfg.clock_drift);
+        // a receiver stamps by its own clock: the signal arrives at GPS time t − δt_r
+        let t_rx = t[k] - dtr;
         let mut epoch = Vec::new();
         for &sat in &sats {
-            let g = geometry(eph, sat, t[k], &r, &v, lla[k].x, lla[k].y, cfg.tau_gps)?;
+            let g = geometry(eph, sat, t_rx, &r, &v, lla[k].x, lla[k].y, cfg.tau_gps)?;
             // draw the noise for every satellite so the streams do not depend on visibility
             let (n1, n2): (f64, f64) = (rng.sample(StandardNormal), rng.sample(StandardNormal));
             if !vis.visible(sat, t[k], g.elevation) {
@@ -131,7 +128,7 @@ pub fn simulate(eph: &Ephemerides, t: &[f64], lla: &[Vec3], vel_ned: &[Vec3], cf
                 System::Gps => (0.0, cfg.sigma_code_gps),
                 System::Glonass => (cfg.tau_gps, cfg.sigma_code_glo),
             };
-            let code = g.range + C_LIGHT * (dtr - g.sat.clock + tau) + cfg.atm.delay(sat, channel, &lla[k], &g, t[k]) + sigma * n1;
+            let code = g.range + C_LIGHT * (dtr - g.sat.clock + tau) + cfg.atm.delay(sat, channel, &lla[k], &g, t_rx) + sigma * n1;
             let rate = g.rate + C_LIGHT * (dtr_dot - g.sat.clock_rate) + cfg.sigma_rate * n2;
             epoch.push((Observation { sat, channel, code, rate }, g.elevation));
         }
@@ -187,15 +184,17 @@ pub fn simulate_table(eph: &Ephemerides, t: &[f64], lla: &[Vec3], vel_ned: &[Vec
 }
 
 /// Group a flat observation table (one row per satellite and epoch, time non-decreasing)
-/// into epochs; rejects decreasing time, non-finite code and duplicated satellites.
+/// into epochs; rejects decreasing or non-finite time, infinite code or rate and
+/// duplicated satellites. A NaN code or rate is a missing observable (not tracked), kept
+/// for the solvers to leave out and report.
 pub fn group_epochs(time: &[f64], obs: &[Observation]) -> Result<Vec<(f64, Vec<Observation>)>> {
     if time.len() != obs.len() {
         return Err(invalid("time", format!("{} time stamps for {} observations", time.len(), obs.len())));
     }
     let mut out: Vec<(f64, Vec<Observation>)> = Vec::new();
     for (i, (&t, o)) in time.iter().zip(obs).enumerate() {
-        if !t.is_finite() || !o.code.is_finite() {
-            return Err(invalid("obs", format!("non-finite time or pseudorange at index {i}")));
+        if !t.is_finite() || o.code.is_infinite() || o.rate.is_infinite() {
+            return Err(invalid("obs", format!("non-finite time or infinite pseudorange or rate at index {i}")));
         }
         match out.last_mut() {
             Some((t0, v)) if *t0 == t => {

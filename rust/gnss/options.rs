@@ -3,6 +3,7 @@
 //! atmosphere corrections, single-point options, and the tightly coupled filter's
 //! formulation, lever arm and clock models. Checked once by [`GnssOptions::check`].
 
+use super::ephemeris::Ephemerides;
 use super::observation::{Atmosphere, SimConfig};
 use super::spp::SppConfig;
 use super::tight::{Formulation, TightConfig};
@@ -10,6 +11,7 @@ use super::C_LIGHT;
 use crate::error::{invalid, Result};
 use crate::imu::ImuKind;
 use crate::math::Vec3;
+use std::f64::consts::FRAC_PI_2;
 
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct GnssOptions {
@@ -23,6 +25,9 @@ pub struct GnssOptions {
     /// Single-point positioning: estimate τ_GPS; σ/sin E weights.
     pub use_tau: bool,
     pub elevation_weight: bool,
+    /// Single-point positioning: elevation mask (rad), residual χ² test with exclusion.
+    pub elevation_mask: f64,
+    pub fault_detection: bool,
     /// Tight coupling: measurement formulation, IMU → antenna lever arm (body, m), use the
     /// pseudorange rates.
     #[serde(with = "crate::options::by_name")]
@@ -55,6 +60,8 @@ impl Default for GnssOptions {
             tropo: true,
             use_tau: true,
             elevation_weight: false,
+            elevation_mask: 10f64.to_radians(),
+            fault_detection: true,
             formulation: Formulation::FirstDifference,
             lever_arm: Vec3::zeros(),
             use_rate: true,
@@ -82,31 +89,44 @@ impl GnssOptions {
                 return Err(invalid(field, format!("must be finite and >= 0, got {x}")));
             }
         }
+        if !(self.elevation_mask.is_finite() && (-FRAC_PI_2..FRAC_PI_2).contains(&self.elevation_mask)) {
+            return Err(invalid("elevation_mask", format!("must be an elevation in [-π/2, π/2) rad, got {}", self.elevation_mask)));
+        }
         crate::error::check_finite("lever_arm", self.lever_arm.as_slice(), 1)?;
         crate::error::check_finite("tau0", &[self.tau0], 1)?;
         crate::error::check_finite("clock0", &self.clock0, 1)
     }
 
-    pub fn atmosphere(&self) -> Atmosphere {
-        Atmosphere::broadcast(self.iono, self.tropo)
+    /// The corrections applied: the navigation message's Klobuchar ionosphere of `eph`
+    /// when `iono`, Saastamoinen when `tropo`.
+    pub fn atmosphere(&self, eph: &Ephemerides) -> Atmosphere {
+        Atmosphere { iono: self.iono.then_some(eph.ionosphere), tropo: self.tropo }
     }
 
-    pub fn spp(&self) -> SppConfig {
-        SppConfig { use_tau: self.use_tau, atm: self.atmosphere(), sigma_gps: self.sigma_code_gps, sigma_glo: self.sigma_code_glo, elevation_weight: self.elevation_weight }
+    pub fn spp(&self, eph: &Ephemerides) -> SppConfig {
+        SppConfig {
+            use_tau: self.use_tau,
+            atm: self.atmosphere(eph),
+            sigma_gps: self.sigma_code_gps,
+            sigma_glo: self.sigma_code_glo,
+            elevation_weight: self.elevation_weight,
+            elevation_mask: self.elevation_mask,
+            fault_detection: self.fault_detection,
+        }
     }
 
     /// The simulator's noise and atmosphere with the true τ_GPS (s), receiver clock
     /// δt_r = `clock_bias` + `clock_drift`·t (s, s/s) and the noise seed.
-    pub fn simulation(&self, tau_gps: f64, clock_bias: f64, clock_drift: f64, seed: u64) -> Result<SimConfig> {
+    pub fn simulation(&self, eph: &Ephemerides, tau_gps: f64, clock_bias: f64, clock_drift: f64, seed: u64) -> Result<SimConfig> {
         for (field, x) in [("tau_gps", tau_gps), ("clock_bias", clock_bias), ("clock_drift", clock_drift)] {
             crate::error::check_finite(field, &[x], 1)?;
         }
         let (sigma_code_gps, sigma_code_glo, sigma_rate) = (self.sigma_code_gps, self.sigma_code_glo, self.sigma_rate);
-        Ok(SimConfig { sigma_code_gps, sigma_code_glo, sigma_rate, tau_gps, clock_bias, clock_drift, atm: self.atmosphere(), seed })
+        Ok(SimConfig { sigma_code_gps, sigma_code_glo, sigma_rate, tau_gps, clock_bias, clock_drift, atm: self.atmosphere(eph), seed })
     }
 
     /// The tight aiding's configuration for an IMU record of `kind`; the c·τ_GPS PSD in m²/s.
-    pub fn tight(&self, kind: ImuKind) -> TightConfig {
+    pub fn tight(&self, eph: &Ephemerides, kind: ImuKind) -> TightConfig {
         TightConfig {
             formulation: self.formulation,
             lever_arm: self.lever_arm,
@@ -114,7 +134,7 @@ impl GnssOptions {
             sigma_code_glo: self.sigma_code_glo,
             sigma_rate: self.sigma_rate,
             use_rate: self.use_rate,
-            atm: self.atmosphere(),
+            atm: self.atmosphere(eph),
             tau_psd: C_LIGHT * C_LIGHT * self.tau_psd,
             clock_h0: self.clock_h0,
             clock_hm2: self.clock_hm2,

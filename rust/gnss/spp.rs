@@ -5,7 +5,7 @@
 use super::ephemeris::Ephemerides;
 use super::geometry::{geometry, Geometry};
 use super::observation::{check_unique, Atmosphere, Observation};
-use super::{System, C_LIGHT};
+use super::{SatId, System, C_LIGHT};
 use crate::earth::{dcm_ned_to_ecef, WGS84};
 use crate::error::{invalid, NavError, Result};
 use crate::math::Vec3;
@@ -20,6 +20,56 @@ pub struct SppConfig {
     pub sigma_glo: f64,
     /// σ_i = σ/sin E_i instead of σ.
     pub elevation_weight: bool,
+    /// Satellites below this elevation (rad) are left out once the position is known.
+    pub elevation_mask: f64,
+    /// Residual χ² test with exclusion of the faulty satellite (RAIM FDE).
+    pub fault_detection: bool,
+}
+
+/// Why a satellite of an epoch is not in its solution.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Exclusion {
+    /// No pseudorange (NaN: not tracked).
+    NoCode,
+    /// No broadcast set valid at the epoch.
+    NoEphemeris,
+    /// Below the elevation mask.
+    Elevation,
+    /// Excluded by the residual χ² test (RAIM FDE).
+    Fault,
+    /// The epoch has fewer usable satellites than unknowns: no solution.
+    TooFew,
+}
+
+impl Exclusion {
+    /// Every reason, in code order (code k + 1 is `ALL[k]`; 0 means used).
+    pub const ALL: [Exclusion; 5] = [Exclusion::NoCode, Exclusion::NoEphemeris, Exclusion::Elevation, Exclusion::Fault, Exclusion::TooFew];
+    /// Its name in result tables.
+    pub const fn name(self) -> &'static str {
+        match self {
+            Exclusion::NoCode => "no_code",
+            Exclusion::NoEphemeris => "no_ephemeris",
+            Exclusion::Elevation => "elevation",
+            Exclusion::Fault => "fault",
+            Exclusion::TooFew => "too_few_satellites",
+        }
+    }
+    /// Its code in result rows (1-based; 0 = used).
+    pub fn code(self) -> f64 {
+        Self::ALL.iter().position(|e| *e == self).map_or(0.0, |k| (k + 1) as f64)
+    }
+}
+
+/// One satellite of an epoch: its look angles and post-fit residual at the solution
+/// (NaN when the satellite has no ephemeris or code, or the epoch no solution), and why it
+/// was left out, if it was.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SatelliteUse {
+    pub sat: SatId,
+    pub elevation: f64,
+    pub azimuth: f64,
+    pub residual: f64,
+    pub excluded: Option<Exclusion>,
 }
 
 /// DOP values of the geometry (unweighted, local NED).
@@ -45,8 +95,13 @@ pub struct SppSolution {
     pub cov: DMatrix<f64>,
     /// Residual metric m = Σ|z_i − h_iᵀx̂|/(N − n) (m), NaN when N = n (Eq. 23).
     pub residual_metric: f64,
-    /// Post-fit residuals (m) per observation, in input order.
+    /// Weighted sum of squared post-fit residuals Σ r_i²/σ_i² of the used satellites.
+    pub chi2: f64,
+    /// Post-fit residuals (m) of the used observations, in input order.
     pub residuals: Vec<f64>,
+    /// Every input observation, in input order: used or why not.
+    pub satellites: Vec<SatelliteUse>,
+    pub n_used: usize,
     pub n_unknowns: usize,
     pub dop: Dop,
     pub iterations: usize,
@@ -57,139 +112,346 @@ fn corrected_code(o: &Observation, g: &Geometry, atm: &Atmosphere, lla: &Vec3, t
     o.code + C_LIGHT * g.sat.clock - atm.delay(o.sat, o.channel, lla, g, t)
 }
 
-/// Position solution at GPS time t from the code observations of one epoch; `x0` is the
-/// initial ECEF guess (the Earth's centre when None).
-// invariant: x has n ∈ {4, 5} unknowns (5 exactly when with_tau), h is m × n, z and
-// w have m = obs.len() rows, i < m; cov is n × n.
-#[allow(clippy::indexing_slicing)]
-pub fn solve_position(eph: &Ephemerides, t: f64, obs: &[Observation], cfg: &SppConfig, x0: Option<Vec3>) -> Result<SppSolution> {
-    check_unique("obs", obs)?;
-    let has_glo = obs.iter().any(|o| o.sat.system == System::Glonass);
-    let with_tau = cfg.use_tau && has_glo;
-    let n = if with_tau { 5 } else { 4 };
-    if obs.len() < n {
-        let what = if with_tau { "position, clock and τ_GPS" } else { "position and clock" };
-        return Err(invalid("obs", format!("{} satellites at t = {t} s; the solver needs at least {n} ({what})", obs.len())));
+/// How long before its stamp a signal may have left the satellite (s): light time
+/// (< 0.09 s for a receiver on the ground or in low orbit) plus a receiver clock offset.
+const SIGNAL_SPAN: f64 = 0.2;
+
+/// Upper 0.1 % point of χ²(k): the tabulated values for k ≤ 10 (Abramowitz & Stegun 1964,
+/// Table 26.8) and the Wilson–Hilferty cube beyond (Wilson & Hilferty 1931; within 0.6 %
+/// for k > 10). RTKLIB's test uses the same level (Takasu 2013, `chisqr` in `pntpos.c`).
+pub fn chi2_threshold(k: usize) -> f64 {
+    const TABLE: [f64; 10] = [10.828, 13.816, 16.266, 18.467, 20.515, 22.458, 24.322, 26.124, 27.877, 29.588];
+    match k {
+        0 => f64::INFINITY,
+        1..=10 => TABLE.get(k - 1).copied().unwrap_or(f64::INFINITY),
+        _ => {
+            let (k, z) = (k as f64, 3.090_232);
+            let c = 2.0 / (9.0 * k);
+            k * (1.0 - c + z * c.sqrt()).powi(3)
+        }
     }
+}
+
+/// The outcome of [`least_squares`]: a converged fit, or too few usable satellites for
+/// the unknowns (with those the mask removed).
+enum Outcome {
+    Fit(Fit),
+    TooFew { used: usize, needed: usize, masked: Vec<usize> },
+}
+
+/// A converged least-squares fit of one set of satellites.
+struct Fit {
+    x: DVector<f64>,
+    with_tau: bool,
+    /// Indices (into the epoch's observations) used, and those the mask removed.
+    used: Vec<usize>,
+    masked: Vec<usize>,
+    h: DMatrix<f64>,
+    residuals: DVector<f64>,
+    weights: DVector<f64>,
+    normal_inverse: DMatrix<f64>,
+    iterations: usize,
+}
+
+impl Fit {
+    fn chi2(&self) -> f64 {
+        self.residuals.iter().zip(self.weights.iter()).map(|(r, w)| r * r * w).sum()
+    }
+    fn redundancy(&self) -> usize {
+        self.used.len().saturating_sub(self.x.len())
+    }
+}
+
+/// Gauss–Newton least squares for (position, c·δt_r[, c·τ_GPS]) from the observations
+/// `candidates` (indices into `obs`), starting at `x0`. Once the position is known
+/// (|r| > 1000 km) satellites below the mask are dropped; the signal leaves each satellite
+/// at the receive time t − c·δt_r/c of the current clock estimate.
+// invariant: x has n ∈ {4, 5} unknowns (5 exactly when with_tau), h is m × n, z and
+// w have m = used.len() rows, i < m; every index in candidates is < obs.len().
+#[allow(clippy::indexing_slicing)]
+fn least_squares(eph: &Ephemerides, t: f64, obs: &[Observation], candidates: &[usize], cfg: &SppConfig, x0: Option<Vec3>) -> Result<Outcome> {
+    let mut x = DVector::<f64>::zeros(5);
+    if let Some(p) = x0 {
+        x.rows_mut(0, 3).copy_from(&p);
+    }
+    let mut previous: Option<Vec<usize>> = None;
+    let mut iterations = 0;
+    loop {
+        iterations += 1;
+        let r = Vec3::new(x[0], x[1], x[2]);
+        let known = r.norm() > 1e6;
+        let lla = if known { WGS84.ecef_to_lla(&r) } else { Vec3::new(0.0, 0.0, -WGS84.a) };
+        let t_rx = t - x[3] / C_LIGHT;
+        let tau = x[4] / C_LIGHT;
+        // the mask is applied afresh at every iterate: early iterates can be far off
+        let (mut used, mut masked, mut geo) = (Vec::new(), Vec::new(), Vec::new());
+        for &i in candidates {
+            let g = geometry(eph, obs[i].sat, t_rx, &r, &Vec3::zeros(), lla.x, lla.y, tau)?;
+            if known && g.elevation < cfg.elevation_mask {
+                masked.push(i);
+            } else {
+                used.push(i);
+                geo.push(g);
+            }
+        }
+        let with_tau = cfg.use_tau && used.iter().any(|&i| obs[i].sat.system == System::Glonass);
+        let n = if with_tau { 5 } else { 4 };
+        if used.len() < n {
+            return Ok(Outcome::TooFew { used: used.len(), needed: n, masked });
+        }
+        let same_set = previous.as_ref() == Some(&used);
+        let m = used.len();
+        let mut h = DMatrix::<f64>::zeros(m, n);
+        let mut z = DVector::<f64>::zeros(m);
+        let mut w = DVector::<f64>::zeros(m);
+        for (k, (&i, g)) in used.iter().zip(&geo).enumerate() {
+            let o = &obs[i];
+            let glo = o.sat.system == System::Glonass;
+            let pred = g.range + x[3] + if glo && with_tau { x[4] } else { 0.0 };
+            z[k] = corrected_code(o, g, &cfg.atm, &lla, t_rx) - pred;
+            let row = -g.los * g.kappa;
+            h[(k, 0)] = row.x;
+            h[(k, 1)] = row.y;
+            h[(k, 2)] = row.z;
+            h[(k, 3)] = 1.0;
+            if with_tau {
+                // ∂P̂/∂(cτ) = 1 − κ uᵀv_s/c on GLONASS rows (the satellite epoch moves by −τ)
+                h[(k, 4)] = if glo { 1.0 - g.kappa * g.los.dot(&g.sat.vel) / C_LIGHT } else { 0.0 };
+            }
+            let s = if glo { cfg.sigma_glo } else { cfg.sigma_gps };
+            let s = if cfg.elevation_weight && known { s / g.elevation.sin().max(0.05) } else { s };
+            w[k] = 1.0 / (s * s);
+        }
+        let hw = DMatrix::from_fn(n, m, |a, b| h[(b, a)] * w[b]);
+        let chol = (&hw * &h).cholesky().ok_or_else(|| NavError::Numerical(format!("singular normal matrix at t = {t} s (degenerate geometry)")))?;
+        let dx = chol.solve(&(&hw * &z));
+        for j in 0..n {
+            x[j] += dx[j];
+        }
+        if !with_tau {
+            x[4] = 0.0;
+        }
+        if dx.rows(0, 3).norm() < 1e-4 && same_set {
+            // final residuals at the converged x: z − H·dx
+            let residuals = &z - &h * &dx;
+            let normal_inverse = chol.inverse();
+            return Ok(Outcome::Fit(Fit { x: x.rows(0, n).into_owned(), with_tau, used, masked, h, residuals, weights: w, normal_inverse, iterations }));
+        }
+        previous = Some(used);
+        if iterations >= 30 {
+            return Err(NavError::Numerical(format!("position solution did not converge at t = {t} s")));
+        }
+    }
+}
+
+/// Position solution at GPS time t from the code observations of one epoch; `x0` is the
+/// initial ECEF guess (the Earth's centre when None). A satellite without code or without
+/// a valid broadcast set, or below the mask, is left out and reported; with
+/// `fault_detection`, while the weighted residuals fail the χ² test ([`chi2_threshold`])
+/// and two or more observations are redundant, the satellite whose removal leaves the
+/// smallest χ² per degree of freedom is excluded (the subset test of RTKLIB's
+/// `raim_fde`, Takasu 2013). With fewer usable satellites than unknowns, the epoch has no
+/// solution ([`Epoch::TooFew`]).
+// invariant: fit.used/masked hold indices < obs.len() (= satellites.len()); the fit's x
+// has n ∈ {4, 5} entries and its normal_inverse is n × n.
+#[allow(clippy::indexing_slicing)]
+fn solve_epoch(eph: &Ephemerides, t: f64, obs: &[Observation], cfg: &SppConfig, x0: Option<Vec3>) -> Result<Epoch> {
+    check_unique("obs", obs)?;
+    let mut satellites: Vec<SatelliteUse> =
+        obs.iter().map(|o| SatelliteUse { sat: o.sat, elevation: f64::NAN, azimuth: f64::NAN, residual: f64::NAN, excluded: None }).collect();
+    let mut no_ephemeris = None;
     for (i, o) in obs.iter().enumerate() {
+        if o.code.is_nan() {
+            satellites[i].excluded = Some(Exclusion::NoCode);
+            continue;
+        }
         if !o.code.is_finite() {
-            return Err(invalid("obs", format!("non-finite pseudorange at index {i}")));
+            return Err(invalid("obs", format!("infinite pseudorange at index {i}")));
+        }
+        // valid over the whole signal path: the transmit time is up to ~0.1 s (light time
+        // plus a receiver clock of up to tens of ms) before the stamp
+        if let Err(e) = eph.state(o.sat, t, 0.0).and_then(|_| eph.state(o.sat, t - SIGNAL_SPAN, 0.0)) {
+            no_ephemeris.get_or_insert(e);
+            satellites[i].excluded = Some(Exclusion::NoEphemeris);
+            continue;
         }
         if o.sat.system == System::Glonass && eph.channel(o.sat)? != o.channel {
             return Err(invalid("obs", format!("{} at index {i}: channel {} but the ephemeris says {}", o.sat.name(), o.channel, eph.channel(o.sat)?)));
         }
     }
-    let m = obs.len();
-    // state (x, y, z, c·δt_r, c·τ_GPS): τ carried in metres for conditioning
-    let mut x = DVector::<f64>::zeros(n);
-    if let Some(p) = x0 {
-        x.rows_mut(0, 3).copy_from(&p);
-    }
-    let mut h = DMatrix::<f64>::zeros(m, n);
-    let mut z = DVector::<f64>::zeros(m);
-    let mut w = DVector::<f64>::zeros(m);
-    let mut iterations = 0;
-    let mut geo = Vec::with_capacity(m);
-    loop {
-        iterations += 1;
-        let r = Vec3::new(x[0], x[1], x[2]);
-        let lla = if r.norm() > 1e6 { WGS84.ecef_to_lla(&r) } else { Vec3::new(0.0, 0.0, -WGS84.a) };
-        let tau = if with_tau { x[4] / C_LIGHT } else { 0.0 };
-        geo.clear();
-        for (i, o) in obs.iter().enumerate() {
-            let g = geometry(eph, o.sat, t, &r, &Vec3::zeros(), lla.x, lla.y, tau)?;
-            let glo = o.sat.system == System::Glonass;
-            let pred = g.range + x[3] + if glo && with_tau { x[4] } else { 0.0 };
-            z[i] = corrected_code(o, &g, &cfg.atm, &lla, t) - pred;
-            let row = -g.los * g.kappa;
-            h[(i, 0)] = row.x;
-            h[(i, 1)] = row.y;
-            h[(i, 2)] = row.z;
-            h[(i, 3)] = 1.0;
-            if with_tau {
-                // ∂P̂/∂(cτ) = 1 − κ uᵀv_s/c on GLONASS rows (the satellite epoch moves by −τ)
-                h[(i, 4)] = if glo { 1.0 - g.kappa * g.los.dot(&g.sat.vel) / C_LIGHT } else { 0.0 };
-            }
-            let s = if glo { cfg.sigma_glo } else { cfg.sigma_gps };
-            let s = if cfg.elevation_weight && r.norm() > 1e6 { s / g.elevation.sin().max(0.05) } else { s };
-            w[i] = 1.0 / (s * s);
-            geo.push(g);
+    let candidates: Vec<usize> = (0..obs.len()).filter(|&i| satellites[i].excluded.is_none()).collect();
+    if candidates.is_empty() {
+        if let Some(e) = no_ephemeris {
+            return Err(e); // no satellite is covered: the time is outside the ephemerides
         }
-        let hw = DMatrix::from_fn(n, m, |a, b| h[(b, a)] * w[b]);
-        let nmat = &hw * &h;
-        let chol = nmat.clone().cholesky().ok_or_else(|| NavError::Numerical(format!("singular normal matrix at t = {t} s (degenerate geometry)")))?;
-        let dx = chol.solve(&(&hw * &z));
-        x += &dx;
-        let done = dx.rows(0, 3).norm() < 1e-4;
-        if done || iterations >= 30 {
-            if !done {
-                return Err(NavError::Numerical(format!("position solution did not converge at t = {t} s")));
+    }
+    let mut fit = match least_squares(eph, t, obs, &candidates, cfg, x0)? {
+        Outcome::Fit(f) => f,
+        Outcome::TooFew { used, needed, masked } => {
+            for u in satellites.iter_mut().filter(|u| u.excluded.is_none()) {
+                u.excluded = Some(Exclusion::TooFew);
             }
-            // final residuals at the converged x: z − H·dx
-            let res = &z - &h * &dx;
-            let mut cov = chol.inverse();
-            if with_tau {
-                for j in 0..5 {
-                    cov[(4, j)] /= C_LIGHT;
-                    cov[(j, 4)] /= C_LIGHT;
+            for i in masked {
+                satellites[i].excluded = Some(Exclusion::Elevation);
+            }
+            return Ok(Epoch::TooFew { used, needed, satellites });
+        }
+    };
+    let mut faults = Vec::new();
+    while cfg.fault_detection && fit.redundancy() >= 2 && fit.chi2() > chi2_threshold(fit.redundancy()) {
+        let start = Vec3::new(fit.x[0], fit.x[1], fit.x[2]);
+        let best = fit
+            .used
+            .iter()
+            .filter_map(|&k| {
+                let rest: Vec<usize> = fit.used.iter().copied().filter(|&i| i != k).collect();
+                match least_squares(eph, t, obs, &rest, cfg, Some(start)) {
+                    Ok(Outcome::Fit(f)) => Some((k, f)),
+                    _ => None,
                 }
-            }
-            let pos = Vec3::new(x[0], x[1], x[2]);
-            let lla = WGS84.ecef_to_lla(&pos);
-            let dop = dop(&h, &lla, n)?;
-            let metric = if m > n { res.iter().map(|v| v.abs()).sum::<f64>() / (m - n) as f64 } else { f64::NAN };
-            return Ok(SppSolution {
-                pos,
-                lla,
-                clock_m: x[3],
-                tau: if with_tau { Some(x[4] / C_LIGHT) } else { None },
-                cov,
-                residual_metric: metric,
-                residuals: res.iter().copied().collect(),
-                n_unknowns: n,
-                dop,
-                iterations,
-            });
+            })
+            .min_by(|a, b| (a.1.chi2() / a.1.redundancy().max(1) as f64).total_cmp(&(b.1.chi2() / b.1.redundancy().max(1) as f64)));
+        let Some((k, f)) = best else { break };
+        faults.push(k);
+        let masked = fit.masked.clone();
+        fit = f;
+        fit.masked.extend(masked);
+    }
+    for &i in &fit.masked {
+        satellites[i].excluded = Some(Exclusion::Elevation);
+    }
+    for &i in &faults {
+        satellites[i].excluded = Some(Exclusion::Fault);
+    }
+    let n = fit.x.len();
+    let pos = Vec3::new(fit.x[0], fit.x[1], fit.x[2]);
+    let lla = WGS84.ecef_to_lla(&pos);
+    let tau = if fit.with_tau { fit.x[4] / C_LIGHT } else { 0.0 };
+    let t_rx = t - fit.x[3] / C_LIGHT;
+    // look angles and residuals of every satellite with code and ephemeris at the solution
+    for (i, o) in obs.iter().enumerate() {
+        if matches!(satellites[i].excluded, Some(Exclusion::NoCode | Exclusion::NoEphemeris)) {
+            continue;
+        }
+        let g = geometry(eph, o.sat, t_rx, &pos, &Vec3::zeros(), lla.x, lla.y, tau)?;
+        let glo = o.sat.system == System::Glonass;
+        let pred = g.range + fit.x[3] + if glo && fit.with_tau { fit.x[4] } else { 0.0 };
+        satellites[i].residual = corrected_code(o, &g, &cfg.atm, &lla, t_rx) - pred;
+        satellites[i].elevation = g.elevation;
+        satellites[i].azimuth = g.azimuth.rem_euclid(std::f64::consts::TAU);
+    }
+    let mut cov = fit.normal_inverse.clone();
+    if fit.with_tau {
+        for j in 0..5 {
+            cov[(4, j)] /= C_LIGHT;
+            cov[(j, 4)] /= C_LIGHT;
+        }
+    }
+    let m = fit.used.len();
+    let metric = if m > n { fit.residuals.iter().map(|v| v.abs()).sum::<f64>() / (m - n) as f64 } else { f64::NAN };
+    let mut used_sorted = fit.used.clone();
+    used_sorted.sort_unstable();
+    let residuals = used_sorted.iter().map(|&i| satellites[i].residual).collect();
+    Ok(Epoch::Solved(SppSolution {
+        pos,
+        lla,
+        clock_m: fit.x[3],
+        tau: fit.with_tau.then_some(tau),
+        cov,
+        residual_metric: metric,
+        chi2: fit.chi2(),
+        residuals,
+        satellites,
+        n_used: m,
+        n_unknowns: n,
+        dop: dop(&fit.h, &lla, n)?,
+        iterations: fit.iterations,
+    }))
+}
+
+/// One epoch of [`solve_epoch`]: solved, or too few usable satellites (`used` of the
+/// `needed` unknowns) with every satellite's reason.
+enum Epoch {
+    Solved(SppSolution),
+    TooFew { used: usize, needed: usize, satellites: Vec<SatelliteUse> },
+}
+
+/// Position solution at GPS time t from the code observations of one epoch
+/// ([`solve_epoch`]); too few usable satellites is an error naming `obs` with the count.
+pub fn solve_position(eph: &Ephemerides, t: f64, obs: &[Observation], cfg: &SppConfig, x0: Option<Vec3>) -> Result<SppSolution> {
+    match solve_epoch(eph, t, obs, cfg, x0)? {
+        Epoch::Solved(s) => Ok(s),
+        Epoch::TooFew { used, needed, .. } => {
+            let what = if needed == 5 { "position, clock and τ_GPS" } else { "position and clock" };
+            Err(invalid("obs", format!("{used} usable satellites at t = {t} s; the solver needs at least {needed} ({what})")))
         }
     }
 }
 
 /// Columns of a [`solve_epochs`] row: time, ECEF and geodetic antenna position, c·δt_r,
-/// τ_GPS and its σ (s; NaN when not estimated), the residual metric, satellites and
+/// τ_GPS and its σ (s; NaN when not estimated), the residual metric, satellites used and
 /// unknowns, DOP values, Doppler velocity (ECEF m/s) and c·δṫ_r (m/s; NaN with fewer than
-/// four rates).
-pub const SPP_COLUMNS: [&str; 22] = [
+/// four rates), satellites excluded, and the weighted residual χ².
+pub const SPP_COLUMNS: [&str; 24] = [
     "time_s", "x_m", "y_m", "z_m", "lat_rad", "lon_rad", "h_m", "clock_m", "tau_gps_s", "sigma_tau_gps_s", "residual_metric_m", "n_sats",
-    "n_unknowns", "gdop", "pdop", "hdop", "vdop", "tdop", "vx_mps", "vy_mps", "vz_mps", "clock_drift_mps",
+    "n_unknowns", "gdop", "pdop", "hdop", "vdop", "tdop", "vx_mps", "vy_mps", "vz_mps", "clock_drift_mps", "n_excluded", "chi2",
 ];
+
+/// Columns of a per-satellite row of [`solve_epochs`]: time, elevation and azimuth (rad),
+/// post-fit residual (m), and the exclusion code (0 used, k + 1 for [`Exclusion::ALL`]`[k]`).
+pub const SPP_SATELLITE_COLUMNS: [&str; 5] = ["time_s", "elevation_rad", "azimuth_rad", "residual_m", "excluded"];
+
+/// The rows of [`solve_epochs`]: one per solved epoch, and one per satellite of every
+/// epoch with its name.
+#[derive(Debug, Clone, Default)]
+pub struct SppRows {
+    pub epochs: Vec<[f64; 24]>,
+    pub satellites: Vec<[f64; 5]>,
+    pub satellite_names: Vec<String>,
+}
 
 /// Single-point positioning epoch by epoch: each position solution starts from the
 /// previous epoch's (the first from the Earth's centre); the Doppler velocity
-/// ([`solve_velocity`], rate σ `sigma_rate` m/s) when at least four rates are finite.
-/// One row per epoch, columns [`SPP_COLUMNS`].
+/// ([`solve_velocity`], rate σ `sigma_rate` m/s) of the used satellites when at least
+/// four of them have a rate. An epoch with fewer usable satellites than unknowns has no
+/// row; its satellites are reported as [`Exclusion::TooFew`] (unless excluded earlier).
 // invariant: tau is Some only for the 5-unknown solution, whose cov is 5 × 5.
 #[allow(clippy::indexing_slicing)]
-pub fn solve_epochs(eph: &Ephemerides, epochs: &[(f64, Vec<Observation>)], cfg: &SppConfig, sigma_rate: f64) -> Result<Vec<[f64; 22]>> {
+pub fn solve_epochs(eph: &Ephemerides, epochs: &[(f64, Vec<Observation>)], cfg: &SppConfig, sigma_rate: f64) -> Result<SppRows> {
     crate::error::check_positive("sigma_rate", sigma_rate)?;
     let mut x0 = None;
-    epochs
-        .iter()
-        .map(|(t, ob)| {
-            let s = solve_position(eph, *t, ob, cfg, x0)?;
-            x0 = Some(s.pos);
-            let (v, d) = if ob.iter().filter(|o| o.rate.is_finite()).count() >= 4 {
-                let (v, d, _) = solve_velocity(eph, *t, ob, &s.pos, sigma_rate)?;
-                (v, d)
-            } else {
-                (Vec3::repeat(f64::NAN), f64::NAN)
-            };
-            let (tau, st) = s.tau.map_or((f64::NAN, f64::NAN), |x| (x, s.cov[(4, 4)].sqrt()));
-            Ok([
-                *t, s.pos.x, s.pos.y, s.pos.z, s.lla.x, s.lla.y, s.lla.z, s.clock_m, tau, st, s.residual_metric, ob.len() as f64,
-                s.n_unknowns as f64, s.dop.gdop, s.dop.pdop, s.dop.hdop, s.dop.vdop, s.dop.tdop, v.x, v.y, v.z, d,
-            ])
-        })
-        .collect()
+    let mut out = SppRows::default();
+    for (t, ob) in epochs {
+        let s = match solve_epoch(eph, *t, ob, cfg, x0)? {
+            Epoch::Solved(s) => s,
+            Epoch::TooFew { satellites, .. } => {
+                for u in satellites {
+                    out.satellites.push([*t, f64::NAN, f64::NAN, f64::NAN, u.excluded.map_or(0.0, Exclusion::code)]);
+                    out.satellite_names.push(u.sat.name());
+                }
+                continue;
+            }
+        };
+        x0 = Some(s.pos);
+        let used: Vec<Observation> = ob.iter().zip(&s.satellites).filter(|(_, u)| u.excluded.is_none()).map(|(o, _)| *o).collect();
+        let (v, d) = if used.iter().filter(|o| o.rate.is_finite()).count() >= 4 {
+            let (v, d, _) = solve_velocity(eph, *t - s.clock_m / C_LIGHT, &used, &s.pos, sigma_rate)?;
+            (v, d)
+        } else {
+            (Vec3::repeat(f64::NAN), f64::NAN)
+        };
+        let (tau, st) = s.tau.map_or((f64::NAN, f64::NAN), |x| (x, s.cov[(4, 4)].sqrt()));
+        let excluded = s.satellites.iter().filter(|u| u.excluded.is_some()).count();
+        out.epochs.push([
+            *t, s.pos.x, s.pos.y, s.pos.z, s.lla.x, s.lla.y, s.lla.z, s.clock_m, tau, st, s.residual_metric, s.n_used as f64,
+            s.n_unknowns as f64, s.dop.gdop, s.dop.pdop, s.dop.hdop, s.dop.vdop, s.dop.tdop, v.x, v.y, v.z, d, excluded as f64, s.chi2,
+        ]);
+        for u in &s.satellites {
+            out.satellites.push([*t, u.elevation, u.azimuth, u.residual, u.excluded.map_or(0.0, Exclusion::code)]);
+            out.satellite_names.push(u.sat.name());
+        }
+    }
+    Ok(out)
 }
 
 /// DOP from the design matrix rotated into local NED (position columns).
@@ -217,7 +479,8 @@ fn dop(h: &DMatrix<f64>, lla: &Vec3, n: usize) -> Result<Dop> {
 }
 
 /// Doppler velocity (Eq. 24): least squares for (v ECEF m/s, c·δṫ_r m/s) at the known
-/// antenna position `pos`, with rows (−κu_iᵀ, 1); returns (velocity, clock drift, covariance).
+/// antenna position `pos` and GPS receive time `t` (the stamp less the receiver clock),
+/// with rows (−κu_iᵀ, 1); returns (velocity, clock drift, covariance).
 // invariant: x has 4 unknowns, h and z one row per used observation (i < used.len()).
 #[allow(clippy::indexing_slicing)]
 pub fn solve_velocity(eph: &Ephemerides, t: f64, obs: &[Observation], pos: &Vec3, sigma: f64) -> Result<(Vec3, f64, DMatrix<f64>)> {
@@ -275,14 +538,14 @@ mod tests {
     fn noiseless_solution_recovers_position_clock_tau_and_velocity() {
         let (eph, lla, obs, sim) = setup(-340e-9, 0.0);
         assert!(obs.iter().filter(|o| o.sat.system == System::Glonass).count() >= 2);
-        let cfg = SppConfig { use_tau: true, atm: sim.atm, sigma_gps: 3.0, sigma_glo: 3.0, elevation_weight: false };
+        let cfg = SppConfig { use_tau: true, atm: sim.atm, sigma_gps: 3.0, sigma_glo: 3.0, elevation_weight: false, elevation_mask: 0.0, fault_detection: false };
         let s = solve_position(&eph, 600.0, &obs, &cfg, None).unwrap();
         let truth = WGS84.lla_to_ecef(&lla);
         assert!((s.pos - truth).norm() < 1e-4, "{}", (s.pos - truth).norm());
         assert!((s.clock_m - C_LIGHT * (2e-4 + 1e-8 * 600.0)).abs() < 1e-4);
         assert!((s.tau.unwrap() + 340e-9).abs() < 1e-13);
         assert!(s.residual_metric < 1e-4);
-        let (v, drift, _) = solve_velocity(&eph, 600.0, &obs, &truth, 0.05).unwrap();
+        let (v, drift, _) = solve_velocity(&eph, 600.0 - s.clock_m / C_LIGHT, &obs, &truth, 0.05).unwrap();
         let vt = dcm_ned_to_ecef(lla.x, lla.y) * Vec3::new(3.0, -2.0, 0.5);
         assert!((v - vt).norm() < 1e-6 && (drift - C_LIGHT * 1e-8).abs() < 1e-6, "{} {}", (v - vt).norm(), drift);
     }
@@ -322,11 +585,11 @@ mod tests {
     #[test]
     fn solve_epochs_rows_follow_the_rules() {
         let (eph, lla, obs, sim) = setup(-340e-9, 0.0);
-        let cfg = SppConfig { use_tau: true, atm: sim.atm, sigma_gps: 3.0, sigma_glo: 3.0, elevation_weight: false };
+        let cfg = SppConfig { use_tau: true, atm: sim.atm, sigma_gps: 3.0, sigma_glo: 3.0, elevation_weight: false, elevation_mask: 0.0, fault_detection: false };
         let gps: Vec<Observation> = obs.iter().filter(|o| o.sat.system == System::Gps).copied().collect();
         let mut few_rates = obs.clone();
         few_rates.iter_mut().skip(3).for_each(|o| o.rate = f64::NAN);
-        let rows = solve_epochs(&eph, &[(600.0, obs.clone()), (600.0, gps.clone()), (600.0, few_rates)], &cfg, 0.05).unwrap();
+        let rows = solve_epochs(&eph, &[(600.0, obs.clone()), (600.0, gps.clone()), (600.0, few_rates)], &cfg, 0.05).unwrap().epochs;
         let truth = WGS84.lla_to_ecef(&lla);
         let col = |name: &str| SPP_COLUMNS.iter().position(|c| *c == name).unwrap();
         for r in &rows {
@@ -341,14 +604,84 @@ mod tests {
     #[test]
     fn bad_input_is_rejected_with_the_count() {
         let (eph, _, obs, sim) = setup(0.0, 0.0);
-        let cfg = SppConfig { use_tau: true, atm: sim.atm, sigma_gps: 3.0, sigma_glo: 3.0, elevation_weight: false };
+        let cfg = SppConfig { use_tau: true, atm: sim.atm, sigma_gps: 3.0, sigma_glo: 3.0, elevation_weight: false, elevation_mask: 0.0, fault_detection: false };
         let e = solve_position(&eph, 600.0, &obs[..3], &cfg, None).unwrap_err().to_string();
-        assert!(e.contains("3 satellites") && e.contains("at least 4"), "{e}");
+        assert!(e.contains("3 usable satellites") && e.contains("at least 4"), "{e}");
         let mut dup = obs.clone();
         dup.push(obs[1]);
         let e = solve_position(&eph, 600.0, &dup, &cfg, None).unwrap_err().to_string();
         assert!(e.contains("duplicated satellite") && e.contains(&format!("index {}", obs.len())), "{e}");
         let e = solve_position(&eph, 30000.0, &obs, &cfg, None).unwrap_err().to_string();
         assert!(e.contains("does not overlap the ephemerides") && e.contains("validity"), "{e}");
+    }
+    fn config(mask_deg: f64, fault_detection: bool) -> SppConfig {
+        let atm = Atmosphere { iono: Some(Default::default()), tropo: true };
+        SppConfig { use_tau: true, atm, sigma_gps: 3.0, sigma_glo: 3.0, elevation_weight: false, elevation_mask: mask_deg.to_radians(), fault_detection }
+    }
+
+    /// Satellites the simulator put below 10° (its true elevations) are the ones the mask
+    /// leaves out; the rest give the truth.
+    #[test]
+    fn the_elevation_mask_leaves_out_exactly_the_low_satellites() {
+        let cfg = ConstellationConfig { gps: true, glonass: true, t_start: 0.0, t_end: 3600.0, tau_gps: 0.0, time: TimeScales::default(), clocks: true, seed: 3 };
+        let eph = nominal(&cfg).unwrap();
+        let lla = Vec3::new(55.75f64.to_radians(), 37.6f64.to_radians(), 200.0);
+        let sim = SimConfig { sigma_code_gps: 0.0, sigma_code_glo: 0.0, sigma_rate: 0.0, tau_gps: 0.0, clock_bias: 1e-3, clock_drift: 0.0, atm: config(0.0, false).atm, seed: 1 };
+        let vis = Visibility { mask: 0.0, ..Default::default() };
+        let epoch = simulate(&eph, &[600.0], &[lla], &[Vec3::zeros()], &sim, &vis).unwrap().remove(0);
+        let low: Vec<SatId> = epoch.iter().filter(|(_, e)| *e < 10f64.to_radians()).map(|(o, _)| o.sat).collect();
+        assert!(!low.is_empty());
+        let obs: Vec<Observation> = epoch.iter().map(|x| x.0).collect();
+        let s = solve_position(&eph, 600.0, &obs, &config(10.0, true), None).unwrap();
+        let masked: Vec<SatId> = s.satellites.iter().filter(|u| u.excluded == Some(Exclusion::Elevation)).map(|u| u.sat).collect();
+        assert_eq!(masked, low);
+        assert_eq!(s.n_used, obs.len() - low.len());
+        assert!((s.pos - WGS84.lla_to_ecef(&lla)).norm() < 1e-4, "{}", (s.pos - WGS84.lla_to_ecef(&lla)).norm());
+    }
+
+    /// A 100 m fault on one satellite fails the χ² test; the subset without it passes and
+    /// gives the noiseless truth. Without fault detection the fault pulls the solution.
+    #[test]
+    fn fault_detection_excludes_a_100_m_pseudorange_fault() {
+        let (eph, lla, mut obs, _) = setup(-340e-9, 0.0);
+        let bad = obs.iter().position(|o| o.sat.system == System::Gps).unwrap();
+        obs[bad].code += 100.0;
+        let truth = WGS84.lla_to_ecef(&lla);
+        let s = solve_position(&eph, 600.0, &obs, &config(0.0, true), None).unwrap();
+        let faults: Vec<usize> = s.satellites.iter().enumerate().filter(|(_, u)| u.excluded == Some(Exclusion::Fault)).map(|(i, _)| i).collect();
+        assert_eq!(faults, vec![bad]);
+        assert!((s.pos - truth).norm() < 1e-4 && s.chi2 < 1e-6);
+        assert!((s.satellites[bad].residual - 100.0).abs() < 1e-3, "{}", s.satellites[bad].residual);
+        let plain = solve_position(&eph, 600.0, &obs, &config(0.0, false), None).unwrap();
+        assert!((plain.pos - truth).norm() > 5.0 && plain.chi2 > chi2_threshold(plain.n_used - plain.n_unknowns));
+    }
+
+    /// A satellite the ephemerides do not have, and one without code, are reported and do
+    /// not change the solution; an epoch left with three satellites has no row.
+    #[test]
+    fn missing_ephemeris_and_code_are_reported_not_fatal() {
+        let (eph, lla, obs, _) = setup(-340e-9, 0.0);
+        let truth = WGS84.lla_to_ecef(&lla);
+        let unknown = (1..=32).map(SatId::gps).find(|s| !eph.satellites().contains(s)).unwrap();
+        let mut more = obs.clone();
+        more.push(Observation { sat: unknown, channel: 0, code: 2.2e7, rate: f64::NAN });
+        more[0].code = f64::NAN;
+        let s = solve_position(&eph, 600.0, &more, &config(0.0, true), None).unwrap();
+        assert_eq!(s.satellites.last().unwrap().excluded, Some(Exclusion::NoEphemeris));
+        assert_eq!(s.satellites[0].excluded, Some(Exclusion::NoCode));
+        assert!((s.pos - truth).norm() < 1e-4 && s.n_used == obs.len() - 1);
+        let gps: Vec<Observation> = obs.iter().filter(|o| o.sat.system == System::Gps).take(3).copied().collect();
+        let rows = solve_epochs(&eph, &[(600.0, obs.clone()), (630.0, gps)], &config(0.0, true), 0.05).unwrap();
+        assert_eq!(rows.epochs.len(), 1);
+        let last: Vec<f64> = rows.satellites.iter().filter(|r| r[0] == 630.0).map(|r| r[4]).collect();
+        assert_eq!(last, vec![Exclusion::TooFew.code(); 3]);
+    }
+
+    /// χ² upper 0.1 % points (tables: Abramowitz & Stegun 1964, Table 26.8).
+    #[test]
+    fn chi2_thresholds_match_the_table() {
+        for (k, x) in [(1, 10.828), (2, 13.816), (3, 16.266), (5, 20.515), (10, 29.588), (20, 45.315), (30, 59.703)] {
+            assert!((chi2_threshold(k) / x - 1.0).abs() < 6e-3, "{k}: {}", chi2_threshold(k));
+        }
     }
 }

@@ -134,7 +134,7 @@ impl TightAiding {
         let a_ev = Mat3::new(0.0, 1.0 / loc.rp, 0.0, -1.0 / loc.rm, 0.0, 0.0, 0.0, -loc.sin / (loc.cos * loc.rp), 0.0);
         let frame_term = skew(&(cne.transpose() * v_a)) * a_ev;
         let mut rows = Vec::new();
-        for o in epoch {
+        for o in epoch.iter().filter(|o| o.code.is_finite()) {
             let glo = o.sat.system == System::Glonass;
             let g = geometry(&self.eph, o.sat, t, &r_a, &v_a, lla_a.x, lla_a.y, tau.map_or(0.0, |x| x.1 / C_LIGHT))?;
             if g.elevation <= 0.0 {

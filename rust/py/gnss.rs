@@ -6,6 +6,7 @@ use super::convert::{real, real_opt, register_choices, rows, seed as seed_arg, t
 use super::filter::floats;
 use crate::earth::Helmert;
 use crate::error::invalid;
+use crate::gnss::atmosphere::Klobuchar;
 use crate::gnss::constellation::{nominal, ConstellationConfig};
 use crate::gnss::ephemeris::Ephemerides;
 use crate::gnss::geometry::look_angles;
@@ -13,7 +14,7 @@ use crate::gnss::glonass_orbit::{propagate_checked, GloEphemeris};
 use crate::gnss::gps_orbit::GpsEphemeris;
 use crate::gnss::observation::{group_epochs, observations, simulate_table, Observation, Visibility};
 use crate::gnss::options::GnssOptions;
-use crate::gnss::spp::{solve_epochs, SPP_COLUMNS};
+use crate::gnss::spp::{solve_epochs, Exclusion, SPP_COLUMNS, SPP_SATELLITE_COLUMNS};
 use crate::gnss::tight::{Formulation, TightAiding};
 use crate::gnss::{SatId, TimeScales};
 use crate::math::Vec3;
@@ -40,11 +41,28 @@ fn sat_id(name: &str) -> PyResult<SatId> {
 #[pymethods]
 impl PyEphemerides {
     #[new]
-    #[pyo3(signature = (gps, glonass, n_leap=18.0, datum=Wrap(Helmert::IDENTITY)))]
-    fn new(gps: PyReadonlyArray2<'_, f64>, glonass: PyReadonlyArray2<'_, f64>, #[pyo3(from_py_with = real)] n_leap: f64, datum: Wrap<Helmert>) -> PyResult<Self> {
+    #[pyo3(signature = (gps, glonass, n_leap=18.0, datum=Wrap(Helmert::IDENTITY), *, ionosphere=None))]
+    fn new(
+        gps: PyReadonlyArray2<'_, f64>, glonass: PyReadonlyArray2<'_, f64>, #[pyo3(from_py_with = real)] n_leap: f64, datum: Wrap<Helmert>, ionosphere: Option<&Bound<'_, PyAny>>,
+    ) -> PyResult<Self> {
         let g = rows::<22>(&gps, "gps")?.iter().map(GpsEphemeris::from_row).collect();
         let r = rows::<14>(&glonass, "glonass")?.iter().enumerate().map(|(i, x)| GloEphemeris::from_row(x, i)).collect::<crate::Result<Vec<_>>>()?;
-        Ok(PyEphemerides { inner: Ephemerides::new(g, r, TimeScales { n_leap }, datum.0)? })
+        let eph = Ephemerides::new(g, r, TimeScales { n_leap }, datum.0)?;
+        let inner = match ionosphere {
+            Some(k) => {
+                let c = floats::<8>(k, "ionosphere")?;
+                eph.with_ionosphere(Klobuchar { alpha: [c[0], c[1], c[2], c[3]], beta: [c[4], c[5], c[6], c[7]] })?
+            }
+            None => eph,
+        };
+        Ok(PyEphemerides { inner })
+    }
+
+    /// The navigation message's Klobuchar coefficients (α₀..α₃, β₀..β₃).
+    #[getter]
+    fn ionosphere(&self) -> Vec<f64> {
+        let k = self.inner.ionosphere;
+        k.alpha.iter().chain(&k.beta).copied().collect()
     }
 
     /// The nominal constellations over GPS times [t_start, t_end].
@@ -109,11 +127,11 @@ super::pickle::picklable!(PyGnssOptions, inner, "GnssOptions");
 #[pymethods]
 impl PyGnssOptions {
     #[new]
-    #[pyo3(signature = (*, sigma_code, sigma_code_glonass, sigma_rate, iono, tropo, use_tau, elevation_weight, formulation, lever_arm, use_rate, tau0, sigma_tau0, tau_psd, clock0, sigma_clock0, clock_h0, clock_hm2))]
+    #[pyo3(signature = (*, sigma_code, sigma_code_glonass, sigma_rate, iono, tropo, use_tau, elevation_weight, elevation_mask, fault_detection, formulation, lever_arm, use_rate, tau0, sigma_tau0, tau_psd, clock0, sigma_clock0, clock_h0, clock_hm2))]
     #[allow(clippy::too_many_arguments)]
     fn new(
         #[pyo3(from_py_with = real)] sigma_code: f64, #[pyo3(from_py_with = real_opt)] sigma_code_glonass: Option<f64>, #[pyo3(from_py_with = real)] sigma_rate: f64, iono: bool, tropo: bool, use_tau: bool, elevation_weight: bool,
-        formulation: Wrap<Formulation>, lever_arm: &Bound<'_, PyAny>, use_rate: bool, #[pyo3(from_py_with = real)] tau0: f64, #[pyo3(from_py_with = real)] sigma_tau0: f64, #[pyo3(from_py_with = real)] tau_psd: f64,
+        #[pyo3(from_py_with = real)] elevation_mask: f64, fault_detection: bool, formulation: Wrap<Formulation>, lever_arm: &Bound<'_, PyAny>, use_rate: bool, #[pyo3(from_py_with = real)] tau0: f64, #[pyo3(from_py_with = real)] sigma_tau0: f64, #[pyo3(from_py_with = real)] tau_psd: f64,
         clock0: &Bound<'_, PyAny>, sigma_clock0: &Bound<'_, PyAny>, #[pyo3(from_py_with = real)] clock_h0: f64, #[pyo3(from_py_with = real)] clock_hm2: f64,
     ) -> PyResult<Self> {
         let (lever_arm, clock0) = (floats::<3>(lever_arm, "lever_arm")?, floats::<2>(clock0, "clock0")?);
@@ -126,6 +144,8 @@ impl PyGnssOptions {
             tropo,
             use_tau,
             elevation_weight,
+            elevation_mask,
+            fault_detection,
             formulation: formulation.0,
             lever_arm: Vec3::from(lever_arm),
             use_rate,
@@ -165,7 +185,7 @@ fn gnss_simulate<'py>(
         outages: outages.map(|o| rows::<2>(&o, "outages")).transpose()?.unwrap_or_default().iter().map(|r| (r[0], r[1])).collect(),
         sat_outages: ids.into_iter().zip(&sat_outages).map(|(s, x)| (s, x.1, x.2)).collect(),
     };
-    let cfg = options.inner.simulation(tau_gps, clock_bias, clock_drift, seed)?;
+    let cfg = options.inner.simulation(&eph.inner, tau_gps, clock_bias, clock_drift, seed)?;
     let e = &eph.inner;
     let tab = py.detach(|| simulate_table(e, &t, &lla, &vel, &cfg, &vis))?;
     let d = PyDict::new(py);
@@ -185,17 +205,19 @@ fn epochs(time: &PyReadonlyArray1<'_, f64>, sat: &[String], channel: &PyReadonly
     Ok(group_epochs(time.as_array().as_slice().ok_or_else(|| invalid("time", "must be contiguous"))?, &obs)?)
 }
 
-/// Epoch-by-epoch single-point positioning (gnss/spp.rs `solve_epochs`): one row per
-/// epoch, columns `SPP_COLUMNS`.
+/// Epoch-by-epoch single-point positioning (gnss/spp.rs `solve_epochs`): the epoch rows
+/// (columns `SPP_COLUMNS`), the satellite rows (`SPP_SATELLITE_COLUMNS`) and their
+/// satellite names.
 #[pyfunction]
+#[allow(clippy::type_complexity)]
 fn gnss_spp<'py>(
     py: Python<'py>, eph: &PyEphemerides, time: PyReadonlyArray1<'py, f64>, sat: Vec<String>, channel: PyReadonlyArray1<'py, i64>,
     code: PyReadonlyArray1<'py, f64>, rate: PyReadonlyArray1<'py, f64>, options: &PyGnssOptions,
-) -> PyResult<Bound<'py, PyArray2<f64>>> {
+) -> PyResult<(Bound<'py, PyArray2<f64>>, Bound<'py, PyArray2<f64>>, Vec<String>)> {
     let ep = epochs(&time, &sat, &channel, &code, &rate)?;
     let (e, o) = (&eph.inner, &options.inner);
-    let out = py.detach(|| solve_epochs(e, &ep, &o.spp(), o.sigma_rate))?;
-    Ok(to_py_rows(py, &out))
+    let out = py.detach(|| solve_epochs(e, &ep, &o.spp(e), o.sigma_rate))?;
+    Ok((to_py_rows(py, &out.epochs), to_py_rows(py, &out.satellites), out.satellite_names))
 }
 
 /// Tightly coupled GNSS as one measurement source of an aided INS
@@ -214,7 +236,8 @@ fn gnss_source<'py>(
         "gnss".to_string(),
         Box::new(move |setup| {
             let (x0, var) = o.tight_initial();
-            let aiding = TightAiding::new(e, ep, o.tight(setup.kind))?;
+            let config = o.tight(&e, setup.kind);
+            let aiding = TightAiding::new(e, ep, config)?;
             Ok(Source { aiding: Box::new(aiding), extra0: x0, p0: Some(DMatrix::from_diagonal(&DVector::from_vec(var))) })
         }),
     ))
@@ -228,5 +251,7 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(gnss_simulate, m)?)?;
     m.add_function(wrap_pyfunction!(gnss_spp, m)?)?;
     m.add("SPP_COLUMNS", SPP_COLUMNS.to_vec())?;
+    m.add("SPP_SATELLITE_COLUMNS", SPP_SATELLITE_COLUMNS.to_vec())?;
+    m.add("SPP_EXCLUSIONS", Exclusion::ALL.iter().map(|e| e.name()).collect::<Vec<_>>())?;
     register_choices::<Formulation>(m, "Formulation")
 }

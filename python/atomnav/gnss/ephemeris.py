@@ -45,14 +45,38 @@ class Ephemerides:
         GPS−UTC leap seconds, s (15 in 2009, 18 since 2017).
     datum : {"identity", "pz90_02_to_wgs84"}, default "identity"
         PZ-90 → WGS-84 transformation.
+    ionosphere : array_like (8,), optional
+        The navigation message's Klobuchar coefficients α₀..α₃ (s, s/semicircle, s/sc²,
+        s/sc³) and β₀..β₃ (s, s/sc, s/sc², s/sc³), as RINEX writes them (ION ALPHA/BETA,
+        GPSA/GPSB; IS-GPS-200 20.3.3.5.1.7); default: the set broadcast on 2009-01-01.
     _core_obj : optional
         Internal: an already built core object (as :meth:`nominal` makes); not for users.
+
+    Attributes
+    ----------
+    week_start : Timestamp or None
+        Start (GPS time) of the GPS week the sets' times count from, when they come from a
+        file (:func:`atomnav.gnss.rinex.read_nav`); None otherwise.
     """
 
+    week_start = None
+
     def __init__(self, gps: pd.DataFrame | None = None, glonass: pd.DataFrame | None = None,
-                 n_leap: float = 18.0, datum: str = "identity", *, _core_obj=None):
+                 n_leap: float = 18.0, datum: str = "identity", *, ionosphere=None, _core_obj=None):
         self._core = instance(_core_obj, _core.GnssEphemerides, "_core_obj") if _core_obj is not None else _core.GnssEphemerides(
-            _table(gps, GPS_COLUMNS, "gps"), _table(glonass, GLONASS_COLUMNS, "glonass"), finite_scalar(n_leap, "n_leap"), datum)
+            _table(gps, GPS_COLUMNS, "gps"), _table(glonass, GLONASS_COLUMNS, "glonass"), finite_scalar(n_leap, "n_leap"), datum,
+            ionosphere=ionosphere)
+
+    @property
+    def ionosphere(self) -> np.ndarray:
+        """The Klobuchar coefficients α₀..α₃, β₀..β₃ applied when ``iono`` is on.
+
+        Returns
+        -------
+        ndarray (8,)
+            α (s, s/semicircle, s/sc², s/sc³) then β (s, s/sc, s/sc², s/sc³).
+        """
+        return np.array(self._core.ionosphere)
 
     @classmethod
     def nominal(cls, t_start: float, t_end: float, gps: bool = True, glonass: bool = True, tau_gps: float = 0.0,

@@ -34,7 +34,7 @@ import numpy as np
 import pandas as pd
 
 from .._validate import input_error
-from .solution import NED_COV, QUALITY, SIGMA_GAINS, PosSolution, cov_columns, gps_minus_utc, parse_epoch, read_text
+from .solution import NED_COV, QUALITY, SIGMA_GAINS, PosSolution, _cov_columns, _parse_epoch, _read_text, gps_minus_utc
 
 #: GGA fix quality → RTKLIB quality name (RTKLIB's own NMEA reading; 0, 7 and 8 are not
 #: measurements).
@@ -99,7 +99,7 @@ def read_nmea(source: str | PathLike | io.TextIOBase, *, date=None, epoch=None,
     epochs: dict[dt.time, dict] = {}
     dates: dict[dt.time, dt.date] = {}
     skipped = 0
-    for number, line in enumerate(read_text(source).splitlines(), start=1):
+    for number, line in enumerate(_read_text(source).splitlines(), start=1):
         start = line.find("$")
         kind = line[start + 3:start + 6] if start >= 0 else ""
         if kind not in ("GGA", "RMC", "GST"):
@@ -132,7 +132,7 @@ def read_nmea(source: str | PathLike | io.TextIOBase, *, date=None, epoch=None,
         raise input_error("source", "the log holds no GGA sentence with a fix")
     utc = _utc_times([t for t, _ in rows], dates, date)
     gps = utc + pd.to_timedelta([float(gps_minus_utc(u)) for u in utc], unit="s")
-    epoch0 = parse_epoch(epoch)
+    epoch0 = _parse_epoch(epoch)
     time_s = ((gps - epoch0) / pd.Timedelta(seconds=1)).to_numpy(float)
     bad = np.flatnonzero(np.diff(time_s) <= 0)
     if len(bad):
@@ -142,6 +142,8 @@ def read_nmea(source: str | PathLike | io.TextIOBase, *, date=None, epoch=None,
 
 
 def _sigma_table(sigma) -> dict[str, float]:
+    if sigma is not None and not isinstance(sigma, Mapping):
+        raise TypeError(f"sigma: expected a mapping of quality name to σ (m), got {type(sigma).__name__}")
     table = dict(NMEA_SIGMA_M if sigma is None else sigma)
     for name, s in table.items():
         if name not in QUALITY.values():
@@ -208,7 +210,7 @@ def _solution(rows, time_s, table, epoch0, skipped) -> PosSolution:
         "n_sats": pd.array([_number(m.num_sats) for m in gga]).astype("Int64"),
         "age_s": np.array([_number(m.age_gps_data) for m in gga]),
         "hdop": hdop,
-        **cov_columns(cov, NED_COV),
+        **_cov_columns(cov, NED_COV),
         "sigma_source": np.where(has_gst, "GST", "table"),
     }
     if any("speed" in e for _, e in rows):

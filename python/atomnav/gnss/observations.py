@@ -103,7 +103,7 @@ def doppler_to_rate(doppler_hz, sat, channel) -> np.ndarray:
     Parameters
     ----------
     doppler_hz : float or array_like, shape (N,)
-        Doppler shifts D, Hz.
+        Doppler shifts D, Hz; NaN where not tracked (the rate is then NaN).
     sat : str or sequence of str, shape (N,)
         Satellite names ("G01", "R05", ...); the first letter selects the system.
     channel : int or array_like, shape (N,)
@@ -122,7 +122,9 @@ def doppler_to_rate(doppler_hz, sat, channel) -> np.ndarray:
         ``channel`` for an unknown GLONASS channel.
     """
     d = np.atleast_1d(as_floats(doppler_hz, "doppler_hz")).reshape(-1)
-    finite(d, "doppler_hz")
+    infinite = np.flatnonzero(np.isinf(d))
+    if infinite.size:  # NaN is a Doppler not tracked: its rate is NaN (missing) too
+        raise input_error("doppler_hz", f"infinite value at index {infinite[0]}", infinite[0])
     sats = np.atleast_1d(np.asarray(sat, dtype=object)).reshape(-1)
     if not all(isinstance(s, str) and s for s in sats):
         raise TypeError("sat: expected satellite names such as 'G01' or 'R05'")
@@ -177,8 +179,10 @@ def obs_arrays(obs: pd.DataFrame) -> tuple:
     """
     instance(obs, pd.DataFrame, "obs")
     numeric = ["time_s", "channel", "code_m", "rate_mps"]
+    # a NaN code or rate is an observable the receiver did not track: the solvers leave it out
     time, channel, code, rate = (np.ascontiguousarray(c) for c in table(obs, numeric, "obs", epoch=_gps_week_start(obs),
-                                                                      epoch_name="GPS week start").T)
+                                                                      epoch_name="GPS week start",
+                                                                      finite=("time_s", "channel")).T)
     if np.any(channel != np.round(channel)) or np.any(np.abs(channel) > 2**31):
         raise input_error("obs", "column 'channel': expected integer FDMA channels")
     sats = obs.iloc[:, locate(obs, ["sat"], "obs")[0]]

@@ -6,6 +6,7 @@ GNSS function takes one (:func:`atomnav.gnss.simulate`, :func:`atomnav.gnss.solv
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 from .. import _core
@@ -31,8 +32,9 @@ class GnssOptions(Config):
     sigma_rate : float, default 0.05
         Pseudorange-rate σ, m/s.
     iono : bool, default True
-        Klobuchar ionosphere (broadcast coefficients of 2009-01-01), in simulation and
-        correction.
+        Klobuchar ionosphere with the navigation message's coefficients
+        (:attr:`Ephemerides.ionosphere`: a navigation file's ION ALPHA/BETA or GPSA/GPSB,
+        the set of 2009-01-01 for nominal constellations), in simulation and correction.
     tropo : bool, default True
         Saastamoinen troposphere, in simulation and correction.
     use_tau : bool, default True
@@ -40,6 +42,13 @@ class GnssOptions(Config):
         False gives the "no-τ" diagnostic of Demidov 2009.
     elevation_weight : bool, default False
         Single-point positioning weights with σ/sin E.
+    elevation_mask : float, default 10° (0.1745 rad)
+        Single-point positioning leaves out satellites below this elevation, rad.
+    fault_detection : bool, default True
+        Single-point positioning tests the weighted residuals against χ² (0.1 % false
+        alarms) and, while the test fails with two or more redundant satellites,
+        excludes the satellite whose removal fits best (RAIM FDE, as RTKLIB's
+        ``raim_fde``; Takasu 2013).
     formulation : str, default "first_difference"
         Tight coupling, one of :data:`FORMULATIONS`: "first_difference" (between-satellite
         differences with c·τ_GPS as an extra state) or "clock_states" (undifferenced rows
@@ -73,6 +82,8 @@ class GnssOptions(Config):
     tropo: bool = True
     use_tau: bool = True
     elevation_weight: bool = False
+    elevation_mask: float = math.radians(10.0)
+    fault_detection: bool = True
     formulation: str = "first_difference"
     lever_arm: tuple = (0.0, 0.0, 0.0)
     use_rate: bool = True

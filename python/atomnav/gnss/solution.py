@@ -204,7 +204,7 @@ def read_pos(source: str | PathLike | io.TextIOBase, *, epoch=None) -> PosSoluti
         with fewer fields than the header names (a truncated line), a field that is not a
         number, an unknown Q, or times that do not increase.
     """
-    lines = read_text(source).splitlines()
+    lines = _read_text(source).splitlines()
     header = [i for i, ln in enumerate(lines) if ln.startswith("%")]
     labels = lines[header[-1]].lstrip("%").split() if header else []
     if not labels or labels[0] not in _TIME_SCALES:
@@ -231,7 +231,7 @@ def read_pos(source: str | PathLike | io.TextIOBase, *, epoch=None) -> PosSoluti
         lat, lon = (_dms(values[:, k:k + 3]) for k in (0, 3))
         values = np.column_stack([lat, lon, values[:, 6:]])
     cols = dict(zip(names, values.T))
-    epoch0 = parse_epoch(epoch)
+    epoch0 = _parse_epoch(epoch)
     time_s = (time - epoch0) / pd.Timedelta(seconds=1)
     bad = np.flatnonzero(np.diff(time_s) <= 0)
     if len(bad):
@@ -251,16 +251,16 @@ def read_pos(source: str | PathLike | io.TextIOBase, *, epoch=None) -> PosSoluti
     out.update(lat_rad=lla[:, 0], lon_rad=lla[:, 1], h_m=lla[:, 2], q=q.astype(np.int64),
                quality=pd.Series(q.astype(np.int64)).map(QUALITY).to_numpy(), n_sats=cols["ns"].astype(np.int64),
                age_s=cols["age(s)"], ratio=cols["ratio"])
-    out.update(cov_columns(cov, NED_COV))
+    out.update(_cov_columns(cov, NED_COV))
     if set(_NEU_VEL) <= set(cols):
         v = np.column_stack([cols["vn(m/s)"], cols["ve(m/s)"], -cols["vu(m/s)"]])
-        out.update(dict(zip(VEL_COLUMNS, v.T)), **cov_columns(_neu_to_ned(_cov(cols, _NEU_VEL[3:])), VEL_COV))
+        out.update(dict(zip(VEL_COLUMNS, v.T)), **_cov_columns(_neu_to_ned(_cov(cols, _NEU_VEL[3:])), VEL_COV))
     elif set(_XYZ_VEL) <= set(cols):
         v_e = np.column_stack([cols[c] for c in _XYZ_VEL[:3]])
         rot = np.stack([earth.dcm_ned_to_ecef(la, lo) for la, lo in lla[:, :2]])
         v = np.einsum("kji,kj->ki", rot, v_e)
         cov_v = np.einsum("kji,kjl,klm->kim", rot, _cov(cols, _XYZ_VEL[3:]), rot)
-        out.update(dict(zip(VEL_COLUMNS, v.T)), **cov_columns(cov_v, VEL_COV))
+        out.update(dict(zip(VEL_COLUMNS, v.T)), **_cov_columns(cov_v, VEL_COV))
     return PosSolution(pd.DataFrame(out), epoch0, scale)
 
 
@@ -280,7 +280,7 @@ def gps_minus_utc(when: pd.Timestamp) -> int:
     return max([n for date, n in LEAP_SECONDS if when >= pd.Timestamp(date)], default=0)
 
 
-def read_text(source) -> str:
+def _read_text(source) -> str:
     """The whole text of a solution file.
 
     Parameters
@@ -295,6 +295,8 @@ def read_text(source) -> str:
     """
     if hasattr(source, "read"):
         return source.read()
+    if not isinstance(source, (str, PathLike)):
+        raise TypeError(f"source: expected a path or a text stream, got {type(source).__name__}")
     path = Path(source)
     with (gzip.open(path, "rt", encoding="utf-8") if path.suffix == ".gz" else open(path, encoding="utf-8")) as f:
         return f.read()
@@ -337,7 +339,7 @@ def _gps_time(raw: pd.DataFrame, dated: bool, scale: str, data_lines) -> pd.Seri
     return utc + pd.to_timedelta(np.array([gps_minus_utc(x) for x in utc], dtype=float), unit="s")
 
 
-def parse_epoch(epoch) -> pd.Timestamp:
+def _parse_epoch(epoch) -> pd.Timestamp:
     """Time 0 of a solution's ``time_s``.
 
     Parameters
@@ -396,7 +398,7 @@ def _from_ecef(xyz: np.ndarray, cov_e: np.ndarray) -> tuple[np.ndarray, np.ndarr
     return lla, np.einsum("kji,kjl,klm->kim", rot, cov_e, rot)
 
 
-def cov_columns(cov: np.ndarray, names: tuple[str, ...]) -> dict:
+def _cov_columns(cov: np.ndarray, names: tuple[str, ...]) -> dict:
     """The six distinct entries of (N, 3, 3) covariances as named columns.
 
     Parameters

@@ -1,9 +1,13 @@
 """Single-point positioning (Demidov 2009, §2.7; Rust ``gnss/spp.rs``): least squares for
-position, receiver clock and τ_GPS per epoch, the thesis's residual metric, DOP, Doppler
-velocity."""
+position, receiver clock and τ_GPS per epoch, with an elevation mask, residual-based fault
+detection and exclusion, the thesis's residual metric, DOP and Doppler velocity; and the
+satellites of every epoch, used or left out with the reason."""
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
+import numpy as np
 import pandas as pd
 
 from .. import _core
@@ -12,13 +16,64 @@ from .ephemeris import Ephemerides
 from .observations import obs_arrays
 from .options import GnssOptions, split_options
 
-#: Columns of :func:`solve` (from the core).
+#: Columns of :attr:`SppResult.epochs` (from the core).
 SPP_COLUMNS = list(_core.SPP_COLUMNS)
+#: Columns of :attr:`SppResult.satellites`.
+SATELLITE_COLUMNS = ["time_s", "sat", "elevation_rad", "azimuth_rad", "residual_m", "used", "excluded"]
+#: Reasons a satellite is left out of an epoch's solution (from the core): ``no_code``
+#: (NaN pseudorange: not tracked), ``no_ephemeris`` (no broadcast set valid then),
+#: ``elevation`` (below ``elevation_mask``), ``fault`` (excluded by the residual test),
+#: ``too_few_satellites`` (the epoch has fewer usable satellites than unknowns: no
+#: solution).
+EXCLUSIONS = tuple(_core.SPP_EXCLUSIONS)
 
 
-def solve(eph: Ephemerides, obs: pd.DataFrame, options: GnssOptions | None = None, **option_fields) -> pd.DataFrame:
+@dataclass(frozen=True)
+class SppResult:
+    """Single-point positions and the satellites behind them (:func:`solve`).
+
+    Attributes
+    ----------
+    epochs : DataFrame
+        One row per solved epoch, columns :data:`SPP_COLUMNS`: ``time_s`` (s), ECEF
+        (``x_m, y_m, z_m``, m) and geodetic (``lat_rad, lon_rad`` rad, ``h_m`` m) antenna
+        position, ``clock_m`` = c·δt_r (m), τ_GPS and its σ (``tau_gps_s``,
+        ``sigma_tau_gps_s``, s, NaN when not estimated), the residual metric
+        Σ|r_i|/(N − n) (``residual_metric_m``, m), ``n_sats`` used, ``n_unknowns``, DOP
+        values, Doppler velocity (``vx_mps, vy_mps, vz_mps``, ECEF m/s; NaN with fewer than
+        four used satellites with a Doppler) and c·δṫ_r (``clock_drift_mps``, m/s),
+        ``n_excluded`` and the weighted residual sum ``chi2`` (Σ r²/σ²).
+    satellites : DataFrame
+        One row per satellite and epoch of the input, columns :data:`SATELLITE_COLUMNS`:
+        elevation and azimuth (rad, from north through east) at the solution, post-fit
+        residual (m; measured − predicted code), ``used``, and ``excluded`` (one of
+        :data:`EXCLUSIONS`, empty when used). Look angles and residual are NaN where the
+        satellite has no code or ephemeris, or the epoch no solution.
+    """
+
+    epochs: pd.DataFrame
+    satellites: pd.DataFrame
+
+    def exclusions(self) -> pd.Series:
+        """Satellite-epochs left out, counted per reason.
+
+        Returns
+        -------
+        Series
+            Count per reason of :data:`EXCLUSIONS` (zeros included).
+        """
+        return self.satellites["excluded"].value_counts().reindex(list(EXCLUSIONS), fill_value=0)
+
+
+def solve(eph: Ephemerides, obs: pd.DataFrame, options: GnssOptions | None = None, **option_fields) -> SppResult:
     """Single-point positioning: one least-squares solution per epoch of the observation
     table (Demidov 2009, §2.7).
+
+    Each epoch starts from the previous solution; the signal's receive time is the stamp
+    less the receiver clock estimate. A satellite without code (NaN), without a valid
+    broadcast set, or below ``elevation_mask`` is left out; with ``fault_detection`` a
+    satellite whose residuals fail the χ² test is excluded. An epoch with fewer usable
+    satellites than unknowns has no row in ``epochs``; its satellites say why.
 
     Parameters
     ----------
@@ -26,34 +81,39 @@ def solve(eph: Ephemerides, obs: pd.DataFrame, options: GnssOptions | None = Non
         Broadcast ephemerides.
     obs : pandas.DataFrame
         Observation table (``time_s`` GPS s, ``sat``, ``channel``, ``code_m`` m,
-        ``rate_mps`` m/s; see :func:`atomnav.gnss.simulate`).
+        ``rate_mps`` m/s, NaN where not tracked; see :func:`atomnav.gnss.simulate`).
     options : GnssOptions, optional
         ``use_tau`` estimates τ_GPS, corrections ``iono``/``tropo``, weights 1/σ² with
         ``sigma_code`` (GLONASS ``sigma_code_glonass``), optionally σ/sin E
-        (``elevation_weight``), Doppler velocity with ``sigma_rate`` (default
-        ``GnssOptions()``).
+        (``elevation_weight``), ``elevation_mask``, ``fault_detection``, Doppler velocity
+        with ``sigma_rate`` (default ``GnssOptions()``).
     **option_fields
         Fields of :class:`GnssOptions` given as keywords (e.g. ``use_tau=False``),
         replacing those of ``options``.
 
     Returns
     -------
-    pandas.DataFrame
-        Columns :data:`SPP_COLUMNS`: ``time_s`` (s), ECEF (``x_m, y_m, z_m``, m) and
-        geodetic (``lat_rad, lon_rad`` rad, ``h_m`` m) antenna position, ``clock_m`` =
-        c·δt_r (m), τ_GPS and its σ (``tau_gps_s``, ``sigma_tau_gps_s``, s, NaN when not
-        estimated), the residual metric Σ|r_i|/(N − n) (``residual_metric_m``, m),
-        ``n_sats``, ``n_unknowns``, DOP values, Doppler velocity (``vx_mps, vy_mps,
-        vz_mps``, ECEF m/s) and c·δṫ_r (``clock_drift_mps``, m/s).
+    SppResult
+        ``epochs`` (one row per solved epoch) and ``satellites`` (one row per input
+        observation).
 
     Raises
     ------
     TypeError
         For a keyword that is not a field of :class:`GnssOptions`.
+    atomnav.InputError
+        Naming ``obs`` for a malformed table, or when no satellite of an epoch has a
+        broadcast set valid at its time (the ephemerides do not cover it).
     """
     instance(eph, Ephemerides, "eph")
     opts, rest = split_options(options, option_fields)
     if rest:
         raise TypeError(f"solve() got an unexpected keyword argument {sorted(rest)[0]!r}")
     with renamed(t="obs"):  # an observation time outside the ephemerides' span is the table's
-        return pd.DataFrame(_core.gnss_spp(eph._core, *obs_arrays(obs), opts.native), columns=SPP_COLUMNS)
+        epochs, sats, names = _core.gnss_spp(eph._core, *obs_arrays(obs), opts.native)
+    code = sats[:, 4].astype(np.int64)
+    reasons = np.array(("",) + EXCLUSIONS, dtype=object)[code]
+    satellites = pd.DataFrame({"time_s": sats[:, 0], "sat": names, "elevation_rad": sats[:, 1],
+                               "azimuth_rad": sats[:, 2], "residual_m": sats[:, 3], "used": code == 0,
+                               "excluded": reasons})
+    return SppResult(pd.DataFrame(epochs, columns=SPP_COLUMNS), satellites)
