@@ -172,3 +172,20 @@ def test_the_mask_and_an_injected_100_m_fault(station):
     without = an.gnss.solve(eph, table[~hit], **OPTIONS)
     np.testing.assert_allclose(r.epochs[["x_m", "y_m", "z_m"]].to_numpy(), without.epochs[["x_m", "y_m", "z_m"]].to_numpy(),
                                atol=1e-3)
+
+
+def test_a_hatanaka_rinex_4_file_keeps_every_epoch():
+    """KMS300DNK (RINEX 4.00 in Hatanaka compression): as many epochs as the file holds
+    once expanded by the reference decompressor (the ``hatanaka`` package)."""
+    import hatanaka
+
+    path = D / "KMS300DNK_R_20221591000_01H_30S_MO.crx"
+    text = hatanaka.decompress(path.read_bytes())
+    text = text.decode() if isinstance(text, bytes) else text
+    epochs = sum(1 for line in text.splitlines() if line.startswith(">"))
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        obs = rinex.read_obs(path, an.gnss.Ephemerides.nominal(0.0, 10.0))
+    assert obs.header["version"] == 4.0 and epochs == 19
+    assert obs.table["time_s"].nunique() == epochs
+    assert obs.week_start == pd.Timestamp("2022-06-05")                 # the Sunday before 2022-06-08
