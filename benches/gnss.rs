@@ -34,7 +34,7 @@ fn bench(c: &mut Criterion) {
     let accel = vec![Vec3::new(0.0, 0.0, -loc.gravity); t.len()];
     let tight = TightConfig {
         formulation: Formulation::FirstDifference, lever_arm: Vec3::new(0.5, 0.0, -1.0), sigma_code_gps: 3.0, sigma_code_glo: 3.0,
-        sigma_rate: 0.05, use_rate: true, atm, tau_psd: 1e-4, clock_h0: 2e-19, clock_hm2: 2e-20, kind: ImuKind::Rates,
+        sigma_rate: 0.05, use_rate: true, atm, elevation_mask: 10f64.to_radians(), tau_psd: 1e-4, clock_h0: 2e-19, clock_hm2: 2e-20, kind: ImuKind::Rates,
     };
     let noise = InsNoise { accel_psd: 1e-8, gyro_psd: 1e-14, accel_bias: BiasModel::RandomConstant, gyro_bias: BiasModel::RandomConstant };
     let acfg = AidedConfig { noise, predict_every: 100, method: Discretization::VanLoan, mode: LoopMode::Closed, sequential: true, gate: Some(10.83) };
@@ -51,7 +51,8 @@ fn bench(c: &mut Criterion) {
             run_aided(ins, &t, &gyro, &accel).unwrap().0.nav.len()
         })
     });
-    let spp = SppConfig { use_tau: true, atm, sigma_gps: 3.0, sigma_glo: 3.0, elevation_weight: false };
+    // the defaults of GnssOptions: 10° mask, fault detection on
+    let spp = SppConfig { use_tau: true, atm, sigma_gps: 3.0, sigma_glo: 3.0, elevation_weight: false, elevation_mask: 10f64.to_radians(), fault_detection: true };
     g.bench_function("spp_one_epoch", |b| b.iter(|| solve_position(&eph, 1.0, &epochs[0].1, &spp, None).unwrap().pos));
     g.finish();
 }

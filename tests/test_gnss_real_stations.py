@@ -189,3 +189,54 @@ def test_a_hatanaka_rinex_4_file_keeps_every_epoch():
     assert obs.header["version"] == 4.0 and epochs == 19
     assert obs.table["time_s"].nunique() == epochs
     assert obs.week_start == pd.Timestamp("2022-06-05")                 # the Sunday before 2022-06-08
+
+
+@pytest.mark.xfail(strict=True, reason="the first-difference filter drifts to 8.6-11 m after 25 min while SPP of the "
+                   "same epochs stays at 1.5-2.3 m (NIS mean 3.1 over 9.7 rows: it does not see it); the clock-state "
+                   "form rejects every update once the receiver's clock swings by 0.5 ms (150 km)")
+def test_tight_coupling_on_a_real_station_file():
+    """DELF's real GPS code (RINEX 2.11, no Doppler) tightly coupled with a tactical IMU
+    simulated at rest at the station for the file's 30 minutes: after the first 5
+    minutes the filter's 3-D error against the station is below the SPP error of the same
+    epochs, and its normalised innovations are consistent (NIS mean within the χ² band of
+    the rows)."""
+    from scipy.stats import chi2
+
+    navs, obs_file, marker = STATIONS["DELF"]
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        eph = rinex.read_nav(D / navs[0])
+        obs = rinex.read_obs(D / obs_file, eph)
+    gps = obs.table[obs.table["sat"].str[0] == "G"]
+    marker = np.array(marker)
+    lla = an.earth.ecef_to_lla(marker)
+    arp = marker + an.earth.dcm_ned_to_ecef(lla[0], lla[1]) @ [0.0, 0.0, -obs.header["antenna_delta_hen_m"][0]]
+    arp_lla = an.earth.ecef_to_lla(arp)
+    t0 = float(gps["time_s"].iloc[0])
+    duration = float(gps["time_s"].iloc[-1] - t0) + 1.0
+    still = an.trajectory.stationary(duration, rate_hz=100.0, origin=tuple(arp_lla))
+    imu = an.imu.corrupt(still.ideal_imu("rates"), errors="tactical", dt=0.01, kind="rates", seed=5)
+    imu["time_s"] += t0
+    spp = an.gnss.solve(eph, gps, **OPTIONS)
+    first = spp.epochs.iloc[0]
+    tac = an.imu.ImuErrors.preset("tactical")
+    p0 = np.diag([5.0**2] * 3 + [0.1**2] * 3 + [np.radians(0.5)**2] * 2 + [np.radians(5.0)**2]
+                 + [tac.accel.bias_sigma**2] * 3 + [tac.gyro.bias_sigma**2] * 3)
+    ins = an.gnss.tight_ins(eph, gps, t0=t0, lla0=first[["lat_rad", "lon_rad", "h_m"]].to_numpy(float),
+                            vel0=np.zeros(3), q0=an.rotation.quat_from_euler([0.0, 0.0, 0.0]), kind="rates", p0_ins=p0,
+                            accel_psd=tac.accel.white**2, gyro_psd=tac.gyro.white**2, predict_every=100,
+                            sigma_code=3.0, elevation_weight=True)
+    result = ins.run(imu["time_s"], imu[[f"gyro_{a}_rad_s" for a in "xyz"]], imu[[f"accel_{a}_mps2" for a in "xyz"]],
+                     progress=False)
+    nav = result.nav
+    at = np.isin(nav["time_s"], spp.epochs["time_s"]) & (nav["time_s"] >= t0 + 300.0)
+    xyz = an.earth.lla_to_ecef(nav.loc[at, ["lat_rad", "lon_rad", "h_m"]].to_numpy())
+    tight = np.linalg.norm(xyz - arp, axis=1)
+    single = _errors(spp, arp)[spp.epochs["time_s"].to_numpy() >= t0 + 300.0]
+    m = result.measurements
+    band = chi2.ppf([0.025, 0.975], m["rows"].sum()) / len(m)
+    print(f"DELF tight: mean {tight.mean():.2f} m (SPP {single.mean():.2f} m) over {len(tight)} epochs; "
+          f"NIS mean {m['nis'].mean():.2f} per update (rows {m['rows'].mean():.1f}, 95 % band {band})")
+    assert len(tight) == len(single) > 40
+    assert tight.mean() < single.mean()
+    assert band[0] <= m["nis"].mean() <= band[1]

@@ -464,3 +464,42 @@ def test_the_docs_images_script_runs_and_keeps_each_image_small(tmp_path, monkey
     images = sorted(p.name for p in tmp_path.iterdir())
     assert images == [f"plots_{n}.png" for n in ("allan", "consistency", "errors", "imu_errors", "trajectory")]
     assert max(p.stat().st_size for p in tmp_path.iterdir()) < 100_000
+
+
+def test_spp_plot_shows_the_sky_the_residuals_and_the_enu_error():
+    """On a real station file (DELF, RINEX 2.11): the sky plot's points are the satellite
+    table's look angles (radius 90° − elevation), the residual lines its residuals, and the
+    E/N/U lines the solution minus the reference rotated by a local-level frame written
+    here (Groves 2013, Eq. 2.150)."""
+    import warnings
+    from pathlib import Path
+
+    from atomnav.gnss import rinex
+
+    d = Path(__file__).parent / "data" / "rinex_stations"
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        eph = rinex.read_nav(d / "brdc0010_cut.21n.gz")
+        obs = rinex.read_obs(d / "delf0010_cut.21o.gz", eph)
+    r = an.gnss.solve(eph, obs.table)
+    ref = np.array([3924687.7020, 301132.7660, 5001910.7750])
+    fig = plots.spp(r, ref)
+    sky, counts, res, enu = fig.axes[:4]
+    seen = r.satellites[np.isfinite(r.satellites["elevation_rad"])]
+    first = seen[seen["sat"] == sorted(seen["sat"].unique())[0]]
+    used = first[first["used"]]
+    np.testing.assert_allclose(sky.lines[0].get_ydata(), 90.0 - np.degrees(used["elevation_rad"]))
+    np.testing.assert_allclose(res.lines[0].get_ydata(), first["residual_m"])
+    lat, lon = np.arctan2(ref[2], np.hypot(ref[0], ref[1]) * (1 - 6.69437999014e-3)), np.arctan2(ref[1], ref[0])
+    east = np.array([-np.sin(lon), np.cos(lon), 0.0])
+    up = np.array([np.cos(lat) * np.cos(lon), np.cos(lat) * np.sin(lon), np.sin(lat)])
+    d_xyz = r.epochs[["x_m", "y_m", "z_m"]].to_numpy() - ref
+    np.testing.assert_allclose(enu.lines[0].get_ydata(), d_xyz @ east, atol=1e-9)
+    np.testing.assert_allclose(enu.lines[2].get_ydata(), d_xyz @ up, atol=1e-3)   # geodetic vs the formula's latitude
+    assert [t.get_text() for t in counts.get_yticklabels()] == list(an.gnss.spp.EXCLUSIONS)
+    plt.close(fig)
+    with pytest.raises(an.InputError) as e:
+        plots.spp(r, [1.0, 2.0, 3.0])
+    assert e.value.parameter == "reference"
+    with pytest.raises(TypeError):
+        plots.spp(r.epochs)

@@ -29,11 +29,12 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from . import _core, plausibility, units
-from ._validate import flag, input_error, instance, integer, locate, positive, probability, renamed, table as read_table
+from . import _core, earth, plausibility, units
+from ._validate import flag, floats, input_error, instance, integer, locate, positive, probability, renamed, table as read_table
 from .filter.aided import AidedResult
 from .filter.analysis import chi2_band
 from .filter.outages import OutageResult
+from .gnss.spp import SppResult
 from .imu import BIAS_COLUMNS
 from .trajectory import Trajectory
 
@@ -487,4 +488,81 @@ def outages(result):
     ax.set_title("Drift in the GNSS outages, against the withheld fixes")
     ax.grid(True, alpha=0.3)
     ax.legend(fontsize=8)
+    return fig
+
+
+def spp(result, reference=None):
+    """Single-point positioning at a glance: the satellites' sky tracks, their post-fit
+    residuals, and (with a reference position) the east/north/up error with the DOP.
+
+    Parameters
+    ----------
+    result : atomnav.gnss.SppResult
+        The result of :func:`atomnav.gnss.solve`.
+    reference : array_like (3,), optional
+        The antenna's true ECEF position, m (a station's published coordinate plus its
+        antenna height).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        A polar sky plot (azimuth from north, clockwise; elevation 90° at the centre) with
+        used satellites as lines and left-out ones as crosses; residuals (m) against time
+        per satellite; and, with ``reference``, the E/N/U error (m) against time with
+        PDOP on a second axis.
+
+    Raises
+    ------
+    atomnav.InputError
+        Naming ``reference`` when it is not a finite ECEF position.
+    """
+    instance(result, SppResult, "result")
+    if reference is not None:
+        reference = floats(reference, "reference").reshape(-1)
+        if reference.shape != (3,) or np.linalg.norm(reference) < 6.0e6:
+            raise input_error("reference", "expected an ECEF position (x, y, z) in m near the Earth's surface")
+    plt = _pyplot()
+    rows = 3 if reference is not None else 2
+    fig = plt.figure(figsize=(10, 3.4 * rows), layout="constrained")
+    sky = fig.add_subplot(rows, 2, 1, projection="polar")
+    sky.set_theta_zero_location("N")
+    sky.set_theta_direction(-1)
+    sats = result.satellites
+    seen = sats[np.isfinite(sats["elevation_rad"])]
+    for i, (name, s) in enumerate(seen.groupby("sat")):
+        used = s[s["used"]]
+        sky.plot(used["azimuth_rad"], 90.0 - np.degrees(used["elevation_rad"]), ".", ms=2, color=f"C{i % 10}")
+        out = s[~s["used"]]
+        sky.plot(out["azimuth_rad"], 90.0 - np.degrees(out["elevation_rad"]), "x", ms=3, color=f"C{i % 10}")
+        sky.annotate(name, (s["azimuth_rad"].iloc[-1], 90.0 - np.degrees(s["elevation_rad"].iloc[-1])), fontsize=6)
+    sky.set_rlim(0.0, 90.0)
+    sky.set_yticks([0, 30, 60, 90], ["90°", "60°", "30°", "0°"])
+    sky.set_title("Sky tracks (× left out)", fontsize=9)
+    counts = fig.add_subplot(rows, 2, 2)
+    reasons = result.exclusions()
+    counts.barh(reasons.index, reasons.to_numpy(), color="C3")
+    counts.set_xlabel("satellite-epochs left out")
+    counts.set_title(f"{int(sats['used'].sum())} satellite-epochs used", fontsize=9)
+    res = fig.add_subplot(rows, 1, 2)
+    for i, (name, s) in enumerate(seen.groupby("sat")):
+        res.plot(s["time_s"], s["residual_m"], "-", lw=0.8, color=f"C{i % 10}", label=name)
+    res.set_xlabel("time (s)")
+    res.set_ylabel("post-fit residual (m)")
+    res.grid(True, alpha=0.3)
+    res.legend(fontsize=6, ncol=8)
+    if reference is not None:
+        e = result.epochs
+        lla = earth.ecef_to_lla(reference)
+        enu = (earth.dcm_ned_to_ecef(lla[0], lla[1]).T @ (e[["x_m", "y_m", "z_m"]].to_numpy() - reference).T).T
+        ax = fig.add_subplot(rows, 1, 3)
+        for k, (label, v) in enumerate((("east", enu[:, 1]), ("north", enu[:, 0]), ("up", -enu[:, 2]))):
+            ax.plot(e["time_s"], v, lw=0.9, color=f"C{k}", label=label)
+        ax.set_xlabel("time (s)")
+        ax.set_ylabel("position error (m)")
+        ax.grid(True, alpha=0.3)
+        dop = ax.twinx()
+        dop.plot(e["time_s"], e["pdop"], "k:", lw=0.8, label="PDOP")
+        dop.set_ylabel("PDOP")
+        ax.legend(loc="upper left", fontsize=8)
+        dop.legend(loc="upper right", fontsize=8)
     return fig

@@ -135,6 +135,7 @@ impl GnssOptions {
             sigma_rate: self.sigma_rate,
             use_rate: self.use_rate,
             atm: self.atmosphere(eph),
+            elevation_mask: self.elevation_mask,
             tau_psd: C_LIGHT * C_LIGHT * self.tau_psd,
             clock_h0: self.clock_h0,
             clock_hm2: self.clock_hm2,

@@ -46,6 +46,9 @@ pub struct TightConfig {
     pub sigma_rate: f64,
     pub use_rate: bool,
     pub atm: Atmosphere,
+    /// Satellites below this elevation (rad) are not used.
+    #[serde(default)]
+    pub elevation_mask: f64,
     /// c·τ_GPS random-walk PSD (m²/s); default (0.1 ns)²/h.
     pub tau_psd: f64,
     /// Receiver oscillator h₀ (s) and h₋₂ (1/s) of Eq. 41 (TCXO 2e-19, 2e-20).
@@ -88,8 +91,11 @@ impl TightAiding {
         }
         for (i, (_, obs)) in epochs.iter().enumerate() {
             for o in obs {
-                if o.sat.system == System::Glonass && eph.channel(o.sat)? != o.channel {
-                    return Err(invalid("obs", format!("epoch {i}: {} on channel {} but the ephemeris says {}", o.sat.name(), o.channel, eph.channel(o.sat)?)));
+                // a GLONASS slot the ephemerides lack is left out at its epochs
+                if let (System::Glonass, Ok(k)) = (o.sat.system, eph.channel(o.sat)) {
+                    if k != o.channel {
+                        return Err(invalid("obs", format!("epoch {i}: {} on channel {} but the ephemeris says {k}", o.sat.name(), o.channel)));
+                    }
                 }
             }
         }
@@ -133,11 +139,22 @@ impl TightAiding {
         let loc = ctx.ell.local(nav.lla.x, nav.lla.z);
         let a_ev = Mat3::new(0.0, 1.0 / loc.rp, 0.0, -1.0 / loc.rm, 0.0, 0.0, 0.0, -loc.sin / (loc.cos * loc.rp), 0.0);
         let frame_term = skew(&(cne.transpose() * v_a)) * a_ev;
+        // the signal arrives at the stamp less the receiver clock, when the clock is a state
+        let tau_s = tau.map_or(0.0, |x| x.1 / C_LIGHT);
+        let t_rx = t - clock.map_or(0.0, |c| c.1 / C_LIGHT);
         let mut rows = Vec::new();
+        let mut uncovered = None;
         for o in epoch.iter().filter(|o| o.code.is_finite()) {
             let glo = o.sat.system == System::Glonass;
-            let g = geometry(&self.eph, o.sat, t, &r_a, &v_a, lla_a.x, lla_a.y, tau.map_or(0.0, |x| x.1 / C_LIGHT))?;
-            if g.elevation <= 0.0 {
+            // a satellite without a set valid then is left out, as in single-point positioning
+            let g = match geometry(&self.eph, o.sat, t_rx, &r_a, &v_a, lla_a.x, lla_a.y, tau_s) {
+                Ok(g) => g,
+                Err(e) => {
+                    uncovered.get_or_insert(e);
+                    continue;
+                }
+            };
+            if g.elevation <= 0.0 || g.elevation < self.cfg.elevation_mask {
                 continue;
             }
             let u_n = cne.transpose() * g.los * g.kappa;
@@ -175,7 +192,7 @@ impl TightAiding {
                 h_code[i] = 1.0;
                 h_rate[i + 1] = 1.0;
             }
-            let measured = o.code + C_LIGHT * g.sat.clock - self.cfg.atm.delay(o.sat, o.channel, &lla_a, &g, t);
+            let measured = o.code + C_LIGHT * g.sat.clock - self.cfg.atm.delay(o.sat, o.channel, &lla_a, &g, t_rx);
             let measured_rate = o.rate + C_LIGHT * g.sat.clock_rate;
             rows.push(Row {
                 sat: o.sat,
@@ -187,7 +204,11 @@ impl TightAiding {
                 h_rate,
             });
         }
-        Ok(rows)
+        match uncovered {
+            // no satellite of the epoch has a set valid then: the ephemerides do not cover it
+            Some(e) if rows.is_empty() && epoch.iter().all(|o| !o.code.is_finite() || self.eph.state(o.sat, t_rx, 0.0).is_err()) => Err(e),
+            _ => Ok(rows),
+        }
     }
 
     /// Keep the reference while it is seen; otherwise the highest GPS satellite (the
@@ -344,7 +365,7 @@ mod tests {
         let obs: Vec<Observation> = simulate(&eph, &[100.0], &[lla], &[vel], &sim, &Visibility::default()).unwrap().remove(0).into_iter().map(|x| x.0).collect();
         let tc = TightConfig {
             formulation: Formulation::ClockStates, lever_arm: Vec3::new(1.0, -0.5, -2.0), sigma_code_gps: 3.0, sigma_code_glo: 3.0, sigma_rate: 0.05,
-            use_rate: true, atm, tau_psd: 0.0, clock_h0: 0.0, clock_hm2: 0.0, kind: ImuKind::Rates,
+            use_rate: true, atm, elevation_mask: 0.0, tau_psd: 0.0, clock_h0: 0.0, clock_hm2: 0.0, kind: ImuKind::Rates,
         };
         let mut aiding = TightAiding::new(eph, vec![(100.0, obs)], tc).unwrap();
         let layout = Layout::ins_with(&aiding.extra_blocks()).unwrap();

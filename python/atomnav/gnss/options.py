@@ -43,7 +43,8 @@ class GnssOptions(Config):
     elevation_weight : bool, default False
         Single-point positioning weights with σ/sin E.
     elevation_mask : float, default 10° (0.1745 rad)
-        Single-point positioning leaves out satellites below this elevation, rad.
+        Single-point positioning and tight coupling leave out satellites below this
+        elevation, rad.
     fault_detection : bool, default True
         Single-point positioning tests the weighted residuals against χ² (0.1 % false
         alarms) and, while the test fails with two or more redundant satellites,
