@@ -1,10 +1,12 @@
 """Draw the images of docs/plots.md (docs/img/plots_*.png) from a short simulated run:
-two minutes of sinusoidal motion, a tactical-grade IMU, 1 Hz position fixes, and an
-hour of a simulated gyro log. Run from the repository root:
+two minutes of sinusoidal motion, a tactical-grade IMU, 1 Hz position fixes, an hour of
+a simulated gyro log, and single-point positioning of a real station's RINEX 2.11 file
+(DELF, tests/data/rinex_stations). Run from the repository root:
 
     .venv/bin/python docs/make_plot_images.py
 """
 
+import warnings
 from pathlib import Path
 
 import matplotlib
@@ -44,12 +46,19 @@ def main() -> None:
     w = 2.0 + 0.1 * 60.0 / np.sqrt(0.1) * rng.standard_normal(36000)
     table = an.noise.allan.allan_variance(w, 0.1)
     fit = an.noise.allan.fit_allan(w, 0.1, terms=("arw", "bias_instability"))
+    stations = Path(__file__).parents[1] / "tests" / "data" / "rinex_stations"
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # georinex's xarray deprecations
+        eph = an.gnss.rinex.read_nav(stations / "brdc0010_cut.21n.gz")
+        obs = an.gnss.rinex.read_obs(stations / "delf0010_cut.21o.gz", eph)
+    delf = np.array([3924687.7020, 301132.7660, 5001910.7750])  # marker; the antenna is 0.05 m above
     figures = {
         "trajectory": an.plots.trajectory(an.strapdown.integrate(meas, **st), traj),
         "errors": an.plots.errors(err, res),
         "imu_errors": an.plots.imu_errors(res, truth=meas),
         "consistency": an.plots.consistency(nis=res, nees=nees, dof=9),
         "allan": an.plots.allan(table, fit, unit=an.units.DEG_PER_HOUR),
+        "spp": an.plots.spp(an.gnss.solve(eph, obs.table[obs.table["sat"].str[0] == "G"], elevation_weight=True), delf),
     }
     for name, fig in figures.items():
         fig.savefig(OUT / f"plots_{name}.png", dpi=55)  # each image under 100 kB

@@ -484,12 +484,12 @@ def test_spp_plot_shows_the_sky_the_residuals_and_the_enu_error():
     r = an.gnss.solve(eph, obs.table)
     ref = np.array([3924687.7020, 301132.7660, 5001910.7750])
     fig = plots.spp(r, ref)
-    sky, counts, res, enu = fig.axes[:4]
+    sky, counts, res, enu = (fig.axes[i] for i in range(4))
     seen = r.satellites[np.isfinite(r.satellites["elevation_rad"])]
     first = seen[seen["sat"] == sorted(seen["sat"].unique())[0]]
     used = first[first["used"]]
     np.testing.assert_allclose(sky.lines[0].get_ydata(), 90.0 - np.degrees(used["elevation_rad"]))
-    np.testing.assert_allclose(res.lines[0].get_ydata(), first["residual_m"])
+    np.testing.assert_allclose(res.lines[0].get_ydata(), used["residual_m"])
     lat, lon = np.arctan2(ref[2], np.hypot(ref[0], ref[1]) * (1 - 6.69437999014e-3)), np.arctan2(ref[1], ref[0])
     east = np.array([-np.sin(lon), np.cos(lon), 0.0])
     up = np.array([np.cos(lat) * np.cos(lon), np.cos(lat) * np.sin(lon), np.sin(lat)])

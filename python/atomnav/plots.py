@@ -507,8 +507,9 @@ def spp(result, reference=None):
     -------
     matplotlib.figure.Figure
         A polar sky plot (azimuth from north, clockwise; elevation 90° at the centre) with
-        used satellites as lines and left-out ones as crosses; residuals (m) against time
-        per satellite; and, with ``reference``, the E/N/U error (m) against time with
+        used satellites as dots and left-out ones as crosses; the count of left-out
+        satellite-epochs per reason; the residuals (m) of the used satellites against time;
+        and, with ``reference``, the E/N/U error (m) against time with
         PDOP on a second axis.
 
     Raises
@@ -522,9 +523,10 @@ def spp(result, reference=None):
         if reference.shape != (3,) or np.linalg.norm(reference) < 6.0e6:
             raise input_error("reference", "expected an ECEF position (x, y, z) in m near the Earth's surface")
     plt = _pyplot()
-    rows = 3 if reference is not None else 2
-    fig = plt.figure(figsize=(10, 3.4 * rows), layout="constrained")
-    sky = fig.add_subplot(rows, 2, 1, projection="polar")
+    layout = [["sky", "why"], ["res", "res"]] + ([["enu", "enu"]] if reference is not None else [])
+    fig, axes = plt.subplot_mosaic(layout, figsize=(10, 3.6 * len(layout)), layout="constrained",
+                                   per_subplot_kw={"sky": {"projection": "polar"}})
+    sky = axes["sky"]
     sky.set_theta_zero_location("N")
     sky.set_theta_direction(-1)
     sats = result.satellites
@@ -538,23 +540,24 @@ def spp(result, reference=None):
     sky.set_rlim(0.0, 90.0)
     sky.set_yticks([0, 30, 60, 90], ["90°", "60°", "30°", "0°"])
     sky.set_title("Sky tracks (× left out)", fontsize=9)
-    counts = fig.add_subplot(rows, 2, 2)
+    counts = axes["why"]
     reasons = result.exclusions()
     counts.barh(reasons.index, reasons.to_numpy(), color="C3")
     counts.set_xlabel("satellite-epochs left out")
     counts.set_title(f"{int(sats['used'].sum())} satellite-epochs used", fontsize=9)
-    res = fig.add_subplot(rows, 1, 2)
+    res = axes["res"]
     for i, (name, s) in enumerate(seen.groupby("sat")):
-        res.plot(s["time_s"], s["residual_m"], "-", lw=0.8, color=f"C{i % 10}", label=name)
+        used = s[s["used"]]
+        res.plot(used["time_s"], used["residual_m"], "-", lw=0.8, color=f"C{i % 10}", label=name if len(used) else "_nolegend_")
     res.set_xlabel("time (s)")
-    res.set_ylabel("post-fit residual (m)")
+    res.set_ylabel("post-fit residual of used satellites (m)")
     res.grid(True, alpha=0.3)
     res.legend(fontsize=6, ncol=8)
     if reference is not None:
         e = result.epochs
         lla = earth.ecef_to_lla(reference)
         enu = (earth.dcm_ned_to_ecef(lla[0], lla[1]).T @ (e[["x_m", "y_m", "z_m"]].to_numpy() - reference).T).T
-        ax = fig.add_subplot(rows, 1, 3)
+        ax = axes["enu"]
         for k, (label, v) in enumerate((("east", enu[:, 1]), ("north", enu[:, 0]), ("up", -enu[:, 2]))):
             ax.plot(e["time_s"], v, lw=0.9, color=f"C{k}", label=label)
         ax.set_xlabel("time (s)")
