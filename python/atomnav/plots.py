@@ -524,7 +524,7 @@ def spp(result, reference=None):
             raise input_error("reference", "expected an ECEF position (x, y, z) in m near the Earth's surface")
     plt = _pyplot()
     layout = [["sky", "why"], ["res", "res"]] + ([["enu", "enu"]] if reference is not None else [])
-    fig, axes = plt.subplot_mosaic(layout, figsize=(10, 3.6 * len(layout)), layout="constrained",
+    fig, axes = plt.subplot_mosaic(layout, figsize=(8.5, 2.6 * len(layout)), layout="constrained",
                                    per_subplot_kw={"sky": {"projection": "polar"}})
     sky = axes["sky"]
     sky.set_theta_zero_location("N")
