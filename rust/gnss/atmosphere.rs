@@ -19,6 +19,19 @@ impl Default for Klobuchar {
 }
 
 impl Klobuchar {
+    /// From the eight broadcast coefficients α₀..α₃, β₀..β₃ in RINEX order (ION ALPHA,
+    /// ION BETA; GPSA, GPSB).
+    pub fn from_coefficients(c: [f64; 8]) -> Klobuchar {
+        let [a0, a1, a2, a3, b0, b1, b2, b3] = c;
+        Klobuchar { alpha: [a0, a1, a2, a3], beta: [b0, b1, b2, b3] }
+    }
+
+    /// The eight coefficients α₀..α₃, β₀..β₃.
+    pub fn coefficients(&self) -> [f64; 8] {
+        let ([a0, a1, a2, a3], [b0, b1, b2, b3]) = (self.alpha, self.beta);
+        [a0, a1, a2, a3, b0, b1, b2, b3]
+    }
+
     /// L1 ionospheric group delay (m) for receiver (lat, lon) rad, elevation and azimuth rad,
     /// GPS time t (s). GLONASS channel frequencies scale it by (f_L1/f_k)².
     pub fn delay(&self, lat: f64, lon: f64, elev: f64, azim: f64, t: f64) -> f64 {

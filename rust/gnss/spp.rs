@@ -116,6 +116,15 @@ fn corrected_code(o: &Observation, g: &Geometry, atm: &Atmosphere, lla: &Vec3, t
 /// (< 0.09 s for a receiver on the ground or in low orbit) plus a receiver clock offset.
 const SIGNAL_SPAN: f64 = 0.2;
 
+/// Measured less predicted code (m) of `o` with geometry `g` at the unknowns `x`
+/// (position, c·δt_r[, c·τ_GPS on GLONASS rows when `with_tau`]).
+// invariant: x has at least 4 entries, 5 when with_tau.
+#[allow(clippy::indexing_slicing)]
+fn code_residual(o: &Observation, g: &Geometry, atm: &Atmosphere, lla: &Vec3, t_rx: f64, x: &DVector<f64>, with_tau: bool) -> f64 {
+    let tau = if with_tau && o.sat.system == System::Glonass { x[4] } else { 0.0 };
+    corrected_code(o, g, atm, lla, t_rx) - (g.range + x[3] + tau)
+}
+
 /// Upper 0.1 % point of χ²(k): the tabulated values for k ≤ 10 (Abramowitz & Stegun 1964,
 /// Table 26.8) and the Wilson–Hilferty cube beyond (Wilson & Hilferty 1931; within 0.6 %
 /// for k > 10). RTKLIB's test uses the same level (Takasu 2013, `chisqr` in `pntpos.c`).
@@ -207,8 +216,7 @@ fn least_squares(eph: &Ephemerides, t: f64, obs: &[Observation], candidates: &[u
         for (k, (&i, g)) in used.iter().zip(&geo).enumerate() {
             let o = &obs[i];
             let glo = o.sat.system == System::Glonass;
-            let pred = g.range + x[3] + if glo && with_tau { x[4] } else { 0.0 };
-            z[k] = corrected_code(o, g, &cfg.atm, &lla, t_rx) - pred;
+            z[k] = code_residual(o, g, &cfg.atm, &lla, t_rx, &x, with_tau);
             let row = -g.los * g.kappa;
             h[(k, 0)] = row.x;
             h[(k, 1)] = row.y;
@@ -334,9 +342,7 @@ fn solve_epoch(eph: &Ephemerides, t: f64, obs: &[Observation], cfg: &SppConfig, 
             continue;
         }
         let g = geometry(eph, o.sat, t_rx, &pos, &Vec3::zeros(), lla.x, lla.y, tau)?;
-        let glo = o.sat.system == System::Glonass;
-        let pred = g.range + fit.x[3] + if glo && fit.with_tau { fit.x[4] } else { 0.0 };
-        satellites[i].residual = corrected_code(o, &g, &cfg.atm, &lla, t_rx) - pred;
+        satellites[i].residual = code_residual(o, &g, &cfg.atm, &lla, t_rx, &fit.x, fit.with_tau);
         satellites[i].elevation = g.elevation;
         satellites[i].azimuth = g.azimuth.rem_euclid(std::f64::consts::TAU);
     }

@@ -143,10 +143,11 @@ impl TightAiding {
         let tau_s = tau.map_or(0.0, |x| x.1 / C_LIGHT);
         let t_rx = t - clock.map_or(0.0, |c| c.1 / C_LIGHT);
         let mut rows = Vec::new();
-        let mut uncovered = None;
+        // a satellite without a set valid then is left out, as in single-point positioning;
+        // an epoch where no satellite has one is outside the ephemerides: that error
+        let (mut covered, mut uncovered) = (0, None);
         for o in epoch.iter().filter(|o| o.code.is_finite()) {
             let glo = o.sat.system == System::Glonass;
-            // a satellite without a set valid then is left out, as in single-point positioning
             let g = match geometry(&self.eph, o.sat, t_rx, &r_a, &v_a, lla_a.x, lla_a.y, tau_s) {
                 Ok(g) => g,
                 Err(e) => {
@@ -154,6 +155,7 @@ impl TightAiding {
                     continue;
                 }
             };
+            covered += 1;
             if g.elevation <= 0.0 || g.elevation < self.cfg.elevation_mask {
                 continue;
             }
@@ -205,8 +207,7 @@ impl TightAiding {
             });
         }
         match uncovered {
-            // no satellite of the epoch has a set valid then: the ephemerides do not cover it
-            Some(e) if rows.is_empty() && epoch.iter().all(|o| !o.code.is_finite() || self.eph.state(o.sat, t_rx, 0.0).is_err()) => Err(e),
+            Some(e) if covered == 0 => Err(e),
             _ => Ok(rows),
         }
     }

@@ -49,10 +49,7 @@ impl PyEphemerides {
         let r = rows::<14>(&glonass, "glonass")?.iter().enumerate().map(|(i, x)| GloEphemeris::from_row(x, i)).collect::<crate::Result<Vec<_>>>()?;
         let eph = Ephemerides::new(g, r, TimeScales { n_leap }, datum.0)?;
         let inner = match ionosphere {
-            Some(k) => {
-                let c = floats::<8>(k, "ionosphere")?;
-                eph.with_ionosphere(Klobuchar { alpha: [c[0], c[1], c[2], c[3]], beta: [c[4], c[5], c[6], c[7]] })?
-            }
+            Some(k) => eph.with_ionosphere(Klobuchar::from_coefficients(floats::<8>(k, "ionosphere")?))?,
             None => eph,
         };
         Ok(PyEphemerides { inner })
@@ -60,9 +57,8 @@ impl PyEphemerides {
 
     /// The navigation message's Klobuchar coefficients (α₀..α₃, β₀..β₃).
     #[getter]
-    fn ionosphere(&self) -> Vec<f64> {
-        let k = self.inner.ionosphere;
-        k.alpha.iter().chain(&k.beta).copied().collect()
+    fn ionosphere(&self) -> [f64; 8] {
+        self.inner.ionosphere.coefficients()
     }
 
     /// The nominal constellations over GPS times [t_start, t_end].

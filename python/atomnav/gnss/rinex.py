@@ -20,7 +20,7 @@ import pandas as pd
 
 from .._validate import input_error, instance, path as checked_path
 from .ephemeris import GLONASS_COLUMNS, GPS_COLUMNS, Ephemerides
-from .observations import C_LIGHT, _gps_week_start, doppler_to_rate, obs_arrays
+from .observations import C_LIGHT, _gps_week_start, doppler_to_rate, gps_week_of, obs_arrays
 from .solution import GPS_EPOCH, gps_minus_utc
 
 WEEK_START = datetime(2017, 1, 1)   # a Sunday: GPS week 1930
@@ -153,19 +153,13 @@ def _seconds(times, week_start: datetime) -> np.ndarray:
     return (pd.to_datetime(np.asarray(times)) - pd.Timestamp(week_start)).total_seconds().to_numpy()
 
 
-def _week_of(t: pd.Timestamp) -> pd.Timestamp:
-    """00:00 of the Sunday that starts the GPS week of ``t``."""
-    t = pd.Timestamp(t)
-    return t.normalize() - pd.Timedelta(days=(t.day_of_week + 1) % 7)
-
-
-def _leap_seconds(header: dict, first_utc) -> float:
+def _leap_seconds(header: dict, when) -> float:
     """GPS − UTC from the header's LEAP SECONDS line, else from the IERS table at the
-    file's first epoch."""
+    UTC time ``when``."""
     line = str(header.get("LEAP SECONDS", "")).split()
     if line and line[0].lstrip("-").isdigit():
         return float(line[0])
-    return float(gps_minus_utc(pd.Timestamp(first_utc)))
+    return float(gps_minus_utc(pd.Timestamp(when)))
 
 
 def read_nav(path, n_leap: float | None = None, datum: str = "identity", week_start: datetime | None = None) -> Ephemerides:
@@ -208,7 +202,7 @@ def read_nav(path, n_leap: float | None = None, datum: str = "identity", week_st
         raise input_error("path", f"no satellite records in {path}")
     times = pd.to_datetime(np.concatenate([nav.time.values for nav, _ in navs]))
     middle = times.sort_values()[len(times) // 2]
-    week = pd.Timestamp(_week_start(week_start)) if week_start is not None else _week_of(middle)
+    week = pd.Timestamp(_week_start(week_start)) if week_start is not None else gps_week_of(middle)
     iono = next((np.asarray(nav.attrs["ionospheric_corr_GPS"], float) for nav, _ in navs
                  if len(nav.attrs.get("ionospheric_corr_GPS", [])) == 8), None)
     leap = _leap_seconds(navs[0][1], middle) if n_leap is None else n_leap
@@ -379,12 +373,14 @@ def read_obs(path, eph: Ephemerides, week_start: datetime | None = None) -> Rine
     df, system, code, code_type, rate_hz, doppler_type = (x[keep] for x in (df, system, code, code_type, rate_hz,
                                                                                doppler_type))
     week = (pd.Timestamp(_week_start(week_start)) if week_start is not None
-            else getattr(eph, "week_start", None) or _week_of(pd.Timestamp(ds.time.values.min())))
+            else getattr(eph, "week_start", None) or gps_week_of(pd.Timestamp(ds.time.values.min())))
     from_header = _glonass_channels(header)
     known = set(eph.satellites)
     sat = df.sv.to_numpy()
-    channel = np.array([(eph.channel(s) if s in known else from_header.get(int(s[1:]), 0)) if s[0] == "R" else 0
-                        for s in sat], dtype=np.int64)
+    names, row_of = np.unique(sat, return_inverse=True)  # one look-up per satellite, not per row
+    per_sat = np.array([(eph.channel(s) if s in known else from_header.get(int(s[1:]), 0)) if s[0] == "R" else 0
+                        for s in names], dtype=np.int64)
+    channel = per_sat[row_of.reshape(-1)]
     rate = doppler_to_rate(rate_hz, sat, channel)
     table = pd.DataFrame({"time_s": _seconds(df.time.values, week), "sat": sat, "channel": channel, "code_m": code,
                           "rate_mps": rate, "code_type": code_type, "doppler_type": doppler_type})
