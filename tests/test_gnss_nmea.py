@@ -164,3 +164,9 @@ def test_wrong_types_raise_type_error():
         read_nmea(DATA / "rtk_0759.nmea", sigma="fraction")
     with pytest.raises(TypeError, match="source"):
         read_nmea(3.0)
+
+
+def test_a_file_name_with_a_null_byte_names_source():
+    with pytest.raises(an.InputError) as e:
+        read_nmea("\x00")
+    assert e.value.parameter == "source"

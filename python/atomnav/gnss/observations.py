@@ -151,22 +151,12 @@ def _gps_week_start(obs: pd.DataFrame):
     if t.dt.tz is not None:
         raise input_error("obs", "column 'time_s' is tz-aware (civil time, which differs from GPS time by the leap seconds): "
                                  "give GPS time as naive datetimes or as GPS seconds of week")
-    return gps_week_of(t.dropna().iloc[0])
+    return _gps_week_of(t.dropna().iloc[0])
 
 
-def gps_week_of(t) -> pd.Timestamp:
-    """00:00 of the Sunday that starts the GPS week of ``t``.
-
-    Parameters
-    ----------
-    t : datetime-like
-        A time on the GPS time scale.
-
-    Returns
-    -------
-    Timestamp
-        The start of its GPS week.
-    """
+def _gps_week_of(t) -> pd.Timestamp:
+    """00:00 of the Sunday that starts the GPS week of the GPS time ``t`` (a checked
+    datetime of the caller)."""
     t = pd.Timestamp(t)
     return t.normalize() - pd.Timedelta(days=(t.day_of_week + 1) % 7)
 

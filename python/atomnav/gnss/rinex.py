@@ -20,7 +20,7 @@ import pandas as pd
 
 from .._validate import input_error, instance, path as checked_path
 from .ephemeris import GLONASS_COLUMNS, GPS_COLUMNS, Ephemerides
-from .observations import C_LIGHT, _gps_week_start, doppler_to_rate, gps_week_of, obs_arrays
+from .observations import C_LIGHT, _gps_week_start, doppler_to_rate, _gps_week_of, obs_arrays
 from .solution import GPS_EPOCH, gps_minus_utc
 
 WEEK_START = datetime(2017, 1, 1)   # a Sunday: GPS week 1930
@@ -202,7 +202,7 @@ def read_nav(path, n_leap: float | None = None, datum: str = "identity", week_st
         raise input_error("path", f"no satellite records in {path}")
     times = pd.to_datetime(np.concatenate([nav.time.values for nav, _ in navs]))
     middle = times.sort_values()[len(times) // 2]
-    week = pd.Timestamp(_week_start(week_start)) if week_start is not None else gps_week_of(middle)
+    week = pd.Timestamp(_week_start(week_start)) if week_start is not None else _gps_week_of(middle)
     iono = next((np.asarray(nav.attrs["ionospheric_corr_GPS"], float) for nav, _ in navs
                  if len(nav.attrs.get("ionospheric_corr_GPS", [])) == 8), None)
     leap = _leap_seconds(navs[0][1], middle) if n_leap is None else n_leap
@@ -373,7 +373,7 @@ def read_obs(path, eph: Ephemerides, week_start: datetime | None = None) -> Rine
     df, system, code, code_type, rate_hz, doppler_type = (x[keep] for x in (df, system, code, code_type, rate_hz,
                                                                                doppler_type))
     week = (pd.Timestamp(_week_start(week_start)) if week_start is not None
-            else getattr(eph, "week_start", None) or gps_week_of(pd.Timestamp(ds.time.values.min())))
+            else getattr(eph, "week_start", None) or _gps_week_of(pd.Timestamp(ds.time.values.min())))
     from_header = _glonass_channels(header)
     known = set(eph.satellites)
     sat = df.sv.to_numpy()

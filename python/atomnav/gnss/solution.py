@@ -298,6 +298,8 @@ def _read_text(source) -> str:
     if not isinstance(source, (str, PathLike)):
         raise TypeError(f"source: expected a path or a text stream, got {type(source).__name__}")
     path = Path(source)
+    if "\x00" in str(path):
+        raise input_error("source", f"not a file name: {str(path)!r} holds a null byte")
     with (gzip.open(path, "rt", encoding="utf-8") if path.suffix == ".gz" else open(path, encoding="utf-8")) as f:
         return f.read()
 
