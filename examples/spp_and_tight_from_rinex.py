@@ -20,7 +20,7 @@ import numpy as np
 import pandas as pd
 
 import atomnav as an
-from atomnav.gnss import rinex                  # RINEX through georinex: pip install "atomnav[gnss]"
+from atomnav.gnss import rinex                  # RINEX 2/3/4, Hatanaka, gzip: read in the core
 from _workdir import enter
 
 workdir = enter()

@@ -142,6 +142,18 @@ class NumericalError(ArithmeticError):
 
 OPTIONS: dict[str, list[str]]
 
+RINEX_CODE_L1: dict[str, list[str]]
+
+RINEX_CODE_L2: dict[str, list[str]]
+
+RINEX_DOPPLER_L1: dict[str, list[str]]
+
+RINEX_GLONASS_RECORD_FIELDS: list[str]
+
+RINEX_GPS_RECORD_FIELDS: list[str]
+
+RINEX_SNR_L1: dict[str, list[str]]
+
 ROTATION_TOLERANCE: float
 
 SPP_COLUMNS: list[str]
@@ -267,6 +279,10 @@ def euler_from_quat_rows(q): ...
 def fine_alignment_p0(lla, q_nb, *, psi_cov_noise, mean_f, mean_w, gravity, horizon, accel_errors, gyro_errors, pos_sigma, vel_sigma, ellipsoid=...): ...
 
 def glonass_propagate(pos, vel, acc, dt, step, j2): ...
+
+def gnss_read_rinex_nav(path): ...
+
+def gnss_read_rinex_obs(path): ...
 
 def gnss_simulate(eph, t, lla, vel_ned, options, *, tau_gps=0.0, clock_bias=0.0, clock_drift=0.0, mask=0.0, only=None, outages=None, sat_outages=..., seed=None): ...
 

@@ -15,6 +15,7 @@ pub mod glonass_orbit;
 pub mod gps_orbit;
 pub mod observation;
 pub mod options;
+pub mod rinex;
 pub mod spp;
 pub mod tight;
 

@@ -14,6 +14,7 @@ mod imu;
 mod kalman;
 mod noise;
 mod pickle;
+mod rinex;
 mod shared;
 mod sources;
 mod rotation;
@@ -66,6 +67,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     filter::register(m)?;
     kalman::register(m)?;
     gnss::register(m)?;
+    rinex::register(m)?;
     sources::register(m)?;
     alignment::register(m)?;
     constraints::register(m)?;

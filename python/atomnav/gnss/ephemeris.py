@@ -57,9 +57,16 @@ class Ephemerides:
     week_start : Timestamp or None
         Start (GPS time) of the GPS week the sets' times count from, when they come from a
         file (:func:`atomnav.gnss.rinex.read_nav`); None otherwise.
+    time_corrections : DataFrame or None
+        The files' time-system corrections (GPUT, GLUT, GLGP, ...: ``system``, ``a0_s``,
+        ``a1_s_per_s``, ``week``, ``seconds_of_week``), when read from files; None otherwise.
+    sources : tuple of pathlib.Path
+        The navigation files the sets were read from (empty when not read from files).
     """
 
     week_start = None
+    time_corrections = None
+    sources = ()
 
     def __init__(self, gps: pd.DataFrame | None = None, glonass: pd.DataFrame | None = None,
                  n_leap: float = 18.0, datum: str = "identity", *, ionosphere=None, _core_obj=None):

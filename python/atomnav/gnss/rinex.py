@@ -1,7 +1,6 @@
-"""RINEX observation and navigation files (RINEX 2.11, 3 and 4 observation files, plain,
-Hatanaka or gzip; RINEX 2 and 3 navigation files) through georinex (optional extra
-``atomnav[gnss]``; no parser of our own, docs/departures.md#rinex-through-georinex), and a
-small RINEX 3 writer for simulated data (tests and exchange).
+"""RINEX observation and navigation files (RINEX 2.11, 3 and 4, plain, Hatanaka or gzip),
+read in the core by the ``rinex`` crate (no parser of our own, docs/departures.md#rinex-reading),
+and a small RINEX 3 writer for simulated data (tests and exchange).
 
 Time: GPS seconds since the start of a GPS week (``week_start``, a datetime in GPS
 time): by default the week of the navigation records' median time, shared by
@@ -18,6 +17,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from .. import _core
 from .._validate import input_error, instance, path as checked_path
 from .ephemeris import GLONASS_COLUMNS, GPS_COLUMNS, Ephemerides
 from .observations import C_LIGHT, _gps_week_start, doppler_to_rate, _gps_week_of, obs_arrays
@@ -132,47 +132,34 @@ def write_obs(path, obs: pd.DataFrame, week_start: datetime = WEEK_START) -> Pat
     return Path(path)
 
 
-def _load(path, what: str, **kw):
-    path = checked_path(path)
-    if not path.is_file():
-        raise FileNotFoundError(f"{what}: no RINEX file {path}")
-    try:
-        import georinex
-    except ImportError as e:  # pragma: no cover - the extra is part of the test environment
-        raise ImportError("reading RINEX needs the optional extra: pip install 'atomnav[gnss]'") from e
-    import warnings
-    try:
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore", FutureWarning)      # xarray defaults inside georinex
-            return georinex.load(str(path), **kw), georinex.rinexheader(str(path))
-    except Exception as e:  # georinex raises many types on malformed input
-        raise input_error("path", f"malformed RINEX {what} file {path}: {e}") from None
-
-
 def _seconds(times, week_start: datetime) -> np.ndarray:
     return (pd.to_datetime(np.asarray(times)) - pd.Timestamp(week_start)).total_seconds().to_numpy()
 
 
-def _leap_seconds(header: dict, when) -> float:
-    """GPS − UTC from the header's LEAP SECONDS line, else from the IERS table at the
-    UTC time ``when``."""
-    line = str(header.get("LEAP SECONDS", "")).split()
-    if line and line[0].lstrip("-").isdigit():
-        return float(line[0])
-    return float(gps_minus_utc(pd.Timestamp(when)))
+def _offset(week: pd.Timestamp) -> float:
+    """Seconds from the GPS epoch (1980-01-06) to ``week``."""
+    return (pd.Timestamp(week) - GPS_EPOCH).total_seconds()
+
+
+def _file(path, what: str) -> Path:
+    path = checked_path(path)
+    if not path.is_file():
+        raise FileNotFoundError(f"{what}: no RINEX file {path}")
+    return path
 
 
 def read_nav(path, n_leap: float | None = None, datum: str = "identity", week_start: datetime | None = None) -> Ephemerides:
-    """Broadcast ephemerides from RINEX navigation files (GPS and GLONASS records; RINEX 2
-    ``.n``/``.g`` or RINEX 3 mixed), read through georinex.
+    """Broadcast ephemerides from RINEX navigation files: the GPS LNAV and GLONASS FDMA
+    records of RINEX 2 ``.n``/``.g``, RINEX 3 and RINEX 4 mixed files, plain or gzip, read
+    in the core by the ``rinex`` crate (docs/departures.md#rinex-reading).
 
     Parameters
     ----------
     path : str, os.PathLike or list of them
         The navigation file, or several (e.g. a RINEX 2 GPS ``.n`` and GLONASS ``.g``).
-        Records of other systems are set aside.
+        Records of other systems (and GPS CNAV) are set aside.
     n_leap : float, optional
-        GPS−UTC leap seconds, s; default: the file's LEAP SECONDS line, else the IERS
+        GPS−UTC leap seconds, s; default: the files' LEAP SECONDS line, else the IERS
         value at the records' median time.
     datum : {"identity", "pz90_02_to_wgs84"}, default "identity"
         PZ-90 → WGS-84 transformation of the GLONASS states.
@@ -185,70 +172,64 @@ def read_nav(path, n_leap: float | None = None, datum: str = "identity", week_st
     -------
     Ephemerides
         The healthy broadcast sets of the files (a set flagged unhealthy is left out), the
-        Klobuchar coefficients of the GPS navigation message (ION ALPHA/BETA or
-        GPSA/GPSB) when a file has them, and ``week_start``.
+        Klobuchar coefficients of the GPS navigation message (ION ALPHA/BETA, GPSA/GPSB, or
+        a RINEX 4 ION LNAV record) when a file has them, the time-system corrections,
+        ``week_start`` and ``sources``.
 
     Raises
     ------
     FileNotFoundError
         When a path is not a file.
     atomnav.InputError
-        Naming ``path`` for a malformed file or files without GPS or GLONASS records.
+        Naming ``path``, the file and the line for a record that cannot be decoded, an
+        unknown RINEX version, or files without GPS or GLONASS records.
     """
-    paths = list(path) if isinstance(path, (list, tuple)) else [path]
-    loaded = [_load(p, "nav") for p in paths]
-    navs = [(nav, header) for nav, header in loaded if "sv" in nav.coords and len(nav.sv)]
-    if not navs:
-        raise input_error("path", f"no satellite records in {path}")
-    times = pd.to_datetime(np.concatenate([nav.time.values for nav, _ in navs]))
-    middle = times.sort_values()[len(times) // 2]
+    paths = [_file(p, "nav") for p in (list(path) if isinstance(path, (list, tuple)) else [path])]
+    files = [_core.gnss_read_rinex_nav(str(p)) for p in paths]
+    gps = np.vstack([f["gps"] for f in files])
+    glo = np.vstack([f["glonass"] for f in files])
+    if not len(gps) and not len(glo):
+        raise input_error("path", f"no GPS or GLONASS records in {', '.join(map(str, paths))}")
+    gf, rf = _core.RINEX_GPS_RECORD_FIELDS, _core.RINEX_GLONASS_RECORD_FIELDS
+    gps = pd.DataFrame(gps, columns=gf)
+    glo = pd.DataFrame(glo, columns=rf)
+    calendar = np.sort(np.concatenate([gps["toc"].to_numpy(), glo["toc_utc"].to_numpy()]))
+    middle = GPS_EPOCH + pd.Timedelta(seconds=float(calendar[len(calendar) // 2]))
     week = pd.Timestamp(_week_start(week_start)) if week_start is not None else _gps_week_of(middle)
-    iono = next((np.asarray(nav.attrs["ionospheric_corr_GPS"], float) for nav, _ in navs
-                 if len(nav.attrs.get("ionospheric_corr_GPS", [])) == 8), None)
-    leap = _leap_seconds(navs[0][1], middle) if n_leap is None else n_leap
-    gps, glo = [], []
-    for nav, _ in navs:
-        for sv in nav.sv.values:
-            d = nav.sel(sv=sv).dropna(dim="time", how="all")
-            t = _seconds(d.time.values, week)
-            if sv[0] == "G":
-                for k in range(len(t)):
-                    r = d.isel(time=k)
-                    v = {c: float(r[c]) for c in ("sqrtA", "Eccentricity", "M0", "DeltaN", "Omega0", "Io", "omega",
-                                                   "OmegaDot", "IDOT", "Cuc", "Cus", "Crc", "Crs", "Cic", "Cis",
-                                                   "SVclockBias", "SVclockDrift", "SVclockDriftRate", "TGD", "Toe")}
-                    if "health" in r and float(r["health"]) != 0.0:
-                        continue
-                    # Toe counts from the start of its own GPS week (the record's GPSWeek)
-                    toe = v["Toe"] + (float(r["GPSWeek"]) * 604800.0 - (week - GPS_EPOCH).total_seconds()
-                                      if "GPSWeek" in r and np.isfinite(float(r["GPSWeek"])) else 0.0)
-                    gps.append([int(sv[1:]), toe, v["sqrtA"], v["Eccentricity"], v["M0"], v["DeltaN"], v["Omega0"],
-                                v["Io"], v["omega"], v["OmegaDot"], v["IDOT"], v["Cuc"], v["Cus"], v["Crc"], v["Crs"],
-                                v["Cic"], v["Cis"], t[k], v["SVclockBias"], v["SVclockDrift"], v["SVclockDriftRate"],
-                                v["TGD"]])
-            elif sv[0] == "R":
-                for k in range(len(t)):
-                    r = d.isel(time=k)
-                    if "health" in r and float(r["health"]) != 0.0:
-                        continue
-                    f = {c: float(r[c]) for c in ("X", "Y", "Z", "dX", "dY", "dZ", "dX2", "dY2", "dZ2", "FreqNum",
-                                                   "SVclockBias", "SVrelFreqBias")}
-                    glo.append([int(sv[1:]), f["FreqNum"], t[k] + 10800.0, f["X"], f["Y"], f["Z"], f["dX"], f["dY"],
-                                f["dZ"], f["dX2"], f["dY2"], f["dZ2"], -f["SVclockBias"], f["SVrelFreqBias"]])
-    gps_t = pd.DataFrame(gps, columns=GPS_COLUMNS).drop_duplicates(["prn", "toe"])
-    glo_t = pd.DataFrame(glo, columns=GLONASS_COLUMNS).drop_duplicates(["slot", "tb"])
-    eph = Ephemerides(gps_t, glo_t, leap, datum, ionosphere=iono)
+    offset = _offset(week)
+    iono = next((np.asarray(f["klobuchar"], float) for f in files if f["klobuchar"] is not None), None)
+    leap = next((f["leap_seconds"] for f in files if f["leap_seconds"] is not None), None)
+    leap = float(n_leap) if n_leap is not None else (float(leap) if leap is not None else float(gps_minus_utc(middle)))
+    gps = gps[gps["health"] == 0.0]
+    glo = glo[glo["health"] == 0.0]
+    gps_t = pd.DataFrame({c: gps[c] for c in GPS_COLUMNS if c in gf and c not in ("toe", "toc")})
+    gps_t["prn"] = gps["prn"].astype(int)
+    # Toe counts from the start of its own GPS week (the record's week number)
+    gps_t["toe"] = gps["toe_sow"] + gps["week"] * 604800.0 - offset
+    gps_t["toc"] = gps["toc"] - offset
+    glo_t = pd.DataFrame({c: glo[c] for c in GLONASS_COLUMNS if c in rf})
+    glo_t["slot"], glo_t["channel"] = glo["slot"].astype(int), glo["channel"].astype(int)
+    glo_t["tb"] = glo["toc_utc"] - offset + 10800.0
+    glo_t["tau_n"] = -glo["minus_tau_n"]
+    eph = Ephemerides(gps_t[GPS_COLUMNS].drop_duplicates(["prn", "toe"]), glo_t[GLONASS_COLUMNS].drop_duplicates(["slot", "tb"]),
+                      leap, datum, ionosphere=iono)
     eph.week_start = week
+    eph.sources = tuple(paths)
+    eph.time_corrections = pd.DataFrame([c for f in files for c in f["time_corrections"]],
+                                        columns=["system", "a0_s", "a1_s_per_s", "week", "seconds_of_week"])
     return eph
 
 
-#: Observation codes read, per system, in order of preference (the first present at an
-#: epoch is used): the civil L1 code, then the P(Y) code, then other tracking modes; RINEX 2
-#: names (C1, P1) and RINEX 3 names.
-CODE_PREFERENCE = {"G": ("C1C", "C1", "C1W", "P1", "C1X", "C1P", "C1L", "C1S"),
-                   "R": ("C1C", "C1", "C1P", "P1")}
+#: Observation codes read, per system letter, in order of preference (the first present at
+#: an epoch is used): the civil L1 code, then the P(Y) code, then other tracking modes;
+#: RINEX 2 names (C1, P1) beside RINEX 3 names.
+CODE_PREFERENCE = _core.RINEX_CODE_L1
+#: Second-frequency codes, in order of preference (for the ionosphere-free combination).
+CODE2_PREFERENCE = _core.RINEX_CODE_L2
 #: Doppler codes read, per system, in order of preference.
-DOPPLER_PREFERENCE = {"G": ("D1C", "D1", "D1W", "D1X", "D1P", "D1L", "D1S"), "R": ("D1C", "D1", "D1P")}
+DOPPLER_PREFERENCE = _core.RINEX_DOPPLER_L1
+#: Carrier-to-noise density (dB-Hz) on the first frequency, in order of preference.
+SNR_PREFERENCE = _core.RINEX_SNR_L1
 #: Systems positioned (others are set aside and counted).
 SYSTEMS = ("G", "R")
 
@@ -262,12 +243,14 @@ class RinexObservations:
     table : DataFrame
         One row per GPS or GLONASS satellite and epoch with a code or a Doppler:
         ``time_s`` (GPS s from ``week_start``), ``sat``, ``channel``, ``code_m`` (m, NaN
-        when not tracked), ``rate_mps`` (m/s, NaN without Doppler), and the RINEX types
-        used, ``code_type`` and ``doppler_type`` (empty when missing).
+        when not tracked), ``rate_mps`` (m/s, NaN without Doppler), ``code2_m`` (the
+        second-frequency code, m, NaN when not tracked), ``snr_dbhz`` (dB-Hz, NaN when not
+        given), and the RINEX types used, ``code_type``, ``code2_type`` and
+        ``doppler_type`` (empty when missing).
     header : dict
         ``marker``, ``receiver``, ``version``, ``time_system``, ``interval_s``,
         ``approx_position_m`` (ECEF, 3), ``antenna_delta_hen_m`` (3), ``glonass_channels``
-        ({slot: k}).
+        ({slot: k}), ``leap_seconds`` (None when the header has none).
     set_aside : Series
         Satellite-epochs of other systems (Galileo E, BeiDou C, QZSS J, SBAS S, IRNSS I),
         counted per system letter.
@@ -276,6 +259,8 @@ class RinexObservations:
         ``n_no_code`` and without Doppler ``n_no_doppler``.
     week_start : Timestamp
         Time 0 of ``time_s`` (GPS time).
+    n_epochs : int
+        Observation epochs in the file (event records excluded).
     """
 
     table: pd.DataFrame
@@ -283,45 +268,39 @@ class RinexObservations:
     set_aside: pd.Series
     missing: pd.DataFrame
     week_start: pd.Timestamp
+    n_epochs: int
 
 
-def _glonass_channels(header: dict) -> dict:
-    """{slot: channel} from the RINEX 3 GLONASS SLOT / FRQ # lines."""
-    words = str(header.get("GLONASS SLOT / FRQ #", "")).split()
-    out = {}
-    for a, b in zip(words, words[1:]):
-        if len(a) == 3 and a[0] == "R" and a[1:].isdigit() and b.lstrip("-").isdigit():
-            out[int(a[1:])] = int(b)
+def _names(index: np.ndarray, system: np.ndarray, preference: dict) -> np.ndarray:
+    """The RINEX type names of preference-list indices (−1: missing, '')."""
+    out = np.full(len(index), "", dtype=object)
+    for sys, codes in preference.items():
+        for k, c in enumerate(codes):
+            out[(system == sys) & (index == k)] = c
     return out
 
 
-def _numbers(header: dict, key: str, n: int) -> list:
-    words = str(header.get(key, "")).split()[:n]
-    try:
-        return [float(w) for w in words] if len(words) == n else [float("nan")] * n
-    except ValueError:
-        return [float("nan")] * n
-
-
-def _first(df: pd.DataFrame, system: np.ndarray, preference: dict) -> tuple[np.ndarray, np.ndarray]:
-    """Per row, the first finite non-zero value among the system's preferred columns, and
-    that column's name ('' when none)."""
-    value = np.full(len(df), np.nan)
-    name = np.full(len(df), "", dtype=object)
-    for sys, codes in preference.items():
-        rows = system == sys
-        for c in codes:
-            if c not in df:
-                continue
-            x = df[c].to_numpy(float)
-            take = rows & np.isnan(value) & np.isfinite(x) & (x != 0.0)
-            value[take], name[take] = x[take], c
-    return value, name
+def _check_coverage(path: Path, t: np.ndarray, eph: Ephemerides, header_lines: int, week: pd.Timestamp) -> None:
+    """Refuse observations that no broadcast record can serve (GPS sets are valid 4 h
+    around Toe in the fit interval of IS-GPS-200, GLONASS sets 30 min around tb)."""
+    gps, glo = eph.tables()
+    valid = [(gps["toe"].min() - 14400.0, gps["toe"].max() + 14400.0)] if len(gps) else []
+    if len(glo):
+        # tb is GLONASS time (UTC + 3 h); the leap seconds do not matter at this scale
+        valid.append((glo["tb"].min() - 10800.0 - 1800.0, glo["tb"].max() - 10800.0 + 1800.0))
+    if not len(t) or any(((t >= a) & (t <= b)).any() for a, b in valid):
+        return
+    when = lambda s: (week + pd.Timedelta(seconds=float(s))).strftime("%Y-%m-%d %H:%M:%S")
+    spans = ", ".join(f"{when(a)} – {when(b)}" for a, b in valid)
+    sources = ", ".join(str(s) for s in eph.sources) or "the ephemerides"
+    raise input_error("path", f"{path}, line {header_lines + 1}, field EPOCH: observations {when(t.min())} – {when(t.max())} GPST "
+                              f"lie outside what the navigation records of {sources} cover ({spans} GPST)")
 
 
 def read_obs(path, eph: Ephemerides, week_start: datetime | None = None) -> RinexObservations:
-    """Code and Doppler observations from a RINEX 2.11, 3 or 4 observation file (plain,
-    Hatanaka ``.crx`` or gzip), read through georinex.
+    """Code, Doppler and SNR observations from a RINEX 2.11, 3 or 4 observation file
+    (plain, Hatanaka ``.crx`` or gzip), read in the core by the ``rinex`` crate
+    (docs/departures.md#rinex-reading).
 
     Parameters
     ----------
@@ -337,8 +316,9 @@ def read_obs(path, eph: Ephemerides, week_start: datetime | None = None) -> Rine
     Returns
     -------
     RinexObservations
-        The observation table with, per satellite, the first code and Doppler of
-        :data:`CODE_PREFERENCE` and :data:`DOPPLER_PREFERENCE` present at each epoch (a
+        The observation table with, per satellite, the first code, second-frequency code,
+        Doppler and SNR of :data:`CODE_PREFERENCE`, :data:`CODE2_PREFERENCE`,
+        :data:`DOPPLER_PREFERENCE` and :data:`SNR_PREFERENCE` present at each epoch (a
         blank, NaN or 0.0 field is missing), the header facts, the records of other
         systems set aside and counted, and what each epoch was missing.
 
@@ -347,50 +327,41 @@ def read_obs(path, eph: Ephemerides, week_start: datetime | None = None) -> Rine
     FileNotFoundError
         When ``path`` is not a file.
     atomnav.InputError
-        Naming ``path`` for a malformed file, a time system other than GPS, or a file
-        without any code type atomnav reads.
+        Naming ``path``, the file, the line and the field for a record that cannot be
+        decoded, an unknown RINEX version, epochs out of order, a time system other than
+        GPS, observations outside what ``eph`` covers, or a file without any code type
+        atomnav reads.
     """
     instance(eph, Ephemerides, "eph")
-    ds, header = _load(path, "obs")
-    time_system = str(ds.attrs.get("time_system", "GPS")).strip() or "GPS"
-    if time_system not in ("GPS", ""):
-        raise input_error("path", f"{path}: time system {time_system!r}; atomnav reads GPS-time observation files")
-    codes = sorted({c for v in CODE_PREFERENCE.values() for c in v} & set(ds.data_vars))
-    if not codes:
-        raise input_error("path", f"{path} has no code type atomnav reads ({sorted(CODE_PREFERENCE['G'])}; found "
-                                  f"{sorted(ds.data_vars)})")
-    dopplers = sorted({c for v in DOPPLER_PREFERENCE.values() for c in v} & set(ds.data_vars))
-    # satellite-epochs of other systems with any observation
-    other = np.array([not str(s).startswith(SYSTEMS) for s in ds.sv.values])
-    seen = ds.isel(sv=np.flatnonzero(other)).to_array().notnull().any("variable").sum("time")
-    set_aside = pd.Series(seen.values, index=[str(s)[0] for s in seen.sv.values]).groupby(level=0).sum()
-    set_aside = set_aside[set_aside > 0].rename("satellite_epochs")
-    df = ds[codes + dopplers].isel(sv=np.flatnonzero(~other)).to_dataframe().reset_index()
-    system = df.sv.str[0].to_numpy()
-    code, code_type = _first(df, system, CODE_PREFERENCE)
-    rate_hz, doppler_type = _first(df, system, DOPPLER_PREFERENCE)
-    keep = np.isfinite(code) | np.isfinite(rate_hz)
-    df, system, code, code_type, rate_hz, doppler_type = (x[keep] for x in (df, system, code, code_type, rate_hz,
-                                                                               doppler_type))
+    path = _file(path, "obs")
+    f = _core.gnss_read_rinex_obs(str(path))
+    h = f["header"]
+    if h["time_system"] not in ("GPST", "GPS"):
+        raise input_error("path", f"{path}: time system {h['time_system']!r}; atomnav reads GPS-time observation files")
+    if not (f["code_type"] >= 0).any():
+        raise input_error("path", f"{path} has no code type atomnav reads ({CODE_PREFERENCE})")
+    sat = np.asarray(f["sat"], dtype=object)
+    system = np.array([s[0] for s in sat]) if len(sat) else np.array([], dtype=str)
+    first = GPS_EPOCH + pd.Timedelta(seconds=float(f["time_s"].min()))
     week = (pd.Timestamp(_week_start(week_start)) if week_start is not None
-            else getattr(eph, "week_start", None) or _gps_week_of(pd.Timestamp(ds.time.values.min())))
-    from_header = _glonass_channels(header)
+            else getattr(eph, "week_start", None) or _gps_week_of(first))
+    time_s = f["time_s"] - _offset(week)
+    _check_coverage(path, time_s, eph, f["header_lines"], week)
+    from_header = h["glonass_channels"]
     known = set(eph.satellites)
-    sat = df.sv.to_numpy()
     names, row_of = np.unique(sat, return_inverse=True)  # one look-up per satellite, not per row
     per_sat = np.array([(eph.channel(s) if s in known else from_header.get(int(s[1:]), 0)) if s[0] == "R" else 0
                         for s in names], dtype=np.int64)
-    channel = per_sat[row_of.reshape(-1)]
-    rate = doppler_to_rate(rate_hz, sat, channel)
-    table = pd.DataFrame({"time_s": _seconds(df.time.values, week), "sat": sat, "channel": channel, "code_m": code,
-                          "rate_mps": rate, "code_type": code_type, "doppler_type": doppler_type})
-    table = table.sort_values(["time_s", "sat"]).reset_index(drop=True)
+    channel = per_sat[row_of.reshape(-1)] if len(sat) else np.zeros(0, dtype=np.int64)
+    table = pd.DataFrame({"time_s": time_s, "sat": sat, "channel": channel, "code_m": f["code_m"],
+                          "rate_mps": doppler_to_rate(f["doppler_hz"], sat, channel), "code2_m": f["code2_m"],
+                          "snr_dbhz": f["snr_dbhz"], "code_type": _names(f["code_type"], system, CODE_PREFERENCE),
+                          "code2_type": _names(f["code2_type"], system, CODE2_PREFERENCE),
+                          "doppler_type": _names(f["doppler_type"], system, DOPPLER_PREFERENCE)})
     missing = table.groupby("time_s").agg(n_sats=("sat", "size"), n_no_code=("code_m", lambda x: int(x.isna().sum())),
                                           n_no_doppler=("rate_mps", lambda x: int(x.isna().sum()))).reset_index()
-    facts = {"marker": str(header.get("MARKER NAME", "")).strip(),
-             "receiver": " ".join(str(header.get("REC # / TYPE / VERS", "")).split()[1:]),
-             "version": float(ds.attrs.get("version", np.nan)), "time_system": time_system or "GPS",
-             "interval_s": float(ds.attrs.get("interval", np.nan)),
-             "approx_position_m": _numbers(header, "APPROX POSITION XYZ", 3),
-             "antenna_delta_hen_m": _numbers(header, "ANTENNA: DELTA H/E/N", 3), "glonass_channels": from_header}
-    return RinexObservations(table, facts, set_aside, missing, week)
+    facts = {k: h[k] for k in ("marker", "receiver", "version", "interval_s", "approx_position_m", "antenna_delta_hen_m",
+                               "glonass_channels", "leap_seconds")}
+    facts["time_system"] = "GPS"
+    set_aside = pd.Series(f["set_aside"], dtype=np.int64, name="satellite_epochs")
+    return RinexObservations(table, facts, set_aside, missing, week, int(f["n_epochs"]))
