@@ -253,7 +253,7 @@ proptest! {
     fn spp_solve(keep in prop::collection::vec(any::<bool>(), 40), code_error in prop::collection::vec(prop_oneof![6 => Just(0.0), 1 => val()], 40), t in prop_oneof![3 => Just(600.0), 1 => val()], x0 in prop::option::of(vec3()), use_tau in any::<bool>(), weight in any::<bool>()) {
         let (eph, all) = gnss_epoch();
         let obs: Vec<Observation> = all.iter().zip(&keep).zip(&code_error).filter(|((_, &k), _)| k).map(|((o, _), &e)| Observation { code: o.code + e, ..o.clone() }).collect();
-        let cfg = SppConfig { use_tau, atm: Atmosphere { iono: None, tropo: true }, sigma_gps: 1.0, sigma_glo: 1.0, elevation_weight: weight, elevation_mask: 0.0, fault_detection: true };
+        let cfg = SppConfig { use_tau, atm: Atmosphere { iono: None, tropo: true }, sigma_gps: 1.0, sigma_glo: 1.0, elevation_weight: weight, elevation_mask: 0.0, fault_detection: true, ionosphere_free: false };
         if let Ok(s) = solve_position(eph, t, &obs, &cfg, x0) {
             prop_assert!(finite(s.pos.iter()) && finite(s.lla.iter()) && s.clock_m.is_finite() && finite(s.cov.iter()) && finite(&s.residuals));
             prop_assert!(s.tau.is_none_or(f64::is_finite));

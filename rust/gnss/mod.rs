@@ -25,6 +25,8 @@ use crate::error::{invalid, Result};
 pub const C_LIGHT: f64 = 299_792_458.0;
 /// GPS L1 carrier (Hz).
 pub const GPS_L1_HZ: f64 = 1575.42e6;
+/// GPS L2 carrier (Hz).
+pub const GPS_L2_HZ: f64 = 1227.60e6;
 /// Earth rotation rate of the GPS ICD (rad/s), used for the Sagnac rotation of both systems.
 pub const OMEGA_E_GPS: f64 = 7.2921151467e-5;
 

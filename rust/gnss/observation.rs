@@ -23,6 +23,9 @@ pub struct Observation {
     pub channel: i8,
     /// Pseudorange (m).
     pub code: f64,
+    /// Second-frequency pseudorange (m; GPS L2, GLONASS L2 of the same channel), for the
+    /// ionosphere-free combination; NaN when absent.
+    pub code2: f64,
     /// Pseudorange rate (m/s) = −λ·Doppler; NaN when absent.
     pub rate: f64,
 }
@@ -130,7 +133,7 @@ pub fn simulate(eph: &Ephemerides, t: &[f64], lla: &[Vec3], vel_ned: &[Vec3], cf
             };
             let code = g.range + C_LIGHT * (dtr - g.sat.clock + tau) + cfg.atm.delay(sat, channel, &lla[k], &g, t_rx) + sigma * n1;
             let rate = g.rate + C_LIGHT * (dtr_dot - g.sat.clock_rate) + cfg.sigma_rate * n2;
-            epoch.push((Observation { sat, channel, code, rate }, g.elevation));
+            epoch.push((Observation { sat, channel, code, code2: f64::NAN, rate }, g.elevation));
         }
         out.push(epoch);
     }
@@ -139,15 +142,16 @@ pub fn simulate(eph: &Ephemerides, t: &[f64], lla: &[Vec3], vel_ned: &[Vec3], cf
 
 /// Observations from the columns of a flat table (satellite names, GLONASS channels,
 /// code m, rate m/s); the channels of GLONASS rows are checked (GPS rows get 0).
-pub fn observations(sat: &[String], channel: &[i64], code: &[f64], rate: &[f64]) -> Result<Vec<Observation>> {
+pub fn observations(sat: &[String], channel: &[i64], code: &[f64], code2: Option<&[f64]>, rate: &[f64]) -> Result<Vec<Observation>> {
     let ids = SatId::from_names(sat, "sat")?;
-    if channel.len() != ids.len() || code.len() != ids.len() || rate.len() != ids.len() {
-        return Err(invalid("sat", format!("{} satellites, {} channels, {} codes, {} rates", ids.len(), channel.len(), code.len(), rate.len())));
+    if channel.len() != ids.len() || code.len() != ids.len() || rate.len() != ids.len() || code2.is_some_and(|c| c.len() != ids.len()) {
+        return Err(invalid("sat", format!("{} satellites, {} channels, {} codes, {} second codes, {} rates", ids.len(), channel.len(), code.len(), code2.map_or(ids.len(), <[f64]>::len), rate.len())));
     }
     (ids.iter().zip(channel).zip(code).zip(rate).enumerate())
         .map(|(i, (((&sat, &ch), &code), &rate))| {
             let channel = if sat.system == System::Glonass { super::check_channel("channel", ch, i)? } else { 0 };
-            Ok(Observation { sat, channel, code, rate })
+            let code2 = code2.and_then(|c| c.get(i).copied()).unwrap_or(f64::NAN);
+            Ok(Observation { sat, channel, code, code2, rate })
         })
         .collect()
 }

@@ -5,9 +5,9 @@
 
 use super::ephemeris::Ephemerides;
 use super::observation::{Atmosphere, SimConfig};
-use super::spp::SppConfig;
+use super::spp::{ionosphere_free_gain, SppConfig};
 use super::tight::{Formulation, TightConfig};
-use super::C_LIGHT;
+use super::{glonass_l1_hz, glonass_l2_hz, C_LIGHT, GPS_L1_HZ, GPS_L2_HZ};
 use crate::error::{invalid, Result};
 use crate::imu::ImuKind;
 use crate::math::Vec3;
@@ -28,6 +28,9 @@ pub struct GnssOptions {
     /// Single-point positioning: elevation mask (rad), residual χ² test with exclusion.
     pub elevation_mask: f64,
     pub fault_detection: bool,
+    /// Single-point positioning with the ionosphere-free code combination (the second
+    /// frequency's code needed; no Klobuchar then).
+    pub ionosphere_free: bool,
     /// Tight coupling: measurement formulation, IMU → antenna lever arm (body, m), use the
     /// pseudorange rates.
     #[serde(with = "crate::options::by_name")]
@@ -62,6 +65,7 @@ impl Default for GnssOptions {
             elevation_weight: false,
             elevation_mask: 10f64.to_radians(),
             fault_detection: true,
+            ionosphere_free: false,
             formulation: Formulation::FirstDifference,
             lever_arm: Vec3::zeros(),
             use_rate: true,
@@ -106,12 +110,13 @@ impl GnssOptions {
     pub fn spp(&self, eph: &Ephemerides) -> SppConfig {
         SppConfig {
             use_tau: self.use_tau,
-            atm: self.atmosphere(eph),
-            sigma_gps: self.sigma_code_gps,
-            sigma_glo: self.sigma_code_glo,
+            atm: Atmosphere { iono: self.iono.then_some(eph.ionosphere).filter(|_| !self.ionosphere_free), tropo: self.tropo },
+            sigma_gps: self.sigma_code_gps * if self.ionosphere_free { ionosphere_free_gain(GPS_L1_HZ, GPS_L2_HZ) } else { 1.0 },
+            sigma_glo: self.sigma_code_glo * if self.ionosphere_free { ionosphere_free_gain(glonass_l1_hz(0), glonass_l2_hz(0)) } else { 1.0 },
             elevation_weight: self.elevation_weight,
             elevation_mask: self.elevation_mask,
             fault_detection: self.fault_detection,
+            ionosphere_free: self.ionosphere_free,
         }
     }
 

@@ -131,28 +131,49 @@ fn parse(path: &Path) -> Result<(Rinex, HeaderText)> {
     Ok((rinex, text))
 }
 
-/// Epoch lines (RINEX 3/4 '>' records) must increase; a file out of order is refused with
-/// the line. RINEX 2 and Hatanaka files are ordered by the crate's epoch-keyed record.
-fn check_epoch_order(path: &Path, header: usize) -> Result<()> {
+/// RINEX 3/4 epoch records ('>' lines) must increase in time and hold as many lines as
+/// their satellite count: the crate keys epochs by time (it would sort a file out of order)
+/// and keeps what a record cut short holds. Hatanaka files are checked by the expansion.
+fn check_epoch_records(path: &Path, header: usize) -> Result<()> {
     let name = path.display();
     let mut last: Option<(f64, usize)> = None;
+    // the open record: its line, its declared line count, the lines seen
+    let mut open_record: Option<(usize, usize, usize)> = None;
+    let short = |(line, declared, seen): (usize, usize, usize)| -> Result<()> {
+        if seen < declared {
+            return Err(invalid("path", format!(
+                "{name}, line {line}, field number of satellites: the epoch record declares {declared} lines but holds {seen} (truncated record)")));
+        }
+        Ok(())
+    };
     for (k, line) in open(path)?.lines().enumerate().skip(header) {
-        let Ok(line) = line else { break };
-        if !line.starts_with("> ") || line.len() < 29 {
+        let line = line.map_err(|e| invalid("path", format!("{name}, line {}: {e}", k + 1)))?;
+        if !line.starts_with('>') {
+            if let Some(r) = open_record.as_mut() {
+                r.2 += 1;
+            }
             continue;
         }
+        if let Some(r) = open_record.take() {
+            short(r)?;
+        }
+        let declared = line.get(32..35).and_then(|x| x.trim().parse::<usize>().ok()).unwrap_or(0);
+        open_record = Some((k + 1, declared, 0));
         let Some(t) = epoch_of_line(&line) else { continue };
         if let Some((prev, prev_line)) = last {
             if t <= prev {
                 let what = if t == prev { "repeats" } else { "precedes" };
                 return Err(invalid("path", format!(
                     "{name}, line {}, field EPOCH: epoch {} {what} the epoch of line {prev_line}; epochs must increase",
-                    k + 1, line[2..29].trim())));
+                    k + 1, line.get(2..29).unwrap_or("").trim())));
             }
         }
         last = Some((t, k + 1));
     }
-    Ok(())
+    match open_record {
+        Some(r) => short(r),
+        None => Ok(()),
+    }
 }
 
 /// Calendar seconds of a RINEX 3/4 epoch line "> yyyy mm dd hh mm ss.sssssss".
@@ -245,7 +266,7 @@ pub fn read_observations(path: &Path) -> Result<ObservationFile> {
         return Err(invalid("path", format!("{name}: not an observation file ({:?})", h.rinex_type)));
     };
     if rinex.header.obs.as_ref().is_none_or(|o| o.crinex.is_none()) && h.version.major >= 3 {
-        check_epoch_order(path, header_lines)?;
+        check_epoch_records(path, header_lines)?;
     }
     let time_system = h.obs.as_ref().and_then(|o| o.timeof_first_obs).map_or("GPS".to_string(), |t| t.time_scale.to_string());
     let header = ObservationHeader {
@@ -367,7 +388,8 @@ fn klobuchar(model: &IonosphereModel) -> Option<[f64; 8]> {
 
 /// Read a navigation file's GPS LNAV and GLONASS FDMA records (others set aside and counted).
 pub fn read_navigation(path: &Path) -> Result<NavigationFile> {
-    let (rinex, _) = parse(path)?;
+    let (rinex, text) = parse(path)?;
+    let header_lines = text.lines;
     let name = path.display();
     let h = &rinex.header;
     let Some(record) = rinex.record.as_nav() else {
@@ -380,8 +402,9 @@ pub fn read_navigation(path: &Path) -> Result<NavigationFile> {
         time_corrections: h.nav.as_ref().map_or(Vec::new(), |n| n.time_offsets.iter().map(correction).collect()),
         ..Default::default()
     };
-    let missing = |sv: &dyn std::fmt::Display, field: &str| -> NavError {
-        invalid("path", format!("{name}: the record of {sv} lacks field {field}"))
+    let missing = |key: &rinex::navigation::NavKey, field: &str| -> NavError {
+        let line = record_line(path, header_lines, key).map_or(String::new(), |l| format!(", line {l}"));
+        invalid("path", format!("{name}{line}, field {field}: the record of {} lacks it (truncated record)", key.sv))
     };
     for (key, frame) in record.iter() {
         match key.frmtype {
@@ -401,7 +424,7 @@ pub fn read_navigation(path: &Path) -> Result<NavigationFile> {
             _ => continue,
         }
         let Some(e) = frame.as_ephemeris() else { continue };
-        let orbit = |k: &str| e.get_orbit_f64(k).ok_or_else(|| missing(&key.sv, k));
+        let orbit = |k: &str| e.get_orbit_f64(k).ok_or_else(|| missing(key, k));
         match (key.sv.constellation, key.msgtype) {
             (Constellation::GPS, NavMessageType::LNAV) => {
                 let mut row = [0.0; GPS_RECORD_WIDTH];
@@ -437,6 +460,17 @@ pub fn read_navigation(path: &Path) -> Result<NavigationFile> {
         }
     }
     Ok(out)
+}
+
+/// The file line where a navigation record starts (only to name it in an error): RINEX 3/4
+/// "G01 2020 06 25 14 00 00", RINEX 2 " 1 20  6 25 14  0".
+fn record_line(path: &Path, header: usize, key: &rinex::navigation::NavKey) -> Option<usize> {
+    let (y, mo, d, h, mi, s, _) = key.epoch.to_gregorian(key.epoch.time_scale);
+    let l = letter(key.sv.constellation)?;
+    let v3 = format!("{l}{:02} {y:04} {mo:02} {d:02} {h:02} {mi:02} {s:02}", key.sv.prn);
+    let v2 = format!("{:2} {:02} {mo:2} {d:2} {h:2} {mi:2}", key.sv.prn, y % 100);
+    let lines = open(path).ok()?.lines().enumerate().skip(header);
+    lines.map_while(|(k, line)| line.ok().map(|line| (k, line))).find(|(_, line)| line.starts_with(&v3) || line.starts_with(&v2)).map(|(k, _)| k + 1)
 }
 
 fn correction(o: &rinex::navigation::TimeOffset) -> TimeCorrection {

@@ -5,7 +5,7 @@
 use super::ephemeris::Ephemerides;
 use super::geometry::{geometry, Geometry};
 use super::observation::{check_unique, Atmosphere, Observation};
-use super::{SatId, System, C_LIGHT};
+use super::{glonass_l1_hz, glonass_l2_hz, SatId, System, C_LIGHT, GPS_L1_HZ, GPS_L2_HZ};
 use crate::earth::{dcm_ned_to_ecef, WGS84};
 use crate::error::{invalid, NavError, Result};
 use crate::math::Vec3;
@@ -24,6 +24,9 @@ pub struct SppConfig {
     pub elevation_mask: f64,
     /// Residual χ² test with exclusion of the faulty satellite (RAIM FDE).
     pub fault_detection: bool,
+    /// Solve with the ionosphere-free code combination ([`ionosphere_free`]); `atm` then
+    /// carries no ionosphere and the σ are those of the combination.
+    pub ionosphere_free: bool,
 }
 
 /// Why a satellite of an epoch is not in its solution.
@@ -39,11 +42,14 @@ pub enum Exclusion {
     Fault,
     /// The epoch has fewer usable satellites than unknowns: no solution.
     TooFew,
+    /// No second-frequency code for the ionosphere-free combination.
+    NoSecondCode,
 }
 
 impl Exclusion {
     /// Every reason, in code order (code k + 1 is `ALL[k]`; 0 means used).
-    pub const ALL: [Exclusion; 5] = [Exclusion::NoCode, Exclusion::NoEphemeris, Exclusion::Elevation, Exclusion::Fault, Exclusion::TooFew];
+    pub const ALL: [Exclusion; 6] =
+        [Exclusion::NoCode, Exclusion::NoEphemeris, Exclusion::Elevation, Exclusion::Fault, Exclusion::TooFew, Exclusion::NoSecondCode];
     /// Its name in result tables.
     pub const fn name(self) -> &'static str {
         match self {
@@ -52,6 +58,7 @@ impl Exclusion {
             Exclusion::Elevation => "elevation",
             Exclusion::Fault => "fault",
             Exclusion::TooFew => "too_few_satellites",
+            Exclusion::NoSecondCode => "no_second_code",
         }
     }
     /// Its code in result rows (1-based; 0 = used).
@@ -110,6 +117,41 @@ pub struct SppSolution {
 /// Code corrected for the satellite clock and the atmosphere: P + c·δt^s − I − T (m).
 fn corrected_code(o: &Observation, g: &Geometry, atm: &Atmosphere, lla: &Vec3, t: f64) -> f64 {
     o.code + C_LIGHT * g.sat.clock - atm.delay(o.sat, o.channel, lla, g, t)
+}
+
+/// The carriers (Hz) of a satellite's first and second code: GPS L1/L2, GLONASS L1/L2 of
+/// its FDMA channel.
+fn carriers(sat: SatId, channel: i8) -> (f64, f64) {
+    match sat.system {
+        System::Gps => (GPS_L1_HZ, GPS_L2_HZ),
+        System::Glonass => (glonass_l1_hz(channel), glonass_l2_hz(channel)),
+    }
+}
+
+/// Noise gain of the ionosphere-free combination of two equally noisy codes on carriers
+/// f₁, f₂: √(f₁⁴ + f₂⁴)/(f₁² − f₂²) (2.98 for GPS L1/L2, 2.96 for GLONASS, whose ratio is
+/// 9/7 on every channel).
+pub fn ionosphere_free_gain(f1: f64, f2: f64) -> f64 {
+    (f1.powi(4) + f2.powi(4)).sqrt() / (f1 * f1 - f2 * f2)
+}
+
+/// The ionosphere-free code combination (f₁²P₁ − f₂²P₂)/(f₁² − f₂²), which removes the
+/// first-order ionospheric delay (Groves 2013, Eq. 9.50), plus c·T_GD: the broadcast GPS
+/// clock refers to this combination, while the L1 clock of the ephemerides includes −T_GD
+/// (IS-GPS-200 20.3.3.3.3.2). NaN where either code is missing.
+pub fn ionosphere_free(eph: &Ephemerides, t: f64, obs: &[Observation]) -> Vec<Observation> {
+    obs.iter()
+        .map(|o| {
+            let (f1, f2) = carriers(o.sat, o.channel);
+            let (a, b) = (f1 * f1, f2 * f2);
+            let code = if o.code.is_finite() && o.code2.is_finite() {
+                (a * o.code - b * o.code2) / (a - b) + C_LIGHT * eph.group_delay(o.sat, t).unwrap_or(0.0)
+            } else {
+                f64::NAN
+            };
+            Observation { code, ..o.clone() }
+        })
+        .collect()
 }
 
 /// How long before its stamp a signal may have left the satellite (s): light time
@@ -287,6 +329,18 @@ fn solve_epoch(eph: &Ephemerides, t: f64, obs: &[Observation], cfg: &SppConfig, 
             return Err(invalid("obs", format!("{} at index {i}: channel {} but the ephemeris says {}", o.sat.name(), o.channel, eph.channel(o.sat)?)));
         }
     }
+    let combined;
+    let obs = if cfg.ionosphere_free {
+        for (i, o) in obs.iter().enumerate() {
+            if satellites[i].excluded.is_none() && !o.code2.is_finite() {
+                satellites[i].excluded = Some(Exclusion::NoSecondCode);
+            }
+        }
+        combined = ionosphere_free(eph, t, obs);
+        &combined[..]
+    } else {
+        obs
+    };
     let candidates: Vec<usize> = (0..obs.len()).filter(|&i| satellites[i].excluded.is_none()).collect();
     if candidates.is_empty() {
         if let Some(e) = no_ephemeris {
@@ -338,7 +392,7 @@ fn solve_epoch(eph: &Ephemerides, t: f64, obs: &[Observation], cfg: &SppConfig, 
     let t_rx = t - fit.x[3] / C_LIGHT;
     // look angles and residuals of every satellite with code and ephemeris at the solution
     for (i, o) in obs.iter().enumerate() {
-        if matches!(satellites[i].excluded, Some(Exclusion::NoCode | Exclusion::NoEphemeris)) {
+        if matches!(satellites[i].excluded, Some(Exclusion::NoCode | Exclusion::NoEphemeris | Exclusion::NoSecondCode)) {
             continue;
         }
         let g = geometry(eph, o.sat, t_rx, &pos, &Vec3::zeros(), lla.x, lla.y, tau)?;
@@ -524,6 +578,7 @@ pub fn solve_velocity(eph: &Ephemerides, t: f64, obs: &[Observation], pos: &Vec3
 mod tests {
     use super::super::constellation::{nominal, ConstellationConfig};
     use super::super::observation::{simulate, SimConfig, Visibility};
+    use super::super::gps_orbit::GpsEphemeris;
     use super::super::TimeScales;
     use super::*;
 
@@ -544,7 +599,7 @@ mod tests {
     fn noiseless_solution_recovers_position_clock_tau_and_velocity() {
         let (eph, lla, obs, sim) = setup(-340e-9, 0.0);
         assert!(obs.iter().filter(|o| o.sat.system == System::Glonass).count() >= 2);
-        let cfg = SppConfig { use_tau: true, atm: sim.atm, sigma_gps: 3.0, sigma_glo: 3.0, elevation_weight: false, elevation_mask: 0.0, fault_detection: false };
+        let cfg = SppConfig { use_tau: true, atm: sim.atm, sigma_gps: 3.0, sigma_glo: 3.0, elevation_weight: false, elevation_mask: 0.0, fault_detection: false, ionosphere_free: false };
         let s = solve_position(&eph, 600.0, &obs, &cfg, None).unwrap();
         let truth = WGS84.lla_to_ecef(&lla);
         assert!((s.pos - truth).norm() < 1e-4, "{}", (s.pos - truth).norm());
@@ -554,6 +609,46 @@ mod tests {
         let (v, drift, _) = solve_velocity(&eph, 600.0 - s.clock_m / C_LIGHT, &obs, &truth, 0.05).unwrap();
         let vt = dcm_ned_to_ecef(lla.x, lla.y) * Vec3::new(3.0, -2.0, 0.5);
         assert!((v - vt).norm() < 1e-6 && (drift - C_LIGHT * 1e-8).abs() < 1e-6, "{} {}", (v - vt).norm(), drift);
+    }
+
+    /// Dual-frequency codes made from the simulator's L1 codes with and without the
+    /// ionosphere (the L1 delay I₁), with group delays T_GD of up to ±10 ns: the L2 code is
+    /// P₁ + (γ − 1)(I₁ + c·T_GD), γ = (f₁/f₂)² (IS-GPS-200 20.3.3.3.3.2). The ionosphere-free
+    /// solution without any ionosphere model recovers the position; L1 alone without the
+    /// model does not.
+    #[test]
+    fn ionosphere_free_combination_removes_the_ionosphere_and_keeps_the_group_delay() {
+        let (nominal_eph, lla, _, sim) = setup(-340e-9, 0.0);
+        let gps = nominal_eph.gps_sets().map(|e| GpsEphemeris { tgd: 1e-8 * ((e.prn as f64) * 0.7).sin(), ..e.clone() }).collect();
+        let eph = Ephemerides::new(gps, nominal_eph.glonass_sets().cloned().collect(), nominal_eph.time, nominal_eph.datum).unwrap();
+        let vis = Visibility { mask: 10f64.to_radians(), ..Default::default() };
+        let run = |atm: Atmosphere| -> Vec<Observation> {
+            let sim = SimConfig { atm, ..sim };
+            simulate(&eph, &[600.0], &[lla], &[Vec3::zeros()], &sim, &vis).unwrap().remove(0).into_iter().map(|x| x.0).collect()
+        };
+        let (with, without) = (run(sim.atm), run(Atmosphere { iono: None, tropo: true }));
+        let dual: Vec<Observation> = with
+            .iter()
+            .zip(&without)
+            .map(|(o, o0)| {
+                let (f1, f2) = carriers(o.sat, o.channel);
+                let gamma = (f1 / f2).powi(2);
+                let code2 = o.code + (gamma - 1.0) * (o.code - o0.code + C_LIGHT * eph.group_delay(o.sat, 600.0).unwrap());
+                Observation { code2, ..o.clone() }
+            })
+            .collect();
+        assert!(dual.iter().any(|o| (o.code2 - o.code).abs() > 3.0));
+        let no_model = Atmosphere { iono: None, tropo: true };
+        let cfg = |ionosphere_free| SppConfig {
+            use_tau: true, atm: no_model, sigma_gps: 3.0, sigma_glo: 3.0, elevation_weight: false, elevation_mask: 0.0, fault_detection: false, ionosphere_free,
+        };
+        let truth = WGS84.lla_to_ecef(&lla);
+        let dual_error = (solve_position(&eph, 600.0, &dual, &cfg(true), None).unwrap().pos - truth).norm();
+        let single_error = (solve_position(&eph, 600.0, &dual, &cfg(false), None).unwrap().pos - truth).norm();
+        assert!(dual_error < 1e-4 && single_error > 1.0, "{dual_error} {single_error}");
+        // the noise gain of the combination: ≈ 2.98 for GPS, 2.96 for GLONASS
+        assert!((ionosphere_free_gain(GPS_L1_HZ, GPS_L2_HZ) - 2.978).abs() < 1e-3);
+        assert!((ionosphere_free_gain(glonass_l1_hz(-7), glonass_l2_hz(-7)) - 94.6678_f64 / 32.0).abs() < 1e-4);
     }
 
     #[test]
@@ -591,7 +686,7 @@ mod tests {
     #[test]
     fn solve_epochs_rows_follow_the_rules() {
         let (eph, lla, obs, sim) = setup(-340e-9, 0.0);
-        let cfg = SppConfig { use_tau: true, atm: sim.atm, sigma_gps: 3.0, sigma_glo: 3.0, elevation_weight: false, elevation_mask: 0.0, fault_detection: false };
+        let cfg = SppConfig { use_tau: true, atm: sim.atm, sigma_gps: 3.0, sigma_glo: 3.0, elevation_weight: false, elevation_mask: 0.0, fault_detection: false, ionosphere_free: false };
         let gps: Vec<Observation> = obs.iter().filter(|o| o.sat.system == System::Gps).copied().collect();
         let mut few_rates = obs.clone();
         few_rates.iter_mut().skip(3).for_each(|o| o.rate = f64::NAN);
@@ -610,7 +705,7 @@ mod tests {
     #[test]
     fn bad_input_is_rejected_with_the_count() {
         let (eph, _, obs, sim) = setup(0.0, 0.0);
-        let cfg = SppConfig { use_tau: true, atm: sim.atm, sigma_gps: 3.0, sigma_glo: 3.0, elevation_weight: false, elevation_mask: 0.0, fault_detection: false };
+        let cfg = SppConfig { use_tau: true, atm: sim.atm, sigma_gps: 3.0, sigma_glo: 3.0, elevation_weight: false, elevation_mask: 0.0, fault_detection: false, ionosphere_free: false };
         let e = solve_position(&eph, 600.0, &obs[..3], &cfg, None).unwrap_err().to_string();
         assert!(e.contains("3 usable satellites") && e.contains("at least 4"), "{e}");
         let mut dup = obs.clone();
@@ -622,7 +717,7 @@ mod tests {
     }
     fn config(mask_deg: f64, fault_detection: bool) -> SppConfig {
         let atm = Atmosphere { iono: Some(Default::default()), tropo: true };
-        SppConfig { use_tau: true, atm, sigma_gps: 3.0, sigma_glo: 3.0, elevation_weight: false, elevation_mask: mask_deg.to_radians(), fault_detection }
+        SppConfig { use_tau: true, atm, sigma_gps: 3.0, sigma_glo: 3.0, elevation_weight: false, elevation_mask: mask_deg.to_radians(), fault_detection, ionosphere_free: false }
     }
 
     /// Satellites the simulator put below 10° (its true elevations) are the ones the mask
@@ -670,7 +765,7 @@ mod tests {
         let truth = WGS84.lla_to_ecef(&lla);
         let unknown = (1..=32).map(SatId::gps).find(|s| !eph.satellites().contains(s)).unwrap();
         let mut more = obs.clone();
-        more.push(Observation { sat: unknown, channel: 0, code: 2.2e7, rate: f64::NAN });
+        more.push(Observation { sat: unknown, channel: 0, code: 2.2e7, code2: f64::NAN, rate: f64::NAN });
         more[0].code = f64::NAN;
         let s = solve_position(&eph, 600.0, &more, &config(0.0, true), None).unwrap();
         assert_eq!(s.satellites.last().unwrap().excluded, Some(Exclusion::NoEphemeris));

@@ -123,11 +123,11 @@ super::pickle::picklable!(PyGnssOptions, inner, "GnssOptions");
 #[pymethods]
 impl PyGnssOptions {
     #[new]
-    #[pyo3(signature = (*, sigma_code, sigma_code_glonass, sigma_rate, iono, tropo, use_tau, elevation_weight, elevation_mask, fault_detection, formulation, lever_arm, use_rate, tau0, sigma_tau0, tau_psd, clock0, sigma_clock0, clock_h0, clock_hm2))]
+    #[pyo3(signature = (*, sigma_code, sigma_code_glonass, sigma_rate, iono, tropo, use_tau, elevation_weight, elevation_mask, fault_detection, ionosphere_free, formulation, lever_arm, use_rate, tau0, sigma_tau0, tau_psd, clock0, sigma_clock0, clock_h0, clock_hm2))]
     #[allow(clippy::too_many_arguments)]
     fn new(
         #[pyo3(from_py_with = real)] sigma_code: f64, #[pyo3(from_py_with = real_opt)] sigma_code_glonass: Option<f64>, #[pyo3(from_py_with = real)] sigma_rate: f64, iono: bool, tropo: bool, use_tau: bool, elevation_weight: bool,
-        #[pyo3(from_py_with = real)] elevation_mask: f64, fault_detection: bool, formulation: Wrap<Formulation>, lever_arm: &Bound<'_, PyAny>, use_rate: bool, #[pyo3(from_py_with = real)] tau0: f64, #[pyo3(from_py_with = real)] sigma_tau0: f64, #[pyo3(from_py_with = real)] tau_psd: f64,
+        #[pyo3(from_py_with = real)] elevation_mask: f64, fault_detection: bool, ionosphere_free: bool, formulation: Wrap<Formulation>, lever_arm: &Bound<'_, PyAny>, use_rate: bool, #[pyo3(from_py_with = real)] tau0: f64, #[pyo3(from_py_with = real)] sigma_tau0: f64, #[pyo3(from_py_with = real)] tau_psd: f64,
         clock0: &Bound<'_, PyAny>, sigma_clock0: &Bound<'_, PyAny>, #[pyo3(from_py_with = real)] clock_h0: f64, #[pyo3(from_py_with = real)] clock_hm2: f64,
     ) -> PyResult<Self> {
         let (lever_arm, clock0) = (floats::<3>(lever_arm, "lever_arm")?, floats::<2>(clock0, "clock0")?);
@@ -142,6 +142,7 @@ impl PyGnssOptions {
             elevation_weight,
             elevation_mask,
             fault_detection,
+            ionosphere_free,
             formulation: formulation.0,
             lever_arm: Vec3::from(lever_arm),
             use_rate,
@@ -196,21 +197,26 @@ fn gnss_simulate<'py>(
 
 /// The flat observation table (time, sat, channel, code, rate; rate NaN when absent)
 /// grouped into epochs.
-fn epochs(time: &PyReadonlyArray1<'_, f64>, sat: &[String], channel: &PyReadonlyArray1<'_, i64>, code: &PyReadonlyArray1<'_, f64>, rate: &PyReadonlyArray1<'_, f64>) -> PyResult<Vec<(f64, Vec<Observation>)>> {
-    let obs = observations(sat, &channel.as_array().to_vec(), &code.as_array().to_vec(), &rate.as_array().to_vec())?;
+fn epochs(
+    time: &PyReadonlyArray1<'_, f64>, sat: &[String], channel: &PyReadonlyArray1<'_, i64>, code: &PyReadonlyArray1<'_, f64>, code2: Option<&PyReadonlyArray1<'_, f64>>,
+    rate: &PyReadonlyArray1<'_, f64>,
+) -> PyResult<Vec<(f64, Vec<Observation>)>> {
+    let code2 = code2.map(|c| c.as_array().to_vec());
+    let obs = observations(sat, &channel.as_array().to_vec(), &code.as_array().to_vec(), code2.as_deref(), &rate.as_array().to_vec())?;
     Ok(group_epochs(time.as_array().as_slice().ok_or_else(|| invalid("time", "must be contiguous"))?, &obs)?)
 }
 
 /// Epoch-by-epoch single-point positioning (gnss/spp.rs `solve_epochs`): the epoch rows
 /// (columns `SPP_COLUMNS`), the satellite rows (`SPP_SATELLITE_COLUMNS`) and their
-/// satellite names.
+/// satellite names. `code2`: the second-frequency codes for `ionosphere_free` (NaN where absent).
 #[pyfunction]
-#[allow(clippy::type_complexity)]
+#[pyo3(signature = (eph, time, sat, channel, code, rate, options, *, code2=None))]
+#[allow(clippy::type_complexity, clippy::too_many_arguments)]
 fn gnss_spp<'py>(
     py: Python<'py>, eph: &PyEphemerides, time: PyReadonlyArray1<'py, f64>, sat: Vec<String>, channel: PyReadonlyArray1<'py, i64>,
-    code: PyReadonlyArray1<'py, f64>, rate: PyReadonlyArray1<'py, f64>, options: &PyGnssOptions,
+    code: PyReadonlyArray1<'py, f64>, rate: PyReadonlyArray1<'py, f64>, options: &PyGnssOptions, code2: Option<PyReadonlyArray1<'py, f64>>,
 ) -> PyResult<(Bound<'py, PyArray2<f64>>, Bound<'py, PyArray2<f64>>, Vec<String>)> {
-    let ep = epochs(&time, &sat, &channel, &code, &rate)?;
+    let ep = epochs(&time, &sat, &channel, &code, code2.as_ref(), &rate)?;
     let (e, o) = (&eph.inner, &options.inner);
     let out = py.detach(|| solve_epochs(e, &ep, &o.spp(e), o.sigma_rate))?;
     Ok((to_py_rows(py, &out.epochs), to_py_rows(py, &out.satellites), out.satellite_names))
@@ -226,7 +232,7 @@ fn gnss_source<'py>(
     eph: &PyEphemerides, time: PyReadonlyArray1<'py, f64>, sat: Vec<String>, channel: PyReadonlyArray1<'py, i64>, code: PyReadonlyArray1<'py, f64>,
     rate: PyReadonlyArray1<'py, f64>, options: &PyGnssOptions,
 ) -> PyResult<AidingSource> {
-    let ep = epochs(&time, &sat, &channel, &code, &rate)?;
+    let ep = epochs(&time, &sat, &channel, &code, None, &rate)?;
     let (e, o) = (eph.inner.clone(), options.inner);
     Ok(AidingSource::deferred(
         "gnss".to_string(),

@@ -50,6 +50,12 @@ class GnssOptions(Config):
         alarms) and, while the test fails with two or more redundant satellites,
         excludes the satellite whose removal fits best (RAIM FDE, as RTKLIB's
         ``raim_fde``; Takasu 2013).
+    ionosphere_free : bool, default False
+        Single-point positioning with the ionosphere-free combination of the first and
+        second codes (``code2_m``, as :func:`atomnav.gnss.rinex.read_obs` gives it;
+        Groves 2013, Eq. 9.50) instead of the Klobuchar correction; satellites without a
+        second code are excluded ("no_second_code"), and the code σ are scaled by the
+        combination's noise gain (×2.98 GPS, ×2.96 GLONASS).
     formulation : str, default "first_difference"
         Tight coupling, one of :data:`FORMULATIONS`: "first_difference" (between-satellite
         differences with c·τ_GPS as an extra state) or "clock_states" (undifferenced rows
@@ -85,6 +91,7 @@ class GnssOptions(Config):
     elevation_weight: bool = False
     elevation_mask: float = math.radians(10.0)
     fault_detection: bool = True
+    ionosphere_free: bool = False
     formulation: str = "first_difference"
     lever_arm: tuple = (0.0, 0.0, 0.0)
     use_rate: bool = True

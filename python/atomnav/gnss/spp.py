@@ -11,7 +11,7 @@ import numpy as np
 import pandas as pd
 
 from .. import _core
-from .._validate import instance, renamed
+from .._validate import input_error, instance, renamed, table
 from .ephemeris import Ephemerides
 from .observations import obs_arrays
 from .options import GnssOptions, split_options
@@ -65,6 +65,15 @@ class SppResult:
         return self.satellites["excluded"].value_counts().reindex(list(EXCLUSIONS), fill_value=0)
 
 
+def _second_code(obs: pd.DataFrame) -> np.ndarray:
+    """The ``code2_m`` column (m; NaN where the second code was not tracked)."""
+    code2 = np.ascontiguousarray(table(obs, ["code2_m"], "obs", finite=False)[:, 0])
+    bad = np.flatnonzero(np.isinf(code2))
+    if bad.size:
+        raise input_error("obs", f"column 'code2_m': non-finite value {code2[bad[0]]} at index {bad[0]}", bad[0])
+    return code2
+
+
 def solve(eph: Ephemerides, obs: pd.DataFrame, options: GnssOptions | None = None, **option_fields) -> SppResult:
     """Single-point positioning: one least-squares solution per epoch of the observation
     table (Demidov 2009, §2.7).
@@ -81,11 +90,13 @@ def solve(eph: Ephemerides, obs: pd.DataFrame, options: GnssOptions | None = Non
         Broadcast ephemerides.
     obs : pandas.DataFrame
         Observation table (``time_s`` GPS s, ``sat``, ``channel``, ``code_m`` m,
-        ``rate_mps`` m/s, NaN where not tracked; see :func:`atomnav.gnss.simulate`).
+        ``rate_mps`` m/s, NaN where not tracked; see :func:`atomnav.gnss.simulate`), and
+        ``code2_m`` (m, NaN where not tracked) with ``ionosphere_free``.
     options : GnssOptions, optional
         ``use_tau`` estimates τ_GPS, corrections ``iono``/``tropo``, weights 1/σ² with
         ``sigma_code`` (GLONASS ``sigma_code_glonass``), optionally σ/sin E
-        (``elevation_weight``), ``elevation_mask``, ``fault_detection``, Doppler velocity
+        (``elevation_weight``), ``elevation_mask``, ``fault_detection``,
+        ``ionosphere_free``, Doppler velocity
         with ``sigma_rate`` (default ``GnssOptions()``).
     **option_fields
         Fields of :class:`GnssOptions` given as keywords (e.g. ``use_tau=False``),
@@ -109,8 +120,9 @@ def solve(eph: Ephemerides, obs: pd.DataFrame, options: GnssOptions | None = Non
     opts, rest = split_options(options, option_fields)
     if rest:
         raise TypeError(f"solve() got an unexpected keyword argument {sorted(rest)[0]!r}")
+    code2 = _second_code(obs) if opts.ionosphere_free else None
     with renamed(t="obs"):  # an observation time outside the ephemerides' span is the table's
-        epochs, sats, names = _core.gnss_spp(eph._core, *obs_arrays(obs), opts.native)
+        epochs, sats, names = _core.gnss_spp(eph._core, *obs_arrays(obs), opts.native, code2=code2)
     code = sats[:, 4].astype(np.int64)
     reasons = np.array(("",) + EXCLUSIONS, dtype=object)[code]
     satellites = pd.DataFrame({"time_s": sats[:, 0], "sat": names, "elevation_rad": sats[:, 1],
