@@ -1,10 +1,12 @@
-"""A station day through atomnav and through RTKLIB side by side: reading a full-day
-RINEX observation file (Hatanaka + gzip, ~2,880 epochs at 30 s) and its navigation file,
-then single-point positioning of every epoch (GPS, L1, 10° mask, broadcast Klobuchar and
-Saastamoinen), against RTKLIB's ``rnx2rtkp`` on the same files and options.
+"""A station day through atomnav, georinex and RTKLIB side by side: reading a full-day
+RINEX observation file (Hatanaka + gzip, ~2,880 epochs at 30 s) and its navigation file
+with atomnav's reader (the ``rinex`` crate in the core) and with georinex (the other
+candidate, ``--georinex``: about 9 minutes for a day), then single-point positioning of
+every epoch (GPS, L1, 10° mask, broadcast Klobuchar and Saastamoinen) against RTKLIB's
+``rnx2rtkp`` on the same files and options.
 
     python benches/bench_rinex.py --obs ESBC00DNK_R_20201770000_01D_30S_MO.crx.gz \\
-        --nav ESBC00DNK_R_20201770000_01D_MN.rnx.gz [--truth 3582104.7678 532590.1779 5232755.1405]
+        --nav ESBC00DNK_R_20201770000_01D_MN.rnx.gz [--truth 3582104.7678 532590.1779 5232755.1405] [--georinex]
 
 The ESBC day of the measurements in docs/departures.md is in the public repository
 rtk-rs/data (``CRNX/V3/`` and ``NAV/V3/``, MPL-2.0); the truth is ESBC's ITRF2014
@@ -38,6 +40,7 @@ def main():
     ap.add_argument("--obs", type=Path, required=True, help="RINEX observation file (.rnx, .crx, .gz)")
     ap.add_argument("--nav", type=Path, required=True, help="RINEX navigation file of the same day")
     ap.add_argument("--truth", type=float, nargs=3, help="marker ECEF x y z (m); the header's ΔH is added")
+    ap.add_argument("--georinex", action="store_true", help="also time georinex reading the same files (minutes)")
     args = ap.parse_args()
 
     t0 = time.perf_counter()
@@ -51,8 +54,21 @@ def main():
     result = an.gnss.solve(eph, gps, elevation_weight=True)
     t3 = time.perf_counter()
     n = len(result.epochs)
-    print(f"atomnav: nav {t1 - t0:.2f} s, obs {t2 - t1:.2f} s ({obs.table['time_s'].nunique()} epochs), "
+    print(f"atomnav: nav {t1 - t0:.2f} s, obs {t2 - t1:.2f} s ({obs.n_epochs} epochs), "
           f"SPP {t3 - t2:.3f} s ({1e3 * (t3 - t2) / max(n, 1):.3f} ms/epoch); total {t3 - t0:.2f} s")
+
+    if args.georinex:
+        import georinex
+
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            s = time.perf_counter()
+            georinex.load(str(args.nav))
+            g1 = time.perf_counter()
+            ds = georinex.load(str(args.obs))
+            g2 = time.perf_counter()
+        print(f"georinex: nav {g1 - s:.2f} s, obs {g2 - g1:.2f} s ({ds.time.size} epochs); "
+              f"atomnav / georinex reading speed ratio {(g2 - s) / (t2 - t0):.0f}x")
 
     theirs = None
     if shutil.which("rnx2rtkp"):

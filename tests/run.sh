@@ -9,6 +9,10 @@ cd "$(dirname "$0")/.."
 python3 -m venv .venv
 .venv/bin/python -m pip install --quiet --upgrade pip
 .venv/bin/python -m pip install ".[test]"
+# RTKLIB's rnx2rtkp, the peer of the GNSS tests (they skip where it cannot be installed)
+if ! command -v rnx2rtkp >/dev/null && command -v apt-get >/dev/null && [ "$(id -u)" = 0 ]; then
+    (apt-get update -qq && apt-get install -y -qq rtklib) >/dev/null 2>&1 || echo "rtklib not installed: the RTKLIB comparisons skip" >&2
+fi
 .venv/bin/python -m pytest tests "$@"
 # No reachable panic in the core: unwrap, expect, panic! and unchecked indexing are denied
 # in non-test code; each place where an invariant makes an index safe carries a justified

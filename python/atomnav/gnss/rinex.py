@@ -39,7 +39,8 @@ def _stamp(t: datetime) -> str:
 
 
 def write_nav(path, eph: Ephemerides, n_leap: float = 18.0, week_start: datetime = WEEK_START) -> Path:
-    """Write the broadcast sets of ``eph`` as a RINEX 3.04 mixed navigation file.
+    """Write the broadcast sets of ``eph`` as a RINEX 3.04 mixed navigation file, with
+    its Klobuchar coefficients (GPSA/GPSB).
 
     Parameters
     ----------
@@ -61,9 +62,12 @@ def write_nav(path, eph: Ephemerides, n_leap: float = 18.0, week_start: datetime
     path, week_start = checked_path(path), _week_start(week_start)
     instance(eph, Ephemerides, "eph")
     gps, glo = eph.tables()
+    alpha, beta = eph.ionosphere[:4], eph.ionosphere[4:]
     lines = [f"{3.04:9.2f}{'':11}{'N: GNSS NAV DATA':20}{'M: Mixed':20}RINEX VERSION / TYPE",
-             f"{'atomnav':20}{'':20}{'':20}PGM / RUN BY / DATE", f"{int(round(n_leap)):6d}{'':54}LEAP SECONDS",
-             f"{'':60}END OF HEADER"]
+             f"{'atomnav':20}{'':20}{'':20}PGM / RUN BY / DATE",
+             f"{'GPSA ':5}{''.join(f'{x:12.4E}' for x in alpha):48}{'':7}IONOSPHERIC CORR",
+             f"{'GPSB ':5}{''.join(f'{x:12.4E}' for x in beta):48}{'':7}IONOSPHERIC CORR",
+             f"{int(round(n_leap)):6d}{'':54}LEAP SECONDS", f"{'':60}END OF HEADER"]
     for _, e in gps.iterrows():
         toc = week_start + timedelta(seconds=float(e.toc))
         # Toe as seconds of its own GPS week, with that week's number

@@ -24,7 +24,7 @@ SATELLITE_COLUMNS = ["time_s", "sat", "elevation_rad", "azimuth_rad", "residual_
 #: (NaN pseudorange: not tracked), ``no_ephemeris`` (no broadcast set valid then),
 #: ``elevation`` (below ``elevation_mask``), ``fault`` (excluded by the residual test),
 #: ``too_few_satellites`` (the epoch has fewer usable satellites than unknowns: no
-#: solution).
+#: solution), ``no_second_code`` (with ``ionosphere_free``: no second-frequency code).
 EXCLUSIONS = tuple(_core.SPP_EXCLUSIONS)
 
 
