@@ -362,8 +362,9 @@ def read_obs(path, eph: Ephemerides, week_start: datetime | None = None) -> Rine
                           "snr_dbhz": f["snr_dbhz"], "code_type": _names(f["code_type"], system, CODE_PREFERENCE),
                           "code2_type": _names(f["code2_type"], system, CODE2_PREFERENCE),
                           "doppler_type": _names(f["doppler_type"], system, DOPPLER_PREFERENCE)})
-    missing = table.groupby("time_s").agg(n_sats=("sat", "size"), n_no_code=("code_m", lambda x: int(x.isna().sum())),
-                                          n_no_doppler=("rate_mps", lambda x: int(x.isna().sum()))).reset_index()
+    flags = pd.DataFrame({"time_s": time_s, "n_sats": 1, "n_no_code": table.code_m.isna().astype(np.int64),
+                          "n_no_doppler": table.rate_mps.isna().astype(np.int64)})
+    missing = flags.groupby("time_s", sort=True).sum().reset_index()
     facts = {k: h[k] for k in ("marker", "receiver", "version", "interval_s", "approx_position_m", "antenna_delta_hen_m",
                                "glonass_channels", "leap_seconds")}
     facts["time_system"] = "GPS"
