@@ -314,7 +314,7 @@ pub fn read_observations(path: &Path) -> Result<ObservationFile> {
                     epoch_rows.len() - 1
                 }
             };
-            let row = &mut epoch_rows[k];
+            let Some(row) = epoch_rows.get_mut(k) else { continue };
             let code = s.observable.to_string();
             let mut snr_rank = NONE;
             set(s.value, rank(&CODE_L1, system, &code), &mut row.code_m, &mut row.code_type);

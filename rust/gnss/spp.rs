@@ -149,7 +149,7 @@ pub fn ionosphere_free(eph: &Ephemerides, t: f64, obs: &[Observation]) -> Vec<Ob
             } else {
                 f64::NAN
             };
-            Observation { code, ..o.clone() }
+            Observation { code, ..*o }
         })
         .collect()
 }
