@@ -52,7 +52,7 @@ fn bench(c: &mut Criterion) {
         })
     });
     // the defaults of GnssOptions: 10° mask, fault detection on
-    let spp = SppConfig { use_tau: true, atm, sigma_gps: 3.0, sigma_glo: 3.0, elevation_weight: false, elevation_mask: 10f64.to_radians(), fault_detection: true };
+    let spp = SppConfig { use_tau: true, atm, sigma_gps: 3.0, sigma_glo: 3.0, elevation_weight: false, elevation_mask: 10f64.to_radians(), fault_detection: true, ionosphere_free: false };
     g.bench_function("spp_one_epoch", |b| b.iter(|| solve_position(&eph, 1.0, &epochs[0].1, &spp, None).unwrap().pos));
     g.finish();
 }
