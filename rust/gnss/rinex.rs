@@ -9,6 +9,7 @@
 //! file's own time scale (GPS time for observations and GPS records, UTC for GLONASS
 //! records), so no leap-second table is applied here.
 
+use super::SatId;
 use crate::error::{invalid, NavError, Result};
 use rinex::navigation::{IonosphereModel, NavFrameType, NavMessageType};
 use rinex::observation::EpochFlag;
@@ -222,8 +223,7 @@ pub struct ObservationHeader {
 #[derive(Debug, Clone, Copy)]
 pub struct ObservationRow {
     pub time_s: f64,
-    pub system: char,
-    pub prn: u8,
+    pub sat: SatId,
     pub code_m: f64,
     pub code_type: u8,
     pub code2_m: f64,
@@ -304,11 +304,12 @@ pub fn read_observations(path: &Path) -> Result<ObservationFile> {
                 }
                 continue;
             }
-            let k = match epoch_rows.iter().position(|r| r.system == system && r.prn == s.sv.prn) {
+            let sat = if system == 'G' { SatId::gps(s.sv.prn) } else { SatId::glonass(s.sv.prn) };
+            let k = match epoch_rows.iter().position(|r| r.sat == sat) {
                 Some(k) => k,
                 None => {
                     epoch_rows.push(ObservationRow {
-                        time_s: t, system, prn: s.sv.prn, code_m: f64::NAN, code_type: NONE, code2_m: f64::NAN, code2_type: NONE,
+                        time_s: t, sat, code_m: f64::NAN, code_type: NONE, code2_m: f64::NAN, code2_type: NONE,
                         doppler_hz: f64::NAN, doppler_type: NONE, snr_dbhz: f64::NAN,
                     });
                     epoch_rows.len() - 1
@@ -327,7 +328,7 @@ pub fn read_observations(path: &Path) -> Result<ObservationFile> {
                 *out.set_aside.entry(c).or_default() += 1;
             }
         }
-        epoch_rows.sort_by_key(|r| (r.system, r.prn));
+        epoch_rows.sort_by_key(|r| r.sat);
         out.rows.extend(epoch_rows.iter().filter(|r| r.code_type != NONE || r.doppler_type != NONE));
     }
     Ok(out)

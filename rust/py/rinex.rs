@@ -36,7 +36,7 @@ fn gnss_read_rinex_obs<'py>(py: Python<'py>, path: PathBuf) -> PyResult<Bound<'p
     let r = &f.rows;
     let kind = |x: u8| if x == NONE { -1i8 } else { x as i8 };
     d.set_item("time_s", column(py, r.iter().map(|x| x.time_s).collect()))?;
-    d.set_item("sat", r.iter().map(|x| format!("{}{:02}", x.system, x.prn)).collect::<Vec<_>>())?;
+    d.set_item("sat", r.iter().map(|x| x.sat.name()).collect::<Vec<_>>())?;
     d.set_item("code_m", column(py, r.iter().map(|x| x.code_m).collect()))?;
     d.set_item("code_type", column(py, r.iter().map(|x| kind(x.code_type)).collect()))?;
     d.set_item("code2_m", column(py, r.iter().map(|x| x.code2_m).collect()))?;

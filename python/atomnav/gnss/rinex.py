@@ -20,7 +20,7 @@ import pandas as pd
 from .. import _core
 from .._validate import input_error, instance, path as checked_path
 from .ephemeris import GLONASS_COLUMNS, GPS_COLUMNS, Ephemerides
-from .observations import C_LIGHT, _gps_week_start, doppler_to_rate, _gps_week_of, obs_arrays
+from .observations import _gps_week_start, doppler_to_rate, _gps_week_of, obs_arrays
 from .solution import GPS_EPOCH, gps_minus_utc
 
 WEEK_START = datetime(2017, 1, 1)   # a Sunday: GPS week 1930
@@ -71,7 +71,7 @@ def write_nav(path, eph: Ephemerides, n_leap: float = 18.0, week_start: datetime
     for _, e in gps.iterrows():
         toc = week_start + timedelta(seconds=float(e.toc))
         # Toe as seconds of its own GPS week, with that week's number
-        since = (pd.Timestamp(week_start) - GPS_EPOCH).total_seconds() + float(e.toe)
+        since = _offset(week_start) + float(e.toe)
         week, toe = divmod(since, 604800.0)
         vals = [e.af0, e.af1, e.af2, 0.0, e.crs, e.delta_n, e.m0, e.cuc, e.e, e.cus, e.sqrt_a, toe, e.cic, e.omega0,
                 e.cis, e.i0, e.crc, e.omega, e.omega_dot, e.idot, 0.0, week, 0.0, 2.0, 0.0, e.tgd, 0.0, toe, 4.0, 0.0, 0.0]
@@ -134,10 +134,6 @@ def write_obs(path, obs: pd.DataFrame, week_start: datetime = WEEK_START) -> Pat
         lines += [f"{sat}{c:14.3f}  {d:14.3f}  " for sat, c, d in zip(ep.sat, ep.code_m, ep.doppler)]
     Path(path).write_text("\n".join(lines) + "\n")
     return Path(path)
-
-
-def _seconds(times, week_start: datetime) -> np.ndarray:
-    return (pd.to_datetime(np.asarray(times)) - pd.Timestamp(week_start)).total_seconds().to_numpy()
 
 
 def _offset(week: pd.Timestamp) -> float:
