@@ -75,6 +75,80 @@ def test_stacked_and_sequential_updates_match_textbook_kf():
     assert np.all(kf.x == 0)
 
 
+def test_default_closed_mode_propagates_a_given_initial_state_like_filterpy():
+    """KalmanFilter(x0=..., p0=...): the default (closed) mode propagates δx̂ by Φ in predict,
+    as filterpy's KalmanFilter does; a run of predicts and updates equals filterpy's."""
+    from filterpy.kalman import KalmanFilter as FilterpyKf
+
+    rng = np.random.default_rng(8)
+    n, m = 4, 2
+    phi = np.eye(n) + 0.2 * rng.standard_normal((n, n))
+    g = rng.standard_normal((n, n))
+    p0, qd = g @ g.T + np.eye(n), np.diag(rng.uniform(0.01, 0.1, n))
+    h, r = rng.standard_normal((m, n)), np.diag([0.3, 0.5])
+    x0 = rng.standard_normal(n)
+    ours = KalmanFilter(x0=x0, p0=p0)
+    peer = FilterpyKf(dim_x=n, dim_z=m)
+    peer.x, peer.P, peer.F, peer.Q, peer.H, peer.R = x0.copy(), p0.copy(), phi, qd, h, r
+    ours.predict(phi, qd)
+    peer.predict()
+    assert np.allclose(ours.x, phi @ x0, rtol=1e-13, atol=1e-13)   # not left at x0
+    for _ in range(5):
+        z = rng.standard_normal(m)
+        ours.update(z, h, r)
+        peer.update(z)
+        ours.predict(phi, qd)
+        peer.predict()
+    assert np.allclose(ours.x, peer.x, rtol=1e-10, atol=1e-12)
+    assert np.allclose(ours.p, peer.P, rtol=1e-10, atol=1e-12)
+
+
+@pytest.mark.parametrize("sequential", [False, True])
+def test_standard_and_joseph_covariance_updates(sequential):
+    """Both forms are selectable: the standard form is P − KSKᵀ = (I − KH)P, the Joseph
+    form (I − KH)P(I − KH)ᵀ + KRKᵀ (equal in exact arithmetic for the optimal gain); with a
+    diagonal R the sequential path equals the stacked one in both forms."""
+    rng = np.random.default_rng(3)
+    n, m = 5, 3
+    g = rng.standard_normal((n, n))
+    p0 = g @ g.T + np.eye(n)
+    h, r = rng.standard_normal((m, n)), np.diag([0.2, 0.4, 0.1])
+    z, x0 = rng.standard_normal(m), rng.standard_normal(n)
+    s = h @ p0 @ h.T + r
+    k = p0 @ h.T @ np.linalg.inv(s)
+    p_standard = (np.eye(n) - k @ h) @ p0
+    for form in ("standard", "joseph"):
+        kf = KalmanFilter(p0, x0=x0, covariance_update=form)
+        kf.update(z, h, r, sequential=sequential)
+        assert np.allclose(kf.x, x0 + k @ (z - h @ x0), rtol=1e-10, atol=1e-12)
+        assert np.allclose(kf.p, (p_standard + p_standard.T) / 2, rtol=1e-9, atol=1e-12), form
+
+
+def test_joseph_form_keeps_a_nearly_removed_variance_positive():
+    """An update that removes almost all of a state's variance (σ² 1e8 → 1e-8): the Joseph
+    form keeps P positive definite with the right remaining variance."""
+    p0 = np.diag([1e8, 1.0])
+    h, r = np.array([[1.0, 0.0]]), np.array([[1e-8]])
+    kf = KalmanFilter(p0, covariance_update="joseph")
+    kf.update([1.0], h, r)
+    assert kf.p[0, 0] == pytest.approx(1e-8 * 1e8 / (1e8 + 1e-8), rel=1e-6)
+    assert np.all(np.linalg.eigvalsh(kf.p) > 0)
+
+
+def test_bad_initial_state_and_update_form():
+    with pytest.raises(atomnav.InputError, match="x0: expected 2 entries") as e:
+        KalmanFilter(np.eye(2), x0=[1.0])
+    assert e.value.parameter == "x0"
+    with pytest.raises(atomnav.InputError) as e:
+        KalmanFilter(np.eye(2), x0=[1.0, np.nan])
+    assert e.value.parameter == "x0" and e.value.index == 1
+    with pytest.raises(atomnav.InputError, match="joseph, standard") as e:
+        KalmanFilter(np.eye(2), covariance_update="jo")
+    assert e.value.parameter == "covariance_update"
+    with pytest.raises(TypeError):
+        KalmanFilter(np.eye(2), [0.0, 0.0])   # x0 is keyword-only
+
+
 def test_gate_rejects_outlier_row_and_reports_it():
     kf = KalmanFilter(np.eye(3), mode="open")
     h, r = np.eye(3), np.eye(3) * 0.01

@@ -1,5 +1,6 @@
 //! Error-state Kalman filter core: predict, stacked or sequential (decorrelated) update
-//! in Joseph form, χ² gating, closed/open loop, positive-definiteness watch, RTS smoother.
+//! in Joseph or standard form, χ² gating, closed/open loop, positive-definiteness watch,
+//! RTS smoother.
 //!
 //! Measurement model: z = H δx + v, v ~ N(0, R), with z = predicted − measured (the
 //! project's δx = estimate − true, README "Conventions"); the estimated error δx̂ is removed
@@ -10,18 +11,35 @@ use super::matrix::{check_covariance, check_square, has_register_kernel, propaga
 use crate::error::{invalid, invalid_at, NavError, Result};
 use nalgebra::{DMatrix, DVector};
 
-/// How the filter's estimate reaches the navigation solution.
+/// How the filter's estimate reaches the navigation solution. In both modes a prediction
+/// propagates δx̂ by Φ; the modes differ in what [`Kf::take_correction`] does.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum LoopMode {
-    /// Feedback: after each update the caller applies δx̂ and the filter resets it to 0.
+    /// Feedback: the caller takes δx̂ (usually after each update) to correct the navigation
+    /// solution, and the filter resets it to 0.
     Closed,
-    /// Estimation: the INS runs free, δx̂ is propagated by Φ and kept.
+    /// Estimation: the INS runs free, δx̂ is kept.
     Open,
 }
 
 impl crate::options::Choice for LoopMode {
     const PARAMETER: &'static str = "mode";
     const CHOICES: &'static [(&'static str, Self)] = &[("closed", LoopMode::Closed), ("open", LoopMode::Open)];
+}
+
+/// The covariance form of the measurement update (Groves 2013, ch. 3).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum UpdateForm {
+    /// P = (I − KH)P(I − KH)ᵀ + KRKᵀ: symmetric and positive semi-definite for any gain.
+    #[default]
+    Joseph,
+    /// P = (I − KH)P, the textbook form (symmetrised after the product).
+    Standard,
+}
+
+impl crate::options::Choice for UpdateForm {
+    const PARAMETER: &'static str = "covariance_update";
+    const CHOICES: &'static [(&'static str, Self)] = &[("joseph", UpdateForm::Joseph), ("standard", UpdateForm::Standard)];
 }
 
 /// Finite and strictly positive (false for NaN).
@@ -59,6 +77,9 @@ pub struct Kf {
     pub p: DMatrix<f64>,
     #[serde(with = "crate::options::by_name")]
     pub mode: LoopMode,
+    /// Covariance form of the measurement update.
+    #[serde(default, with = "crate::options::by_name")]
+    pub form: UpdateForm,
     /// Number of predictions done (the "epoch" named by numerical errors).
     pub epoch: usize,
     /// Work buffer of the covariance propagation (kept to avoid an allocation per step).
@@ -87,9 +108,28 @@ impl Kf {
         if n == 0 {
             return Err(invalid("p0", "must have at least one state, got 0x0"));
         }
-        let kf = Kf { x: DVector::zeros(n), p: p0, mode, epoch: 0, scratch: Vec::new(), algebra: Algebra::Kernels, work: (DMatrix::zeros(0, 0), DMatrix::zeros(0, 0)) };
+        let kf = Kf { x: DVector::zeros(n), p: p0, mode, form: UpdateForm::Joseph, epoch: 0, scratch: Vec::new(), algebra: Algebra::Kernels, work: (DMatrix::zeros(0, 0), DMatrix::zeros(0, 0)) };
         let algebra = if has_register_kernel(n) { Algebra::Kernels } else { Algebra::by_size(n, KF_FAER_MIN) };
         Ok(kf.with_algebra(algebra))
+    }
+
+    /// The same filter starting from the estimate `x0` (n entries, finite) instead of 0.
+    pub fn with_state(mut self, x0: &[f64]) -> Result<Kf> {
+        let n = self.size();
+        if x0.len() != n {
+            return Err(invalid("x0", format!("expected {n} entries like p0, got {}", x0.len())));
+        }
+        if let Some((i, v)) = x0.iter().enumerate().find(|(_, v)| !v.is_finite()) {
+            return Err(invalid_at("x0", i, format!("non-finite value {v} at index {i}")));
+        }
+        self.x = DVector::from_column_slice(x0);
+        Ok(self)
+    }
+
+    /// The same filter with its measurement updates in `form`.
+    pub fn with_update_form(mut self, form: UpdateForm) -> Kf {
+        self.form = form;
+        self
     }
 
     /// The same filter with its covariance products on `algebra` (benches and tests; the
@@ -120,7 +160,7 @@ impl Kf {
         Ok(())
     }
 
-    /// δx̂ ← Φδx̂ (open loop), P ← ΦPΦᵀ + Q_d (Tennstedt et al. 2021, Eq. 31), for a Q_d
+    /// δx̂ ← Φδx̂, P ← ΦPΦᵀ + Q_d (Tennstedt et al. 2021, Eq. 31), for a Q_d
     /// that is a covariance by construction: only the shapes are checked.
     pub fn predict(&mut self, phi: &DMatrix<f64>, qd: &DMatrix<f64>) -> Result<()> {
         let n = self.size();
@@ -143,12 +183,13 @@ impl Kf {
         self.epoch += 1;
         let n = self.size();
         match self.algebra {
+            // δx̂ = 0 (a closed loop after its feedback) stays 0: skip the product
             Algebra::Kernels => {
-                let x = (self.mode == LoopMode::Open).then_some(self.x.as_mut_slice());
+                let x = self.x.iter().any(|&v| v != 0.0).then_some(self.x.as_mut_slice());
                 propagate_covariance(self.p.as_mut_slice(), x, phi.as_slice(), qd.as_slice(), n, &mut self.scratch);
             }
             Algebra::Faer => {
-                if self.mode == LoopMode::Open {
+                if self.x.iter().any(|&v| v != 0.0) {
                     self.x = phi * &self.x;
                 }
                 let (out, t) = &mut self.work;
@@ -167,7 +208,8 @@ impl Kf {
     /// (z̄ = L⁻¹z, H̄ = L⁻¹H) and process scalar rows;
     /// otherwise one stacked vector update. `gate`: χ² threshold — on yᵀS⁻¹y (stacked)
     /// or on each scalar row's y²/s (sequential); rejected rows are reported, not applied.
-    /// Covariance in Joseph form P = (I − KH)P(I − KH)ᵀ + KRKᵀ.
+    /// Covariance in the filter's [`UpdateForm`]: Joseph P = (I − KH)P(I − KH)ᵀ + KRKᵀ
+    /// (default) or standard P = (I − KH)P.
     ///
     /// A NaN component of z is a missing measurement: the update uses the components that
     /// are not NaN, with their rows of z and H and their rows and columns of R (the rows of
@@ -253,7 +295,7 @@ impl Kf {
         }
         let k = chol.solve(&ph.transpose()).transpose();
         self.x += &k * &y;
-        self.joseph(&k, h, r);
+        self.update_covariance(&k, h, r);
         Ok(UpdateReport { innovation: y.as_slice().to_vec(), nis: vec![nis], rejected: vec![], skipped: vec![] })
     }
 
@@ -282,14 +324,19 @@ impl Kf {
             }
             let k = ph / s;
             self.x += k.column(0) * y;
-            self.joseph(&k, &hi, &one);
+            self.update_covariance(&k, &hi, &one);
         }
         Ok(UpdateReport { innovation, nis, rejected, skipped: vec![] })
     }
 
-    fn joseph(&mut self, k: &DMatrix<f64>, h: &DMatrix<f64>, r: &DMatrix<f64>) {
+    fn update_covariance(&mut self, k: &DMatrix<f64>, h: &DMatrix<f64>, r: &DMatrix<f64>) {
         let n = self.size();
         let a = DMatrix::identity(n, n) - k * h;
+        if self.form == UpdateForm::Standard {
+            self.p = &a * &self.p;
+            symmetrize(&mut self.p);
+            return;
+        }
         let krk = k * r * k.transpose();
         match self.algebra {
             Algebra::Kernels => self.p = &a * &self.p * a.transpose() + krk,

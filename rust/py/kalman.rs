@@ -7,7 +7,7 @@ use super::filter::{mats, stack_to_py};
 use crate::error::NavError;
 use crate::filter::analysis::Scenario as CoreScenario;
 use crate::filter::discretize::{discretize_checked, Discretization};
-use crate::filter::kf::{rts as core_rts, stored_steps, Kf, LoopMode};
+use crate::filter::kf::{rts as core_rts, stored_steps, Kf, LoopMode, UpdateForm};
 use crate::filter::riccati;
 use nalgebra::{DMatrix, DVector};
 use numpy::ndarray::{Array2, Array3};
@@ -107,9 +107,13 @@ super::pickle::picklable!(KalmanFilter, inner, "KalmanFilter", locked);
 #[pymethods]
 impl KalmanFilter {
     #[new]
-    #[pyo3(signature = (p0, mode=Wrap(LoopMode::Closed)))]
-    fn new(p0: PyReadonlyArray2<'_, f64>, mode: Wrap<LoopMode>) -> PyResult<Self> {
-        Ok(KalmanFilter { inner: Mutex::new(Kf::new(mat(&p0, "p0")?, mode.0)?) })
+    #[pyo3(signature = (p0, *, x0=None, mode=Wrap(LoopMode::Closed), covariance_update=Wrap(UpdateForm::Joseph)))]
+    fn new(p0: PyReadonlyArray2<'_, f64>, x0: Option<PyReadonlyArray1<'_, f64>>, mode: Wrap<LoopMode>, covariance_update: Wrap<UpdateForm>) -> PyResult<Self> {
+        let mut kf = Kf::new(mat(&p0, "p0")?, mode.0)?.with_update_form(covariance_update.0);
+        if let Some(x0) = x0 {
+            kf = kf.with_state(&vector(&x0, "x0")?)?;
+        }
+        Ok(KalmanFilter { inner: Mutex::new(kf) })
     }
 
     fn predict(&self, py: Python<'_>, phi: PyReadonlyArray2<'_, f64>, qd: PyReadonlyArray2<'_, f64>) -> PyResult<()> {
@@ -269,6 +273,7 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<KalmanFilter>()?;
     m.add_class::<Scenario>()?;
     register_choices::<LoopMode>(m, "LoopMode")?;
+    register_choices::<UpdateForm>(m, "UpdateForm")?;
     register_choices::<Discretization>(m, "Discretization")?;
     Ok(())
 }

@@ -14,7 +14,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .. import _core, plausibility
-from .._validate import as_floats, finite_scalar, flag, input_error, instance, integer, json_object, renamed, rows
+from .._validate import as_floats, finite_scalar, flag, input_error, instance, integer, json_object, renamed, rows, vector
 from .riccati import _mat
 
 #: Standard blocks and their sizes (read from the core, ``rust/filter/layout.rs``); extra
@@ -335,31 +335,47 @@ class UpdateResult(tuple):
 class KalmanFilter:
     """Error-state Kalman filter.
 
-    p0: initial covariance (PD); mode "closed" (feedback: :meth:`take_correction` hands δx̂
-    to the caller and resets it) or "open" (δx̂ propagated by Φ and kept). A covariance
-    that loses positive definiteness raises :class:`atomnav.NumericalError` naming the epoch.
-    One filter may be shared by threads (calls run one after another; the core holds the
-    lock) and pickled or deep-copied between steps: the copy continues bit for bit.
+    The state estimate δx̂ starts at ``x0`` (default 0) with covariance ``p0``; every
+    :meth:`predict` propagates both (δx̂ ← Φδx̂, P ← ΦPΦᵀ + Q_d). ``mode`` decides what
+    :meth:`take_correction` does: "closed" (feedback) hands δx̂ to the caller to correct the
+    navigation solution and resets it to 0; "open" hands it over and keeps it. A covariance
+    that loses positive definiteness raises :class:`atomnav.NumericalError` naming the
+    epoch. One filter may be shared by threads (calls run one after another; the core holds
+    the lock) and pickled or deep-copied between steps: the copy continues bit for bit.
 
     Parameters
     ----------
     p0 : array_like (n, n)
         Initial covariance (positive definite), squared state units.
+    x0 : array_like (n,), optional
+        Initial state estimate, state units (default zeros).
     mode : {"closed", "open"}, default "closed"
         "closed" (feedback: :meth:`take_correction` hands δx̂ to the caller and resets
-        it) or "open" (δx̂ propagated by Φ and kept).
+        it) or "open" (δx̂ kept).
+    covariance_update : {"joseph", "standard"}, default "joseph"
+        Covariance form of :meth:`update`: Joseph P = (I − KH)P(I − KH)ᵀ + KRKᵀ, which
+        stays symmetric positive semi-definite under rounding and for any gain, or the
+        standard P = (I − KH)P (symmetrised), cheaper and textbook-equal for the optimal gain.
 
     References
     ----------
     P. D. Groves, *Principles of GNSS, Inertial, and Multisensor Integrated Navigation
     Systems*, 2nd ed. (2013), ch. 3.
+
+    Examples
+    --------
+    >>> kf = KalmanFilter(p0=np.eye(2), x0=[1.0, 0.0])              # doctest: +SKIP
+    >>> kf.predict([[1.0, 0.1], [0.0, 1.0]], 1e-4 * np.eye(2))      # doctest: +SKIP
+    >>> kf.x                                                        # doctest: +SKIP
+    array([1., 0.])
     """
 
-    def __init__(self, p0, mode: str = "closed"):
-        self._core = _core.KalmanFilter(_mat(p0, "p0"), mode)
+    def __init__(self, p0, *, x0=None, mode: str = "closed", covariance_update: str = "joseph"):
+        x0 = None if x0 is None else vector(x0, None, "x0")
+        self._core = _core.KalmanFilter(_mat(p0, "p0"), x0=x0, mode=mode, covariance_update=covariance_update)
 
     def predict(self, phi, qd, steps: int = 1) -> None:
-        """P ← ΦPΦᵀ + Q_d (and δx̂ ← Φδx̂ in open loop), ``steps`` times (multirate: pass
+        """δx̂ ← Φδx̂ and P ← ΦPΦᵀ + Q_d, ``steps`` times (multirate: pass
         Φ(ΔT), Q_d(ΔT) for ΔT = MΔt and steps=1).
 
         Parameters
