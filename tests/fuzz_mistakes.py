@@ -381,7 +381,7 @@ CATALOGUE: tuple[Clean, ...] = (
        "    kf.update([z], kf_h, kf_r)\n"
        "    rows.append((kf_phi, *prior, kf.x, kf.p))\n"
        "phi, x_prior, p_prior, x_post, p_post = (np.array(c) for c in zip(*rows))"),
-    _c("atomnav.filter.engine.ins_error_model", "an.filter.engine.ins_error_model(lla, vel_ned, q_nb, f_b, 1e-6, 1e-10)",
+    _c("atomnav.filter.engine.ins_error_model", "an.filter.engine.ins_error_model(lla, vel_ned, q_nb, f_b, gyro_psd=1e-10, accel_psd=1e-6)",
        "lla, vel_ned, q_nb, f_b = traj.lla[:50], traj.vel_ned[:50], traj.q_nb[:50], imu_accel[:50]", (),
        LLA_ROWS + (Unit("f_b", "accel"),)),
     _c("atomnav.filter.analysis.Scenario",

@@ -279,3 +279,63 @@ def test_bad_baro_psd():
 def test_bad_baro_bias_without_sigma0():
     with pytest.raises(ValueError, match="baro_bias_sigma0: required with baro_bias"):
         position_aided_ins(**_no_fix_kwargs(vertical="damped", baro_bias=BiasModel()))
+
+
+def _static_engine(**extra):
+    n = 1001
+    t = np.arange(n) / 100.0
+    gyro = np.tile([OMEGA * np.cos(LAT), 0.0, -OMEGA * np.sin(LAT)], (n, 1))
+    accel = np.tile([0.0, 0.0, -earth.gravity(LAT, H)], (n, 1))
+    p0 = np.diag(np.r_[[1.0] * 3, [0.01] * 3, [1e-6] * 3, [1e-6] * 3, [1e-12] * 3])
+    ins = position_aided_ins(0.0, [LAT, LON, H], [0, 0, 0], [1, 0, 0, 0], "rates", np.arange(1.0, 10.0), [[LAT, LON, H]] * 9,
+                             np.eye(3), p0=p0, gyro_psd=1e-14, accel_psd=1e-8, predict_every=10, **extra)
+    return ins, t, gyro, accel
+
+
+def test_full_covariance_per_epoch_is_the_engines_and_matches_sigma():
+    ins, t, g, a = _static_engine()
+    res = ins.run(t, g, a, progress=False, covariance=True, chunk_s=3.0)
+    cov = res.covariance
+    assert cov.shape == (len(res.nav), 15, 15)
+    assert np.array_equal(cov[-1], ins._core.covariance)            # the engine's P after the last epoch
+    sig = res.nav[[f"sigma_{lab}" for lab in ins.labels]].to_numpy()
+    assert np.array_equal(np.sqrt(np.diagonal(cov, axis1=1, axis2=2)), sig)
+    assert np.allclose(cov, np.transpose(cov, (0, 2, 1)), rtol=0, atol=1e-15)
+    # streamed chunk by chunk: the same covariances; off by default
+    ins2, *_ = _static_engine()
+    first, rest = ins2.process(t[:400], g[:400], a[:400], covariance=True), ins2.process(t[400:900], g[400:900], a[400:900])
+    last = ins2.process(t[900:], g[900:], a[900:], covariance=True)
+    assert np.array_equal(first.covariance, cov[:len(first.nav)])
+    assert rest.covariance is None
+    assert np.array_equal(last.covariance, cov[len(first.nav) + len(rest.nav):len(first.nav) + len(rest.nav) + len(last.nav)])
+
+
+def test_nees_helper_against_numpy_and_bad_requests():
+    from atomnav import trajectory
+
+    truth = trajectory.stationary(10.0, 100.0, origin=(LAT, LON, H))
+    imu = truth.ideal_imu("rates")
+    ins, t, *_ = _static_engine()
+    g = imu[["gyro_x_rad_s", "gyro_y_rad_s", "gyro_z_rad_s"]].to_numpy()
+    a = imu[["accel_x_mps2", "accel_y_mps2", "accel_z_mps2"]].to_numpy() + [0.0, 0.0, 1e-3]
+    res = ins.run(t, g, a, progress=False, covariance=True)
+    out = res.nees(truth, blocks=("position", "attitude"))
+    err = truth.errors(res.nav)
+    k = len(res.nav) // 2
+    e = err.loc[k, ["dpos_n_m", "dpos_e_m", "dpos_d_m", "psi_n_rad", "psi_e_rad", "psi_d_rad"]].to_numpy(float)
+    idx = [0, 1, 2, 6, 7, 8]
+    assert out["nees"][k] == pytest.approx(e @ np.linalg.inv(res.covariance[k][np.ix_(idx, idx)]) @ e, rel=1e-9)
+    assert (out["dof"] == 6).all()
+    band = res.nis_band()
+    assert {"nis_low", "nis_high", "inside"} <= set(band.columns) and len(band) == len(res.measurements)
+    with pytest.raises(InputError) as e1:
+        res.nees(truth, blocks=("position", "clock"))
+    assert e1.value.parameter == "blocks"
+    plain = _static_engine()[0].run(t, g, a, progress=False)
+    assert plain.covariance is None
+    with pytest.raises(InputError) as e2:
+        plain.nees(truth)
+    assert e2.value.parameter == "covariance"
+    with pytest.raises(InputError, match="stream the record") as e3:
+        _static_engine()[0].run(t, g, a, progress=False, covariance=True, covariance_memory=10_000)
+    assert e3.value.parameter == "covariance"

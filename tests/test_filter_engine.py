@@ -284,7 +284,7 @@ def test_bad_mode_name():
 
 def test_bad_bias_model_name():
     with pytest.raises(ValueError, match='accel_bias: unknown bias model "flicker"'):
-        ins_error_model([[0.5, 0, 0]], [[0, 0, 0]], [[1, 0, 0, 0]], [[0, 0, -9.8]], 0.0, 0.0, accel_bias=BiasModel("flicker"))
+        ins_error_model([[0.5, 0, 0]], [[0, 0, 0]], [[1, 0, 0, 0]], [[0, 0, -9.8]], gyro_psd=0.0, accel_psd=0.0, accel_bias=BiasModel("flicker"))
 
 
 def test_layout_is_indexed_by_name_only():
@@ -303,9 +303,41 @@ def test_error_model_names_the_layout_missing_a_navigation_block():
     without them is rejected naming ``layout`` (``blocks`` in the core)."""
     one = (np.array([[0.9, 0.1, 100.0]]), np.zeros((1, 3)), np.array([[1.0, 0, 0, 0]]), np.array([[0, 0, -9.8]]))
     with pytest.raises(atomnav.InputError, match='no block "attitude"') as e:
-        ins_error_model(*one, 1e-6, 1e-10, layout=Layout(["position", "velocity"]))
+        ins_error_model(*one, gyro_psd=1e-10, accel_psd=1e-6, layout=Layout(["position", "velocity"]))
     assert e.value.parameter == "layout"
     with pytest.raises(atomnav.InputError) as e:
         atomnav._core.ins_error_dynamics([("position", None), ("velocity", None)], *one, accel_psd=0.0, gyro_psd=0.0,
                                          accel_bias=("random_constant", 0.0, 0.0), gyro_bias=("random_constant", 0.0, 0.0))
     assert e.value.parameter == "blocks"
+
+
+def test_p0_from_per_block_sigma_named_by_the_layout():
+    lay = Layout(INS15 + (("clock", 2),))
+    p0 = lay.covariance(position=3.0, velocity=(0.1, 0.2, 0.3), attitude=1e-3, accel_bias=2e-3, gyro_bias=1e-5, clock=(30.0, 0.5))
+    sigma = np.r_[[3.0] * 3, [0.1, 0.2, 0.3], [1e-3] * 3, [2e-3] * 3, [1e-5] * 3, [30.0, 0.5]]
+    assert np.array_equal(p0, np.diag(sigma**2))
+    assert np.array_equal(np.diag(p0)[lay["clock"]], [900.0, 0.25])
+    ok = dict(position=1.0, velocity=1.0, attitude=1.0, accel_bias=1.0, gyro_bias=1.0)
+    for bad, name in ((dict(ok, gyro_bias=-1.0), "gyro_bias"), ({k: v for k, v in ok.items() if k != "attitude"}, "attitude"),
+                      (dict(ok, clock=1.0), "clock"), (dict(ok, velocity=(1.0, 2.0)), "velocity")):
+        with pytest.raises(atomnav.InputError) as e:
+            Layout().covariance(**bad)
+        assert e.value.parameter == name
+
+
+def test_noise_arguments_are_keyword_only_so_their_order_cannot_matter():
+    """pyins and most texts give gyro before accel; atomnav's noise arguments are keyword-only,
+    so swapping them positionally (a silent 1e4× model error) is a TypeError."""
+    from atomnav.filter import position_aided_ins
+
+    one = ([[0.5, 0.1, 0.0]], [[0.0, 0.0, 0.0]], [[1.0, 0, 0, 0]], [[0.0, 0.0, -9.8]])
+    with pytest.raises(TypeError):
+        ins_error_model(*one, 1e-6, 1e-10)
+    a = ins_error_model(*one, gyro_psd=1e-10, accel_psd=1e-6)
+    b = ins_error_model(*one, accel_psd=1e-6, gyro_psd=1e-10)
+    assert all(np.array_equal(x, y) for x, y in zip(a, b))
+    assert a[1][0][Layout()["velocity"], Layout()["velocity"]][0, 0] == 1e-6      # accel PSD drives velocity
+    assert a[1][0][Layout()["attitude"], Layout()["attitude"]][0, 0] == 1e-10    # gyro PSD drives attitude
+    with pytest.raises(TypeError):
+        position_aided_ins(0.0, [0.5, 0.1, 0.0], [0, 0, 0], [1, 0, 0, 0], "rates", [1.0], [[0.5, 0.1, 0.0]], np.eye(3),
+                           np.eye(15), 1e-10, 1e-6)

@@ -190,9 +190,9 @@ def test_sine_motion_euler_angles_in_degrees_warn_naming_attitude_poly(sine, no_
 def test_ins_error_model_specific_force_in_g_warns_naming_f_b(no_unit_warning):
     lla, vel, q = np.tile([LAT, LON, H], (5, 1)), np.zeros((5, 3)), np.tile([1.0, 0, 0, 0], (5, 1))
     f_b = np.tile([0.0, 0.0, -earth.gravity(LAT, H)], (5, 1))
-    an.filter.engine.ins_error_model(lla, vel, q, f_b, 1e-6, 1e-10)  # clean: quiet
+    an.filter.engine.ins_error_model(lla, vel, q, f_b, gyro_psd=1e-10, accel_psd=1e-6)  # clean: quiet
     with pytest.warns(UnitWarning) as record:
-        an.filter.engine.ins_error_model(lla, vel, q, f_b / G0, 1e-6, 1e-10)
+        an.filter.engine.ins_error_model(lla, vel, q, f_b / G0, gyro_psd=1e-10, accel_psd=1e-6)
     (w,) = _unit_warnings(record)
     assert (w.parameter, w.unit) == ("f_b", "g")
     assert w.factor == pytest.approx(G0, rel=1e-15)

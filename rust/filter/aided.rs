@@ -160,6 +160,9 @@ pub struct AidedOutput {
     pub extra: Vec<f64>,
     /// σ of every state, epochs × n.
     pub sigma: Vec<f64>,
+    /// The error-state covariance P of every epoch, epochs × n² (column-major n × n
+    /// blocks; empty unless [`AidedIns::output_covariance`] is on).
+    pub covariance: Vec<f64>,
     /// Per measurement: its time, number of rows, innovations (concatenated), NIS (summed
     /// over rows), the number of rows the χ² gate rejected and the name of the sensor that
     /// made it ([`Aiding::source_name`]).
@@ -393,6 +396,9 @@ pub struct AidedIns<A: Aiding> {
     ix: InsIndex,
     /// Store the forward pass for the smoother ([`AidedOutput::forward`]).
     store: bool,
+    /// Output the full covariance of every epoch ([`AidedOutput::covariance`]).
+    #[serde(default)]
+    covariance_out: bool,
 }
 
 impl<A: Aiding> AidedIns<A> {
@@ -447,6 +453,7 @@ impl<A: Aiding> AidedIns<A> {
             baro: BaroModel { noise_psd: 0.0, bias: None },
             ix,
             store: false,
+            covariance_out: false,
         })
     }
 
@@ -518,6 +525,12 @@ impl<A: Aiding> AidedIns<A> {
     /// Current error-state covariance P (n × n), e.g. for NEES.
     pub fn covariance(&self) -> &DMatrix<f64> {
         &self.kf.p
+    }
+
+    /// Output the full error-state covariance of every epoch from now on
+    /// ([`AidedOutput::covariance`], 8n² bytes per epoch), or stop.
+    pub fn output_covariance(&mut self, on: bool) {
+        self.covariance_out = on;
     }
 
     /// Measurements not applied yet (their time is after the last processed sample).
@@ -753,6 +766,9 @@ impl<A: Aiding> AidedIns<A> {
         out.gyro_bias.push(bg);
         out.extra.extend(extra.iter());
         out.sigma.extend(self.kf.p.diagonal().iter().map(|d| d.sqrt()));
+        if self.covariance_out {
+            out.covariance.extend_from_slice(self.kf.p.as_slice());
+        }
     }
 }
 

@@ -96,7 +96,7 @@ fn ins_error_dynamics<'py>(
 /// The aided INS (filter/aided.rs) with any aiding sensor, fed chunk by chunk. Built by
 /// `aided_ins_from_sources`. `process` and `finish` return
 /// (nav (14, E) column table, accel_bias (E, 3), gyro_bias (E, 3), extra (E, n_extra),
-/// sigma (E, n), meas_time (M,), meas_rows (M,), innovation (ΣM rows,), nis (M,),
+/// sigma (E, n), covariance (E, n, n) or None, meas_time (M,), meas_rows (M,), innovation (ΣM rows,), nis (M,),
 /// rejected (M,), source (list of M sensor names), forward) for the epochs and
 /// measurements of that call; `forward` is the stored forward pass of those epochs (empty
 /// unless `store_forward_pass` was called):
@@ -202,6 +202,7 @@ impl PyAidedIns {
             vec3_to_py(py, &o.gyro_bias).into_any(),
             flat_to_py(py, ne, n_extra, o.extra).into_any(),
             flat_to_py(py, ne, n, o.sigma).into_any(),
+            Self::covariance_stack(py, o.covariance, ne, n)?,
             o.meas_time.into_pyarray(py).into_any(),
             o.meas_rows.into_pyarray(py).into_any(),
             o.innovation.into_pyarray(py).into_any(),
@@ -211,6 +212,17 @@ impl PyAidedIns {
             Self::forward(py, o.forward, n, n_extra)?.into_any(),
         ];
         pyo3::types::PyTuple::new(py, items)
+    }
+
+    /// The per-epoch covariances (E, n, n) from their column-major blocks, or None when
+    /// they were not asked for.
+    fn covariance_stack<'py>(py: Python<'py>, flat: Vec<f64>, epochs: usize, n: usize) -> PyResult<Bound<'py, PyAny>> {
+        if flat.is_empty() {
+            return Ok(py.None().into_bound(py));
+        }
+        let blocks = Array3::from_shape_vec((epochs, n, n), flat).map_err(|e| NavError::Numerical(format!("covariance output: {e}")))?;
+        // column-major blocks read row-major are the transposes: swap back
+        Ok(blocks.permuted_axes([0, 2, 1]).as_standard_layout().into_owned().into_pyarray(py).into_any())
     }
 
     fn forward<'py>(py: Python<'py>, f: ForwardPass, n: usize, n_extra: usize) -> PyResult<OutputTuple<'py>> {
@@ -272,6 +284,12 @@ impl PyAidedIns {
     /// End of the record: one last epoch at the last sample.
     fn finish<'py>(&self, py: Python<'py>) -> PyResult<OutputTuple<'py>> {
         self.call(py, |ins, out| ins.finish(out))
+    }
+
+    /// Output the full error-state covariance of every epoch (the sixth item of what
+    /// `process` and `finish` return) from now on, or stop.
+    fn output_covariance(&self, py: Python<'_>, on: bool) {
+        super::shared::lock(py, &self.inner).output_covariance(on);
     }
 
     /// Store the forward pass of every epoch from the first sample on (the last item of

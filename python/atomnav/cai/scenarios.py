@@ -391,8 +391,9 @@ def slalom_covariance(gravity: str = "earth", *, duration: float = 60.0, attitud
     f_b = imu[["accel_x_mps2", "accel_y_mps2", "accel_z_mps2"]].to_numpy()
     df = traj.df
     f, qc = ins_error_model(df[["lat_rad", "lon_rad", "h_m"]].to_numpy(), df[["vn_mps", "ve_mps", "vd_mps"]].to_numpy(),
-                            df[["qw", "qx", "qy", "qz"]].to_numpy(), f_b, setup.accel_psd, setup.gyro_psd,
-                            BiasModel("random_walk", psd=setup.accel_bias_psd), BiasModel("random_walk", psd=setup.gyro_bias_psd),
+                            df[["qw", "qx", "qy", "qz"]].to_numpy(), f_b, gyro_psd=setup.gyro_psd, accel_psd=setup.accel_psd,
+                            gyro_bias=BiasModel("random_walk", psd=setup.gyro_bias_psd),
+                            accel_bias=BiasModel("random_walk", psd=setup.accel_bias_psd),
                             ellipsoid=ell)
     # H of one shot at the mean specific force (the phase Jacobian varies little along the path)
     t = np.arange(0.0, 2 * sensor.T + 1e-12, 0.005)

@@ -17,6 +17,7 @@ filtered one (:attr:`AidedResult.smoothed`)."""
 
 from __future__ import annotations
 
+from contextlib import contextmanager
 from dataclasses import dataclass
 
 import numpy as np
@@ -27,7 +28,7 @@ from .._validate import as_floats, finite_scalar, flag, input_error, instance, i
 from ._forward import ForwardStore, epoch_bytes
 from ..strapdown import _table
 from ..trajectory import imu_kind
-from .engine import BiasModel, Config, _floats
+from .engine import INS15, BiasModel, Config, Layout, _floats
 from .riccati import _mat
 
 #: Names of the vertical-channel options (from the core).
@@ -257,7 +258,10 @@ class AidedResult:
     with too few satellites, has no row). ``innovation``: the
     innovations of all measurements, concatenated in order (``measurements.rows`` each).
     ``smoothed``: the smoothed solution when the engine was built with ``smooth=True``
-    (:meth:`AidedIns.run`), else None.
+    (:meth:`AidedIns.run`), else None. ``covariance``: the full error-state covariance of
+    every epoch when asked for (``covariance=True`` of :meth:`AidedIns.run` or
+    :meth:`AidedIns.process`), else None; :meth:`nees` checks it against a reference
+    trajectory, :meth:`nis_band` the innovations against their χ² band.
 
     Attributes
     ----------
@@ -269,12 +273,90 @@ class AidedResult:
         Innovations of all measurements, concatenated (units of the measurement rows).
     smoothed : SmoothedResult or None
         The smoothed solution, or None.
+    covariance : numpy.ndarray (E, n, n) or None
+        Error-state covariance of every row of ``nav`` (after the epoch's updates), in the
+        state order of :attr:`AidedIns.labels` (the 15 INS states of
+        :data:`atomnav.filter.INS15` first), SI units of the states squared; None unless
+        asked for.
     """
 
     nav: pd.DataFrame
     measurements: pd.DataFrame
     innovation: np.ndarray
     smoothed: SmoothedResult | None = None
+    covariance: np.ndarray | None = None
+
+    def nees(self, truth, blocks=("position", "velocity", "attitude")) -> pd.DataFrame:
+        """Normalised estimation error squared of every epoch against a reference
+        trajectory: εᵀP⁻¹ε over the chosen blocks, with ε = estimate − truth from
+        :meth:`atomnav.trajectory.Trajectory.errors` (NED position m, NED velocity m/s,
+        attitude error ψ rad) and P the matching blocks of :attr:`covariance`.
+
+        For a consistent filter the NEES is χ²-distributed with ``dof`` degrees of
+        freedom; averaged over R independent runs it lies in
+        :func:`atomnav.filter.chi2_band` (dof, R) at about 95 % of epochs (Bar-Shalom, Li &
+        Kirubarajan 2001, §5.4).
+
+        Parameters
+        ----------
+        truth : atomnav.trajectory.Trajectory
+            The reference motion; every row of :attr:`nav` must be one of its time stamps.
+        blocks : sequence of {"position", "velocity", "attitude"}, default all three
+            The navigation blocks checked.
+
+        Returns
+        -------
+        pandas.DataFrame
+            ``time_s`` (s), ``nees`` (dimensionless) and ``dof`` (3 per block).
+
+        Raises
+        ------
+        atomnav.InputError
+            Naming ``covariance`` when the run did not output it, or ``blocks``.
+        """
+        from ..trajectory import Trajectory
+
+        instance(truth, Trajectory, "truth")
+        if self.covariance is None:
+            raise input_error("covariance", "this result has no covariance: run the aided INS with covariance=True")
+        names = [blocks] if isinstance(blocks, str) else list(blocks)
+        columns = {"position": "dpos", "velocity": "dvel", "attitude": "psi"}
+        if not names or any(b not in columns for b in names) or len(set(names)) != len(names):
+            raise input_error("blocks", f"expected distinct names among {list(columns)}, got {blocks!r}")
+        err = truth.errors(self.nav)
+        cols = [c for b in names for c in err.columns if c.startswith(columns[b] + "_")]
+        idx = np.concatenate([np.arange(15)[Layout(INS15)[b]] for b in names])
+        e = err[cols].to_numpy()
+        p = self.covariance[:, idx[:, None], idx[None, :]]
+        nees = np.einsum("ki,ki->k", e, np.linalg.solve(p, e[:, :, None])[:, :, 0])
+        return pd.DataFrame({"time_s": err["time_s"].to_numpy(), "nees": nees, "dof": len(idx)})
+
+    def nis_band(self, p: float = 0.95) -> pd.DataFrame:
+        """The normalised innovation squared of every applied measurement against its
+        two-sided χ² band: a measurement of m rows has NIS ~ χ²(m) for a consistent filter
+        (Bar-Shalom, Li & Kirubarajan 2001, §5.4), so about a fraction ``p`` of the rows of
+        one sensor should be ``inside``.
+
+        Parameters
+        ----------
+        p : float, default 0.95
+            Probability of the band, in (0, 1).
+
+        Returns
+        -------
+        pandas.DataFrame
+            :attr:`measurements` with ``nis_low``, ``nis_high`` (the band for the row's
+            degrees of freedom) and ``inside`` (bool).
+        """
+        from .analysis import chi2_band
+
+        out = self.measurements.copy()
+        dof = out["rows"].to_numpy()
+        band = {m: chi2_band(int(m), 1, p) for m in np.unique(dof)}
+        out["nis_low"] = [band[m][0] for m in dof]
+        out["nis_high"] = [band[m][1] for m in dof]
+        out["inside"] = (out["nis"] >= out["nis_low"]) & (out["nis"] <= out["nis_high"])
+        return out
 
 
 @dataclass
@@ -350,10 +432,10 @@ class AidedIns:
         return self._core.pending
 
     def _result(self, out) -> AidedResult:
-        *solution, mt, mrows, innov, nis, rejected, source, _forward = out
+        *solution, covariance, mt, mrows, innov, nis, rejected, source, _forward = out
         meas = pd.DataFrame({"time_s": mt, "rows": mrows, "nis": nis, "rejected_rows": rejected,
                              "source": pd.Series(source, dtype="str")})
-        return AidedResult(self._nav(*solution), meas, innov)
+        return AidedResult(self._nav(*solution), meas, innov, covariance=covariance)
 
     def _nav(self, nav, ba, bg, extra, sigma) -> pd.DataFrame:
         """The table of :attr:`AidedResult.nav` from the core's columns."""
@@ -367,7 +449,7 @@ class AidedIns:
             table[f"sigma_{lab}"] = sigma[:, i]
         return table
 
-    def process(self, time, gyro, accel, h_ref=None) -> AidedResult:
+    def process(self, time, gyro, accel, h_ref=None, *, covariance: bool = False) -> AidedResult:
         """Feed one chunk of the IMU record: ``time`` (N,) s, ``gyro``/``accel`` (N, 3) as
         rates (rad/s, m/s²) or increments (rad, m/s) per the ``kind`` given at
         construction, ``h_ref`` (N,) m the reference altitude of a damped vertical
@@ -385,6 +467,10 @@ class AidedIns:
         h_ref : array_like (N,), optional
             Reference (barometric) altitude, m; required with a damped vertical channel,
             refused with a free one.
+        covariance : bool, default False
+            Also return the full error-state covariance of every epoch of the chunk
+            (:attr:`AidedResult.covariance`, 8n² bytes per epoch): streaming the record
+            chunk by chunk keeps the memory bounded.
 
         Returns
         -------
@@ -408,7 +494,17 @@ class AidedIns:
         """
         t, g, a, h = _imu(time, gyro, accel, h_ref)
         self._plausible(t, g, a)
-        return self._call(self._core.process, t, g, a, h)
+        with self._covariance_output(covariance):
+            return self._call(self._core.process, t, g, a, h)
+
+    @contextmanager
+    def _covariance_output(self, covariance):
+        """The core outputs every epoch's covariance inside the block when ``covariance``."""
+        self._core.output_covariance(flag(covariance, "covariance"))
+        try:
+            yield
+        finally:
+            self._core.output_covariance(False)
 
     def _plausible(self, t, g, a) -> None:
         """The unit warnings of an IMU record (:func:`atomnav.plausibility.imu`): accelerations
@@ -495,17 +591,24 @@ class AidedIns:
         nav = pd.concat(navs[::-1], ignore_index=True)
         return SmoothedResult(nav, np.concatenate(covs[::-1]) if covariance else None)
 
-    def finish(self) -> AidedResult:
+    def finish(self, *, covariance: bool = False) -> AidedResult:
         """End of the record: a last epoch at the last sample if steps are left over.
+
+        Parameters
+        ----------
+        covariance : bool, default False
+            Also return the covariance of the last epoch (:attr:`AidedResult.covariance`).
 
         Returns
         -------
         AidedResult
             The last epoch and its measurements (empty tables if none).
         """
-        return self._call(self._core.finish)
+        with self._covariance_output(covariance):
+            return self._call(self._core.finish)
 
-    def run(self, time, gyro, accel, h_ref=None, chunk_s: float = 60.0, progress: bool = True) -> AidedResult:
+    def run(self, time, gyro, accel, h_ref=None, chunk_s: float = 60.0, progress: bool = True, *,
+            covariance: bool = False, covariance_memory: int = 1 << 30) -> AidedResult:
         """Run a whole IMU record (see :meth:`process`; ``h_ref`` (N,) m with a damped
         vertical channel) in chunks of about ``chunk_s`` seconds (a fixed number of
         samples) with a progress bar. Every measurement must lie inside the record. The
@@ -529,6 +632,13 @@ class AidedIns:
             Approximate chunk length, s.
         progress : bool, default True
             Show a progress bar.
+        covariance : bool, default False
+            Also return the full error-state covariance of every epoch
+            (:attr:`AidedResult.covariance`, for :meth:`AidedResult.nees`).
+        covariance_memory : int, default 2**30
+            Largest number of bytes the covariances may take (8n² per epoch); a longer
+            record is refused before it runs: stream it with :meth:`process`
+            (``covariance=True`` per chunk) and keep what you need of each chunk.
 
         Returns
         -------
@@ -542,8 +652,9 @@ class AidedIns:
             Bad samples, naming their index in the record; ``partial`` holds every epoch
             computed before the error.
         atomnav.InputError
-            Naming ``time`` (fewer than 2 samples, or a measurement outside the record)
-            or ``chunk_s``.
+            Naming ``time`` (fewer than 2 samples, or a measurement outside the record),
+            ``chunk_s``, or ``covariance`` when the covariances would take more than
+            ``covariance_memory`` bytes.
 
         Warns
         -----
@@ -565,6 +676,14 @@ class AidedIns:
             raise input_error("time", f"the measurement at {mt[i]:g} s (index {i}) is outside the IMU span [{t[0]:g}, {t[-1]:g}] s", i)
         # chunks of a fixed sample count from the mean step (one chunk when the end times
         # are not usable; the engine then names the bad sample)
+        if flag(covariance, "covariance"):
+            # at most one epoch per `predict_every` samples plus one per measurement
+            epochs = n // self.setup.predict_every + len(mt) + 1
+            need = 8 * len(self.labels) ** 2 * epochs
+            if need > integer(covariance_memory, "covariance_memory", 0):
+                raise input_error("covariance", f"the covariances of up to {epochs} epochs take {need / 2**20:.0f} MiB, more than "
+                                                f"covariance_memory = {covariance_memory / 2**20:.0f} MiB: raise it, or stream the "
+                                                "record with process(..., covariance=True) chunk by chunk")
         step = (t[-1] - t[0]) / (n - 1)
         size = max(1, int(chunk_s / step)) if np.isfinite(step) and step > 0 else n
         bounds = list(range(0, n, size)) + [n]
@@ -572,10 +691,11 @@ class AidedIns:
         from tqdm.auto import tqdm  # imported here: tqdm.auto pulls in asyncio, which slows `import atomnav`
 
         try:
-            for lo, hi in tqdm(list(zip(bounds[:-1], bounds[1:])), desc="aided INS", unit="chunk",
-                               disable=not progress or len(bounds) <= 2):
-                parts.append(self._call(self._core.process, t[lo:hi], g[lo:hi], a[lo:hi], None if h is None else h[lo:hi]))
-            parts.append(self.finish())
+            with self._covariance_output(covariance):
+                for lo, hi in tqdm(list(zip(bounds[:-1], bounds[1:])), desc="aided INS", unit="chunk",
+                                   disable=not progress or len(bounds) <= 2):
+                    parts.append(self._call(self._core.process, t[lo:hi], g[lo:hi], a[lo:hi], None if h is None else h[lo:hi]))
+                parts.append(self._call(self._core.finish))
         except (ValueError, _core.NumericalError) as e:
             if isinstance(getattr(e, "partial", None), AidedResult):
                 e.partial = _concat(parts + [e.partial])
@@ -605,13 +725,15 @@ def _imu(time, gyro, accel, h_ref):
 
 
 def _concat(parts: list[AidedResult]) -> AidedResult:
+    covs = [p.covariance for p in parts if p.covariance is not None]
     return AidedResult(pd.concat([p.nav for p in parts], ignore_index=True),
                        pd.concat([p.measurements for p in parts], ignore_index=True),
-                       np.concatenate([p.innovation for p in parts]))
+                       np.concatenate([p.innovation for p in parts]),
+                       covariance=np.concatenate(covs) if covs else None)
 
 
-def position_aided_ins(t0: float, lla0, vel0, q0, kind: str, fix_time, fix_lla, fix_cov, *, p0, accel_psd: float,
-                       gyro_psd: float, **options) -> AidedIns:
+def position_aided_ins(t0: float, lla0, vel0, q0, kind: str, fix_time, fix_lla, fix_cov, *, p0, gyro_psd: float,
+                       accel_psd: float, **options) -> AidedIns:
     """A position-aided 15-state INS.
 
     Fixes are applied at the first IMU epoch at or after their time. The INS arguments
@@ -637,10 +759,10 @@ def position_aided_ins(t0: float, lla0, vel0, q0, kind: str, fix_time, fix_lla, 
         NED covariance of each fix, m².
     p0 : array_like (15, 15)
         Initial covariance, SI units of the states squared.
+    gyro_psd : float
+        Gyro white-noise PSD, rad²/s (keyword-only, like every noise argument).
     accel_psd : float
         Accelerometer white-noise PSD, (m/s²)²/Hz.
-    gyro_psd : float
-        Gyro white-noise PSD, rad²/s.
     **options
         The other fields of :class:`InsSetup`: bias models, ``ba0``/``bg0``,
         ``predict_every``, ``method``, ``mode``, ``sequential``, ``gate``, ``ellipsoid``,

@@ -181,6 +181,52 @@ class Layout:
         """Name of every state component, e.g. ``velocity[2]``."""
         return [f"{n}[{i}]" for n, s in self._ranges.items() for i in range(s.stop - s.start)]
 
+    def covariance(self, **sigma) -> np.ndarray:
+        """A diagonal covariance (e.g. the initial P₀) from the σ of every block, named by
+        the layout, so no index is counted by hand.
+
+        Parameters
+        ----------
+        **sigma : float or array_like
+            One keyword per block of the layout (every block, none other): its σ in the
+            block's SI units (position m, velocity m/s, attitude rad, accel_bias m/s²,
+            gyro_bias rad/s, ...), one value for the whole block or one per component.
+
+        Returns
+        -------
+        numpy.ndarray (n, n)
+            diag(σ²) in layout order.
+
+        Raises
+        ------
+        atomnav.InputError
+            Naming a block that is missing or not in the layout, or a σ that is negative,
+            non-finite or of the wrong length.
+
+        Examples
+        --------
+        >>> p0 = Layout().covariance(position=3.0, velocity=0.1, attitude=(1e-3, 1e-3, 1e-2),
+        ...                          accel_bias=2e-3, gyro_bias=1e-5)  # doctest: +SKIP
+        """
+        unknown = [b for b in sigma if b not in self._ranges]
+        if unknown:
+            raise input_error(unknown[0], f"not a block of this layout (it has: {', '.join(self._ranges)})")
+        missing = [b for b in self._ranges if b not in sigma]
+        if missing:
+            raise input_error(missing[0], f"no sigma given for the block {missing[0]!r}: give every block of the layout "
+                                          f"({', '.join(self._ranges)})")
+        diag = np.zeros(self.size)
+        for name, block in self._ranges.items():
+            width = block.stop - block.start
+            v = np.atleast_1d(as_floats(sigma[name], name))
+            if v.ndim != 1 or len(v) not in (1, width):
+                raise input_error(name, f"expected one sigma or {width} (one per component), got shape {v.shape}")
+            bad = np.nonzero(~np.isfinite(v) | (v < 0))[0]
+            if bad.size:
+                raise input_error(name, f"sigma must be finite and >= 0, got {v[bad[0]]} at index {bad[0]}", int(bad[0]))
+            diag[block] = np.broadcast_to(v, (width,)) ** 2
+        return np.diag(diag)
+
 
 def discretize(f, qc, dt: float, method: str = "van_loan") -> tuple[np.ndarray, np.ndarray]:
     """(Φ, Q_d) of ẋ = Fx + w, E[wwᵀ] = Q_c δ(t−s), over dt (s).
@@ -243,8 +289,8 @@ class BiasModel(Config):
         return (self.kind, finite_scalar(self.psd, "psd"), 0.0)
 
 
-def ins_error_model(lla, vel_ned, q_nb, f_b, accel_psd: float, gyro_psd: float,
-                    accel_bias: BiasModel = BiasModel(), gyro_bias: BiasModel = BiasModel(), *,
+def ins_error_model(lla, vel_ned, q_nb, f_b, *, gyro_psd: float, accel_psd: float,
+                    gyro_bias: BiasModel = BiasModel(), accel_bias: BiasModel = BiasModel(),
                     layout: Layout | None = None, ellipsoid: str = "WGS84") -> tuple[np.ndarray, np.ndarray]:
     """Continuous 15-state NED INS error model F, Q_c (docs/departures.md#error-states-in-metres) along a trajectory.
 
@@ -258,11 +304,11 @@ def ins_error_model(lla, vel_ned, q_nb, f_b, accel_psd: float, gyro_psd: float,
         Attitude quaternion body → NED, scalar first.
     f_b : array_like (N, 3)
         Compensated specific force in the body frame, m/s².
+    gyro_psd : float
+        Gyro white-noise PSD, rad²/s = ARW² (keyword-only, like every noise argument).
     accel_psd : float
         Accelerometer white-noise PSD, (m/s²)²/Hz = VRW².
-    gyro_psd : float
-        Gyro white-noise PSD, rad²/s = ARW².
-    accel_bias, gyro_bias : BiasModel, default BiasModel()
+    gyro_bias, accel_bias : BiasModel, default BiasModel()
         Bias processes (default random constant).
     layout : Layout, optional
         State layout (default the 15 states of :data:`INS15`).
