@@ -69,3 +69,26 @@ def test_in_shot_noise_includes_the_euler_terms():
     assert np.allclose(np.diag(sigma)[[0, 1, 4, 5]], [acc + rot + lev, acc + rot + lev, acc + rot, acc + rot], rtol=1e-2), np.diag(sigma)
     assert abs(np.sqrt(rot) - 0.3667) < 1e-3 and abs(np.sqrt(lev) - 0.370) < 1e-3
     assert cross.shape == (2, 15, 6) and np.all(cross == 0.0)  # F = 0: no coupling
+
+
+def test_slalom_preset_takes_its_motion_parameters():
+    """speed, amplitude, period and origin reach the motion: the preset equals a campaign on
+    atomnav.trajectory.slalom with the same parameters, and differs from the paper's path."""
+    from atomnav import trajectory
+
+    kw = dict(origin=(0.7, -1.2, 300.0), speed=3.0, amp=1.0, period=6.0)
+    res = cai.slalom(1, seed=5, duration=4.0, progress=False, **kw)
+    motion = trajectory.slalom(duration=4.0, **kw).motion
+    config = cai.ScenarioConfig(cai.seed003_sensor((0.0, 0.0, 0.1)), cai.seed003_filter(), gravity="kinematic")
+    same = cai.run_campaign(motion, config, runs=1, seed=5, progress=False)
+    assert np.array_equal(res.hybrid, same.hybrid) and np.array_equal(res.free, same.free)
+    paper = cai.slalom(1, seed=5, duration=4.0, progress=False)
+    assert not np.array_equal(res.free, paper.free)
+    assert res.params["speed_mps"] == 3.0 and res.params["period_s"] == 6.0
+
+
+def test_car_preset_takes_origin_and_heading():
+    a = cai.car_mc(1, seed=3, origin=(0.3, 0.1, 10.0), heading=1.0, progress=False)
+    b = cai.car_mc(1, seed=3, progress=False)
+    assert a.hybrid.shape == b.hybrid.shape and not np.array_equal(a.free, b.free)
+    assert a.params["heading_rad"] == 1.0

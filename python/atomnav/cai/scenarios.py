@@ -11,7 +11,7 @@ import numpy as np
 import pandas as pd
 
 from .. import _core
-from .._validate import finite_result, flag, input_error, instance, positive, renamed, vector
+from .._validate import finite_result, finite_scalar, flag, input_error, instance, positive, renamed, vector
 from ..imu import ImuErrors
 from ._config import ConfigMixin, _ImuModel
 from .campaign import run_campaign
@@ -171,7 +171,7 @@ def seed003_filter(attitude_sigma0: float = 1e-7) -> FilterSetup:
 
 
 def car_mc(runs: int = 100, seed: int = 2023, *, gravity: str = "kinematic", lever=(0.0, 0.0, 0.0), vibration: bool = True,
-           progress: bool = True) -> HybridResult:
+           origin=HANNOVER, heading: float = 0.0, progress: bool = True) -> HybridResult:
     """Car Monte Carlo of Tennstedt et al. 2023 (§2.8): 40 s car-like profile with vibration,
     the 26 s shock and the ×2 vibration window 33–35 s; 200 Hz navigation-grade IMU
     (preset ``navigation``), T = 25 ms, filter every 2T, ``runs`` runs; ``gravity`` =
@@ -198,6 +198,10 @@ def car_mc(runs: int = 100, seed: int = 2023, *, gravity: str = "kinematic", lev
         IMU → release-point lever arm in the body frame (m).
     vibration : bool
         Include the vibration, the shock and the vibration window of the profile.
+    origin : array_like (3,), default Hannover (52.38° N, 9.72° E, 60 m)
+        Start of the profile: latitude (rad), longitude (rad), height (m).
+    heading : float, default 0.0
+        Initial heading of the car, rad.
     progress : bool
         Show a progress bar over runs.
 
@@ -206,17 +210,22 @@ def car_mc(runs: int = 100, seed: int = 2023, *, gravity: str = "kinematic", lev
     HybridResult
         The Monte-Carlo result (see :func:`atomnav.cai.run_campaign`).
     """
-    motion = _core.Motion.car(vector(HANNOVER, 3, "origin"), 0.0, bool(instance(vibration, (bool, np.bool_), "vibration")))
+    motion = _core.Motion.car(vector(origin, 3, "origin"), finite_scalar(heading, "heading"),
+                              bool(instance(vibration, (bool, np.bool_), "vibration")))
     config = ScenarioConfig(seed003_sensor(lever), seed003_filter(), gravity=gravity)
     return run_campaign(motion, config, runs=runs, seed=seed, name="car_mc", progress=progress,
-                        params={"gravity": gravity, "lever_m": tuple(lever), "vibration": vibration})
+                        params={"gravity": gravity, "lever_m": tuple(lever), "vibration": vibration,
+                                "origin": tuple(map(float, origin)), "heading_rad": float(heading)})
 
 
 def slalom(runs: int = 100, seed: int = 2024, *, gravity: str = "kinematic", duration: float = 60.0, lever=(0.0, 0.0, 0.1),
            aiding: bool = True, sensor: CaiSensor | None = None, setup: FilterSetup | None = None,
+           origin=HANNOVER, speed: float = 5.0, amp: float = 2.0, period: float = 10.0,
            progress: bool = True) -> HybridResult:
-    """Smooth slalom of Tennstedt et al. 2023 (§2.8): north = 5t m, east = 2 sin(2πt/10) m,
-    level, heading along the path, 60 s; otherwise as :func:`car_mc`. ``aiding=False`` runs
+    """Smooth slalom of Tennstedt et al. 2023 (§2.8): north = ``speed``·t m, east =
+    ``amp``·sin(2πt/``period``) m, level, heading along the path, 60 s (the paper's 5 m/s,
+    2 m, 10 s by default; :func:`atomnav.trajectory.slalom` is the same motion); otherwise
+    as :func:`car_mc`. ``aiding=False`` runs
     the same filter without CAI updates; ``sensor`` / ``setup`` replace the paper's CAI and
     filter (e.g. :func:`accelerometer_sensor`, the 21-state filter with misalignment and
     lever-arm states, or option a).
@@ -240,6 +249,14 @@ def slalom(runs: int = 100, seed: int = 2024, *, gravity: str = "kinematic", dur
         Replaces the paper's CAI (:func:`seed003_sensor`).
     setup : FilterSetup, optional
         Replaces the paper's filter (:func:`seed003_filter`).
+    origin : array_like (3,), default Hannover (52.38° N, 9.72° E, 60 m)
+        Start of the path: latitude (rad), longitude (rad), height (m).
+    speed : float, default 5.0
+        Speed along north, m/s.
+    amp : float, default 2.0
+        East amplitude of the slalom, m.
+    period : float, default 10.0
+        Period of the slalom, s.
     progress : bool
         Show a progress bar over runs.
 
@@ -253,11 +270,13 @@ def slalom(runs: int = 100, seed: int = 2024, *, gravity: str = "kinematic", dur
     if setup is not None:
         instance(setup, FilterSetup, "setup")
     instance(aiding, (bool, np.bool_), "aiding")
-    motion = _core.Motion.slalom(vector(HANNOVER, 3, "origin"), 5.0, 2.0, 10.0, positive(duration, "duration"))
+    motion = _core.Motion.slalom(vector(origin, 3, "origin"), finite_scalar(speed, "speed"), finite_scalar(amp, "amp"),
+                                 positive(period, "period"), positive(duration, "duration"))
     config = ScenarioConfig(seed003_sensor(lever) if sensor is None else sensor, seed003_filter() if setup is None else setup,
                             gravity=gravity, aiding=flag(aiding, "aiding"))
     return run_campaign(motion, config, runs=runs, seed=seed, name="slalom", progress=progress,
-                        params={"gravity": gravity, "lever_m": tuple(lever), "duration_s": duration})
+                        params={"gravity": gravity, "lever_m": tuple(lever), "duration_s": duration,
+                                "origin": tuple(map(float, origin)), "speed_mps": float(speed), "amp_m": float(amp), "period_s": float(period)})
 
 
 def satellite(days: float = 4.0, seed: int = 2021, *, drift: bool = True, progress: bool = True) -> HybridResult:
