@@ -87,7 +87,8 @@ pub struct SimConfig {
     pub sigma_rate: f64,
     /// True τ_GPS (s) added as c·τ to GLONASS code.
     pub tau_gps: f64,
-    /// Receiver clock δt_r = bias + drift·t (s, s/s).
+    /// Receiver clock δt_r(t) = bias + drift·(t − t₀) (s, s/s), t₀ the first epoch of the
+    /// simulated record: the bias is the clock offset at the start, whatever the time of week.
     pub clock_bias: f64,
     pub clock_drift: f64,
     pub atm: Atmosphere,
@@ -101,7 +102,8 @@ pub fn receiver_ecef(lla: &Vec3, vel_ned: &Vec3) -> (Vec3, Vec3) {
 
 /// Observations stamped `t` by the receiver's clock (the signals arrive at GPS time
 /// t − δt_r) of a receiver at `lla` moving with `vel_ned`, each with its true elevation
-/// (rad). Satellites are those with ephemerides, in the order of
+/// (rad). The receiver clock is δt_r(t) = `clock_bias` + `clock_drift`·(t − t₀) from the
+/// first epoch t₀ of `t`. Satellites are those with ephemerides, in the order of
 /// `Ephemerides::satellites`.
 // invariant: lla and vel_ned have one row per epoch of t (checked above), k < t.len().
 #[allow(clippy::indexing_slicing)]
@@ -113,9 +115,10 @@ pub fn simulate(eph: &Ephemerides, t: &[f64], lla: &[Vec3], vel_ned: &[Vec3], cf
     let mut rng = ChaCha8Rng::seed_from_u64(cfg.seed);
     let sats = eph.satellites();
     let mut out = Vec::with_capacity(t.len());
+    let t0 = t.first().copied().unwrap_or(0.0);
     for k in 0..t.len() {
         let (r, v) = receiver_ecef(&lla[k], &vel_ned[k]);
-        let (dtr, dtr_dot) = (cfg.clock_bias + cfg.clock_drift * t[k], cfg.clock_drift);
+        let (dtr, dtr_dot) = (cfg.clock_bias + cfg.clock_drift * (t[k] - t0), cfg.clock_drift);
         // a receiver stamps by its own clock: the signal arrives at GPS time t − δt_r
         let t_rx = t[k] - dtr;
         let mut epoch = Vec::new();

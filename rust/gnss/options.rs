@@ -121,7 +121,8 @@ impl GnssOptions {
     }
 
     /// The simulator's noise and atmosphere with the true τ_GPS (s), receiver clock
-    /// δt_r = `clock_bias` + `clock_drift`·t (s, s/s) and the noise seed.
+    /// δt_r(t) = `clock_bias` + `clock_drift`·(t − t₀) from the record's first epoch t₀
+    /// (s, s/s) and the noise seed.
     pub fn simulation(&self, eph: &Ephemerides, tau_gps: f64, clock_bias: f64, clock_drift: f64, seed: u64) -> Result<SimConfig> {
         for (field, x) in [("tau_gps", tau_gps), ("clock_bias", clock_bias), ("clock_drift", clock_drift)] {
             crate::error::check_finite(field, &[x], 1)?;

@@ -67,19 +67,25 @@ impl Exclusion {
     }
 }
 
-/// One satellite of an epoch: its look angles and post-fit residual at the solution
-/// (NaN when the satellite has no ephemeris or code, or the epoch no solution), and why it
-/// was left out, if it was.
+/// One satellite of an epoch: its look angles, post-fit residual and code σ at the
+/// solution (NaN when the satellite has no ephemeris or code, or the epoch no solution),
+/// and why it was left out, if it was.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SatelliteUse {
     pub sat: SatId,
     pub elevation: f64,
     pub azimuth: f64,
     pub residual: f64,
+    /// Code σ (m) the least squares gives (or would give) this satellite: weight 1/σ².
+    pub sigma: f64,
     pub excluded: Option<Exclusion>,
 }
 
-/// DOP values of the geometry (unweighted, local NED).
+/// Unweighted DOP values of the satellites used (Langley 1999, "Dilution of precision",
+/// GPS World 10(5)): Q = (GᵀG)⁻¹ with rows (−u_ENU, 1[, 1 on GLONASS rows when τ_GPS is
+/// estimated]); PDOP² = Q_EE + Q_NN + Q_UU, HDOP² = Q_EE + Q_NN, VDOP² = Q_UU, TDOP² = Q of
+/// the receiver clock, GDOP² = PDOP² + TDOP² (the τ_GPS column widens them, its own
+/// variance is not summed).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Dop {
     pub gdop: f64,
@@ -112,6 +118,16 @@ pub struct SppSolution {
     pub n_unknowns: usize,
     pub dop: Dop,
     pub iterations: usize,
+}
+
+/// Code σ (m) of a satellite: the system's σ, divided by sin E (floored at 0.05) with
+/// `elevation_weight` once the elevation is known.
+fn code_sigma(cfg: &SppConfig, sat: SatId, elevation: Option<f64>) -> f64 {
+    let s = if sat.system == System::Glonass { cfg.sigma_glo } else { cfg.sigma_gps };
+    match elevation {
+        Some(e) if cfg.elevation_weight => s / e.sin().max(0.05),
+        _ => s,
+    }
 }
 
 /// Code corrected for the satellite clock and the atmosphere: P + c·δt^s − I − T (m).
@@ -197,7 +213,6 @@ struct Fit {
     /// Indices (into the epoch's observations) used, and those the mask removed.
     used: Vec<usize>,
     masked: Vec<usize>,
-    h: DMatrix<f64>,
     residuals: DVector<f64>,
     weights: DVector<f64>,
     normal_inverse: DMatrix<f64>,
@@ -268,8 +283,7 @@ fn least_squares(eph: &Ephemerides, t: f64, obs: &[Observation], candidates: &[u
                 // ∂P̂/∂(cτ) = 1 − κ uᵀv_s/c on GLONASS rows (the satellite epoch moves by −τ)
                 h[(k, 4)] = if glo { 1.0 - g.kappa * g.los.dot(&g.sat.vel) / C_LIGHT } else { 0.0 };
             }
-            let s = if glo { cfg.sigma_glo } else { cfg.sigma_gps };
-            let s = if cfg.elevation_weight && known { s / g.elevation.sin().max(0.05) } else { s };
+            let s = code_sigma(cfg, o.sat, known.then_some(g.elevation));
             w[k] = 1.0 / (s * s);
         }
         let hw = DMatrix::from_fn(n, m, |a, b| h[(b, a)] * w[b]);
@@ -285,7 +299,7 @@ fn least_squares(eph: &Ephemerides, t: f64, obs: &[Observation], candidates: &[u
             // final residuals at the converged x: z − H·dx
             let residuals = &z - &h * &dx;
             let normal_inverse = chol.inverse();
-            return Ok(Outcome::Fit(Fit { x: x.rows(0, n).into_owned(), with_tau, used, masked, h, residuals, weights: w, normal_inverse, iterations }));
+            return Ok(Outcome::Fit(Fit { x: x.rows(0, n).into_owned(), with_tau, used, masked, residuals, weights: w, normal_inverse, iterations }));
         }
         previous = Some(used);
         if iterations >= 30 {
@@ -308,7 +322,7 @@ fn least_squares(eph: &Ephemerides, t: f64, obs: &[Observation], candidates: &[u
 fn solve_epoch(eph: &Ephemerides, t: f64, obs: &[Observation], cfg: &SppConfig, x0: Option<Vec3>) -> Result<Epoch> {
     check_unique("obs", obs)?;
     let mut satellites: Vec<SatelliteUse> =
-        obs.iter().map(|o| SatelliteUse { sat: o.sat, elevation: f64::NAN, azimuth: f64::NAN, residual: f64::NAN, excluded: None }).collect();
+        obs.iter().map(|o| SatelliteUse { sat: o.sat, elevation: f64::NAN, azimuth: f64::NAN, residual: f64::NAN, sigma: f64::NAN, excluded: None }).collect();
     let mut no_ephemeris = None;
     for (i, o) in obs.iter().enumerate() {
         if o.code.is_nan() {
@@ -390,15 +404,21 @@ fn solve_epoch(eph: &Ephemerides, t: f64, obs: &[Observation], cfg: &SppConfig, 
     let lla = WGS84.ecef_to_lla(&pos);
     let tau = if fit.with_tau { fit.x[4] / C_LIGHT } else { 0.0 };
     let t_rx = t - fit.x[3] / C_LIGHT;
-    // look angles and residuals of every satellite with code and ephemeris at the solution
+    // look angles, residuals and σ of every satellite with code and ephemeris at the
+    // solution; the lines of sight of the used ones for the DOP
+    let mut lines_of_sight = Vec::with_capacity(fit.used.len());
     for (i, o) in obs.iter().enumerate() {
         if matches!(satellites[i].excluded, Some(Exclusion::NoCode | Exclusion::NoEphemeris | Exclusion::NoSecondCode)) {
             continue;
         }
         let g = geometry(eph, o.sat, t_rx, &pos, &Vec3::zeros(), lla.x, lla.y, tau)?;
         satellites[i].residual = code_residual(o, &g, &cfg.atm, &lla, t_rx, &fit.x, fit.with_tau);
+        satellites[i].sigma = code_sigma(cfg, o.sat, Some(g.elevation));
         satellites[i].elevation = g.elevation;
         satellites[i].azimuth = g.azimuth.rem_euclid(std::f64::consts::TAU);
+        if fit.used.contains(&i) {
+            lines_of_sight.push((g.los, o.sat.system == System::Glonass));
+        }
     }
     let mut cov = fit.normal_inverse.clone();
     if fit.with_tau {
@@ -424,7 +444,7 @@ fn solve_epoch(eph: &Ephemerides, t: f64, obs: &[Observation], cfg: &SppConfig, 
         satellites,
         n_used: m,
         n_unknowns: n,
-        dop: dop(&fit.h, &lla, n)?,
+        dop: dop(&lines_of_sight, &lla, fit.with_tau)?,
         iterations: fit.iterations,
     }))
 }
@@ -450,24 +470,35 @@ pub fn solve_position(eph: &Ephemerides, t: f64, obs: &[Observation], cfg: &SppC
 
 /// Columns of a [`solve_epochs`] row: time, ECEF and geodetic antenna position, c·δt_r,
 /// τ_GPS and its σ (s; NaN when not estimated), the residual metric, satellites used and
-/// unknowns, DOP values, Doppler velocity (ECEF m/s) and c·δṫ_r (m/s; NaN with fewer than
-/// four rates), satellites excluded, and the weighted residual χ².
-pub const SPP_COLUMNS: [&str; 24] = [
+/// unknowns, unweighted DOP values ([`Dop`]), Doppler velocity (ECEF m/s) and c·δṫ_r (m/s;
+/// NaN with fewer than four rates), satellites excluded, the weighted residual χ², and
+/// the σ (m) of the position (ECEF and local east, north, up) and of c·δt_r from the
+/// least-squares covariance (GᵀWG)⁻¹.
+pub const SPP_COLUMNS: [&str; 31] = [
     "time_s", "x_m", "y_m", "z_m", "lat_rad", "lon_rad", "h_m", "clock_m", "tau_gps_s", "sigma_tau_gps_s", "residual_metric_m", "n_sats",
     "n_unknowns", "gdop", "pdop", "hdop", "vdop", "tdop", "vx_mps", "vy_mps", "vz_mps", "clock_drift_mps", "n_excluded", "chi2",
+    "sigma_x_m", "sigma_y_m", "sigma_z_m", "sigma_e_m", "sigma_n_m", "sigma_u_m", "sigma_clock_m",
 ];
 
 /// Columns of a per-satellite row of [`solve_epochs`]: time, elevation and azimuth (rad),
-/// post-fit residual (m), and the exclusion code (0 used, k + 1 for [`Exclusion::ALL`]`[k]`).
-pub const SPP_SATELLITE_COLUMNS: [&str; 5] = ["time_s", "elevation_rad", "azimuth_rad", "residual_m", "excluded"];
+/// post-fit residual (m), the code σ of its weight (m), and the exclusion code (0 used,
+/// k + 1 for [`Exclusion::ALL`]`[k]`).
+pub const SPP_SATELLITE_COLUMNS: [&str; 6] = ["time_s", "elevation_rad", "azimuth_rad", "residual_m", "sigma_m", "excluded"];
+
+/// The unknowns of an epoch's covariance ([`SppRows::covariance`]), in order:
+/// ECEF position (m), c·δt_r (m), τ_GPS (s).
+pub const SPP_COVARIANCE_STATES: [&str; 5] = ["x_m", "y_m", "z_m", "clock_m", "tau_gps_s"];
 
 /// The rows of [`solve_epochs`]: one per solved epoch, and one per satellite of every
 /// epoch with its name.
 #[derive(Debug, Clone, Default)]
 pub struct SppRows {
-    pub epochs: Vec<[f64; 24]>,
-    pub satellites: Vec<[f64; 5]>,
+    pub epochs: Vec<[f64; 31]>,
+    pub satellites: Vec<[f64; 6]>,
     pub satellite_names: Vec<String>,
+    /// Per solved epoch, the 5 × 5 covariance of [`SPP_COVARIANCE_STATES`] (row-major;
+    /// m², m·s, s²), with the τ_GPS row and column NaN when τ_GPS is not estimated.
+    pub covariance: Vec<[f64; 25]>,
 }
 
 /// Single-point positioning epoch by epoch: each position solution starts from the
@@ -475,7 +506,8 @@ pub struct SppRows {
 /// ([`solve_velocity`], rate σ `sigma_rate` m/s) of the used satellites when at least
 /// four of them have a rate. An epoch with fewer usable satellites than unknowns has no
 /// row; its satellites are reported as [`Exclusion::TooFew`] (unless excluded earlier).
-// invariant: tau is Some only for the 5-unknown solution, whose cov is 5 × 5.
+// invariant: tau is Some only for the 5-unknown solution, whose cov is 5 × 5; cov is at
+// least 4 × 4 (position, clock).
 #[allow(clippy::indexing_slicing)]
 pub fn solve_epochs(eph: &Ephemerides, epochs: &[(f64, Vec<Observation>)], cfg: &SppConfig, sigma_rate: f64) -> Result<SppRows> {
     crate::error::check_positive("sigma_rate", sigma_rate)?;
@@ -486,7 +518,7 @@ pub fn solve_epochs(eph: &Ephemerides, epochs: &[(f64, Vec<Observation>)], cfg: 
             Epoch::Solved(s) => s,
             Epoch::TooFew { satellites, .. } => {
                 for u in satellites {
-                    out.satellites.push([*t, f64::NAN, f64::NAN, f64::NAN, u.excluded.map_or(0.0, Exclusion::code)]);
+                    out.satellites.push([*t, f64::NAN, f64::NAN, f64::NAN, f64::NAN, u.excluded.map_or(0.0, Exclusion::code)]);
                     out.satellite_names.push(u.sat.name());
                 }
                 continue;
@@ -502,40 +534,51 @@ pub fn solve_epochs(eph: &Ephemerides, epochs: &[(f64, Vec<Observation>)], cfg: 
         };
         let (tau, st) = s.tau.map_or((f64::NAN, f64::NAN), |x| (x, s.cov[(4, 4)].sqrt()));
         let excluded = s.satellites.iter().filter(|u| u.excluded.is_some()).count();
+        let mut cov = [f64::NAN; 25];
+        for (k, c) in cov.iter_mut().enumerate() {
+            let (a, b) = (k / 5, k % 5);
+            if a < s.cov.nrows() && b < s.cov.ncols() {
+                *c = s.cov[(a, b)];
+            }
+        }
+        let cne = dcm_ned_to_ecef(s.lla.x, s.lla.y);
+        let ned = cne.transpose() * s.cov.fixed_view::<3, 3>(0, 0) * cne;
         out.epochs.push([
             *t, s.pos.x, s.pos.y, s.pos.z, s.lla.x, s.lla.y, s.lla.z, s.clock_m, tau, st, s.residual_metric, s.n_used as f64,
             s.n_unknowns as f64, s.dop.gdop, s.dop.pdop, s.dop.hdop, s.dop.vdop, s.dop.tdop, v.x, v.y, v.z, d, excluded as f64, s.chi2,
+            s.cov[(0, 0)].sqrt(), s.cov[(1, 1)].sqrt(), s.cov[(2, 2)].sqrt(), ned[(1, 1)].sqrt(), ned[(0, 0)].sqrt(), ned[(2, 2)].sqrt(),
+            s.cov[(3, 3)].sqrt(),
         ]);
+        out.covariance.push(cov);
         for u in &s.satellites {
-            out.satellites.push([*t, u.elevation, u.azimuth, u.residual, u.excluded.map_or(0.0, Exclusion::code)]);
+            out.satellites.push([*t, u.elevation, u.azimuth, u.residual, u.sigma, u.excluded.map_or(0.0, Exclusion::code)]);
             out.satellite_names.push(u.sat.name());
         }
     }
     Ok(out)
 }
 
-/// DOP from the design matrix rotated into local NED (position columns).
-// invariant: h has n ≥ 4 columns (the solver's unknowns: position, clock[, τ]), so q
-// is n × n with n ≥ 4 and i < rows of h, j < 3.
+/// [`Dop`] of the unit lines of sight (ECEF) of the used satellites at the solution
+/// `lla`, each flagged GLONASS or not; the τ_GPS column is present when `with_tau`.
+// invariant: q is n × n with n ≥ 4 (position, clock[, τ]); rows are k < los.len().
 #[allow(clippy::indexing_slicing)]
-fn dop(h: &DMatrix<f64>, lla: &Vec3, n: usize) -> Result<Dop> {
-    let cne = dcm_ned_to_ecef(lla.x, lla.y);
-    let mut g = h.clone();
-    for i in 0..h.nrows() {
-        let v = cne.transpose() * Vec3::new(h[(i, 0)], h[(i, 1)], h[(i, 2)]);
-        for j in 0..3 {
-            g[(i, j)] = v[j];
+fn dop(los: &[(Vec3, bool)], lla: &Vec3, with_tau: bool) -> Result<Dop> {
+    let cne = dcm_ned_to_ecef(lla.x, lla.y).transpose();
+    let n = if with_tau { 5 } else { 4 };
+    let mut g = DMatrix::<f64>::zeros(los.len(), n);
+    for (k, (u, glonass)) in los.iter().enumerate() {
+        let ned = cne * u;
+        g[(k, 0)] = -ned.y; // east
+        g[(k, 1)] = -ned.x; // north
+        g[(k, 2)] = ned.z; // up: −u_U = +u_D
+        g[(k, 3)] = 1.0;
+        if with_tau && *glonass {
+            g[(k, 4)] = 1.0;
         }
     }
     let q = (g.transpose() * &g).try_inverse().ok_or_else(|| NavError::Numerical("singular DOP matrix".into()))?;
-    let tr: f64 = (0..n).map(|i| q[(i, i)]).sum();
-    Ok(Dop {
-        gdop: tr.sqrt(),
-        pdop: (q[(0, 0)] + q[(1, 1)] + q[(2, 2)]).sqrt(),
-        hdop: (q[(0, 0)] + q[(1, 1)]).sqrt(),
-        vdop: q[(2, 2)].sqrt(),
-        tdop: q[(3, 3)].sqrt(),
-    })
+    let (h2, v2, t2) = (q[(0, 0)] + q[(1, 1)], q[(2, 2)], q[(3, 3)]);
+    Ok(Dop { gdop: (h2 + v2 + t2).sqrt(), pdop: (h2 + v2).sqrt(), hdop: h2.sqrt(), vdop: v2.sqrt(), tdop: t2.sqrt() })
 }
 
 /// Doppler velocity (Eq. 24): least squares for (v ECEF m/s, c·δṫ_r m/s) at the known
@@ -603,7 +646,8 @@ mod tests {
         let s = solve_position(&eph, 600.0, &obs, &cfg, None).unwrap();
         let truth = WGS84.lla_to_ecef(&lla);
         assert!((s.pos - truth).norm() < 1e-4, "{}", (s.pos - truth).norm());
-        assert!((s.clock_m - C_LIGHT * (2e-4 + 1e-8 * 600.0)).abs() < 1e-4);
+        // the simulated clock is bias + drift·(t − t_start): the single epoch is the start
+        assert!((s.clock_m - C_LIGHT * 2e-4).abs() < 1e-4);
         assert!((s.tau.unwrap() + 340e-9).abs() < 1e-13);
         assert!(s.residual_metric < 1e-4);
         let (v, drift, _) = solve_velocity(&eph, 600.0 - s.clock_m / C_LIGHT, &obs, &truth, 0.05).unwrap();
@@ -774,7 +818,8 @@ mod tests {
         let gps: Vec<Observation> = obs.iter().filter(|o| o.sat.system == System::Gps).take(3).copied().collect();
         let rows = solve_epochs(&eph, &[(600.0, obs.clone()), (630.0, gps)], &config(0.0, true), 0.05).unwrap();
         assert_eq!(rows.epochs.len(), 1);
-        let last: Vec<f64> = rows.satellites.iter().filter(|r| r[0] == 630.0).map(|r| r[4]).collect();
+        let excluded = SPP_SATELLITE_COLUMNS.iter().position(|c| *c == "excluded").unwrap();
+        let last: Vec<f64> = rows.satellites.iter().filter(|r| r[0] == 630.0).map(|r| r[excluded]).collect();
         assert_eq!(last, vec![Exclusion::TooFew.code(); 3]);
     }
 

@@ -14,7 +14,7 @@ use crate::gnss::glonass_orbit::{propagate_checked, GloEphemeris};
 use crate::gnss::gps_orbit::GpsEphemeris;
 use crate::gnss::observation::{group_epochs, observations, simulate_table, Observation, Visibility};
 use crate::gnss::options::GnssOptions;
-use crate::gnss::spp::{solve_epochs, Exclusion, SPP_COLUMNS, SPP_SATELLITE_COLUMNS};
+use crate::gnss::spp::{solve_epochs, Exclusion, SPP_COLUMNS, SPP_COVARIANCE_STATES, SPP_SATELLITE_COLUMNS};
 use crate::gnss::tight::{Formulation, TightAiding};
 use crate::gnss::{SatId, TimeScales};
 use crate::math::Vec3;
@@ -161,7 +161,7 @@ impl PyGnssOptions {
 
 /// Simulated observation table: dict of sat (list of str), channel, time_s, code_m, rate_mps,
 /// elevation_rad (truth). Truth: τ_GPS `tau_gps` (s), receiver clock
-/// `clock_bias` + `clock_drift`·t (s); visibility: elevation `mask` (rad), `only` a
+/// `clock_bias` + `clock_drift`·(t − t[0]) (s); visibility: elevation `mask` (rad), `only` a
 /// satellite subset, `outages` (K, 2) GPS-time windows, `sat_outages` [(sat, start, end)].
 #[pyfunction]
 #[pyo3(signature = (eph, t, lla, vel_ned, options, *, tau_gps=0.0, clock_bias=0.0, clock_drift=0.0, mask=0.0, only=None, outages=None, sat_outages=Vec::new(), seed=None))]
@@ -207,19 +207,20 @@ fn epochs(
 }
 
 /// Epoch-by-epoch single-point positioning (gnss/spp.rs `solve_epochs`): the epoch rows
-/// (columns `SPP_COLUMNS`), the satellite rows (`SPP_SATELLITE_COLUMNS`) and their
-/// satellite names. `code2`: the second-frequency codes for `ionosphere_free` (NaN where absent).
+/// (columns `SPP_COLUMNS`), the satellite rows (`SPP_SATELLITE_COLUMNS`), their
+/// satellite names, and the epochs' covariances of `SPP_COVARIANCE_STATES` as rows of 25
+/// (5 × 5 row-major). `code2`: the second-frequency codes for `ionosphere_free` (NaN where absent).
 #[pyfunction]
 #[pyo3(signature = (eph, time, sat, channel, code, rate, options, *, code2=None))]
 #[allow(clippy::type_complexity, clippy::too_many_arguments)]
 fn gnss_spp<'py>(
     py: Python<'py>, eph: &PyEphemerides, time: PyReadonlyArray1<'py, f64>, sat: Vec<String>, channel: PyReadonlyArray1<'py, i64>,
     code: PyReadonlyArray1<'py, f64>, rate: PyReadonlyArray1<'py, f64>, options: &PyGnssOptions, code2: Option<PyReadonlyArray1<'py, f64>>,
-) -> PyResult<(Bound<'py, PyArray2<f64>>, Bound<'py, PyArray2<f64>>, Vec<String>)> {
+) -> PyResult<(Bound<'py, PyArray2<f64>>, Bound<'py, PyArray2<f64>>, Vec<String>, Bound<'py, PyArray2<f64>>)> {
     let ep = epochs(&time, &sat, &channel, &code, code2.as_ref(), &rate)?;
     let (e, o) = (&eph.inner, &options.inner);
     let out = py.detach(|| solve_epochs(e, &ep, &o.spp(e), o.sigma_rate))?;
-    Ok((to_py_rows(py, &out.epochs), to_py_rows(py, &out.satellites), out.satellite_names))
+    Ok((to_py_rows(py, &out.epochs), to_py_rows(py, &out.satellites), out.satellite_names, to_py_rows(py, &out.covariance)))
 }
 
 /// Tightly coupled GNSS as one measurement source of an aided INS
@@ -254,6 +255,7 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(gnss_spp, m)?)?;
     m.add("SPP_COLUMNS", SPP_COLUMNS.to_vec())?;
     m.add("SPP_SATELLITE_COLUMNS", SPP_SATELLITE_COLUMNS.to_vec())?;
+    m.add("SPP_COVARIANCE_STATES", SPP_COVARIANCE_STATES.to_vec())?;
     m.add("SPP_EXCLUSIONS", Exclusion::ALL.iter().map(|e| e.name()).collect::<Vec<_>>())?;
     register_choices::<Formulation>(m, "Formulation")
 }

@@ -40,9 +40,11 @@ def simulate(eph: Ephemerides, time, lla, vel_ned, options: GnssOptions | None =
     tau_gps : float, default 0.0
         True GPS−GLONASS system-time offset τ_GPS on the GLONASS code, s.
     clock_bias : float, default 0.0
-        Receiver clock bias, s: δt_r = clock_bias + clock_drift·t.
+        Receiver clock offset at the first epoch, s: δt_r(t) = clock_bias +
+        clock_drift·(t − time[0]), so the bias is the offset at the start of the record
+        whatever its time of week.
     clock_drift : float, default 0.0
-        Receiver clock drift, s/s.
+        Receiver clock drift, s/s (δt_r grows by clock_drift·Δt s over Δt s).
     mask_deg : float, default 10.0
         Elevation mask, degrees.
     only : list of str, optional

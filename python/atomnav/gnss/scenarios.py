@@ -125,7 +125,8 @@ def build(sc: Scenario | str, clock=(0.0, 0.0)) -> dict:
     sc : Scenario or str
         The scenario, or the name of one of :data:`SCENARIOS`.
     clock : array_like, shape (2,), default (0, 0)
-        True receiver clock (bias s, drift s/s).
+        True receiver clock (bias s, drift s/s): δt_r(t) = bias + drift·t, t (s) from the
+        start of the run (the first GNSS epoch is at 1 s).
 
     Returns
     -------
@@ -157,7 +158,8 @@ def build(sc: Scenario | str, clock=(0.0, 0.0)) -> dict:
     if sc.n_sats is not None:
         only = eph.top(sc.n_sats, 0.0, traj.lla[0]) if sc.n_sats > 0 else []
     outages = [] if sc.outage is None else [(sc.outage[0], sc.outage[0] + sc.outage[1])]
-    obs = simulate(eph, t_gnss, lla, vel, tau_gps=0.0, clock_bias=clock[0], clock_drift=clock[1], only=only,
+    # the simulator's bias is the offset at its first epoch t_gnss[0], the run starts at 0
+    obs = simulate(eph, t_gnss, lla, vel, tau_gps=0.0, clock_bias=clock[0] + clock[1] * t_gnss[0], clock_drift=clock[1], only=only,
                    outages=outages, seed=sc.seed + 1000)
     tilt, heading = INITIAL_ATTITUDE[sc.imu_class]
     a, g = errors.accel, errors.gyro
@@ -238,7 +240,8 @@ def run(sc: Scenario | str, progress: bool = False, clock=(0.0, 0.0), **override
     progress : bool, default False
         Show a progress bar.
     clock : array_like, shape (2,), default (0, 0)
-        True receiver clock (bias s, drift s/s).
+        True receiver clock (bias s, drift s/s): δt_r(t) = bias + drift·t, t (s) from the
+        start of the run (the first GNSS epoch is at 1 s).
     **overrides
         Fields of :class:`Scenario` to replace (e.g. ``seed=3``).
 
