@@ -28,7 +28,7 @@ def test_euler_matrix_and_d1_d2_match_finite_differences():
             dc = (_spec_euler(b + e) - _spec_euler(b - e)) / (2 * h)
             assert np.linalg.norm(_vee(c.T @ dc) - astro.d1(b)[:, i]) < 1e-9  # C(β+δβ) ≈ C(I + [D1δβ×])
             assert np.linalg.norm(_vee(dc @ c.T) - astro.d2(b)[:, i]) < 1e-9  # ≈ (I + [D2δβ×])C
-        assert np.abs(astro.euler_from_dcm(c) - np.r_[b[0] % (2 * np.pi), b[1:]]).max() < 1e-12
+        assert np.abs(astro.euler_from_dcm(c) - b).max() < 1e-12  # |ψ|, |γ| < π: returned as given
 
 
 def test_q_about_increment_axis_commutes():
@@ -155,3 +155,80 @@ def test_weak_direction_sigma_per_arcsec_of_residual(stand_truth):
     est = astro.calibrate(ds_imu, ds_avu @ Rotation.from_rotvec(noise).as_matrix())
     assert est.sigma_weak == pytest.approx(units.ARCSEC / np.sqrt(obs["eigenvalues"][0]), rel=0.05)
     assert abs(est.weak_axis_mf[2]) > 0.9
+
+
+def test_negative_heading_mount_calibrates_to_a_negative_angle(stand_truth):
+    # a −0.1° heading mount is reported as −0.1°, not 359.9°
+    _, ds_imu = stand_truth
+    beta = np.radians([-0.1, 0.3, -0.2])
+    c = _spec_euler(beta)
+    est = astro.calibrate(ds_imu, np.einsum("ji,njk,kl->nil", c, ds_imu, c))
+    assert np.abs(est.beta - beta).max() < 1e-9
+
+
+def test_euler_angles_at_pi_are_plus_pi():
+    # the boundary of (−π, π]: atan2 of a signed zero gives −π, which is reported as +π
+    heading = np.diag([-1.0, -1.0, 1.0])
+    heading[0, 1] = -0.0
+    roll = np.diag([-1.0, 1.0, -1.0])
+    assert astro.euler_from_dcm(heading)[0] == np.pi and astro.euler_from_dcm(roll)[2] == np.pi
+    for b in ([np.pi, 0.1, 0.2], [-np.pi + 1e-9, 0.0, 0.0], [0.3, -0.2, np.pi]):
+        got = astro.euler_from_dcm(_spec_euler(b))
+        assert np.all((got[[0, 2]] > -np.pi) & (got[[0, 2]] <= np.pi))
+        assert np.allclose(_spec_euler(got), _spec_euler(b), atol=1e-15)
+
+
+def test_model_covariance_is_the_stacked_sandwich(stand_truth):
+    # oracle: Σ_f built element by element as a 3M × 3M matrix from ε_n = θ_{n+1} − ΔS_nᵀθ_n
+    # (star errors θ_j ~ N(0, P_j), shared by neighbours) and independent gyro errors, then
+    # (HᵀH)⁻¹HᵀΣ_fH(HᵀH)⁻¹ with the finite-difference Jacobian of the residual
+    tr, ds_imu = stand_truth
+    c = tr["c_true"]
+    rng = np.random.default_rng(4)
+    noise = Rotation.from_rotvec(rng.normal(0, 1e-5, (len(ds_imu), 3))).as_matrix()
+    ds_avu = np.einsum("ji,njk,kl->nil", c, ds_imu, c) @ noise
+    m = len(ds_imu)
+    a = rng.normal(size=(m + 1, 3, 3)) * 1e-5
+    p_avu = a @ a.transpose(0, 2, 1)
+    b = rng.normal(size=(m, 3, 3)) * 1e-6
+    e_imu = b @ b.transpose(0, 2, 1)
+    est = astro.calibrate(ds_imu, ds_avu, e_imu=e_imu, p_avu=p_avu)
+    assert est.covariance == "model"
+    ch = est.c
+
+    def f(cc):
+        r = np.einsum("nji,kj,nkl,lm->nim", ds_avu, cc, ds_imu, cc) - np.eye(3)
+        return 0.5 * np.stack([r[:, 2, 1] - r[:, 1, 2], r[:, 0, 2] - r[:, 2, 0], r[:, 1, 0] - r[:, 0, 1]], axis=1).ravel()
+
+    h = np.column_stack([(f(ch @ Rotation.from_rotvec(e * 1e-7).as_matrix()) - f(ch @ Rotation.from_rotvec(-e * 1e-7).as_matrix())) / 2e-7
+                         for e in np.eye(3)])
+    # ε as a linear map of the stacked star errors θ (3(M+1)) and the MF gyro errors (3M)
+    g_star = np.zeros((3 * m, 3 * (m + 1)))
+    g_gyro = np.zeros((3 * m, 3 * m))
+    for n in range(m):
+        g_star[3 * n:3 * n + 3, 3 * n + 3:3 * n + 6] = np.eye(3)
+        g_star[3 * n:3 * n + 3, 3 * n:3 * n + 3] = -ds_avu[n].T
+        g_gyro[3 * n:3 * n + 3, 3 * n:3 * n + 3] = ch.T
+    from scipy.linalg import block_diag
+    sigma_f = g_star @ block_diag(*p_avu) @ g_star.T + g_gyro @ block_diag(*e_imu) @ g_gyro.T
+    ai = np.linalg.inv(h.T @ h)
+    p_theta = ai @ h.T @ sigma_f @ h @ ai
+    assert np.allclose(est.p_theta, p_theta, rtol=1e-5, atol=0)
+    di = np.linalg.inv(astro.d1(est.beta))
+    assert np.allclose(est.p_beta, di @ p_theta @ di.T, rtol=1e-5, atol=0)
+    # the paper's sandwich on request: Σ_f = I ⊗ P_S
+    paper = astro.calibrate(ds_imu, ds_avu, covariance="paper_sandwich")
+    p_s = est.residuals.T @ est.residuals / m
+    assert np.allclose(paper.p_theta, ai @ h.T @ np.kron(np.eye(m), p_s) @ h @ ai, rtol=1e-5, atol=0)
+
+
+def test_covariance_options_are_checked(stand_truth):
+    _, ds_imu = stand_truth
+    m = len(ds_imu)
+    e, p = np.tile(np.eye(3) * 1e-12, (m, 1, 1)), np.tile(np.eye(3) * 1e-12, (m + 1, 1, 1))
+    for kw, name in [(dict(covariance="model"), "e_imu"), (dict(e_imu=e), "p_avu"), (dict(p_avu=p), "e_imu"),
+                     (dict(e_imu=e, p_avu=p, covariance="residual"), "e_imu"), (dict(e_imu=e[:-1], p_avu=p), "e_imu"),
+                     (dict(e_imu=e, p_avu=p[:-1]), "p_avu"), (dict(covariance="sandwich"), "covariance")]:
+        with pytest.raises(atomnav.InputError) as err:
+            astro.calibrate(ds_imu, ds_imu, **kw)
+        assert err.value.parameter == name, (kw.keys(), err.value)

@@ -195,3 +195,23 @@ def test_user_p_avu_not_psd_rejected(scn, run7):
     p = np.tile(np.eye(3) * 1e-10, (73, 1, 1))
     p[2] = np.array([[1.0, 2.0, 0.0], [2.0, 1.0, 0.0], [0.0, 0.0, 1.0]]) * 1e-10
     _bad_p_avu(scn, run7, p, "p_avu: not positive semi-definite.*at index 2")
+
+
+def test_named_results_unpack_and_pickle(scn):
+    import copy
+    import pickle
+
+    obs = _simulate(scn, 16 * AS, 3)
+    att = astro.star_attitudes(obs, len(scn["epochs"]), scn["cameras"], 16 * AS, up_gcrs=scn["up_gcrs"], n_refr=scn["n_refr"])
+    assert isinstance(att, astro.StarAttitudes)
+    s, p, count = att  # unpacks in the old tuple order
+    assert s is att.s_gcrs_vf and p is att.p_avu and count is att.stars
+    inc = astro.astro_increments(att.s_gcrs_vf, att.p_avu)
+    ds, e = inc
+    assert isinstance(inc, astro.AstroIncrements) and ds is inc.ds_avu and e is inc.e_avu
+    assert np.abs(att.s_gcrs_vf[:-1] @ inc.ds_avu - att.s_gcrs_vf[1:]).max() < 1e-14
+    for obj in (att, inc):
+        for back in (pickle.loads(pickle.dumps(obj)), copy.deepcopy(obj)):
+            assert type(back) is type(obj)
+            for a, b in zip(obj, back):
+                assert a.dtype == b.dtype and np.array_equal(a, b)

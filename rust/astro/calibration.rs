@@ -201,6 +201,34 @@ impl Choice for Solver {
     const CHOICES: &'static [(&'static str, Self)] = &[("so3", Solver::So3), ("paper_euler", Solver::PaperEuler)];
 }
 
+/// How the mount covariance P_β is formed (docs/departures.md#correlated-increment-residuals).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum CovarianceForm {
+    /// The sandwich with Σ_f from the given error covariances E_n^imu, P_j^avu, including
+    /// the neighbour blocks of shared star epochs ([`model_covariance`]).
+    Model,
+    /// The same structure with one star-attitude covariance P̂ and one gyro-increment
+    /// covariance Q̂ estimated from the residuals ([`residual_covariance`]).
+    Residual,
+    /// The paper's sandwich with P_S, increments taken as independent (Vasilyuk et al. 2024, E18).
+    PaperSandwich,
+}
+
+impl Choice for CovarianceForm {
+    const PARAMETER: &'static str = "covariance";
+    const CHOICES: &'static [(&'static str, Self)] =
+        &[("model", CovarianceForm::Model), ("residual", CovarianceForm::Residual), ("paper_sandwich", CovarianceForm::PaperSandwich)];
+}
+
+/// Error covariances of the increments: E_n^imu (MF, rad², one per interval), P_j^avu (VF,
+/// rad², one per epoch) and, in the consistent gyro mode, the constant errors.
+#[derive(Clone, Copy)]
+pub struct IncrementErrors<'a> {
+    pub e_imu: &'a [Mat3],
+    pub p_avu: &'a [Mat3],
+    pub constant: Option<&'a ConstantGyroErrors<'a>>,
+}
+
 #[derive(Debug, Clone, Copy)]
 pub struct Options {
     pub init: Init,
@@ -209,11 +237,14 @@ pub struct Options {
     /// Stop when ‖Δθ‖ (SO(3)) or ‖Δβ‖ (Euler) ≤ tol (rad) (paper: 1e-9).
     pub tol: f64,
     pub residual_form: ResidualForm,
+    /// How P_β is formed; `None` picks `Model` when the error covariances are given and
+    /// `Residual` otherwise.
+    pub covariance: Option<CovarianceForm>,
 }
 
 impl Default for Options {
     fn default() -> Self {
-        Self { init: Init::Axes, solver: Solver::So3, max_iter: 50, tol: 1e-9, residual_form: ResidualForm::Full }
+        Self { init: Init::Axes, solver: Solver::So3, max_iter: 50, tol: 1e-9, residual_form: ResidualForm::Full, covariance: None }
     }
 }
 
@@ -224,7 +255,7 @@ impl Options {
             return Err(invalid("max_iter", "must be ≥ 1"));
         }
         check_positive("tol", tol)?;
-        Ok(Options { init, solver, max_iter, tol, residual_form })
+        Ok(Options { init, solver, max_iter, tol, residual_form, covariance: None })
     }
 }
 
@@ -242,6 +273,8 @@ pub struct Calibration {
     pub p_theta: Mat3,
     pub p_beta: Mat3,
     pub p_clb: Mat3,
+    /// The form P_θ, P_β and P^clb were computed in.
+    pub covariance: CovarianceForm,
     /// Singular values of the stacked Jacobian H at the solution (descending) and their ratio.
     pub singular_values: Vec3,
     pub condition_number: f64,
@@ -296,14 +329,44 @@ fn normal_equations_euler_fd(beta: &Vec3, ds_imu: &[Mat3], ds_avu: &[Mat3]) -> (
     (a, g)
 }
 
+/// Gauss–Newton on SO(3) without error covariances: [`calibrate_with`] with `None`.
+pub fn calibrate(ds_imu: &[Mat3], ds_avu: &[Mat3], opt: &Options) -> Result<Calibration> {
+    calibrate_with(ds_imu, ds_avu, opt, None)
+}
+
+/// The covariance form of a call: `opt.covariance`, or `Model` when `errors` are given and
+/// `Residual` otherwise; the error covariances are checked against the M increments.
+fn covariance_form(opt: &Options, errors: Option<&IncrementErrors>, m: usize) -> Result<CovarianceForm> {
+    let form = match (opt.covariance, errors) {
+        (None | Some(CovarianceForm::Model), Some(_)) => CovarianceForm::Model,
+        (None, None) => CovarianceForm::Residual,
+        (Some(CovarianceForm::Model), None) => return Err(invalid("e_imu", "covariance='model' needs the error covariances e_imu and p_avu")),
+        (Some(f), Some(_)) => return Err(invalid("e_imu", format!("e_imu and p_avu are only used with covariance='model', got covariance={:?}", f.name()))),
+        (Some(f), None) => f,
+    };
+    if let Some(e) = errors {
+        super::stars::check_covariances("e_imu", e.e_imu, m)?;
+        super::stars::check_covariances("p_avu", e.p_avu, m + 1)?;
+        if let Some(k) = e.constant {
+            if k.sensitivities.len() != m {
+                return Err(invalid("j_m", format!("expected {m} sensitivities, got {}", k.sensitivities.len())));
+            }
+        }
+    }
+    Ok(form)
+}
+
 /// Gauss–Newton on SO(3): C_j = C_{j−1} exp([Δθ×]), Δθ = −(HᵀH)⁻¹Hᵀf, stop at ‖Δθ‖ ≤ tol
-/// (Vasilyuk et al. 2024 §3), then the sandwich covariance.
+/// (Vasilyuk et al. 2024 §3), then P_θ in the form of [`covariance_form`]: the model
+/// sandwich of `errors`, the residual estimate of the same structure, or the paper's
+/// sandwich (docs/departures.md#correlated-increment-residuals).
 ///
 /// Errors: an unobservable trajectory (κ < 1e-12, the null direction named) is
 /// `InvalidInput`; no convergence within `max_iter`, or convergence to a point whose
 /// residuals are not small against the rotations (a wrong local minimum), is `Numerical`.
-pub fn calibrate(ds_imu: &[Mat3], ds_avu: &[Mat3], opt: &Options) -> Result<Calibration> {
+pub fn calibrate_with(ds_imu: &[Mat3], ds_avu: &[Mat3], opt: &Options, errors: Option<&IncrementErrors>) -> Result<Calibration> {
     check_increments(ds_imu, ds_avu)?;
+    let form = covariance_form(opt, errors, ds_imu.len())?;
     if let Init::Given(c) = opt.init {
         crate::math::check_rotation("c0", 0, &c)?;
     }
@@ -365,25 +428,24 @@ pub fn calibrate(ds_imu: &[Mat3], ds_avu: &[Mat3], opt: &Options) -> Result<Cali
             "Gauss–Newton converged to a wrong stationary point (largest |f_n|/chord = {relative_misfit:.3} > {MAX_RELATIVE_MISFIT}); start from init='axes'"
         )));
     }
-    // E18: P_S = (1/(N−1)) Σ f fᵀ (D6, D7); P_θ = (HᵀH)⁻¹(Σ H_nᵀ P_S H_n)(HᵀH)⁻¹.
+    // E18: P_S = (1/(N−1)) Σ f fᵀ (D6, D7)
     let m = residuals.len() as f64;
     let mut p_s: Mat3 = residuals.iter().map(|f| f * f.transpose()).sum::<Mat3>() / m;
     if opt.residual_form == ResidualForm::Diagonal {
         p_s = Mat3::from_diagonal(&p_s.diagonal());
     }
-    let mut a = Mat3::zeros();
-    let mut mid = Mat3::zeros();
-    for (i, s) in ds_imu.iter().zip(ds_avu) {
-        let h = jacobian_block(&c, i, s);
-        a += h.transpose() * h;
-        mid += h.transpose() * p_s * h;
-    }
+    let h = jacobian_blocks(&c, ds_imu, ds_avu);
+    let a: Mat3 = h.iter().map(|h| h.transpose() * h).sum();
     let a_inv = a.try_inverse().ok_or_else(|| NavError::Numerical("singular HᵀH at the solution".into()))?;
-    let p_theta = a_inv * mid * a_inv;
+    let p_theta = match (form, errors) {
+        (CovarianceForm::Model, Some(e)) => model_theta(&c, &h, ds_avu, &a_inv, e).0,
+        (CovarianceForm::Residual, _) => residual_theta(&h, &residuals, ds_avu, &a_inv),
+        // the paper's sandwich, P_θ = (HᵀH)⁻¹(Σ H_nᵀ P_S H_n)(HᵀH)⁻¹ (E18)
+        _ => a_inv * h.iter().map(|h| h.transpose() * p_s * h).sum::<Mat3>() * a_inv,
+    };
     let beta = euler_from_dcm(&c);
     // θ = D1 δβ ⇒ P_β = D1⁻¹ P_θ D1⁻ᵀ; P^clb = D2 P_β D2ᵀ (Eq. 8)
-    let d1_inv = d1(&beta).try_inverse().ok_or_else(|| NavError::Numerical("Euler angles at gimbal lock (|ϑ| = 90°)".into()))?;
-    let p_beta = d1_inv * p_theta * d1_inv.transpose();
+    let p_beta = theta_to_beta(&beta, &p_theta)?;
     let p_clb = d2(&beta) * p_beta * d2(&beta).transpose();
     let (ev, _) = sorted_eigen(&a);
     let singular_values = Vec3::new(ev.z.max(0.0).sqrt(), ev.y.max(0.0).sqrt(), ev.x.max(0.0).sqrt());
@@ -397,12 +459,110 @@ pub fn calibrate(ds_imu: &[Mat3], ds_avu: &[Mat3], opt: &Options) -> Result<Cali
         p_theta,
         p_beta,
         p_clb,
+        covariance: form,
         condition_number: singular_values.x / singular_values.z,
         singular_values,
         weak_axis_mf: c * obs.weak_axis_vf(),
         sigma_weak: (p_s.trace() / 3.0).sqrt() / obs.eigenvalues.x.max(0.0).sqrt(),
         observability: obs,
     })
+}
+
+/// The Jacobian blocks H_n of every increment pair at C.
+fn jacobian_blocks(c: &Mat3, ds_imu: &[Mat3], ds_avu: &[Mat3]) -> Vec<Mat3> {
+    ds_imu.iter().zip(ds_avu).map(|(i, a)| jacobian_block(c, i, a)).collect()
+}
+
+/// P_β = D1⁻¹ P_θ D1⁻ᵀ at the Euler angles β (Eq. 8).
+fn theta_to_beta(beta: &Vec3, p_theta: &Mat3) -> Result<Mat3> {
+    let d1_inv = d1(beta).try_inverse().ok_or_else(|| NavError::Numerical("Euler angles at gimbal lock (|ϑ| = 90°)".into()))?;
+    Ok(d1_inv * p_theta * d1_inv.transpose())
+}
+
+/// The nearest positive semi-definite matrix of the symmetric part of `m` (negative
+/// eigenvalues set to zero).
+fn psd_part(m: &Mat3) -> Mat3 {
+    let e = SymmetricEigen::new(0.5 * (m + m.transpose()));
+    e.eigenvectors * Mat3::from_diagonal(&e.eigenvalues.map(|x| x.max(0.0))) * e.eigenvectors.transpose()
+}
+
+/// The two parts of HᵀΣ_fH for Σ_f of independent gyro increments with VF covariances
+/// `gyro(n)` and star attitudes with covariances `p(j)` shared by neighbouring increments
+/// (E13): the gyro part Σ H_nᵀ gyro(n) H_n and the star part
+/// Σ H_nᵀ(P_{n+1} + ΔS_nᵀP_nΔS_n)H_n + Σ [H_nᵀ(−P_{n+1}ΔS_{n+1})H_{n+1} + transpose]
+/// (= Σ_j L_jᵀP_jL_j with L_j = H_{j−1} − ΔS_jH_j, positive semi-definite).
+// invariant: h and ds_avu have m entries (the callers' increments), p is read at j ≤ m;
+// n + 1 < m where h[n + 1], ds_avu[n + 1] are read.
+#[allow(clippy::indexing_slicing)]
+fn score_covariance(h: &[Mat3], ds_avu: &[Mat3], gyro: impl Fn(usize) -> Mat3, p: impl Fn(usize) -> Mat3) -> (Mat3, Mat3) {
+    let m = h.len();
+    let (mut gyro_part, mut star) = (Mat3::zeros(), Mat3::zeros());
+    for n in 0..m {
+        gyro_part += h[n].transpose() * gyro(n) * h[n];
+        star += h[n].transpose() * (p(n + 1) + ds_avu[n].transpose() * p(n) * ds_avu[n]) * h[n];
+        if n + 1 < m {
+            let x = h[n].transpose() * (-p(n + 1) * ds_avu[n + 1]) * h[n + 1];
+            star += x + x.transpose();
+        }
+    }
+    (gyro_part, star)
+}
+
+/// P_θ^model and its systematic part P_θ^sys (rad², VF) from the error covariances.
+// invariant: e_imu and the sensitivities have h.len() entries, p_avu h.len() + 1
+// (checked by the callers).
+#[allow(clippy::indexing_slicing)]
+fn model_theta(c: &Mat3, h: &[Mat3], ds_avu: &[Mat3], a_inv: &Mat3, errors: &IncrementErrors) -> (Mat3, Mat3) {
+    let constant = errors.constant;
+    // the constant part of E_n^imu enters through g_m, g_b below (all n, p pairs at once)
+    let white = |n: usize| {
+        let e = errors.e_imu[n];
+        let e = match constant {
+            Some(k) => {
+                let (jm, jb) = &k.sensitivities[n];
+                e - (jm * k.p_m * jm.transpose() + jb * jb.transpose() * k.sigma_b.powi(2))
+            }
+            None => e,
+        };
+        c.transpose() * e * c
+    };
+    let (gyro, star) = score_covariance(h, ds_avu, white, |j| errors.p_avu[j]);
+    let p_sys = match constant {
+        Some(k) => {
+            let (mut g_m, mut g_b) = (SMatrix::<f64, 3, 9>::zeros(), Mat3::zeros());
+            for (hn, (jm, jb)) in h.iter().zip(k.sensitivities) {
+                g_m += hn.transpose() * c.transpose() * jm;
+                g_b += hn.transpose() * c.transpose() * jb;
+            }
+            let (gm, gb) = (a_inv * g_m, a_inv * g_b);
+            gm * k.p_m * gm.transpose() + gb * gb.transpose() * k.sigma_b.powi(2)
+        }
+        None => Mat3::zeros(),
+    };
+    (a_inv * (gyro + star) * a_inv + p_sys, p_sys)
+}
+
+/// P_θ from the residuals alone with the structure of [`model_covariance`]: one star-attitude
+/// covariance P̂ (VF) from the lag-1 moment in the frame where it is constant,
+/// E[f_n f_{n+1}ᵀ] ΔS_{n+1}ᵀ = −P, made positive semi-definite, and one gyro-increment
+/// covariance Q̂ = mean(f_n f_nᵀ) − P̂ − mean(ΔS_nᵀP̂ΔS_n) (VF). Q̂ is the difference of
+/// moments dominated by the star noise; when its part makes P_θ indefinite, the star
+/// part alone (a lower bound, since the gyro part is positive semi-definite) is returned.
+fn residual_theta(h: &[Mat3], f: &[Vec3], ds_avu: &[Mat3], a_inv: &Mat3) -> Mat3 {
+    let m = f.len() as f64;
+    let lag1: Mat3 = f.iter().zip(f.iter().skip(1)).zip(ds_avu.iter().skip(1)).map(|((a, b), s)| a * b.transpose() * s.transpose()).sum();
+    let p_hat = if f.len() > 1 { psd_part(&(-lag1 / (m - 1.0))) } else { Mat3::zeros() };
+    let lag0: Mat3 = f.iter().map(|x| x * x.transpose()).sum::<Mat3>() / m;
+    let star0: Mat3 = ds_avu.iter().map(|s| s.transpose() * p_hat * s).sum::<Mat3>() / m;
+    let q = lag0 - p_hat - star0;
+    let q_hat = 0.5 * (q + q.transpose());
+    let (gyro, star) = score_covariance(h, ds_avu, |_| q_hat, |_| p_hat);
+    let full = a_inv * (gyro + star) * a_inv;
+    if SymmetricEigen::new(full).eigenvalues.min() >= 0.0 {
+        full
+    } else {
+        a_inv * star * a_inv
+    }
 }
 
 /// Constant gyro errors of the consistent mode (E8): per-interval sensitivities
@@ -418,9 +578,6 @@ pub struct ConstantGyroErrors<'a> {
 /// cov(ε_n, ε_{n+1}) = −P_n^avu ΔS_{n+1}, and with constant gyro errors the cross blocks
 /// Cᵀ(J_m,n P_m J_m,pᵀ + J_b,n P_b J_b,pᵀ)C — and its systematic part
 /// P_β^sys = G_mP_mG_mᵀ + G_bP_bG_bᵀ, G = −(HᵀH)⁻¹Σ_n H_nᵀCᵀJ_n. Returns (P_β^model, P_β^sys) in rad².
-// invariant: ds_imu, ds_avu, e_imu, h (and the sensitivities) have m entries and
-// p_avu m + 1 (checked above); n < m, n + 1 ≤ m.
-#[allow(clippy::indexing_slicing)]
 pub fn model_covariance(c: &Mat3, ds_imu: &[Mat3], ds_avu: &[Mat3], e_imu: &[Mat3], p_avu: &[Mat3], constant: Option<&ConstantGyroErrors>) -> Result<(Mat3, Mat3)> {
     let m = ds_imu.len();
     if ds_avu.len() != m {
@@ -429,36 +586,11 @@ pub fn model_covariance(c: &Mat3, ds_imu: &[Mat3], ds_avu: &[Mat3], e_imu: &[Mat
     if e_imu.len() != m || p_avu.len() != m + 1 || constant.is_some_and(|k| k.sensitivities.len() != m) {
         return Err(invalid("e_imu", format!("expected {m} interval covariances (and sensitivities) and {} epoch covariances", m + 1)));
     }
-    let h: Vec<Mat3> = ds_imu.iter().zip(ds_avu).map(|(i, a)| jacobian_block(c, i, a)).collect();
+    let h = jacobian_blocks(c, ds_imu, ds_avu);
     let a_inv = h.iter().map(|h| h.transpose() * h).sum::<Mat3>().try_inverse().ok_or_else(|| NavError::Numerical("singular HᵀH".into()))?;
-    let (mut g_m, mut g_b) = (SMatrix::<f64, 3, 9>::zeros(), Mat3::zeros());
-    let mut mid = Mat3::zeros();
-    for n in 0..m {
-        let mut e = e_imu[n];
-        if let Some(k) = constant {
-            // the constant part enters through g_m, g_b below (all n, p pairs at once)
-            let (jm, jb) = &k.sensitivities[n];
-            e -= jm * k.p_m * jm.transpose() + jb * jb.transpose() * k.sigma_b.powi(2);
-            g_m += h[n].transpose() * c.transpose() * jm;
-            g_b += h[n].transpose() * c.transpose() * jb;
-        }
-        let e_avu = p_avu[n + 1] + ds_avu[n].transpose() * p_avu[n] * ds_avu[n];
-        mid += h[n].transpose() * (c.transpose() * e * c + e_avu) * h[n];
-        if n + 1 < m {
-            let x = h[n].transpose() * (-p_avu[n + 1] * ds_avu[n + 1]) * h[n + 1];
-            mid += x + x.transpose();
-        }
-    }
-    let d1_inv = d1(&euler_from_dcm(c)).try_inverse().ok_or_else(|| NavError::Numerical("Euler angles at gimbal lock (|ϑ| = 90°)".into()))?;
-    let to_beta = |p: Mat3| d1_inv * p * d1_inv.transpose();
-    let p_sys = match constant {
-        Some(k) => {
-            let (gm, gb) = (a_inv * g_m, a_inv * g_b);
-            gm * k.p_m * gm.transpose() + gb * gb.transpose() * k.sigma_b.powi(2)
-        }
-        None => Mat3::zeros(),
-    };
-    Ok((to_beta(a_inv * mid * a_inv + p_sys), to_beta(p_sys)))
+    let (p_theta, p_sys) = model_theta(c, &h, ds_avu, &a_inv, &IncrementErrors { e_imu, p_avu, constant });
+    let beta = euler_from_dcm(c);
+    Ok((theta_to_beta(&beta, &p_theta)?, theta_to_beta(&beta, &p_sys)?))
 }
 
 /// P^mfa = C P^avu Cᵀ + P^clb: IMU attitude from stars through the calibrated mount (Eq. 8, E19).

@@ -30,13 +30,22 @@ pub fn euler_dcm(b: &Vec3) -> Mat3 {
     rpsi * rth * rg
 }
 
-/// Canonical angles of C: ϑ = asin(C32), ψ = atan2(C12, C22) ∈ [0, 2π), γ = atan2(−C31, C33).
-/// Singular at |ϑ| = 90°.
+/// Canonical angles of C: ϑ = asin(C32) ∈ [−π/2, π/2], ψ = atan2(C12, C22) and
+/// γ = atan2(−C31, C33), both in (−π, π]. Singular at |ϑ| = 90°.
 pub fn euler_from_dcm(c: &Mat3) -> Vec3 {
     let th = c[(2, 1)].clamp(-1.0, 1.0).asin();
-    let psi = c[(0, 1)].atan2(c[(1, 1)]).rem_euclid(2.0 * std::f64::consts::PI);
-    let g = (-c[(2, 0)]).atan2(c[(2, 2)]);
+    let psi = half_open(c[(0, 1)].atan2(c[(1, 1)]));
+    let g = half_open((-c[(2, 0)]).atan2(c[(2, 2)]));
     Vec3::new(psi, th, g)
+}
+
+/// An atan2 angle in [−π, π] moved to (−π, π]: −π (from a signed zero) becomes π.
+fn half_open(a: f64) -> f64 {
+    if a <= -std::f64::consts::PI {
+        a + 2.0 * std::f64::consts::PI
+    } else {
+        a
+    }
 }
 
 /// D1(β): θ^clb = D1 δβ with C(β + δβ) ≈ C(β)(I + [θ^clb×]) (Vasilyuk et al. 2024, Eq. 8).
@@ -107,6 +116,13 @@ mod tests {
         // C ŷ = (sψ cϑ, cψ cϑ, sϑ): heading clockwise from North, pitch nose-up.
         let y = c * Vec3::y();
         assert!((y - Vec3::new(b.x.sin() * b.y.cos(), b.x.cos() * b.y.cos(), b.y.sin())).norm() < 1e-15);
+        // every angle in (−π, π]: a small negative heading stays negative, −π (a signed zero) is π
+        let small = Vec3::new(-0.1f64.to_radians(), 0.2, -0.3);
+        assert!((euler_from_dcm(&euler_dcm(&small)) - small).norm() < 1e-14);
+        let flip = Mat3::new(-1.0, -0.0, 0.0, 0.0, -1.0, 0.0, 0.0, 0.0, 1.0);
+        assert_eq!(euler_from_dcm(&flip).x, std::f64::consts::PI);
+        let roll = Mat3::new(-1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, -1.0);
+        assert_eq!(euler_from_dcm(&roll).z, std::f64::consts::PI);
         let phi = Vec3::new(0.01, -0.02, 0.005);
         assert!((rotation_angle(&dcm_from_rotvec(&phi)) - phi.norm()).abs() < 1e-17);
     }

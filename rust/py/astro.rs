@@ -1,8 +1,8 @@
 //! Bindings of astro/: gyro increments, star attitudes, mount calibration, scenario runs.
 
 use super::convert::{index_count, mat_to_py, mats, mats_to_py, quat_to_py, real, register_choices, seed, vec3_rows, vec3_to_py, vector, Wrap};
-use crate::astro::calibration::{self, Calibration, DiffForm, Init, Observability, Options, ResidualForm, Solver, Start, Verdict};
-use crate::astro::increments::{self, GyroErrorMode, GyroErrorModel, ImuRecord, TaylorVariant};
+use crate::astro::calibration::{self, Calibration, CovarianceForm, DiffForm, IncrementErrors, Init, Observability, Options, ResidualForm, Solver, Start, Verdict};
+use crate::astro::increments::{self, GyroErrorMode, GyroErrorModel, ImuRecord, Mat39, TaylorVariant};
 use crate::astro::scenario::{self, Run, Scenario};
 use crate::astro::stars::{self, Camera, Catalog, Observations};
 use crate::astro::{d1, d2, euler_dcm, euler_from_dcm};
@@ -155,6 +155,7 @@ fn calibration_dict<'py>(py: Python<'py>, c: &Calibration) -> PyResult<Bound<'py
     d.set_item("p_theta", mat_to_py(py, &c.p_theta))?;
     d.set_item("p_beta", mat_to_py(py, &c.p_beta))?;
     d.set_item("p_clb", mat_to_py(py, &c.p_clb))?;
+    d.set_item("covariance", c.covariance.name())?;
     d.set_item("singular_values", vec_to_py(py, &c.singular_values))?;
     d.set_item("condition_number", c.condition_number)?;
     d.set_item("weak_axis_mf", vec_to_py(py, &c.weak_axis_mf))?;
@@ -163,8 +164,25 @@ fn calibration_dict<'py>(py: Python<'py>, c: &Calibration) -> PyResult<Bound<'py
     Ok(d)
 }
 
+/// The consistent gyro mode's sensitivities `j_m` (M, 3, 9), `j_b` (M, 3, 3) with the budget
+/// `sigmas` (all or none), for the constant-error terms of the model covariance.
+fn constant_errors(j_m: Option<PyReadonlyArray3<'_, f64>>, j_b: Option<PyReadonlyArray3<'_, f64>>, sigmas: Option<(f64, f64, f64, f64)>) -> PyResult<Option<(Vec<(Mat39, Mat3)>, GyroErrorModel)>> {
+    match (j_m, j_b, sigmas) {
+        (None, None, None) => Ok(None),
+        (Some(jm), Some(jb), Some(sg)) => {
+            let (jm, jb) = (mats::<3, 9>(&jm, "j_m")?, mats::<3, 3>(&jb, "j_b")?);
+            if jm.len() != jb.len() {
+                return Err(invalid("j_b", format!("expected {} sensitivities like j_m, got {}", jm.len(), jb.len())).into());
+            }
+            Ok(Some((jm.into_iter().zip(jb).collect(), gyro_model(sg, GyroErrorMode::Consistent)?)))
+        }
+        _ => Err(invalid("j_m", "give j_m, j_b and sigmas together (consistent gyro mode) or none of them").into()),
+    }
+}
+
 #[pyfunction]
-#[pyo3(signature = (ds_imu, ds_avu, *, init=Wrap(Start::Axes), c0=None, solver=Wrap(Solver::So3), max_iter=None, tol=1e-9, residual_form=Wrap(ResidualForm::Full)))]
+#[pyo3(signature = (ds_imu, ds_avu, *, init=Wrap(Start::Axes), c0=None, solver=Wrap(Solver::So3), max_iter=None, tol=1e-9, residual_form=Wrap(ResidualForm::Full),
+                    covariance=None, e_imu=None, p_avu=None, j_m=None, j_b=None, sigmas=None))]
 #[allow(clippy::too_many_arguments)]
 fn astro_calibrate<'py>(
     py: Python<'py>,
@@ -176,12 +194,30 @@ fn astro_calibrate<'py>(
     max_iter: Option<Bound<'py, PyAny>>,
     #[pyo3(from_py_with = real)] tol: f64,
     residual_form: Wrap<ResidualForm>,
+    covariance: Option<Wrap<CovarianceForm>>,
+    e_imu: Option<PyReadonlyArray3<'py, f64>>,
+    p_avu: Option<PyReadonlyArray3<'py, f64>>,
+    j_m: Option<PyReadonlyArray3<'py, f64>>,
+    j_b: Option<PyReadonlyArray3<'py, f64>>,
+    sigmas: Option<(f64, f64, f64, f64)>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let (a, b) = (mats::<3, 3>(&ds_imu, "ds_imu")?, mats::<3, 3>(&ds_avu, "ds_avu")?);
     let c0 = c0.map(|c| mat3_arg(&c, "c0")).transpose()?;
     let max_iter = max_iter.map(|n| index_count(&n, "max_iter", 1, usize::MAX)).transpose()?.unwrap_or(Options::default().max_iter);
-    let opt = Options::new(Init::new(init.0, c0)?, solver.0, max_iter, tol, residual_form.0)?;
-    let cal = py.detach(|| calibration::calibrate(&a, &b, &opt))?;
+    let opt = Options { covariance: covariance.map(|c| c.0), ..Options::new(Init::new(init.0, c0)?, solver.0, max_iter, tol, residual_form.0)? };
+    let covs = match (e_imu, p_avu) {
+        (None, None) => None,
+        (Some(e), Some(p)) => Some((mats::<3, 3>(&e, "e_imu")?, mats::<3, 3>(&p, "p_avu")?)),
+        (None, Some(_)) => return Err(invalid("e_imu", "give e_imu with p_avu").into()),
+        (Some(_), None) => return Err(invalid("p_avu", "give p_avu with e_imu").into()),
+    };
+    let sens = constant_errors(j_m, j_b, sigmas)?;
+    if sens.is_some() && covs.is_none() {
+        return Err(invalid("e_imu", "the constant gyro errors j_m, j_b need e_imu and p_avu").into());
+    }
+    let constant = sens.as_ref().map(|(s, m)| calibration::ConstantGyroErrors { sensitivities: s, p_m: m.p_m(), sigma_b: m.sigma_b });
+    let errors = covs.as_ref().map(|(e, p)| IncrementErrors { e_imu: e, p_avu: p, constant: constant.as_ref() });
+    let cal = py.detach(|| calibration::calibrate_with(&a, &b, &opt, errors.as_ref()))?;
     calibration_dict(py, &cal)
 }
 
@@ -269,17 +305,10 @@ fn astro_model_covariance<'py>(
     let (e, p) = (mats::<3, 3>(&e_imu, "e_imu")?, mats::<3, 3>(&p_avu, "p_avu")?);
     stars::check_covariances("e_imu", &e, a.len())?;
     stars::check_covariances("p_avu", &p, a.len() + 1)?;
-    let sens: Option<(Vec<_>, GyroErrorModel)> = match (j_m, j_b, sigmas) {
-        (None, None, None) => None,
-        (Some(jm), Some(jb), Some(sg)) => {
-            let (jm, jb) = (mats::<3, 9>(&jm, "j_m")?, mats::<3, 3>(&jb, "j_b")?);
-            if jm.len() != a.len() || jb.len() != a.len() {
-                return Err(invalid("j_m", format!("expected {} sensitivities, got {} and {}", a.len(), jm.len(), jb.len())).into());
-            }
-            Some((jm.into_iter().zip(jb).collect(), gyro_model(sg, GyroErrorMode::Consistent)?))
-        }
-        _ => return Err(invalid("j_m", "give j_m, j_b and sigmas together (consistent gyro mode) or none of them").into()),
-    };
+    let sens = constant_errors(j_m, j_b, sigmas)?;
+    if sens.as_ref().is_some_and(|(s, _)| s.len() != a.len()) {
+        return Err(invalid("j_m", format!("expected {} sensitivities, got {}", a.len(), sens.as_ref().map_or(0, |(s, _)| s.len()))).into());
+    }
     let constant = sens.as_ref().map(|(s, m)| calibration::ConstantGyroErrors { sensitivities: s, p_m: m.p_m(), sigma_b: m.sigma_b });
     let (pm, ps) = calibration::model_covariance(&c, &a, &b, &e, &p, constant.as_ref())?;
     Ok((mat_to_py(py, &pm), mat_to_py(py, &ps)))
@@ -445,6 +474,7 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     register_choices::<Start>(m, "CalibrationInit")?;
     register_choices::<Solver>(m, "CalibrationSolver")?;
     register_choices::<ResidualForm>(m, "ResidualForm")?;
+    register_choices::<CovarianceForm>(m, "MountCovariance")?;
     register_choices::<DiffForm>(m, "DiffForm")?;
     register_choices::<GyroErrorMode>(m, "GyroErrorMode")?;
     register_choices::<TaylorVariant>(m, "TaylorVariant")?;

@@ -23,7 +23,7 @@ import numpy as np
 
 from .. import _core, plausibility
 from .._validate import as_floats, input_error, instance, integers, path as checked_path, positive, renamed, rows, scalar, vector
-from .results import D17_CAVEAT, Calibration, Observations, _store_rows
+from .results import D17_CAVEAT, AstroIncrements, Calibration, Observations, StarAttitudes, _store_rows
 from .scenario import Vasilyuk2024
 
 NED_TO_ENU = np.array([[0.0, 1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, -1.0]])
@@ -72,7 +72,7 @@ def euler_dcm(beta) -> np.ndarray:
 
 
 def euler_from_dcm(c) -> np.ndarray:
-    """Canonical Euler angles (ψ ∈ [0, 2π), ϑ, γ) of rotation matrices.
+    """Canonical Euler angles (ψ ∈ (−π, π], ϑ ∈ [−π/2, π/2], γ ∈ (−π, π]) of rotation matrices.
 
     Parameters
     ----------
@@ -82,7 +82,8 @@ def euler_from_dcm(c) -> np.ndarray:
     Returns
     -------
     numpy.ndarray, shape (3,) or (N, 3)
-        β = (ψ, ϑ, γ), rad; (3, 3) → (3,), (N, 3, 3) → (N, 3).
+        β = (ψ, ϑ, γ), rad; (3, 3) → (3,), (N, 3, 3) → (N, 3). ψ and γ lie in (−π, π]
+        (a −0.1° heading reads −0.1°, π reads +π), ϑ in [−π/2, π/2].
 
     Notes
     -----
@@ -291,13 +292,41 @@ def observability(ds_avu) -> dict:
     return _core.astro_observability(_mats(ds_avu, "ds_avu"))
 
 
+def _constant_terms(increments: Increments | None, model: GyroErrorModel | None):
+    """(j_m, j_b, sigmas) of the consistent gyro mode, or three None."""
+    if model is not None:
+        instance(model, GyroErrorModel, "model")
+    if increments is not None:
+        instance(increments, Increments, "increments")
+    if model is None or model.mode != "consistent":
+        return None, None, None
+    if increments is None or increments.j_m is None:
+        raise input_error("increments", "the consistent gyro mode needs the Increments with j_m, j_b")
+    return increments.j_m, increments.j_b, model._sigmas()
+
+
 def calibrate(ds_imu, ds_avu, *, init: str = "axes", c0=None, solver: str = "so3", max_iter: int = 50,
-              tol: float = 1e-9, residual_form: str = "full", gyro_error_model: str = "unspecified") -> Calibration:
+              tol: float = 1e-9, residual_form: str = "full", covariance: str | None = None, e_imu=None, p_avu=None,
+              increments: Increments | None = None, model: GyroErrorModel | None = None,
+              gyro_error_model: str = "unspecified") -> Calibration:
     """Mount C_MF^VF from increment pairs ΔS^avu = Cᵀ ΔS^imu C (Vasilyuk et al. 2024, §3).
 
-    Gauss–Newton on the increment residuals; P_β is the paper's residual sandwich. The
-    option names are ``_core.OPTIONS["CalibrationInit"]``, ``["CalibrationSolver"]`` and
-    ``["ResidualForm"]``.
+    Gauss–Newton on the increment residuals f_n, then the sandwich
+    P_θ = (HᵀH)⁻¹HᵀΣ_fH(HᵀH)⁻¹ of the stacked residual covariance Σ_f. Consecutive star
+    increments ΔS_n^avu = S_{n−1}ᵀS_n share the epoch S_n, so Σ_f has the neighbour blocks
+    −P_n^avu ΔS_{n+1}; the reported P_β includes them by default
+    (docs/departures.md#correlated-increment-residuals):
+
+    - with ``e_imu`` and ``p_avu`` given, ``covariance="model"`` (the default then): Σ_f
+      from those covariances, as :func:`model_covariance`;
+    - without them, ``covariance="residual"`` (the default then): the same structure with
+      one star-attitude covariance and one gyro-increment covariance estimated from the
+      residuals (their lag-1 and lag-0 moments);
+    - ``covariance="paper_sandwich"``: the paper's Σ_f = I ⊗ P_S, increments taken as
+      independent (Vasilyuk et al. 2024, E18).
+
+    The option names are ``_core.OPTIONS["CalibrationInit"]``, ``["CalibrationSolver"]``,
+    ``["ResidualForm"]`` and ``["MountCovariance"]``.
 
     Parameters
     ----------
@@ -318,21 +347,37 @@ def calibrate(ds_imu, ds_avu, *, init: str = "axes", c0=None, solver: str = "so3
     tol : float, default 1e-9
         Stop at a step ≤ ``tol``, rad.
     residual_form : {"full", "diagonal"}, default "full"
-        Form of the residual covariance P_S in the sandwich.
+        Form of the residual covariance P_S (reported as ``p_s``, used by
+        ``covariance="paper_sandwich"``).
+    covariance : {"model", "residual", "paper_sandwich"}, optional
+        Form of P_θ, P_β and P^clb; default "model" when ``e_imu`` and ``p_avu`` are given,
+        else "residual".
+    e_imu : array_like, shape (M, 3, 3), optional
+        Gyro interval covariances E^imu in MF, rad² (e.g. :attr:`Increments.cov`); give
+        with ``p_avu``.
+    p_avu : array_like, shape (M + 1, 3, 3), optional
+        Star-attitude covariances P^avu of the M + 1 epochs in VF, rad² (e.g.
+        :attr:`StarAttitudes.p_avu`); give with ``e_imu``.
+    increments : Increments, optional
+        The gyro increments; needed (with ``j_m``/``j_b``) when ``model.mode`` is
+        "consistent", for the constant-error terms, as in :func:`model_covariance`.
+    model : GyroErrorModel, optional
+        Gyro error budget; only its "consistent" mode changes the result.
     gyro_error_model : str, default "unspecified"
         Provenance label of the gyro model, stored in the result.
 
     Returns
     -------
     Calibration
-        The mount, its Euler angles and covariances (rad, rad²) and the identifiability
-        report.
+        The mount, its Euler angles and covariances (rad, rad²), the covariance form used
+        (``covariance``) and the identifiability report.
 
     Raises
     ------
     atomnav.InputError
         When the trajectory cannot determine the mount (κ < 1e-12; the message names the
-        null direction).
+        null direction), or naming ``e_imu``/``p_avu`` when only one is given, when
+        ``covariance="model"`` lacks them or another form is given them.
     atomnav.NumericalError
         When Gauss–Newton does not converge or stops at a wrong stationary point.
 
@@ -340,10 +385,21 @@ def calibrate(ds_imu, ds_avu, *, init: str = "axes", c0=None, solver: str = "so3
     -----
     RuntimeWarning
         When the mount is weakly observable (κ < 1e-4), naming the weak direction in VF.
+
+    Notes
+    -----
+    Without error covariances the residuals carry little information on gyro noise along
+    an axis the trajectory keeps turning about (the star part of the score telescopes
+    there); the residual σ of that angle is then noisy from run to run
+    (docs/departures.md#correlated-increment-residuals). Give ``e_imu`` and ``p_avu``
+    where they are known.
     """
     c0 = None if c0 is None else rows(c0, 3, "c0")
+    jm, jb, sigmas = _constant_terms(increments, model)
     d = _core.astro_calibrate(_mats(ds_imu, "ds_imu"), _mats(ds_avu, "ds_avu"), init=init, c0=c0, solver=solver,
-                              max_iter=max_iter, tol=scalar(tol, "tol"), residual_form=residual_form)
+                              max_iter=max_iter, tol=scalar(tol, "tol"), residual_form=residual_form, covariance=covariance,
+                              e_imu=None if e_imu is None else _mats(e_imu, "e_imu"),
+                              p_avu=None if p_avu is None else _mats(p_avu, "p_avu"), j_m=jm, j_b=jb, sigmas=sigmas)
     if d["observability"]["verdict"] == "warn":
         k = d["observability"]["weak_axis_vf"]
         warnings.warn(f"weakly observable mount: kappa = {d['observability']['kappa']:.3e} < 1e-4, "
@@ -510,7 +566,7 @@ def refraction_apply(s, up, n: float) -> np.ndarray:
 
 
 def star_attitudes(obs: Observations, n_epochs: int, cameras, sigma_s_rad: float, p_alpha=None,
-                   up_gcrs=None, n_refr: float = 1.0, p_avu=None):
+                   up_gcrs=None, n_refr: float = 1.0, p_avu=None) -> StarAttitudes:
     """Star attitudes of the virtual camera VF per epoch and their covariance.
 
     Merges the cameras into VF, removes refraction, solves Wahba's problem per epoch and
@@ -542,12 +598,10 @@ def star_attitudes(obs: Observations, n_epochs: int, cameras, sigma_s_rad: float
 
     Returns
     -------
-    s_gcrs_vf : numpy.ndarray, shape (N, 3, 3)
-        Star attitudes S_GCRS^VF.
-    p_avu : numpy.ndarray, shape (N, 3, 3)
-        P^avu, rad².
-    stars : numpy.ndarray of int64, shape (N,)
-        Stars used per epoch.
+    StarAttitudes
+        ``s_gcrs_vf`` (N, 3, 3) the star attitudes S_GCRS^VF, ``p_avu`` (N, 3, 3) P^avu in
+        rad², ``stars`` (N,) the stars used per epoch; unpacks as
+        ``s_gcrs_vf, p_avu, stars``.
     """
     instance(obs, Observations, "obs")
     cams = _mats(cameras, "cameras")
@@ -555,14 +609,14 @@ def star_attitudes(obs: Observations, n_epochs: int, cameras, sigma_s_rad: float
     up = None if up_gcrs is None else rows(up_gcrs, 3, "up_gcrs")
     # the observations' fields are checked by the core under their own names: errors name ``obs``
     with renamed(epoch="obs", camera="obs", star_directions="obs", catalog_directions="obs"):
-        return _core.astro_star_attitudes(np.ascontiguousarray(obs.epoch, dtype=np.int64),
+        return StarAttitudes(*_core.astro_star_attitudes(np.ascontiguousarray(obs.epoch, dtype=np.int64),
                                       np.ascontiguousarray(obs.camera, dtype=np.int64),
                                       rows(obs.s_cf, 3, "star_directions"), rows(obs.g, 3, "catalog_directions"),
                                       n_epochs, cameras=cams, p_alpha=pa, sigma_s=scalar(sigma_s_rad, "sigma_s_rad"), up_gcrs=up,
-                                      n_refr=scalar(n_refr, "n_refr"), p_avu=None if p_avu is None else _mats(p_avu, "p_avu"))
+                                      n_refr=scalar(n_refr, "n_refr"), p_avu=None if p_avu is None else _mats(p_avu, "p_avu")))
 
 
-def astro_increments(s_vf, p_avu):
+def astro_increments(s_vf, p_avu) -> AstroIncrements:
     """Star-attitude increments ΔS_n^avu = S_{n−1}ᵀ S_n and their covariance
     E_n^avu = P_n + ΔS_nᵀ P_{n−1} ΔS_n (Vasilyuk et al. 2024).
 
@@ -575,12 +629,11 @@ def astro_increments(s_vf, p_avu):
 
     Returns
     -------
-    ds_avu : numpy.ndarray, shape (N − 1, 3, 3)
-        ΔS_n^avu.
-    e_avu : numpy.ndarray, shape (N − 1, 3, 3)
-        E_n^avu, rad².
+    AstroIncrements
+        ``ds_avu`` (N − 1, 3, 3) the increments ΔS_n^avu and ``e_avu`` (N − 1, 3, 3) their
+        covariances E_n^avu, rad²; unpacks as ``ds_avu, e_avu``.
     """
-    return _core.astro_astro_increments(_mats(s_vf, "s_vf"), _mats(p_avu, "p_avu"))
+    return AstroIncrements(*_core.astro_astro_increments(_mats(s_vf, "s_vf"), _mats(p_avu, "p_avu")))
 
 
 def model_covariance(cal: Calibration, ds_imu, ds_avu, e_imu, p_avu, increments: Increments | None = None,
@@ -623,12 +676,7 @@ def model_covariance(cal: Calibration, ds_imu, ds_avu, e_imu, p_avu, increments:
         Naming ``increments`` when the consistent mode lacks the sensitivities.
     """
     instance(cal, Calibration, "cal")
-    if model is not None:
-        instance(model, GyroErrorModel, "model")
-    consistent = model is not None and model.mode == "consistent"
-    if consistent and (increments is None or increments.j_m is None):
-        raise input_error("increments", "the consistent gyro mode needs the Increments with j_m, j_b")
-    extra = (increments.j_m, increments.j_b, model._sigmas()) if consistent else (None, None, None)
+    extra = _constant_terms(increments, model)
     return _core.astro_model_covariance(rows(cal.c, 3, "c"), _mats(ds_imu, "ds_imu"), _mats(ds_avu, "ds_avu"),
                                         _mats(e_imu, "e_imu"), _mats(p_avu, "p_avu"), *extra)
 
@@ -700,6 +748,6 @@ __all__ = [
     "NED_TO_ENU", "D17_CAVEAT", "euler_dcm", "euler_from_dcm", "d1", "d2", "GyroErrorModel", "Increments",
     "gyro_increments", "dead_reckoning_cov", "observability", "Calibration", "calibrate", "Catalog",
     "synthetic_catalog", "load_catalog", "refractive_index", "refraction_correct", "refraction_apply",
-    "Observations", "star_attitudes", "astro_increments", "model_covariance", "aberration", "simulate_observations",
+    "Observations", "StarAttitudes", "star_attitudes", "AstroIncrements", "astro_increments", "model_covariance", "aberration", "simulate_observations",
     "Vasilyuk2024",
 ]

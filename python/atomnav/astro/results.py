@@ -42,6 +42,9 @@ class Calibration:
     p_clb : numpy.ndarray, shape (3, 3)
         Calibration error covariance P^clb = D2 P_β D2ᵀ in MF, rad² (Vasilyuk et al.
         2024, Eq. 8).
+    covariance : {"model", "residual", "paper_sandwich"}
+        The form P_θ, P_β and P^clb were computed in, as chosen by
+        :func:`atomnav.astro.calibrate` (docs/departures.md#correlated-increment-residuals).
     singular_values : numpy.ndarray, shape (3,)
         Singular values of the stacked Jacobian H at the solution, descending.
     condition_number : float
@@ -69,6 +72,7 @@ class Calibration:
     p_theta: np.ndarray
     p_beta: np.ndarray
     p_clb: np.ndarray
+    covariance: str
     singular_values: np.ndarray
     condition_number: float
     weak_axis_mf: np.ndarray
@@ -110,7 +114,7 @@ class Calibration:
         obs = {f"obs_{k}": np.asarray(v) for k, v in self.observability.items()}
         np.savez(checked_path(path), **{k: getattr(self, k) for k in _RESULT_ARRAYS}, iterations=self.iterations,
                  relative_misfit=self.relative_misfit, condition_number=self.condition_number, sigma_weak=self.sigma_weak,
-                 gyro_error_model=self.gyro_error_model, caveat=self.caveat, **obs)
+                 covariance=self.covariance, gyro_error_model=self.gyro_error_model, caveat=self.caveat, **obs)
 
     @classmethod
     def load(cls, path) -> "Calibration":
@@ -139,6 +143,8 @@ class Calibration:
                 obs = {k[4:]: (z[k].item() if z[k].ndim == 0 else z[k]) for k in z.files if k.startswith("obs_")}
                 return cls(**kw, iterations=int(z["iterations"]), relative_misfit=float(z["relative_misfit"]),
                            condition_number=float(z["condition_number"]), sigma_weak=float(z["sigma_weak"]),
+                           # files written before the covariance was recorded hold the paper's sandwich
+                           covariance=str(z["covariance"]) if "covariance" in z.files else "paper_sandwich",
                            observability=obs,
                            gyro_error_model=str(z["gyro_error_model"]), caveat=str(z["caveat"]))
         except (ValueError, KeyError, EOFError, zipfile.BadZipFile) as e:  # not an .npz, or one without our arrays
@@ -183,3 +189,52 @@ class Observations:
     def __post_init__(self):
         _store_rows(self, epoch=integers(self.epoch, "epoch"), camera=integers(self.camera, "camera"),
                     s_cf=rows(self.s_cf, 3, "s_cf"), g=rows(self.g, 3, "g"))
+
+
+@dataclass(frozen=True, eq=False)
+class StarAttitudes:
+    """Star attitudes of the virtual camera VF per epoch, as returned by
+    :func:`atomnav.astro.star_attitudes` (Vasilyuk et al. 2024).
+
+    Unpacks in the order of its fields, ``s_gcrs_vf, p_avu, stars = star_attitudes(...)``.
+
+    Attributes
+    ----------
+    s_gcrs_vf : numpy.ndarray, shape (N, 3, 3)
+        Star attitudes S_GCRS^VF (rotation matrices, VF into GCRS).
+    p_avu : numpy.ndarray, shape (N, 3, 3)
+        Their covariances P^avu in VF, rad².
+    stars : numpy.ndarray of int64, shape (N,)
+        Stars used per epoch.
+    """
+
+    s_gcrs_vf: np.ndarray
+    p_avu: np.ndarray
+    stars: np.ndarray
+
+    def __iter__(self):
+        return iter((self.s_gcrs_vf, self.p_avu, self.stars))
+
+
+@dataclass(frozen=True, eq=False)
+class AstroIncrements:
+    """Star-attitude increments between consecutive epochs, as returned by
+    :func:`atomnav.astro.astro_increments` (Vasilyuk et al. 2024).
+
+    Unpacks in the order of its fields, ``ds_avu, e_avu = astro_increments(...)``.
+
+    Attributes
+    ----------
+    ds_avu : numpy.ndarray, shape (N − 1, 3, 3)
+        Increments ΔS_n^avu = S_{n−1}ᵀ S_n in VF (rotation matrices).
+    e_avu : numpy.ndarray, shape (N − 1, 3, 3)
+        Their covariances E_n^avu = P_n + ΔS_nᵀ P_{n−1} ΔS_n, rad². Neighbouring increments
+        share an epoch and are correlated; :func:`atomnav.astro.calibrate` takes the epoch
+        covariances P^avu for that.
+    """
+
+    ds_avu: np.ndarray
+    e_avu: np.ndarray
+
+    def __iter__(self):
+        return iter((self.ds_avu, self.e_avu))
