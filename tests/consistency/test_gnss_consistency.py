@@ -107,3 +107,50 @@ def test_spp_sigma_matches_its_scatter(program):
 def test_spp_sigma_matches_its_scatter_full(program):
     """Full size: 200 draws × 25 epochs = 5000 pooled values per block (sampling σ 0.01)."""
     _check(program, 200, 25)
+
+
+# --- the tightly coupled GNSS/INS filter (Demidov 2009's MOVE program, scenarios.build) ---
+
+
+def _tight_nees(runs, duration, motion):
+    """Run-averaged NEES of position, velocity and attitude from the full covariance the
+    filter returns, over ``runs`` seeds (each draws its IMU errors from the preset's model,
+    the initial error from P₀, the satellite clocks and the code/rate noise)."""
+    from atomnav.gnss import scenarios as S
+
+    nees = []
+    for seed in range(runs):
+        setup = S.build(S.Scenario("precise", motion=motion, duration_s=duration, seed=seed))
+        ins = g.tight_ins(setup["eph"], setup["obs"], **setup["args"])
+        m = setup["imu"]
+        res = ins.run(m["time_s"].to_numpy(), m[["dtheta_x_rad", "dtheta_y_rad", "dtheta_z_rad"]].to_numpy(),
+                      m[["dv_x_mps", "dv_y_mps", "dv_z_mps"]].to_numpy(), h_ref=setup["h_ref"], chunk_s=300.0,
+                      progress=False, covariance=True)
+        nees.append(res.nees(setup["trajectory"])["nees"].to_numpy())
+    return np.mean(nees, axis=0)
+
+
+def _check_tight(runs, duration, motion):
+    nees = _tight_nees(runs, duration, motion)
+    lo, hi = an.filter.chi2_band(9, runs)
+    inside = np.mean((nees >= lo) & (nees <= hi))
+    assert inside >= 0.90, (motion, inside, nees.mean(), lo, hi)
+
+
+def test_tight_filter_nees_50_runs_reduced():
+    """50 runs of 60 s of the drive: the run-averaged NEES (9 states) inside the χ² 95 %
+    band at ≥ 90 % of the epochs."""
+    _check_tight(50, 60.0, "MOVE")
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("motion", [
+    "MOVE",
+    # measured: 83 % of epochs inside, the other 17 % all below the band (run-mean NEES
+    # 8.40 for 9): the filter is conservative when stationary
+    pytest.param("STAT", marks=pytest.mark.xfail(strict=True, reason="stationary: NEES below the χ² band at 17 % of "
+                                                                     "epochs (conservative covariance)")),
+])
+def test_tight_filter_nees_50_runs_full(motion):
+    """50 runs of 600 s."""
+    _check_tight(50, 600.0, motion)
