@@ -525,6 +525,17 @@ def _finite(x, depth=0) -> bool:
     return True
 
 
+def _reads_keyword(fn, name) -> bool:
+    """Whether ``fn`` takes ``**kwargs`` and ``name`` can be one of them: such a callable
+    (e.g. ``Layout.covariance(**sigma)``, one keyword per state block) names the keyword it
+    read or missed."""
+    try:
+        params = inspect.signature(fn).parameters.values()
+    except (TypeError, ValueError):
+        return False
+    return isinstance(name, str) and name.isidentifier() and any(p.kind == p.VAR_KEYWORD for p in params)
+
+
 def classify(t: Target, fn, kwargs: dict) -> tuple[str, str, float, str | None]:
     """Call ``fn(**kwargs)``: (outcome class, message, seconds, class name of an API
     instance it returned)."""
@@ -537,7 +548,7 @@ def classify(t: Target, fn, kwargs: dict) -> tuple[str, str, float, str | None]:
     except atomnav.InputError as e:
         p = getattr(e, "parameter", None)
         base = str(p).split(".")[0].split("[")[0] if p is not None else None
-        cls = "InputError" if base in t.param_names() else "InputError(bad parameter)"
+        cls = "InputError" if base in t.param_names() or _reads_keyword(fn, base) else "InputError(bad parameter)"
         return cls, f"parameter={p!r}: {e}", time.perf_counter() - start, None
     except TypeError as e:
         return "TypeError", str(e), time.perf_counter() - start, None

@@ -606,6 +606,8 @@ EXEMPT = {
     "atomnav.trajectory.Trajectory.ideal_imu": "takes an option name; the table is its output",
     # result containers: the library builds them from its own checked arrays and returns them
     "atomnav.astro.Increments": "the result of astro.gyro_increments",
+    "atomnav.astro.results.StarAttitudes": "the result of astro.star_attitudes",
+    "atomnav.astro.results.AstroIncrements": "the result of astro.astro_increments",
     "atomnav.cai.results.HybridResult": "the result of a CAI hybrid Monte Carlo",
     "atomnav.noise.filters.KalmanResult": "the result of noise.filters.kalman",
     "atomnav.noise.allan.AllanFit": "the result of noise.allan.fit_allan",

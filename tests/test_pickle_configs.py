@@ -443,6 +443,8 @@ def test_every_public_class_is_covered():
         "PositionFixes", "VelocityFixes", "ZeroVelocity", "ZeroRate", "NonHolonomic", "GnssObservations", "Source", "AidingSource",
         # test_constraints.py
         "StillPeriods",
+        # test_astro_stars.py
+        "StarAttitudes", "AstroIncrements",
         # tests above
         "AidedIns", "AidedSetup", "CaiChannels", "CaiSetup", "CaiGravity", "CaiMotion", "CaiHybrid", "AstroScenario",
         "Vasilyuk2024", "Scenario", "Calibration", "Observations",

@@ -269,6 +269,8 @@ pub struct FilterOutput {
     pub r: Vec<f64>,
     /// K_k, row-major N×n.
     pub gain: Vec<f64>,
+    /// Posterior variance of ω̂_k, the (0, 0) entry of P_k.
+    pub var: Vec<f64>,
 }
 
 /// Largest state dimension the filter supports (ARMA orders p, q ≤ 3 need at most 7).
@@ -362,6 +364,7 @@ impl<const N: usize> Core<N> {
             if record {
                 out.r.push(rs.r);
                 out.gain.extend_from_slice(self.gain.as_slice());
+                out.var.push(self.p[(0, 0)]);
             }
         }
         Ok(())

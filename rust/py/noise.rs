@@ -157,15 +157,15 @@ impl PyArmaFilterConfig {
     }
 }
 
-type FilterArrays<'py> = (Arr<'py>, Arr<'py>, Bound<'py, PyArray2<f64>>);
+type FilterArrays<'py> = (Arr<'py>, Arr<'py>, Bound<'py, PyArray2<f64>>, Arr<'py>);
 
 fn output_to_py<'py>(py: Python<'py>, out: FilterOutput, n: usize) -> FilterArrays<'py> {
     let rows = out.gain.len() / n;
-    (out.xhat.into_pyarray(py), out.r.into_pyarray(py), flat_to_py(py, rows, n, out.gain))
+    (out.xhat.into_pyarray(py), out.r.into_pyarray(py), flat_to_py(py, rows, n, out.gain), out.var.into_pyarray(py))
 }
 
-/// Batch Kalman filter; returns (ω̂, R history, gain history (N, n)); histories are empty
-/// unless `record`.
+/// Batch Kalman filter; returns (ω̂, R history, gain history (N, n), posterior variance of
+/// ω̂); histories are empty unless `record`.
 #[pyfunction]
 #[pyo3(signature = (omega, config, *, record=true))]
 fn kalman_filter<'py>(py: Python<'py>, omega: PyReadonlyArray1<'py, f64>, config: PyRef<'py, PyArmaFilterConfig>, record: bool) -> PyResult<FilterArrays<'py>> {

@@ -1,0 +1,142 @@
+"""Monte-Carlo consistency of the uncertainties the noise-analysis tools report.
+
+- Allan variance (overlapping "allan" and "modified"): the χ² confidence interval
+  (dev_lo, dev_hi) at 68.3 % must cover the true deviation in about 68.3 % of records. The
+  true values are exact: σ²/m for white rate noise of variance σ² per sample, and for a
+  rate random walk the variance of the weighted increment sum, computed here from the
+  increments' weights (no formula of the code under test).
+- ARMA fit: the scatter of the estimated coefficients over records equals the standard
+  errors it reports (statsmodels' exact ML), on ARMA(1,1) and ARMA(2,1) programs that
+  are not Niu et al. 2025's.
+- ARMA Kalman filter: the scatter of ω̂ − ω equals √var (the filter's posterior variance)
+  when the model and R are the truth's (the exact noise form); the paper's noise form and
+  the adaptive filters are reported, with their measured ratio, in their docstrings.
+
+Criterion: a coverage inside the binomial 3σ band of the run count, a scatter/σ ratio
+inside [0.85, 1.15] (with R runs the ratio's sampling spread is ≈ 1/√(2R); R ≥ 200 keeps
+the band beyond 3 spreads). Reduced sizes in CI, full sizes under ``slow``.
+"""
+
+import numpy as np
+import pytest
+from scipy.signal import lfilter
+
+from atomnav.noise import allan, arma, filters
+
+
+def _coverage_band(p, runs):
+    half = 3 * np.sqrt(p * (1 - p) / runs)
+    return p - half, p + half
+
+
+def _random_walk_avar(m, q):
+    """Exact Allan variance at m samples of a rate random walk with increment variance q:
+    ½ var(ȳ₂ − ȳ₁) with ȳ the m-sample averages, from the weights of the increments."""
+    i = np.arange(2 * m)
+    w = np.array([((i >= j) & (i >= m)).sum() - ((i >= j) & (i < m)).sum() for j in range(2 * m)]) / m
+    return 0.5 * q * np.sum(w**2)
+
+
+def _coverage(kind, process, runs, n=4096, seed=1):
+    rng = np.random.default_rng(seed)
+    hits, total = 0, 0
+    for _ in range(runs):
+        e = rng.standard_normal(n)
+        y, noise_type = (e, "white_fm") if process == "white" else (np.cumsum(e), "random_walk_fm")
+        t = allan.allan_variance(y, 0.01, m=[1, 2, 4, 8, 16], kind=kind, noise=noise_type)
+        if kind == "allan":
+            true = 1.0 / t["m"] if process == "white" else np.array([_random_walk_avar(m, 1.0) for m in t["m"]])
+        else:  # modified Allan of white rate noise: σ²/m · (2m² + 1)/(3m²)... checked by brute force below
+            true = _true_mvar(t["m"].to_numpy(), process)
+        inside = (t["dev_lo"] ** 2 <= true) & (true <= t["dev_hi"] ** 2)
+        hits += inside.to_numpy(int)
+        total += 1
+    return hits / total
+
+
+def _true_mvar(ms, process, draws=20000, seed=99):
+    """Modified Allan variance by brute force: the mean over many independent records of
+    the squared second-level difference (independent of the code's estimator and EDF)."""
+    rng = np.random.default_rng(seed)
+    out = []
+    for m in ms:
+        e = rng.standard_normal((draws, 3 * m))
+        y = e if process == "white" else np.cumsum(e, axis=1)
+        x = np.cumsum(y, axis=1) * 0.01                                 # phase
+        x = np.c_[np.zeros(draws), x]
+        d = x[:, 2 * m:3 * m + 1][:, :m] - 2 * x[:, m:2 * m] + x[:, :m]   # m second differences
+        out.append(np.mean(d.mean(axis=1) ** 2) / (2 * (m * 0.01) ** 2))
+    return np.array(out)
+
+
+@pytest.mark.parametrize("kind, process", [("allan", "white"), ("allan", "random_walk")])
+def test_allan_confidence_interval_covers_the_truth_reduced(kind, process):
+    cover = _coverage(kind, process, runs=300)
+    lo, hi = _coverage_band(0.683, 300)
+    assert np.all((cover >= lo) & (cover <= hi)), cover
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("kind, process", [("allan", "white"), ("allan", "random_walk"), ("modified", "white")])
+def test_allan_confidence_interval_covers_the_truth_full(kind, process):
+    cover = _coverage(kind, process, runs=2000, seed=2)
+    lo, hi = _coverage_band(0.683, 2000)
+    assert np.all((cover >= lo) & (cover <= hi)), cover
+
+
+def _arma_ratios(ar, ma, draws, n=1500, seed=5):
+    rng = np.random.default_rng(seed)
+    est, se = [], []
+    for _ in range(draws):
+        a = rng.standard_normal(n + 200) * 0.3
+        x = lfilter(np.r_[1.0, ma], np.r_[1.0, -np.asarray(ar)], a)[200:]
+        fit = arma.fit_arma(x, order=(len(ar), len(ma)), differenced=True)
+        est.append(np.r_[fit.ar, fit.ma])
+        se.append([fit.se[f"ar.L{i + 1}"] for i in range(len(ar))] + [fit.se[f"ma.L{i + 1}"] for i in range(len(ma))])
+    return np.std(est, axis=0, ddof=1) / np.mean(se, axis=0), np.mean(est, axis=0)
+
+
+def test_arma_standard_errors_match_the_scatter_reduced():
+    """40 draws (statsmodels' exact ML takes about a second a fit): the ratio's sampling
+    spread is ≈ 1/√80 = 0.11, so the honest 3σ band at this size is [0.66, 1.34]."""
+    ratio, mean = _arma_ratios((0.6,), (0.3,), draws=40, n=400)
+    assert np.all((ratio > 0.66) & (ratio < 1.34)), ratio
+    assert np.allclose(mean, [0.6, 0.3], atol=0.06), mean
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("ar, ma", [((0.6,), (0.3,)), ((0.5, -0.3), (0.4,))])
+def test_arma_standard_errors_match_the_scatter_full(ar, ma):
+    ratio, mean = _arma_ratios(ar, ma, draws=200)
+    assert np.all((ratio > 0.85) & (ratio < 1.15)), ratio
+    assert np.allclose(mean, np.r_[ar, ma], atol=0.03), mean
+
+
+def _filter_ratio(ar, ma, r, runs, n=2000, burn=500, seed=7, form="exact"):
+    sigma2 = 0.04
+    model = filters.ArimaStateSpace(ar, ma, sigma2, d=0, noise_form=form)
+    rng = np.random.default_rng(seed)
+    err, var = [], []
+    for _ in range(runs):
+        a = rng.standard_normal(n + 500) * np.sqrt(sigma2)
+        w = lfilter(np.r_[1.0, ma], np.r_[1.0, -np.asarray(ar)], a)[500:]
+        z = w + rng.standard_normal(n) * np.sqrt(r)
+        out = filters.kalman(z, model, r0=r, p0=1.0)
+        err.append(out.omega_hat[burn:] - w[burn:])
+        var.append(out.var[burn:])
+    err, var = np.concatenate(err), np.concatenate(var)
+    return np.std(err) / np.sqrt(np.mean(var)), np.mean(err**2 / var)
+
+
+@pytest.mark.parametrize("ar, ma, r", [((0.9,), (0.4,), 0.05), ((1.2, -0.4), (0.3,), 0.2)])
+def test_arma_kalman_posterior_variance_matches_the_scatter_reduced(ar, ma, r):
+    ratio, nees = _filter_ratio(ar, ma, r, runs=20)
+    assert 0.85 < ratio < 1.15, ratio
+    assert 0.85 < nees < 1.15, nees
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("ar, ma, r", [((0.9,), (0.4,), 0.05), ((1.2, -0.4), (0.3,), 0.2)])
+def test_arma_kalman_posterior_variance_matches_the_scatter_full(ar, ma, r):
+    ratio, nees = _filter_ratio(ar, ma, r, runs=200)
+    assert 0.95 < ratio < 1.05, ratio
