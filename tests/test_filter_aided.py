@@ -339,3 +339,15 @@ def test_nees_helper_against_numpy_and_bad_requests():
     with pytest.raises(InputError, match="stream the record") as e3:
         _static_engine()[0].run(t, g, a, progress=False, covariance=True, covariance_memory=10_000)
     assert e3.value.parameter == "covariance"
+
+
+def test_one_fix_covariance_serves_every_fix():
+    """fix_cov may be a single (3, 3) matrix: the run equals the one with the stack tiled."""
+    ins, t, g, a = _static_engine()
+    one = ins.run(t, g, a, progress=False)
+    p0 = np.array(ins.setup.p0)
+    tiled = position_aided_ins(0.0, [LAT, LON, H], [0, 0, 0], [1, 0, 0, 0], "rates", np.arange(1.0, 10.0), [[LAT, LON, H]] * 9,
+                               np.tile(np.eye(3), (9, 1, 1)), p0=p0, gyro_psd=1e-14, accel_psd=1e-8, predict_every=10)
+    other = tiled.run(t, g, a, progress=False)
+    assert np.array_equal(one.nav.to_numpy(), other.nav.to_numpy())
+    assert len(one.measurements) == 9
