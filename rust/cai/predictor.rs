@@ -5,10 +5,14 @@
 //! position x in the sensor frame s obeys (docs/departures.md#specific-force-drives-the-atoms)
 //!   ẍ = −f_s − 2ω×ẋ − ω×(ω×x) − ω̇×x + Γ_s x,   x(0) = 0, ẋ(0) = v0,
 //! with (Eq. 7) f_s = C_sb (f_b + ω̇_b×l + ω_b×(ω_b×l)) − Γ_s C_sb l and (Eq. 8) ω = C_sb ω_b.
-//! The IMU inputs are interpolated between samples (linear by default, or cubic) and
+//! The gravity gradient is given once, as Γ_b0 in the body frame b at the shot's start, and
+//! turns with the body during the shot: Γ_s(τ) = C_sb R(τ)ᵀ Γ_b0 R(τ) C_bs, R = C_b0b with
+//! Ṙ = R[ω_b×] (docs/departures.md#gravity-gradient-frame).
+//! The IMU inputs are interpolated between samples (cubic by default, or linear) and
 //! bias-corrected with the current estimates; the ODE is integrated with RK4 on a grid made
 //! of the IMU sample times and the pulse times (`substeps` RK4 steps per grid interval);
-//! φ = k·D[x].
+//! φ = k·D[x]. [`error_bound`] estimates the discretisation error from the samples
+//! (docs/cai_predictor_accuracy.md).
 //!
 //! Breakdown (exact decomposition, docs/departures.md#per-term-breakdown): the solution of the linear ODE is
 //! x = x_h + x_p, x_h = Φ(t) v0 (homogeneous part; Φ shared by all channels with the same
@@ -19,7 +23,7 @@
 //! and the six terms add up to the total by construction.
 
 use crate::error::{check_finite, check_increasing, check_positive, invalid, Result};
-use crate::math::{dcm_from_rotvec, Mat3, Vec3};
+use crate::math::{dcm_from_rotvec, skew, Mat3, Vec3};
 use crate::options::Choice;
 
 /// One interferometer channel: effective wave vector k (rad/m, in s), lever arm l from the
@@ -61,6 +65,16 @@ pub enum OmegaDotKind {
     Given,
 }
 
+impl OmegaDotKind {
+    /// The ω̇ source when none is named: the given samples when there are some, else the
+    /// derivative of the gyro interpolant, whose lever-arm Euler term integrates by parts to
+    /// the interpolated rate and so keeps the interpolation's order
+    /// (docs/cai_predictor_accuracy.md#angular-acceleration).
+    pub fn default_for(given: bool) -> Self {
+        if given { OmegaDotKind::Given } else { OmegaDotKind::Pwl }
+    }
+}
+
 impl Choice for OmegaDotKind {
     const PARAMETER: &'static str = "omega_dot";
     const CHOICES: &'static [(&'static str, Self)] =
@@ -73,14 +87,21 @@ const STENCIL_PAD: usize = 3;
 
 /// Largest Savitzky–Golay half width accepted (a window of 2m + 1 samples).
 pub const MAX_SAVGOL_HALF_WIDTH: usize = 1000;
+/// Savitzky–Golay half width when none is given.
+pub const DEFAULT_SAVGOL_HALF_WIDTH: usize = 2;
 /// Largest number of RK4 steps per grid interval accepted.
 pub const MAX_SUBSTEPS: usize = 1000;
+/// RK4 steps per grid interval when none is given: the grid is the IMU sample times, so the
+/// RK4 error is of higher order than the interpolation error (docs/cai_predictor_accuracy.md).
+pub const DEFAULT_SUBSTEPS: usize = 1;
 
 impl OmegaDot {
-    /// The ω̇ source `kind` with its parameters: the half width m ≥ 1 of a Savitzky–Golay
-    /// window, the per-sample values (rad/s², body frame) of `Given` (required by it and
-    /// refused by the other kinds, which would ignore them).
-    pub fn new(kind: OmegaDotKind, savgol_half_width: usize, given: Option<Vec<Vec3>>) -> Result<Self> {
+    /// The ω̇ source `kind` (None: [`OmegaDotKind::default_for`]) with its parameters: the
+    /// half width m ≥ 1 of a Savitzky–Golay window, the per-sample values (rad/s², body
+    /// frame) of `Given` (required by it and refused by the other kinds, which would ignore
+    /// them).
+    pub fn new(kind: Option<OmegaDotKind>, savgol_half_width: usize, given: Option<Vec<Vec3>>) -> Result<Self> {
+        let kind = kind.unwrap_or_else(|| OmegaDotKind::default_for(given.is_some()));
         if kind == OmegaDotKind::Savgol && !(1..=MAX_SAVGOL_HALF_WIDTH).contains(&savgol_half_width) {
             return Err(invalid("savgol_half_width", format!("must be in [1, {MAX_SAVGOL_HALF_WIDTH}], got {savgol_half_width}")));
         }
@@ -100,7 +121,7 @@ impl OmegaDot {
         if kind == OmegaDotKind::Given {
             return Err(Self::given_without_samples());
         }
-        Self::new(kind, savgol_half_width, None)
+        Self::new(Some(kind), savgol_half_width, None)
     }
 
     /// The error of a "given" ω̇ where no per-sample values exist.
@@ -119,14 +140,28 @@ impl OmegaDot {
 }
 
 /// Interpolation of the IMU samples between sample times.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, Default)]
 pub enum Interpolation {
     /// Piecewise linear: integrated error ∝ h² (relative (hΩ)²/12 for a
     /// sinusoid of angular frequency Ω).
     Linear,
     /// Cubic Hermite with central-difference tangents (Catmull–Rom on non-uniform grids,
-    /// one-sided at the record ends): error ∝ h⁴ for smooth signals.
+    /// one-sided at the record ends): integrated error ∝ h⁴ for smooth signals (the
+    /// default).
+    #[default]
     Cubic,
+}
+
+impl Interpolation {
+    /// Order p of the integrated interpolation error (∝ h^p) and its coefficient c_p in
+    /// |δφ| ≤ c_p h^p T² max|g⁽ᵖ⁾| (docs/cai_predictor_accuracy.md#interpolation-error):
+    /// 1/12 for linear, 11/720 for cubic.
+    fn error_order(self) -> (usize, f64) {
+        match self {
+            Interpolation::Linear => (2, 1.0 / 12.0),
+            Interpolation::Cubic => (4, 11.0 / 720.0),
+        }
+    }
 }
 
 impl Choice for Interpolation {
@@ -157,7 +192,9 @@ pub struct PredictorConfig {
     pub t_sep: f64,
     /// RK4 steps per grid interval (≥ 1).
     pub substeps: usize,
-    /// Gravity-gradient tensor Γ_s in the sensor frame (1/s²); None = no gradient.
+    /// Gravity-gradient tensor Γ_b0 in the body frame b at each shot's start (1/s²), turned
+    /// into each channel's frame by C_sb and with the body during the shot; None = no
+    /// gradient.
     pub gradient: Option<Mat3>,
     /// Estimated accelerometer bias (m/s²) subtracted from the specific force.
     pub bias_a: Vec3,
@@ -190,18 +227,26 @@ struct BodyStage {
     f: Vec3,
     w: Vec3,
     wd: Vec3,
+    /// Attitude R = C_b0b relative to the body at the shot start.
+    att: Mat3,
 }
 
 /// Sensor-frame quantities of one channel at one stage.
 #[derive(Clone, Copy)]
 struct ChStage {
     tau: f64,
+    /// ω_b (body frame), for the attitude tangent of the Jacobian.
+    w_b: Vec3,
     w: Vec3,
     wd: Vec3,
     f_acc: Vec3,
     f_cen: Vec3,
     f_eul: Vec3,
-    /// −Γ_s C_sb l (gravity gradient acting over the lever arm).
+    /// Γ_b = Rᵀ Γ_b0 R (body frame) and Γ_s = C_sb Γ_b C_bs at this stage; zero without a
+    /// gradient.
+    g_b: Mat3,
+    g_s: Mat3,
+    /// −C_sb Γ_b l (gravity gradient acting over the lever arm).
     f_gl: Vec3,
 }
 
@@ -209,14 +254,18 @@ impl ChStage {
     fn new(b: &BodyStage, ch: &Channel, gradient: Option<&Mat3>) -> Self {
         let c = &ch.c_sb;
         let l = &ch.lever;
+        let g_b = gradient.map_or(Mat3::zeros(), |g| b.att.transpose() * g * b.att);
         ChStage {
             tau: b.tau,
+            w_b: b.w,
             w: c * b.w,
             wd: c * b.wd,
             f_acc: c * b.f,
             f_cen: c * b.w.cross(&b.w.cross(l)),
             f_eul: c * b.wd.cross(l),
-            f_gl: gradient.map_or(Vec3::zeros(), |g| -(g * (c * l))),
+            g_b,
+            g_s: c * g_b * c.transpose(),
+            f_gl: -(c * (g_b * l)),
         }
     }
     fn f_s(&self) -> Vec3 {
@@ -224,12 +273,12 @@ impl ChStage {
     }
 }
 
-/// (E5) right-hand side of the atom acceleration.
+/// (E5) right-hand side of the atom acceleration, with the stage's gradient when `gradient`.
 #[inline]
-fn atom_accel(s: &ChStage, x: &Vec3, v: &Vec3, force: &Vec3, gradient: Option<&Mat3>) -> Vec3 {
+fn atom_accel(s: &ChStage, x: &Vec3, v: &Vec3, force: &Vec3, gradient: bool) -> Vec3 {
     let mut a = -force - 2.0 * s.w.cross(v) - s.w.cross(&s.w.cross(x)) - s.wd.cross(x);
-    if let Some(g) = gradient {
-        a += g * x;
+    if gradient {
+        a += s.g_s * x;
     }
     a
 }
@@ -320,20 +369,30 @@ impl Record<'_> {
             Wd::Interpolant => w_rate,
             Wd::PerSample(v) => self.interp(v, i, abs_t).0,
         };
-        BodyStage { tau: t, f: f - self.bias_a, w: w - self.bias_g, wd }
+        BodyStage { tau: t, f: f - self.bias_a, w: w - self.bias_g, wd, att: Mat3::identity() }
     }
 
-    /// The three RK4 stage inputs of each sub-step of each segment of a shot.
+    /// The three RK4 stage inputs of each sub-step of each segment of a shot, with the
+    /// body attitude R = C_b0b carried along: over a sub-step the rotation vector is
+    /// α1 + α2 + ⅔ α1×α2 (trapezoid increments of ω_b on the two halves, two-sample coning
+    /// correction), R(mid) = R(a) exp([α1×]).
     fn stages(&self, shot: usize) -> Vec<([BodyStage; 3], bool)> {
         let Some((ts, segs)) = self.shots.get(shot) else { return Vec::new() };
         let mut out = Vec::with_capacity(segs.len() * self.substeps);
+        let mut att = Mat3::identity();
         for seg in segs {
             let h = (seg.b - seg.a) / self.substeps as f64;
             for j in 0..self.substeps {
                 let a = seg.a + j as f64 * h;
                 let b = if j + 1 == self.substeps { seg.b } else { a + h };
-                let st = [self.body(*ts, seg, a), self.body(*ts, seg, 0.5 * (a + b)), self.body(*ts, seg, b)];
-                out.push((st, seg.pulse && j + 1 == self.substeps));
+                let (mut s0, mut s1, mut s2) = (self.body(*ts, seg, a), self.body(*ts, seg, 0.5 * (a + b)), self.body(*ts, seg, b));
+                let half = 0.25 * (b - a);
+                let (a1, a2) = (half * (s0.w + s1.w), half * (s1.w + s2.w));
+                s0.att = att;
+                s1.att = att * dcm_from_rotvec(&a1);
+                att *= dcm_from_rotvec(&(a1 + a2 + 2.0 / 3.0 * a1.cross(&a2)));
+                s2.att = att;
+                out.push(([s0, s1, s2], seg.pulse && j + 1 == self.substeps));
             }
         }
         out
@@ -506,7 +565,7 @@ struct GeometrySolution {
 /// Right-hand side for [Φ e_1, Φ e_2, Φ e_3, x_p] and their velocities (8 vectors).
 // invariant: fixed-size arrays of 8 vectors indexed by 2c, 2c + 1 with c < 4.
 #[allow(clippy::indexing_slicing)]
-fn block_rhs(s: &ChStage, y: &[Vec3; 8], force: &Vec3, gradient: Option<&Mat3>) -> [Vec3; 8] {
+fn block_rhs(s: &ChStage, y: &[Vec3; 8], force: &Vec3, gradient: bool) -> [Vec3; 8] {
     let zero = Vec3::zeros();
     let mut d = [zero; 8];
     for c in 0..4 {
@@ -535,9 +594,9 @@ fn solve_geometry(rec: &Record, stages: &[([BodyStage; 3], bool)], ch: &Channel,
             eul += wk * c.f_eul;
         }
         let refs = [&cs[0], &cs[1], &cs[2]];
-        rk4(&mut y, h, refs, |s, y| block_rhs(s, y, &s.f_s(), None));
-        if let Some(g) = gradient {
-            rk4(&mut yg, h, refs, |s, y| block_rhs(s, y, &(s.f_s() + s.f_gl), Some(g)));
+        rk4(&mut y, h, refs, |s, y| block_rhs(s, y, &s.f_s(), false));
+        if gradient.is_some() {
+            rk4(&mut yg, h, refs, |s, y| block_rhs(s, y, &(s.f_s() + s.f_gl), true));
         }
         if *pulse {
             (mid, mid_g) = (y, yg);
@@ -597,6 +656,168 @@ pub fn predict(imu: Imu, shots: &[f64], channels: &[Channel], cfg: &PredictorCon
     Ok(out)
 }
 
+/// A-priori bound of the discretisation error of [`predict`] per row (shot × channel),
+/// estimated from the samples around each shot (docs/cai_predictor_accuracy.md). Its parts
+/// scale differently with the sample interval h: the interpolation error as h^p (p = 2
+/// linear, 4 cubic), the Savitzky–Golay ω̇ error as h², the omitted Euler terms
+/// (`OmegaDot::Zero`) not at all.
+#[derive(Clone, Debug)]
+pub struct ErrorBound {
+    /// [∝ h^p, ∝ h², fixed] (rad) per row.
+    parts: Vec<[f64; 3]>,
+    order: i32,
+    /// 1/h of the largest sample interval h around any shot (Hz).
+    pub rate_hz: f64,
+}
+
+/// Margin between the tolerance and the bound at the advised rate: the sampled derivative
+/// estimates change slightly with the rate (by ≈ (hν)²/6 for a sine of angular frequency ν).
+const RATE_MARGIN: f64 = 1.05;
+
+impl ErrorBound {
+    /// The bound (rad) of each row; infinite where the record holds fewer samples around the
+    /// shot than the estimate needs (p + 2).
+    pub fn rad(&self) -> Vec<f64> {
+        self.parts.iter().map(|p| p.iter().sum()).collect()
+    }
+
+    /// The largest bound (rad) at the sample intervals scaled by r.
+    fn at(&self, r: f64) -> f64 {
+        self.parts.iter().map(|&[a, b, c]| a * r.powi(self.order) + b * r * r + c).fold(0.0, f64::max)
+    }
+
+    /// The lowest IMU rate (Hz, rounded up to two significant digits) at which the bound is
+    /// below `tolerance` (rad) by the margin 1.05, the record's rate if it already is; None
+    /// when no rate reaches it (the Euler terms are omitted, or the bound is infinite).
+    pub fn rate_needed(&self, tolerance: f64) -> Result<Option<f64>> {
+        check_positive("tolerance_rad", tolerance)?;
+        let target = tolerance / RATE_MARGIN;
+        if !(self.at(0.0) < target) || !self.rate_hz.is_finite() {
+            return Ok(None);
+        }
+        if self.at(1.0) <= target {
+            return Ok(Some(self.rate_hz));
+        }
+        // at(r) increases with r; at(0) < target < at(1): bisection on r = h'/h
+        let (mut lo, mut hi) = (0.0, 1.0);
+        for _ in 0..100 {
+            let mid = 0.5 * (lo + hi);
+            if self.at(mid) <= target { lo = mid } else { hi = mid }
+        }
+        let rate = self.rate_hz / lo;
+        let unit = 10f64.powf(rate.log10().floor() - 1.0);
+        Ok(Some((rate / unit).ceil() * unit))
+    }
+}
+
+/// Largest norm of p! times the p-th divided difference of `g` over the times `t` (an
+/// estimate of max |g⁽ᵖ⁾|); None with fewer than p + 1 samples.
+fn max_derivative(t: &[f64], g: &[Vec3], p: usize) -> Option<f64> {
+    if g.len() <= p {
+        return None;
+    }
+    let mut d = g.to_vec();
+    for q in 1..=p {
+        d = d.windows(2).zip(t.windows(q + 1)).map(|(v, s)| match (v, s) {
+            ([a, b], [t0, .., t1]) => (b - a) / (t1 - t0),
+            _ => Vec3::zeros(),
+        }).collect();
+    }
+    let fact: f64 = (1..=p).map(|j| j as f64).product();
+    Some(fact * d.iter().map(|v| v.norm()).fold(0.0, f64::max))
+}
+
+/// Central differences of ω (one-sided at the ends): the tangents of the cubic
+/// interpolant, a sample of the derivative of the gyro interpolant.
+fn central_differences(t: &[f64], w: &[Vec3]) -> Vec<Vec3> {
+    let n = t.len();
+    (0..n)
+        .map(|i| {
+            let (a, b) = (i.saturating_sub(1), (i + 1).min(n.saturating_sub(1)));
+            match (t.get(a), t.get(b), w.get(a), w.get(b)) {
+                (Some(ta), Some(tb), Some(wa), Some(wb)) if tb > ta => (wb - wa) / (tb - ta),
+                _ => Vec3::zeros(),
+            }
+        })
+        .collect()
+}
+
+/// A-priori bound of the discretisation error of [`predict`] with the same inputs
+/// (docs/cai_predictor_accuracy.md#the-bound). Per shot, from the samples whose
+/// interpolation stencils reach into it (interval h, the largest there), with
+/// F = f_b + ω̇*×l + ω_b×(ω_b×l) (ω̇* the ω̇ series the predictor interpolates),
+/// V = |v0| + 2T max|F|, X = 2T V, Ω = max|ω_b| and D_p(g) ≈ max|g⁽ᵖ⁾| from divided
+/// differences:
+///   interpolation   |k| T² c_p h^p [D_p(F) + 2V D_p(ω) + X (D_p(ω̇*) + 2Ω D_p(ω))],
+///   Savitzky–Golay  |k| T² (|l| + X) h² D_3(ω) Σj⁴ / (6 Σj²),
+///   ω̇ omitted       |k| T² (|l| + X) max|ω̇|,
+/// c_2 = 1/12 (linear), c_4 = 11/720 (cubic).
+// invariant: i0 ≤ i1 < n (clamped), so the window slices are in range.
+#[allow(clippy::indexing_slicing)]
+pub fn error_bound(imu: Imu, shots: &[f64], channels: &[Channel], cfg: &PredictorConfig) -> Result<ErrorBound> {
+    let rec = prepare(imu, shots, channels, cfg)?;
+    let (p, c_p) = cfg.interpolation.error_order();
+    let n = imu.t.len();
+    let t_sep = cfg.t_sep;
+    let mut parts = Vec::with_capacity(shots.len() * channels.len());
+    let mut h_max: f64 = 0.0;
+    for &ts in shots {
+        // the intervals holding the shot, one stencil sample either side, widened to p + 2
+        // samples where the record allows
+        let mut i0 = imu.t.partition_point(|&x| x <= ts).saturating_sub(2);
+        let mut i1 = imu.t.partition_point(|&x| x < ts + 2.0 * t_sep).saturating_add(1).min(n - 1);
+        while i1 - i0 < p + 1 && (i0 > 0 || i1 + 1 < n) {
+            i0 = i0.saturating_sub(1);
+            i1 = (i1 + 1).min(n - 1);
+        }
+        let t = &imu.t[i0..=i1];
+        let h = t.windows(2).map(|w| match w { [a, b] => b - a, _ => 0.0 }).fold(0.0, f64::max);
+        h_max = h_max.max(h);
+        let w: Vec<Vec3> = imu.w[i0..=i1].iter().map(|w| w - rec.bias_g).collect();
+        let f: Vec<Vec3> = imu.f[i0..=i1].iter().map(|f| f - rec.bias_a).collect();
+        // central differences with the record's neighbours of the window (one-sided only at
+        // the record's ends, as the interpolant's tangents)
+        let (a, b) = (i0.saturating_sub(1), (i1 + 1).min(n - 1));
+        let wide: Vec<Vec3> = imu.w[a..=b].iter().map(|w| w - rec.bias_g).collect();
+        let wd_cd = central_differences(&imu.t[a..=b], &wide)[i0 - a..=i1 - a].to_vec();
+        let (wd, savgol_part, omitted) = match (&rec.wd, &cfg.omega_dot) {
+            (Wd::PerSample(v), OmegaDot::Savgol { half_width }) => {
+                let m = *half_width as f64;
+                // Σ_{j=1..m} j⁴ / Σ j² = (3m² + 3m − 1)/5
+                let coef = (3.0 * m * m + 3.0 * m - 1.0) / 30.0;
+                (v[i0..=i1].to_vec(), max_derivative(t, &w, 3).map(|d| coef * h * h * d), 0.0)
+            }
+            (Wd::PerSample(v), _) => (v[i0..=i1].to_vec(), Some(0.0), 0.0),
+            (Wd::Interpolant, _) => (wd_cd, Some(0.0), 0.0),
+            (Wd::Zero, _) => {
+                let most = wd_cd.iter().map(|v| v.norm()).fold(0.0, f64::max);
+                (vec![Vec3::zeros(); t.len()], Some(0.0), most)
+            }
+        };
+        let omega = w.iter().map(|v| v.norm()).fold(0.0, f64::max);
+        let d_w = max_derivative(t, &w, p);
+        let d_wd = max_derivative(t, &wd, p);
+        for ch in channels {
+            let l = &ch.lever;
+            let force: Vec<Vec3> = f.iter().zip(&w).zip(&wd).map(|((f, w), wd)| f + wd.cross(l) + w.cross(&w.cross(l))).collect();
+            let big_f = force.iter().map(|v| v.norm()).fold(0.0, f64::max);
+            let speed = ch.v0.norm() + 2.0 * t_sep * big_f;
+            let reach = 2.0 * t_sep * speed;
+            let scale = ch.k.norm() * t_sep * t_sep;
+            let row = match (max_derivative(t, &force, p), d_w, d_wd, savgol_part) {
+                (Some(d_f), Some(d_w), Some(d_wd), Some(sg)) => [
+                    scale * c_p * h.powi(p as i32) * (d_f + 2.0 * speed * d_w + reach * (d_wd + 2.0 * omega * d_w)),
+                    scale * (l.norm() + reach) * sg,
+                    scale * (l.norm() + reach) * omitted,
+                ],
+                _ => [f64::INFINITY, 0.0, 0.0],
+            };
+            parts.push(row);
+        }
+    }
+    Ok(ErrorBound { parts, order: p as i32, rate_hz: 1.0 / h_max })
+}
+
 /// Finite inputs near the f64 range can overflow on the way: an error, not a NaN row.
 fn check_rows<const W: usize>(rows: &[[f64; W]]) -> Result<()> {
     match rows.iter().position(|r| !r.iter().all(|v| v.is_finite())) {
@@ -605,20 +826,28 @@ fn check_rows<const W: usize>(rows: &[[f64; W]]) -> Result<()> {
     }
 }
 
-/// Per-stage sensitivities of (ω_s, ω̇_s, forcing F) to the 12 Jacobian parameters.
+/// Per-stage sensitivities of (ω_s, ω̇_s, forcing F, Γ_s) to the 12 Jacobian parameters
+/// (the gyro bias also turns Γ through the attitude: see [`jacobian`]).
 struct Tangent {
     dw: [Vec3; 12],
     dwd: [Vec3; 12],
     df: [Vec3; 12],
+    dg: [Mat3; 12],
+}
+
+/// δΓ = −[θ×]Γ + Γ[θ×] of Γ seen from a frame turned by the small rotation θ.
+fn turned(g: &Mat3, theta: &Vec3) -> Mat3 {
+    let k = skew(theta);
+    g * k - k * g
 }
 
 // invariant: fixed-size arrays of 12 vectors indexed by j, 3 + j, 6 + j, 9 + j with j < 3.
 #[allow(clippy::indexing_slicing)]
-fn tangent(b: &BodyStage, s: &ChStage, ch: &Channel, gradient: Option<&Mat3>) -> Tangent {
+fn tangent(b: &BodyStage, s: &ChStage, ch: &Channel, gradient: bool) -> Tangent {
     let c = &ch.c_sb;
     let l = &ch.lever;
     let zero = Vec3::zeros();
-    let mut t = Tangent { dw: [zero; 12], dwd: [zero; 12], df: [zero; 12] };
+    let mut t = Tangent { dw: [zero; 12], dwd: [zero; 12], df: [zero; 12], dg: [Mat3::zeros(); 12] };
     let f_body_lever = s.f_s(); // C_sb (f_b + ω̇×l + ω×(ω×l))
     for j in 0..3 {
         let e = Vec3::ith(j, 1.0);
@@ -629,11 +858,14 @@ fn tangent(b: &BodyStage, s: &ChStage, ch: &Channel, gradient: Option<&Mat3>) ->
         t.dw[3 + j] = c * dwb;
         t.df[3 + j] = c * (dwb.cross(&b.w.cross(l)) + b.w.cross(&dwb.cross(l)));
         // lever arm.
-        t.df[6 + j] = c * (b.wd.cross(&e) + b.w.cross(&b.w.cross(&e))) - gradient.map_or(zero, |g| g * (c * e));
-        // misalignment: δC_sb = −[e×] C_sb.
+        t.df[6 + j] = c * (b.wd.cross(&e) + b.w.cross(&b.w.cross(&e))) - s.g_s * (c * e);
+        // misalignment: δC_sb = −[e×] C_sb turns every sensor-frame vector and Γ_s.
         t.dw[9 + j] = -e.cross(&s.w);
         t.dwd[9 + j] = -e.cross(&s.wd);
-        t.df[9 + j] = -e.cross(&f_body_lever) + gradient.map_or(zero, |g| g * e.cross(&(c * l)));
+        t.df[9 + j] = -e.cross(&(f_body_lever + s.f_gl));
+        if gradient {
+            t.dg[9 + j] = turned(&s.g_s, &e);
+        }
     }
     t
 }
@@ -643,42 +875,56 @@ fn tangent(b: &BodyStage, s: &ChStage, ch: &Channel, gradient: Option<&Mat3>) ->
 /// `shot * channels.len() + channel`. Euler terms (ω̇) are removed from the linearisation
 /// point unless `euler` (the paper's Eq. 31 item 8;
 /// docs/departures.md#euler-terms-and-angular-acceleration); use [`jacobian_fd`] to check.
-// invariant: fixed-size arrays: y holds 26 = 2 + 2·12 vectors indexed by 2 + 2p and
-// 3 + 2p (p < 12) or 2p (p < 13), mid 13, the stage arrays 3 (i < 3).
+// invariant: fixed-size arrays: y holds 29 = 2 + 2·12 + 3 vectors indexed by 2 + 2p and
+// 3 + 2p (p < 12), 26 + j (j < 3) or 2p (p < 13), mid 13, the stage arrays 3 (i < 3).
 #[allow(clippy::indexing_slicing)]
 pub fn jacobian(imu: Imu, shots: &[f64], channels: &[Channel], cfg: &PredictorConfig, euler: bool) -> Result<Vec<[f64; 12]>> {
     let cfg = jacobian_config(cfg, euler);
     let rec = prepare(imu, shots, channels, &cfg)?;
     let grad = cfg.gradient.as_ref();
+    let with_grad = grad.is_some();
     let mut out = Vec::with_capacity(shots.len() * channels.len());
     for s in 0..shots.len() {
         let stages = rec.stages(s);
         for ch in channels {
-            // y[0..2] = base (x, v); y[2+2p..4+2p] = tangent (δx, δv) of parameter p.
-            let mut y = [Vec3::zeros(); 26];
+            // y[0..2] = base (x, v); y[2+2p..4+2p] = tangent (δx, δv) of parameter p;
+            // y[26 + j] = δθ, the attitude tangent R → R exp([δθ×]) of the gyro bias j,
+            // δθ̇ = δω_b − ω_b × δθ with δω_b = −e_j: it turns Γ_b by δΓ_b = Γ_b[δθ×] − [δθ×]Γ_b.
+            let mut y = [Vec3::zeros(); 29];
             y[1] = ch.v0;
             let mut mid = [Vec3::zeros(); 13];
             for (st, pulse) in &stages {
                 let cs = [0, 1, 2].map(|i| ChStage::new(&st[i], ch, grad));
-                let tg = [0, 1, 2].map(|i| tangent(&st[i], &cs[i], ch, grad));
+                let tg = [0, 1, 2].map(|i| tangent(&st[i], &cs[i], ch, with_grad));
                 let h = cs[2].tau - cs[0].tau;
                 let pairs = [(&cs[0], &tg[0]), (&cs[1], &tg[1]), (&cs[2], &tg[2])];
                 rk4(&mut y, h, [&pairs[0], &pairs[1], &pairs[2]], |(s, tg), y| {
                     let (x, v) = (y[0], y[1]);
                     let force = s.f_s() + s.f_gl;
-                    let mut d = [Vec3::zeros(); 26];
+                    let mut d = [Vec3::zeros(); 29];
                     d[0] = v;
-                    d[1] = atom_accel(s, &x, &v, &force, grad);
+                    d[1] = atom_accel(s, &x, &v, &force, with_grad);
                     for p in 0..12 {
                         let (dx, dv) = (y[2 + 2 * p], y[3 + 2 * p]);
                         let (dw, dwd) = (tg.dw[p], tg.dwd[p]);
                         d[2 + 2 * p] = dv;
                         // δ of (E5): linear part on (δx, δv) plus the input perturbation.
-                        d[3 + 2 * p] = atom_accel(s, &dx, &dv, &tg.df[p], grad)
+                        d[3 + 2 * p] = atom_accel(s, &dx, &dv, &tg.df[p], with_grad)
                             - 2.0 * dw.cross(&v)
                             - dw.cross(&s.w.cross(&x))
                             - s.w.cross(&dw.cross(&x))
-                            - dwd.cross(&x);
+                            - dwd.cross(&x)
+                            + tg.dg[p] * x;
+                    }
+                    if with_grad {
+                        let c = &ch.c_sb;
+                        for j in 0..3 {
+                            let theta = y[26 + j];
+                            d[26 + j] = -Vec3::ith(j, 1.0) - s.w_b.cross(&theta);
+                            let dg_b = turned(&s.g_b, &theta);
+                            // a = −(f_s + f_gl) + Γ_s x with f_gl = −C_sb Γ_b l, Γ_s = C_sb Γ_b C_bs
+                            d[3 + 2 * (3 + j)] += c * (dg_b * (c.transpose() * x + ch.lever));
+                        }
                     }
                     d
                 });
@@ -766,11 +1012,14 @@ mod tests {
                 v0: Vec3::ith((j + 1) % 3, 2.8),
             })
             .collect();
-        for euler in [false, true] {
+        // Earth's gradient, and 3000 × a tensor not symmetric about any body axis (turned by
+        // the misalignment and, through the attitude, by the gyro bias)
+        let strong = 3e-3 * Mat3::new(-1.2, 0.4, 0.3, 0.4, -1.9, 0.2, 0.3, 0.2, 3.1);
+        for (euler, gradient) in [(false, Mat3::from_diagonal(&Vec3::new(-1.5e-6, -1.5e-6, 3.086e-6))), (true, Mat3::from_diagonal(&Vec3::new(-1.5e-6, -1.5e-6, 3.086e-6))), (false, strong), (true, strong)] {
             let cfg = PredictorConfig {
                 t_sep: 0.025,
                 substeps: 2,
-                gradient: Some(Mat3::from_diagonal(&Vec3::new(-1.5e-6, -1.5e-6, 3.086e-6))),
+                gradient: Some(gradient),
                 bias_a: Vec3::new(1e-4, -2e-4, 3e-4),
                 bias_g: Vec3::new(1e-5, 2e-5, -1e-5),
                 omega_dot: OmegaDot::Savgol { half_width: 2 },

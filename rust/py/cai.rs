@@ -14,8 +14,8 @@ use crate::cai::hybrid::{GravityModel, HybridConfig, HybridScenario, PhaseSource
 use crate::cai::noise_id::{fringe_track, ml_windows, FringeEkf, Method, MlConfig, MAX_ML_ITER};
 use crate::cai::oracle::{imu_from_motion, oracle_phase, AnalyticMotion, Gravity, SineMotion, YawDrive};
 use crate::cai::predictor::{
-    channels_from_rows, jacobian, jacobian_fd, predict, Channel, Imu, Interpolation, OmegaDot, OmegaDotKind, PredictorConfig, JACOBIAN_PARAMS,
-    MAX_SAVGOL_HALF_WIDTH, MAX_SUBSTEPS, TERM_NAMES,
+    channels_from_rows, error_bound, jacobian, jacobian_fd, predict, Channel, Imu, Interpolation, OmegaDot, OmegaDotKind, PredictorConfig,
+    DEFAULT_SAVGOL_HALF_WIDTH, DEFAULT_SUBSTEPS, JACOBIAN_PARAMS, MAX_SAVGOL_HALF_WIDTH, MAX_SUBSTEPS, TERM_NAMES,
 };
 use crate::cai::readout::{populations, steer_all};
 use crate::cai::sensitivity::{convolution_phase, ideal_transfers, sensitivity_samples, Pulses};
@@ -103,6 +103,7 @@ super::pickle::picklable!(CaiSetup, self, "CaiSetup");
 impl CaiSetup {
     #[new]
     #[allow(clippy::too_many_arguments, non_snake_case)]
+    /// `omega_dot`, `savgol_half_width`, `interpolation`, `substeps` None: the core's defaults.
     #[pyo3(signature = (t, specific_force, angular_rate, shots, channels, T, *, omega_dot, angular_acceleration, savgol_half_width, interpolation, substeps,
         gradient, bias_a, bias_g))]
     fn new(
@@ -112,17 +113,18 @@ impl CaiSetup {
         shots: PyReadonlyArray1<'_, f64>,
         channels: &CaiChannels,
         #[pyo3(from_py_with = real)] T: f64,
-        omega_dot: Wrap<OmegaDotKind>,
+        omega_dot: Option<Wrap<OmegaDotKind>>,
         angular_acceleration: Option<PyReadonlyArray2<'_, f64>>,
-        savgol_half_width: &Bound<'_, PyAny>,
-        interpolation: Wrap<Interpolation>,
-        substeps: &Bound<'_, PyAny>,
+        savgol_half_width: Option<&Bound<'_, PyAny>>,
+        interpolation: Option<Wrap<Interpolation>>,
+        substeps: Option<&Bound<'_, PyAny>>,
         gradient: Option<PyReadonlyArray2<'_, f64>>,
         bias_a: PyReadonlyArray1<'_, f64>,
         bias_g: PyReadonlyArray1<'_, f64>,
     ) -> PyResult<Self> {
         let given = angular_acceleration.map(|a| raw3(&a, "angular_acceleration")).transpose()?;
-        let omega_dot = OmegaDot::new(omega_dot.0, count(savgol_half_width, "savgol_half_width", 0, MAX_SAVGOL_HALF_WIDTH)?, given)?;
+        let half_width = savgol_half_width.map_or(Ok(DEFAULT_SAVGOL_HALF_WIDTH), |m| count(m, "savgol_half_width", 0, MAX_SAVGOL_HALF_WIDTH))?;
+        let omega_dot = OmegaDot::new(omega_dot.map(|o| o.0), half_width, given)?;
         Ok(CaiSetup {
             t: t.as_array().iter().copied().collect(),
             f: raw3(&specific_force, "specific_force")?,
@@ -131,12 +133,12 @@ impl CaiSetup {
             channels: channels.0.clone(),
             cfg: PredictorConfig {
                 t_sep: T,
-                substeps: count(substeps, "substeps", 1, MAX_SUBSTEPS)?,
+                substeps: substeps.map_or(Ok(DEFAULT_SUBSTEPS), |s| count(s, "substeps", 1, MAX_SUBSTEPS))?,
                 gradient: gradient_tensor(gradient)?,
                 bias_a: vec3(&bias_a, "bias_a")?,
                 bias_g: vec3(&bias_g, "bias_g")?,
                 omega_dot,
-                interpolation: interpolation.0,
+                interpolation: interpolation.map(|i| i.0).unwrap_or_default(),
             },
         })
     }
@@ -145,6 +147,17 @@ impl CaiSetup {
     fn predict<'py>(&self, py: Python<'py>) -> PyResult<Arr2<'py>> {
         let out = py.detach(|| predict(self.imu(), &self.shots, &self.channels, &self.cfg))?;
         Ok(to_py_rows(py, &out))
+    }
+
+    /// Error bound (rad) per shot · channel, the IMU rate (Hz) at which it falls below
+    /// `tolerance_rad` (None: no rate does) and the record's rate (Hz).
+    fn error_bound<'py>(&self, py: Python<'py>, #[pyo3(from_py_with = real)] tolerance_rad: f64) -> PyResult<(Arr1<'py>, Option<f64>, f64)> {
+        let (bound, needed) = py.detach(|| -> crate::error::Result<_> {
+            let b = error_bound(self.imu(), &self.shots, &self.channels, &self.cfg)?;
+            let needed = b.rate_needed(tolerance_rad)?;
+            Ok((b, needed))
+        })?;
+        Ok((vec_to_py(py, bound.rad()), needed, bound.rate_hz))
     }
 
     /// ∂φ/∂(b_a, b_g, l, γ): (shots · channels, 12); `fd_steps` (b_a, b_g, l, γ) given →
@@ -349,6 +362,9 @@ fn cai_ml_identify<'py>(
     d.set_item("a", vec_to_py(py, res.iter().map(|r| r.a).collect()))?;
     d.set_item("b", vec_to_py(py, res.iter().map(|r| r.b).collect()))?;
     d.set_item("hessian_eigenvalues", to_py_rows(py, &res.iter().map(|r| r.hessian_eigenvalues).collect::<Vec<_>>()))?;
+    d.set_item("se_theta", to_py_rows(py, &res.iter().map(|r| r.se_theta).collect::<Vec<_>>()))?;
+    d.set_item("se_a", vec_to_py(py, res.iter().map(|r| r.se_a).collect()))?;
+    d.set_item("se_b", vec_to_py(py, res.iter().map(|r| r.se_b).collect()))?;
     Ok(d)
 }
 

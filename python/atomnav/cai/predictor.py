@@ -10,6 +10,7 @@ is driven by the SPECIFIC FORCE at the s origin, so a constant specific force f_
 
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -17,7 +18,7 @@ import pandas as pd
 
 from .. import _core, plausibility
 from .._validate import (as_floats, broadcast, finite, finite_result, finite_scalar, flag, input_error, instance, nonnegative,
-                         positive, renamed, rows, shaped, vector)
+                         positive, renamed, rows, scalar, shaped, vector)
 from ._config import ConfigMixin
 
 #: ⁸⁷Rb D2 wavelength (m) and the two-photon effective wave number 4π/λ (rad/m).
@@ -139,9 +140,8 @@ def _gradient(gradient):
 
 def _setup(t, specific_force, angular_rate, shots, T, channels, angular_acceleration, omega_dot,
            savgol_half_width, interpolation, substeps, gradient, bias_a, bias_g):
-    """Validated shot start times (s) and the core predictor set up on them."""
-    if omega_dot is None:
-        omega_dot = "savgol" if angular_acceleration is None else "given"
+    """Validated shot start times (s) and the core predictor set up on them; options left
+    None take the core's defaults."""
     instance(channels, Channels, "channels")
     t = vector(t, None, "t")
     f = np.ascontiguousarray(as_floats(specific_force, "specific_force"))
@@ -181,11 +181,16 @@ class PhasePrediction:
     terms : dict of str to numpy.ndarray
         Phase (rad) per term, each an array (S, C), keyed by :data:`TERMS` (``total``
         first).
+    error_bound_rad : numpy.ndarray, shape (S, C)
+        Bound of the discretisation error of ``total`` estimated from the IMU samples
+        (rad; ``docs/cai_predictor_accuracy.md``); inf where the record holds too few
+        samples around a shot to estimate it.
     """
 
     shots: np.ndarray
     channels: Channels
     terms: dict
+    error_bound_rad: np.ndarray
 
     @property
     def total(self) -> np.ndarray:
@@ -197,22 +202,27 @@ class PhasePrediction:
         Returns
         -------
         pandas.DataFrame
-            One row per shot and channel: ``shot_start_s``, ``channel`` and one
-            ``<term>_rad`` column per term of :data:`TERMS` (rad).
+            One row per shot and channel: ``shot_start_s``, ``channel``, one
+            ``<term>_rad`` column per term of :data:`TERMS` (rad) and ``error_bound_rad``
+            (rad).
         """
         n, c = self.total.shape
         d = {"shot_start_s": np.repeat(self.shots, c), "channel": np.tile(self.channels.names, n)}
         d.update({f"{k}_rad": v.ravel() for k, v in self.terms.items()})
+        d["error_bound_rad"] = self.error_bound_rad.ravel()
         return pd.DataFrame(d)
 
 
 def predict_phase(t, specific_force, angular_rate, shots, T: float, channels: Channels, *, angular_acceleration=None,
-                  omega_dot: str | None = None, savgol_half_width: int = 2, interpolation: str = "linear",
-                  substeps: int = 1, gradient=None, bias_a=0.0, bias_g=0.0) -> PhasePrediction:
+                  omega_dot: str | None = None, savgol_half_width: int | None = None, interpolation: str | None = None,
+                  substeps: int | None = None, gradient=None, bias_a=0.0, bias_g=0.0,
+                  tolerance_rad: float = 0.01) -> PhasePrediction:
     """Atom strapdown phase of every shot and channel, with breakdown (Tennstedt et al. 2023, Eqs. 5–8).
 
     Departures from the paper are described in
-    ``docs/departures.md#full-phase-predictor``.
+    ``docs/departures.md#full-phase-predictor``. The discretisation error is bounded from
+    the IMU samples (``docs/cai_predictor_accuracy.md``); an :class:`ImuRateWarning`
+    names the bound and the IMU rate needed when it exceeds ``tolerance_rad``.
 
     Parameters
     ----------
@@ -231,42 +241,80 @@ def predict_phase(t, specific_force, angular_rate, shots, T: float, channels: Ch
         The interferometer channels (C of them).
     angular_acceleration : array_like, shape (N, 3), optional
         Angular acceleration ω̇ in the body frame (rad/s²), e.g. from a simulator.
-    omega_dot : {"given", "savgol", "pwl", "zero"}, optional
+    omega_dot : {"given", "pwl", "savgol", "zero"}, optional
         Source of ω̇ for the Euler terms: "given" (default when ``angular_acceleration``
-        is passed), "savgol" (default otherwise: quadratic Savitzky–Golay derivative of the
-        gyro, 5 points with half width ``savgol_half_width`` = 2), "pwl" (derivative of the
-        gyro interpolant), "zero" (no Euler terms).
-    savgol_half_width : int
-        Half width m of the Savitzky–Golay window (2m + 1 samples).
-    interpolation : {"linear", "cubic"}
-        Interpolation of the IMU inputs between samples; "cubic" makes the error ∝ h⁴
-        instead of h² (h the sample interval).
-    substeps : int
+        is passed), "pwl" (default otherwise: derivative of the gyro interpolant, whose
+        lever-arm Euler term keeps the interpolation's order), "savgol" (quadratic
+        Savitzky–Golay derivative of the gyro over 2m + 1 samples, error ∝ h²), "zero" (no
+        Euler terms).
+    savgol_half_width : int, optional
+        Half width m of the Savitzky–Golay window (2m + 1 samples); default 2.
+    interpolation : {"cubic", "linear"}, optional
+        Interpolation of the IMU inputs between samples; default "cubic" (integrated error
+        ∝ h⁴, h the sample interval; "linear": ∝ h², Tennstedt et al. 2023's setup).
+    substeps : int, optional
         RK4 steps per interval of the integration grid (the IMU sample times and the pulse
-        times).
+        times); default 1.
     gradient : array_like, shape (3, 3), optional
-        Gravity-gradient tensor Γ_s in the sensor frame s (1/s²); None: no gradient.
+        Gravity-gradient tensor Γ_b0 in the IMU body frame b at each shot's start (1/s²),
+        e.g. C_bi Γ_i C_ib for a tensor Γ_i in an inertial frame; the predictor turns it
+        into each channel's frame (C_sb) and with the body during the shot. None: no
+        gradient.
     bias_a : float or array_like, shape (3,)
         Estimated accelerometer bias (m/s²), subtracted from ``specific_force``
         (measured = true + bias).
     bias_g : float or array_like, shape (3,)
         Estimated gyro bias (rad/s), subtracted from ``angular_rate``.
+    tolerance_rad : float
+        Largest acceptable discretisation error (rad); a larger error bound gives an
+        :class:`ImuRateWarning` (``np.inf``: never).
 
     Returns
     -------
     PhasePrediction
-        Phases (rad) of shape (S, C), total and per term.
+        Phases (rad) of shape (S, C), total and per term, and the error bound.
+
+    Warns
+    -----
+    ImuRateWarning
+        When the error bound exceeds ``tolerance_rad``: the message names the bound (rad)
+        and the IMU rate (Hz) at which it falls below the tolerance.
     """
+    tolerance = scalar(tolerance_rad, "tolerance_rad")
+    if not tolerance > 0:
+        raise input_error("tolerance_rad", f"must be > 0 (np.inf: never warn), got {tolerance}")
     shots, setup = _setup(t, specific_force, angular_rate, shots, T, channels, angular_acceleration, omega_dot,
                           savgol_half_width, interpolation, substeps, gradient, bias_a, bias_g)
     out = setup.predict().reshape(len(shots), len(channels), len(TERMS))
-    return PhasePrediction(shots, channels, {k: out[:, :, i] for i, k in enumerate(TERMS)})
+    bound, needed, rate = setup.error_bound(min(tolerance, np.finfo(float).max))
+    bound = bound.reshape(len(shots), len(channels))
+    if bound.size and bound.max() > tolerance:
+        _warn_rate(bound.max(), tolerance, rate, needed)
+    return PhasePrediction(shots, channels, {k: out[:, :, i] for i, k in enumerate(TERMS)}, bound)
+
+
+class ImuRateWarning(RuntimeWarning):
+    """The IMU record is too coarse for the requested phase accuracy (see
+    ``docs/cai_predictor_accuracy.md``)."""
+
+
+def _warn_rate(bound, tolerance, rate, needed):
+    """Warn that the error bound (rad) exceeds the tolerance (rad) at the record's rate (Hz)."""
+    msg = (f"the predicted phase may be off by up to {bound:.3g} rad, above tolerance_rad = {tolerance:.3g} rad, "
+           f"at the IMU rate of {rate:.6g} Hz (interpolation error of the IMU samples; "
+           f"docs/cai_predictor_accuracy.md): ")
+    if needed is None:
+        msg += ("no IMU rate reaches the tolerance with these options (omega_dot='zero' omits the Euler terms, or the "
+                "record is too short around a shot to estimate the bound)")
+    else:
+        msg += f"an IMU rate of at least {needed:.6g} Hz is needed"
+    warnings.warn(msg, ImuRateWarning, stacklevel=3)
 
 
 def phase_jacobian(t, specific_force, angular_rate, shots, T: float, channels: Channels, *, euler: bool = False,
-                   fd_steps=None, angular_acceleration=None, omega_dot: str | None = None, savgol_half_width: int = 2,
-                   interpolation: str = "linear", substeps: int = 1, gradient=None, bias_a=0.0,
-                   bias_g=0.0) -> np.ndarray:
+                   fd_steps=None, angular_acceleration=None, omega_dot: str | None = None,
+                   savgol_half_width: int | None = None, interpolation: str | None = None, substeps: int | None = None,
+                   gradient=None, bias_a=0.0, bias_g=0.0) -> np.ndarray:
     """Jacobian ∂φ/∂(b_a, b_g, l, γ) of the predicted phase.
 
     Analytic tangent-linear derivative of the predictor of :func:`predict_phase` at the
@@ -295,21 +343,25 @@ def phase_jacobian(t, specific_force, angular_rate, shots, T: float, channels: C
         central finite differences of :func:`predict_phase` instead (the checker).
     angular_acceleration : array_like, shape (N, 3), optional
         Angular acceleration ω̇ in the body frame (rad/s²), e.g. from a simulator.
-    omega_dot : {"given", "savgol", "pwl", "zero"}, optional
+    omega_dot : {"given", "pwl", "savgol", "zero"}, optional
         Source of ω̇ for the Euler terms: "given" (default when ``angular_acceleration``
-        is passed), "savgol" (default otherwise: quadratic Savitzky–Golay derivative of the
-        gyro, 5 points with half width ``savgol_half_width`` = 2), "pwl" (derivative of the
-        gyro interpolant), "zero" (no Euler terms).
-    savgol_half_width : int
-        Half width m of the Savitzky–Golay window (2m + 1 samples).
-    interpolation : {"linear", "cubic"}
-        Interpolation of the IMU inputs between samples; "cubic" makes the error ∝ h⁴
-        instead of h² (h the sample interval).
-    substeps : int
+        is passed), "pwl" (default otherwise: derivative of the gyro interpolant, whose
+        lever-arm Euler term keeps the interpolation's order), "savgol" (quadratic
+        Savitzky–Golay derivative of the gyro over 2m + 1 samples, error ∝ h²), "zero" (no
+        Euler terms).
+    savgol_half_width : int, optional
+        Half width m of the Savitzky–Golay window (2m + 1 samples); default 2.
+    interpolation : {"cubic", "linear"}, optional
+        Interpolation of the IMU inputs between samples; default "cubic" (integrated error
+        ∝ h⁴, h the sample interval; "linear": ∝ h², Tennstedt et al. 2023's setup).
+    substeps : int, optional
         RK4 steps per interval of the integration grid (the IMU sample times and the pulse
-        times).
+        times); default 1.
     gradient : array_like, shape (3, 3), optional
-        Gravity-gradient tensor Γ_s in the sensor frame s (1/s²); None: no gradient.
+        Gravity-gradient tensor Γ_b0 in the IMU body frame b at each shot's start (1/s²),
+        e.g. C_bi Γ_i C_ib for a tensor Γ_i in an inertial frame; the predictor turns it
+        into each channel's frame (C_sb) and with the body during the shot. None: no
+        gradient.
     bias_a : float or array_like, shape (3,)
         Estimated accelerometer bias (m/s²), subtracted from ``specific_force``
         (measured = true + bias).
