@@ -72,3 +72,17 @@ def test_coning_motion_attitude():
     one_time = np.linalg.norm(np.cross(dth[1], dth[2])) / 12
     cold = R.attitude_error_angle(q_cold[-1:], q_true[-1:])[0]
     assert 0.5 * one_time < cold < 2 * one_time, (cold, one_time)
+
+
+def test_euler_angles_are_in_the_half_open_interval():
+    """roll and yaw in (−π, π]: a rotation of −π about an axis reads +π (the same rotation),
+    and a small negative yaw stays negative (not 2π − ε)."""
+    import atomnav as an
+
+    for euler in ([-np.pi, 0.0, -np.pi], [np.pi, 0.0, np.pi]):
+        for out in (an.rotation.euler_from_dcm(an.rotation.dcm_from_euler(euler)),
+                    an.rotation.euler_from_quat(an.rotation.quat_from_euler(euler))):
+            assert out[0] == pytest.approx(np.pi, abs=1e-12) and out[2] == pytest.approx(np.pi, abs=1e-12), out
+            assert -np.pi < out[0] <= np.pi and -np.pi < out[2] <= np.pi
+    out = an.rotation.euler_from_dcm(an.rotation.dcm_from_euler([-1e-3, 0.0, -1e-3]))
+    assert out[0] == pytest.approx(-1e-3, rel=1e-9) and out[2] == pytest.approx(-1e-3, rel=1e-9)

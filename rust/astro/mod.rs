@@ -11,7 +11,7 @@ pub mod increments;
 pub mod scenario;
 pub mod stars;
 
-use crate::math::{Mat3, Vec3};
+use crate::math::{half_open, Mat3, Vec3};
 
 /// vee(M) = ½(M32 − M23, M13 − M31, M21 − M12).
 pub fn vee(m: &Mat3) -> Vec3 {
@@ -37,15 +37,6 @@ pub fn euler_from_dcm(c: &Mat3) -> Vec3 {
     let psi = half_open(c[(0, 1)].atan2(c[(1, 1)]));
     let g = half_open((-c[(2, 0)]).atan2(c[(2, 2)]));
     Vec3::new(psi, th, g)
-}
-
-/// An atan2 angle in [−π, π] moved to (−π, π]: −π (from a signed zero) becomes π.
-fn half_open(a: f64) -> f64 {
-    if a <= -std::f64::consts::PI {
-        a + 2.0 * std::f64::consts::PI
-    } else {
-        a
-    }
 }
 
 /// D1(β): θ^clb = D1 δβ with C(β + δβ) ≈ C(β)(I + [θ^clb×]) (Vasilyuk et al. 2024, Eq. 8).

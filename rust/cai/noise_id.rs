@@ -25,11 +25,6 @@ pub struct FringeEkf {
     pub r: f64,
 }
 
-fn wrap(phi: f64) -> f64 {
-    let w = (phi + PI).rem_euclid(2.0 * PI) - PI;
-    if w == -PI { PI } else { w }
-}
-
 /// Track ζ over the readouts `p` with known input phases `psi` (rad); returns ζ after each
 /// update (A kept > 0, φ wrapped to (−π, π]).
 // invariant: fixed-size 3-vectors and 3 × 3 matrices indexed by constants < 3; the
@@ -63,7 +58,7 @@ pub fn fringe_track(p: &[f64], psi: &[f64], cfg: &FringeEkf) -> Result<Vec<[f64;
             let j = Matrix3::from_diagonal(&Vector3::new(1.0, 1.0, -1.0));
             pm = j * pm * j;
         }
-        z[1] = wrap(z[1]);
+        z[1] = crate::math::wrap_pi(z[1]);
         out.push([z[0], z[1], z[2]]);
     }
     Ok(out)
@@ -114,6 +109,14 @@ pub struct MlResult {
     /// Eigenvalues (ascending in magnitude) of the 3 × 3 Hessian of ln L w.r.t. (σ_p0², σ_φ², σ_A²)
     /// at the estimate: one is ≈ 0 (the unidentifiable direction).
     pub hessian_eigenvalues: [f64; 3],
+    /// Standard errors of (σ_p0, σ_φ, σ_A) from the observed information of the free
+    /// variances, (−H_ff)⁻¹, by the delta method σ(θ) = σ(θ²)/(2θ); 0 for a component
+    /// held fixed, +∞ where the information is not positive definite (an estimate on the
+    /// boundary).
+    pub se_theta: [f64; 3],
+    /// Standard errors of the identifiable a and b from the same covariance.
+    pub se_a: f64,
+    pub se_b: f64,
 }
 
 struct Data<'a> {
@@ -261,6 +264,14 @@ pub fn ml_identify(x: &[f64], phi: &[f64], amp: &[f64], cfg: &MlConfig) -> Resul
     let mut eig: Vec<f64> = hv.symmetric_eigen().eigenvalues.iter().copied().collect();
     eig.sort_by(|p, q| p.abs().total_cmp(&q.abs()));
     let a_mean2 = (amp.iter().sum::<f64>() / n as f64).powi(2);
+    let cov = free_variance_covariance(&hv, &free);
+    let se_theta = std::array::from_fn(|j| match &cov {
+        Some(c) => if c[(j, j)] > 0.0 { c[(j, j)].sqrt() / (2.0 * th[j]) } else { 0.0 },
+        None => if free.contains(&j) { f64::INFINITY } else { 0.0 },
+    });
+    // a = s₀ + s₂, b = Ā² s₁ − s₂ in the variances s = θ²
+    let linear = |w: Vector3<f64>| cov.as_ref().map_or(f64::INFINITY, |c| (w.transpose() * c * w)[(0, 0)].max(0.0).sqrt());
+    let (se_a, se_b) = (linear(Vector3::new(1.0, 0.0, 1.0)), linear(Vector3::new(0.0, a_mean2, -1.0)));
     Ok(MlResult {
         theta: th,
         iterations,
@@ -269,7 +280,28 @@ pub fn ml_identify(x: &[f64], phi: &[f64], amp: &[f64], cfg: &MlConfig) -> Resul
         a: th[0] * th[0] + th[2] * th[2],
         b: a_mean2 * th[1] * th[1] - th[2] * th[2],
         hessian_eigenvalues: [eig[0], eig[1], eig[2]],
+        se_theta,
+        se_a,
+        se_b,
     })
+}
+
+/// Covariance of the variances (σ_p0², σ_φ², σ_A²) from the observed information
+/// (−H)⁻¹ restricted to the `free` ones (zero rows and columns for the fixed ones); None
+/// when that information is not positive definite.
+// invariant: free holds indices < 3 of the 3 × 3 matrices; r, k < free.len().
+#[allow(clippy::indexing_slicing)]
+fn free_variance_covariance(hv: &Matrix3<f64>, free: &[usize]) -> Option<Matrix3<f64>> {
+    let k = free.len();
+    let info = nalgebra::DMatrix::from_fn(k, k, |r, c| -hv[(free[r], free[c])]);
+    let inv = info.cholesky()?.inverse();
+    let mut cov = Matrix3::zeros();
+    for r in 0..k {
+        for c in 0..k {
+            cov[(free[r], free[c])] = inv[(r, c)];
+        }
+    }
+    Some(cov)
 }
 
 /// ML over consecutive batches of `batch` samples (each from `cfg.theta0`), or over a

@@ -214,12 +214,27 @@ pub fn dcm_from_euler(roll: f64, pitch: f64, yaw: f64) -> Mat3 {
     )
 }
 
-/// (roll, pitch, yaw) of C_nb; yaw in (−π, π], pitch in [−π/2, π/2].
+/// An atan2 angle, in [−π, π], moved to (−π, π]: −π (from a negative or signed-zero
+/// sine) becomes π; every other value is returned unchanged, bit for bit.
+pub fn half_open(a: f64) -> f64 {
+    if a <= -std::f64::consts::PI {
+        std::f64::consts::PI
+    } else {
+        a
+    }
+}
+
+/// Any angle wrapped to (−π, π].
+pub fn wrap_pi(a: f64) -> f64 {
+    half_open((a + std::f64::consts::PI).rem_euclid(std::f64::consts::TAU) - std::f64::consts::PI)
+}
+
+/// (roll, pitch, yaw) of C_nb; roll and yaw in (−π, π], pitch in [−π/2, π/2].
 pub fn euler_from_dcm(c: &Mat3) -> Vec3 {
-    let roll = c[(2, 1)].atan2(c[(2, 2)]);
+    let roll = half_open(c[(2, 1)].atan2(c[(2, 2)]));
     // asin loses accuracy near ±π/2; atan2 with the row norm keeps it.
     let pitch = (-c[(2, 0)]).atan2((c[(2, 1)] * c[(2, 1)] + c[(2, 2)] * c[(2, 2)]).sqrt());
-    let yaw = c[(1, 0)].atan2(c[(0, 0)]);
+    let yaw = half_open(c[(1, 0)].atan2(c[(0, 0)]));
     Vec3::new(roll, pitch, yaw)
 }
 
@@ -244,7 +259,7 @@ pub fn euler_from_quat(q: &Quat) -> Vec3 {
     let (c10, c00) = (2.0 * (x * y + w * z), w * w + x * x - y * y - z * z);
     // musl's atan2 (the libm crate): within 1 ulp of glibc's at two thirds of its cost,
     // which matters where a table of states gets its Euler columns
-    Vec3::new(libm::atan2(c21, c22), libm::atan2(-c20, (c21 * c21 + c22 * c22).sqrt()), libm::atan2(c10, c00))
+    Vec3::new(half_open(libm::atan2(c21, c22)), libm::atan2(-c20, (c21 * c21 + c22 * c22).sqrt()), half_open(libm::atan2(c10, c00)))
 }
 
 /// DCM of a rotation vector: exp([φ×]) (Rodrigues).
