@@ -102,7 +102,13 @@ def seed003_sensor(lever=(0.0, 0.0, 0.1), v0: float = 2.8, T: float = 0.025, inf
         Pulse separation (s).
     inflation : tuple of float, optional
         White-noise PSDs (q_a m²/s³, q_g rad²/s) of the IMU for the in-shot R inflation;
-        None: no inflation.
+        None: no inflation. The inflation makes the filter conservative by design: it
+        treats the in-shot IMU noise as independent readout noise, though the same noise
+        drives the step's velocity and tilt errors. Measured over Monte-Carlo runs on a
+        3 m/s slalom and a drive with a sinusoidal yaw rate (lever arm 0): actual scatter /
+        reported σ 0.38–0.68 (position), 0.39–0.60 (velocity), 0.51–0.68 (attitude), mean
+        NEES ≈ 10 of 15 states. Without it σ is closer for the navigation states
+        (0.61–1.09) but the bias states are overconfident (mean NEES ≈ 140).
     interpolation : {"linear", "cubic"}
         Interpolation of the IMU inputs in the predictor.
     omega_dot : {"pwl", "savgol", "zero"}
