@@ -692,7 +692,7 @@ impl ErrorBound {
     pub fn rate_needed(&self, tolerance: f64) -> Result<Option<f64>> {
         check_positive("tolerance_rad", tolerance)?;
         let target = tolerance / RATE_MARGIN;
-        if !(self.at(0.0) < target) || !self.rate_hz.is_finite() {
+        if self.at(0.0) >= target || !self.rate_hz.is_finite() {
             return Ok(None);
         }
         if self.at(1.0) <= target {
