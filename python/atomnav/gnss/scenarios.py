@@ -159,8 +159,8 @@ def build(sc: Scenario | str, clock=(0.0, 0.0)) -> dict:
         only = eph.top(sc.n_sats, 0.0, traj.lla[0]) if sc.n_sats > 0 else []
     outages = [] if sc.outage is None else [(sc.outage[0], sc.outage[0] + sc.outage[1])]
     # the simulator's bias is the offset at its first epoch t_gnss[0], the run starts at 0
-    obs = simulate(eph, t_gnss, lla, vel, tau_gps=0.0, clock_bias=clock[0] + clock[1] * t_gnss[0], clock_drift=clock[1], only=only,
-                   outages=outages, seed=sc.seed + 1000)
+    obs = simulate(eph, t_gnss, lla, vel, tau_gps=0.0, clock_bias=clock[0] + clock[1] * t_gnss[0], clock_drift=clock[1],
+                   only=only, outages=outages, seed=sc.seed + 1000)
     tilt, heading = INITIAL_ATTITUDE[sc.imu_class]
     a, g = errors.accel, errors.gyro
     p0 = np.diag(np.r_[[10.0 ** 2] * 3, [0.1 ** 2] * 3, [tilt ** 2, tilt ** 2, heading ** 2],
