@@ -451,7 +451,7 @@ def test_every_public_class_is_covered():
         # members of the classes above (TriadErrors, GaussMarkov, Flicker in ImuErrors; UpdateResult
         # is a tuple), the Comparison report (dataclass of tables, like AllanFit), bases and exceptions
         "TriadErrors", "GaussMarkov", "Flicker", "UpdateResult", "Comparison", "Config", "ConfigMixin", "Stateful",
-        "MonteCarloIncomplete", "UnitWarning",
+        "MonteCarloIncomplete", "UnitWarning", "ImuRateWarning",
     }
     public = set()
     for m in pkgutil.walk_packages(an.__path__, "atomnav."):

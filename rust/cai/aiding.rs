@@ -261,7 +261,7 @@ pub fn shot_times(t0: f64, t_end: f64, t_sep: f64, period: f64) -> Result<Vec<f6
 
 impl CaiConfig {
     /// An ideal interferometer: readout offset ½ and contrast 1, piecewise-linear Ω̇,
-    /// linear IMU interpolation, one substep, no R inflation, no extra states (γ, l), the
+    /// the predictor's default (cubic) IMU interpolation, one substep, no R inflation, no extra states (γ, l), the
     /// force term as an accelerometer bias, rate samples. Change fields with struct update
     /// syntax (`CaiConfig { contrast: 0.9, ..CaiConfig::ideal(…) }`).
     pub fn ideal(channels: Vec<Channel>, t_sep: f64, shots: Vec<f64>, sigma_p: f64) -> Self {
@@ -274,7 +274,7 @@ impl CaiConfig {
             sigma_p,
             inflation: None,
             omega_dot: OmegaDot::Pwl,
-            interpolation: Interpolation::Linear,
+            interpolation: Interpolation::default(),
             substeps: 1,
             jacobian_euler: false,
             misalignment: None,

@@ -5,7 +5,7 @@ CAI-aided INS with its Monte-Carlo scenarios (``sensor``, ``scenarios``, ``campa
 ``results``)."""
 
 from .predictor import (
-    JACOBIAN_PARAMS, K_RB87, LAMBDA_RB87, TERMS, Channels, PhasePrediction, SineMotion, YawDrive,
+    JACOBIAN_PARAMS, K_RB87, LAMBDA_RB87, TERMS, Channels, ImuRateWarning, PhasePrediction, SineMotion, YawDrive,
     acceleration_noise, capture_limits, in_shot_noise_phase, check_jacobian, dynamic_range, k_eff, motion_imu, oracle_phase,
     phase_constant, phase_jacobian, phase_noise, phase_seed000, phase_series, predict_phase,
     readout_jacobian, sagnac_phase, scale_factors, t_sep_from_total, total_from_t_sep,

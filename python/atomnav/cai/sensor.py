@@ -58,13 +58,15 @@ class CaiSensor(ConfigMixin):
     inflation : tuple of float, optional
         White-noise PSDs (q_a m²/s³, q_g rad²/s) of the IMU(s) for the in-shot R
         inflation (Tennstedt et al. 2021, §2.4); None: no inflation.
-    omega_dot : {"savgol", "pwl", "zero"}
+    omega_dot : {"savgol", "pwl", "zero"}, optional
         Source of ω̇ for the Euler terms of the predictor (:data:`OMEGA_DOT_OPTIONS` but
-        "given"), as in :func:`predict_phase`.
+        "given"), as in :func:`predict_phase`; None: the predictor's accurate default (ω̇
+        from the gyro interpolant, docs/cai_predictor_accuracy.md).
     savgol_half_width : int
         Half width m of the Savitzky–Golay ω̇ window (2m + 1 samples).
-    interpolation : {"linear", "cubic"}
-        Interpolation of the IMU inputs in the predictor (:data:`INTERPOLATION_OPTIONS`).
+    interpolation : {"linear", "cubic"}, optional
+        Interpolation of the IMU inputs in the predictor (:data:`INTERPOLATION_OPTIONS`);
+        None: the predictor's default (cubic).
     substeps : int
         RK4 steps per interval of the predictor's integration grid.
     jacobian_euler : bool
@@ -99,9 +101,9 @@ class CaiSensor(ConfigMixin):
     contrast: float = 1.0
     sigma_p: float = float(np.sqrt(1e-3))
     inflation: tuple | None = None
-    omega_dot: str = "savgol"
+    omega_dot: str | None = None
     savgol_half_width: int = 2
-    interpolation: str = "linear"
+    interpolation: str | None = None
     substeps: int = 1
     jacobian_euler: bool = False
     misalignment_psd: float | None = None
