@@ -634,15 +634,46 @@ impl Choice for NoiseType {
     ];
 }
 
+impl NoiseType {
+    /// Exponent α of the rate spectrum S_y(f) ∝ f^α: 2 (white PM), 1 (flicker PM),
+    /// 0 (white FM), −1 (flicker FM), −2 (random-walk FM).
+    pub fn alpha(self) -> i32 {
+        match self {
+            NoiseType::WhitePm => 2,
+            NoiseType::FlickerPm => 1,
+            NoiseType::WhiteFm => 0,
+            NoiseType::FlickerFm => -1,
+            NoiseType::RandomWalkFm => -2,
+        }
+    }
+}
+
+impl Kind {
+    /// Order d of the phase difference: 2 (Allan, modified Allan) or 3 (Hadamard).
+    pub fn order(self) -> u32 {
+        match self {
+            Kind::Hadamard => 3,
+            Kind::Allan | Kind::Modified => 2,
+        }
+    }
+}
+
 /// Equivalent degrees of freedom of `kind` at each averaging factor of `m` for a record
-/// of `np` phase points: [`edf_overlapping_allan`] for the Allan variance, the
-/// non-overlapping count [`edf_non_overlapping`] otherwise.
+/// of `np` phase points (docs/departures.md#allan-edf):
+/// - Allan: Howe's approximations, [`edf_overlapping_allan`];
+/// - modified Allan and Hadamard: for white PM, white FM and random-walk FM at
+///   (d+1)m ≤ 100 the exact EDF of the sampled estimator, [`edf_sampled`]; otherwise
+///   Greenhall & Riley 2003, [`edf_greenhall`].
 pub fn edf(kind: Kind, noise: NoiseType, np: usize, m: &[usize]) -> Result<Vec<f64>> {
-    if let Some((i, mi)) = m.iter().enumerate().find(|(_, &mj)| mj == 0 || mj >= np) {
-        return Err(invalid_at("m", i, format!("averaging factor {mi} at index {i} outside [1, {np}) for {np} phase points")));
+    if let Some((i, mi)) = m.iter().enumerate().find(|(_, &mj)| mj == 0 || kind.terms(np, mj) == 0) {
+        return Err(invalid_at("m", i, format!("averaging factor {mi} at index {i} leaves no term of the sum for {np} phase points (a term spans {} points)", kind.span(*mi).saturating_add(1))));
     }
     Ok(m.iter()
-        .map(|&mj| if kind == Kind::Allan { edf_overlapping_allan(noise, np, mj) } else { edf_non_overlapping(kind, np, mj) })
+        .map(|&mj| match kind {
+            Kind::Allan => edf_overlapping_allan(noise, np, mj),
+            _ if noise != NoiseType::FlickerPm && noise != NoiseType::FlickerFm && (f64::from(kind.order()) + 1.0) * mj as f64 <= J_MAX => edf_sampled(kind, noise, np, mj),
+            _ => edf_greenhall(kind, noise, np, mj),
+        })
         .collect())
 }
 
@@ -667,11 +698,188 @@ pub fn edf_overlapping_allan(noise: NoiseType, np: usize, m: usize) -> f64 {
     edf.max(1.0)
 }
 
-/// Conservative EDF for the modified Allan and overlapping Hadamard variances: the
-/// number of non-overlapping terms, ⌊(Np−1)/m⌋ − d + 1 (d = 2 or 3 differences), at least 1.
-pub fn edf_non_overlapping(kind: Kind, np: usize, m: usize) -> f64 {
-    let d = if kind == Kind::Allan { 2 } else { 3 };
-    (((np - 1) / m) as f64 - d as f64 + 1.0).max(1.0)
+/// Greenhall & Riley 2003 J_max: longest sum evaluated term by term.
+const J_MAX: f64 = 100.0;
+
+/// C(2d, d−k) for k = 0…d (d = 2 or 3): the autocorrelation of the d-th difference.
+fn binomial_2d(d: u32) -> &'static [f64] {
+    if d == 2 {
+        &[6.0, 4.0, 1.0]
+    } else {
+        &[20.0, 15.0, 6.0, 1.0]
+    }
+}
+
+/// Generalised autocovariance of the continuous power-law process w (Greenhall & Riley
+/// 2003 Eq. 7), α ∈ [−2, 2]; the overall sign and scale cancel in the EDF.
+fn gr_sw(t: f64, alpha: i32) -> f64 {
+    match alpha {
+        2 => -t.abs(),
+        1 if t == 0.0 => 0.0,
+        1 => t * t * t.abs().ln(),
+        0 => t.abs().powi(3),
+        -1 if t == 0.0 => 0.0,
+        -1 => t.powi(4) * t.abs().ln(),
+        _ => t.abs().powi(5),
+    }
+}
+
+/// Phase autocovariance behind filter factor F (Greenhall & Riley 2003 Eq. 8); `None`
+/// is F = ∞ (the phase sampled without a filter, α ≤ 0).
+fn gr_sx(t: f64, f: Option<f64>, alpha: i32) -> f64 {
+    match f {
+        None => gr_sw(t, alpha + 2),
+        Some(f) => f * f * (2.0 * gr_sw(t, alpha) - gr_sw(t - 1.0 / f, alpha) - gr_sw(t + 1.0 / f, alpha)),
+    }
+}
+
+/// Autocovariance of the d-th difference of the phase at lag t (in τ; Eq. 9).
+fn gr_sz(t: f64, f: Option<f64>, alpha: i32, d: u32) -> f64 {
+    let mut acc = 0.0;
+    for (k, c) in binomial_2d(d).iter().enumerate() {
+        let (sign, k) = (if k % 2 == 0 { 1.0 } else { -1.0 }, k as f64);
+        acc = if k == 0.0 { c * gr_sx(t, f, alpha) } else { acc + sign * c * gr_sx(t - k, f, alpha) + sign * c * gr_sx(t + k, f, alpha) };
+    }
+    acc
+}
+
+/// Greenhall & Riley 2003 Eq. 10: M·sz(0)²/EDF from J lags of stride 1/S.
+fn gr_basic_sum(j: f64, m_terms: f64, s: f64, f: Option<f64>, alpha: i32, d: u32) -> f64 {
+    let first = gr_sz(0.0, f, alpha, d).powi(2);
+    let second = (1.0 - j / m_terms) * gr_sz(j / s, f, alpha, d).powi(2);
+    let mut third = 0.0;
+    let mut jj = 1.0;
+    while jj < j {
+        third += 2.0 * (1.0 - jj / m_terms) * gr_sz(jj / s, f, alpha, d).powi(2);
+        jj += 1.0;
+    }
+    first + second + third
+}
+
+/// Greenhall & Riley 2003 Table 1 (modified variances, many lags): (a₀, a₁), d = 2, 3.
+fn gr_table1(alpha: i32, d: u32) -> (f64, f64) {
+    match (alpha, d) {
+        (2, 2) => (7.0 / 9.0, 0.5),
+        (2, _) => (22.0 / 25.0, 2.0 / 3.0),
+        (1, 2) => (0.997, 0.616),
+        (1, _) => (1.141, 0.843),
+        (0, 2) => (1.033, 0.607),
+        (0, _) => (1.184, 0.848),
+        (-1, 2) => (1.048, 0.534),
+        (-1, _) => (1.180, 0.816),
+        (_, 2) => (1.302, 0.535),
+        _ => (1.175, 0.777),
+    }
+}
+
+/// Greenhall & Riley 2003 Table 2 (unmodified variances, many lags), α ≤ 1: (a₀, a₁).
+fn gr_table2(alpha: i32, d: u32) -> (f64, f64) {
+    match (alpha, d) {
+        (1, 2) => (790.0, 410.0),
+        (1, _) => (9950.0, 6520.0),
+        (0, 2) => (2.0 / 3.0, 1.0 / 3.0),
+        (0, _) => (7.0 / 9.0, 0.5),
+        (-1, 2) => (0.852, 0.375),
+        (-1, _) => (0.997, 0.617),
+        (_, 2) => (1.079, 0.368),
+        _ => (1.033, 0.607),
+    }
+}
+
+/// Equivalent degrees of freedom of the overlapping estimator `kind` (stride τ₀) on
+/// continuous-time power-law noise, by C. A. Greenhall and W. J. Riley, "Uncertainty of
+/// stability variances based on finite differences", PTTI 2003, §3.4–3.6 (the algorithm
+/// of Stable32 and allantools' `edf_greenhall`): filter factor F = 1 (modified) or m,
+/// stride factor S = m, d = 2 (Allan, modified Allan) or 3 (Hadamard), M terms,
+/// J = min(M, (d+1)S), J_max = 100, r = M/S. For white PM (α = 2, unmodified) the
+/// closed form of their case 4, (1 + 2 Σ_{k<min(⌈r⌉, d+1)} (1 − k/r) C(2d,d−k)²/C(2d,d)²)/M,
+/// which is exact. `np` phase points, factor `m` with at least one term.
+pub fn edf_greenhall(kind: Kind, noise: NoiseType, np: usize, m: usize) -> f64 {
+    let (alpha, d) = (noise.alpha(), kind.order());
+    let (n, m, df) = (np as f64, m as f64, f64::from(d));
+    let modified = kind == Kind::Modified;
+    let s = m;
+    let l = if modified { m } else { 1.0 } + m * df;
+    let m_terms = 1.0 + (s * (n - l) / m).floor();
+    let j = m_terms.min((df + 1.0) * s);
+    let r = m_terms / s;
+    let inv = if modified {
+        let sz0 = gr_sz(0.0, Some(1.0), alpha, d).powi(2);
+        if j <= J_MAX {
+            gr_basic_sum(j, m_terms, s, Some(1.0), alpha, d) / (sz0 * m_terms)
+        } else if r > df + 1.0 {
+            let (a0, a1) = gr_table1(alpha, d);
+            (a0 - a1 / r) / r
+        } else {
+            gr_basic_sum(J_MAX, J_MAX, J_MAX / r, Some(1.0), alpha, d) / (sz0 * J_MAX)
+        }
+    } else if alpha <= 0 {
+        if j <= J_MAX {
+            let f = if m * (df + 1.0) <= J_MAX { Some(m) } else { None };
+            gr_basic_sum(j, m_terms, s, f, alpha, d) / (gr_sz(0.0, f, alpha, d).powi(2) * m_terms)
+        } else if r > df + 1.0 {
+            let (a0, a1) = gr_table2(alpha, d);
+            (a0 - a1 / r) / r
+        } else {
+            gr_basic_sum(J_MAX, J_MAX, J_MAX / r, None, alpha, d) / (gr_sz(0.0, None, alpha, d).powi(2) * J_MAX)
+        }
+    } else if alpha == 1 {
+        // Table 3: the log-m normalisation of flicker PM
+        let (b0, b1) = if d == 2 { (15.23, 12.0) } else { (47.8, 40.0) };
+        let b = (b0 + b1 * m.ln()).powi(2);
+        if j <= J_MAX {
+            gr_basic_sum(j, m_terms, s, Some(m), 1, d) / (gr_sz(0.0, Some(m), 1, d).powi(2) * m_terms)
+        } else if r > df + 1.0 {
+            let (a0, a1) = gr_table2(alpha, d);
+            (a0 - a1 / r) / (b * r)
+        } else {
+            gr_basic_sum(J_MAX, J_MAX, J_MAX / r, Some(J_MAX / r), 1, d) / (b * J_MAX)
+        }
+    } else {
+        let c = binomial_2d(d);
+        let c0 = c.first().copied().unwrap_or(1.0);
+        let lags = c.iter().enumerate().skip(1).take_while(|(k, _)| (*k as f64) < r.ceil());
+        (1.0 + 2.0 * lags.map(|(k, ck)| (1.0 - k as f64 / r) * ck * ck).sum::<f64>() / (c0 * c0)) / m_terms
+    };
+    1.0 / inv
+}
+
+/// Exact equivalent degrees of freedom 2E[V]²/Var[V] of the estimator `kind` at factor
+/// `m` on sampled Gaussian noise whose d-th phase differences have finite memory: white PM
+/// (iid phase), white FM (iid rate) and random-walk FM (rate a random walk of iid steps).
+/// With z_i = Σ_k h_k x_{i+k} the M terms of the sum (h the weights of `kind`) and ρ
+/// their autocorrelation, 1/EDF = Σ_{|l|<M} (1 − |l|/M) ρ(l)²/M: Greenhall & Riley
+/// 2003 Eq. 10 summed over every lag, from the autocovariance of the samples rather
+/// than of a continuous-time model (which misstates the EDF at small m). The phase
+/// generalised autocovariance at integer lag k is δ_k, −|k| and |k|³ − |k|. Cost O(m²).
+pub fn edf_sampled(kind: Kind, noise: NoiseType, np: usize, m: usize) -> f64 {
+    let diff: &[f64] = if kind.order() == 2 { &[1.0, -2.0, 1.0] } else { &[1.0, -3.0, 3.0, -1.0] };
+    let mut h = vec![0.0; kind.span(m) + 1];
+    for i in 0..if kind == Kind::Modified { m } else { 1 } {
+        for (k, c) in diff.iter().enumerate() {
+            if let Some(v) = h.get_mut(i + k * m) {
+                *v += c;
+            }
+        }
+    }
+    // autocorrelation of the weights, R(q) = Σ_i h_i h_{i+q}
+    let rh: Vec<f64> = (0..h.len()).map(|q| h.iter().zip(h.iter().skip(q)).map(|(a, b)| a * b).sum()).collect();
+    let s = |k: usize| -> f64 {
+        let k = k as f64;
+        match noise {
+            NoiseType::WhitePm => f64::from(u8::from(k == 0.0)),
+            NoiseType::WhiteFm => -k,
+            _ => k * k * k - k,
+        }
+    };
+    // autocovariance of the terms at lag l: Σ_q R(|q|) s(|l + q|)
+    let gamma: Vec<f64> = (0..h.len())
+        .map(|l| rh.iter().enumerate().map(|(q, r)| if q == 0 { r * s(l) } else { r * (s(l + q) + s(l.abs_diff(q))) }).sum())
+        .collect();
+    let m_terms = kind.terms(np, m) as f64;
+    let g0 = gamma.first().copied().unwrap_or(1.0);
+    let tail: f64 = gamma.iter().enumerate().skip(1).filter(|(l, _)| (*l as f64) < m_terms).map(|(l, g)| 2.0 * (1.0 - l as f64 / m_terms) * (g / g0).powi(2)).sum();
+    m_terms / (1.0 + tail)
 }
 
 /// Result of the five-term fit σ²(τ) = Σ_{k=−2}^{2} A_k τ^k (Niu et al. 2025 Eq. 19).
@@ -906,7 +1114,19 @@ mod tests {
     fn edf_picks_the_formula_of_the_kind() {
         let e = edf(Kind::Allan, NoiseType::WhiteFm, 1001, &[1, 10]).unwrap();
         assert_eq!(e, vec![edf_overlapping_allan(NoiseType::WhiteFm, 1001, 1), edf_overlapping_allan(NoiseType::WhiteFm, 1001, 10)]);
-        // non-overlapping count ⌊(Np−1)/m⌋ − 2 for the Hadamard variance
-        assert_eq!(edf(Kind::Hadamard, NoiseType::WhiteFm, 1001, &[10]).unwrap(), vec![98.0]);
+        // (d+1)m ≤ 100: exact sampled EDF; beyond, and for flicker noise, Greenhall & Riley
+        assert_eq!(edf(Kind::Hadamard, NoiseType::WhiteFm, 1001, &[25, 26]).unwrap(), vec![edf_sampled(Kind::Hadamard, NoiseType::WhiteFm, 1001, 25), edf_greenhall(Kind::Hadamard, NoiseType::WhiteFm, 1001, 26)]);
+        assert_eq!(edf(Kind::Modified, NoiseType::FlickerFm, 1001, &[2]).unwrap(), vec![edf_greenhall(Kind::Modified, NoiseType::FlickerFm, 1001, 2)]);
+    }
+
+    /// Two closed forms: at m = 1 the Allan terms of random-walk FM are its iid steps
+    /// (EDF = M), and white PM (iid phase) gives Greenhall & Riley's exact case 4.
+    #[test]
+    fn sampled_edf_meets_closed_forms() {
+        assert!((edf_sampled(Kind::Allan, NoiseType::RandomWalkFm, 500, 1) - 498.0).abs() < 1e-9);
+        for (np, m) in [(40, 3), (30, 9), (1000, 7)] {
+            let (a, b) = (edf_sampled(Kind::Hadamard, NoiseType::WhitePm, np, m), edf_greenhall(Kind::Hadamard, NoiseType::WhitePm, np, m));
+            assert!((a / b - 1.0).abs() < 1e-12, "{np} {m}: {a} vs {b}");
+        }
     }
 }
