@@ -1,10 +1,13 @@
 """Monte-Carlo consistency of the uncertainties the noise-analysis tools report.
 
-- Allan variance (overlapping "allan" and "modified"): the χ² confidence interval
-  (dev_lo, dev_hi) at 68.3 % must cover the true deviation in about 68.3 % of records. The
-  true values are exact: σ²/m for white rate noise of variance σ² per sample, and for a
-  rate random walk the variance of the weighted increment sum, computed here from the
-  increments' weights (no formula of the code under test).
+- Allan family (overlapping Allan, modified Allan, overlapping Hadamard): the χ²
+  confidence interval (dev_lo, dev_hi) at 68.3 % must cover the true deviation in about
+  68.3 % of records, for white rate noise and a rate random walk, at m = 1 … 16. The true
+  values are exact: σ²/m for the Allan variance of white rate noise of variance σ² per
+  sample, for a rate random walk the variance of the weighted increment sum, computed here
+  from the increments' weights, and for the modified Allan and Hadamard variances the
+  brute-force definition evaluated on every unit impulse of the driving noise (no
+  formula of the code under test).
 - ARMA fit: the scatter of the estimated coefficients over records equals the standard
   errors it reports (statsmodels' exact ML), on ARMA(1,1) and ARMA(2,1) programs that
   are not Niu et al. 2025's.
@@ -40,36 +43,44 @@ def _random_walk_avar(m, q):
 def _coverage(kind, process, runs, n=4096, seed=1):
     rng = np.random.default_rng(seed)
     hits, total = 0, 0
+    ms = [1, 2, 4, 8, 16]
+    if kind == "allan":
+        true = 1.0 / np.array(ms) if process == "white" else np.array([_random_walk_avar(m, 1.0) for m in ms])
+    else:
+        true = np.array([_true_var(kind, m, process) for m in ms])
     for _ in range(runs):
         e = rng.standard_normal(n)
         y, noise_type = (e, "white_fm") if process == "white" else (np.cumsum(e), "random_walk_fm")
-        t = allan.allan_variance(y, 0.01, m=[1, 2, 4, 8, 16], kind=kind, noise=noise_type)
-        if kind == "allan":
-            true = 1.0 / t["m"] if process == "white" else np.array([_random_walk_avar(m, 1.0) for m in t["m"]])
-        else:  # modified Allan of white rate noise: σ²/m · (2m² + 1)/(3m²)... checked by brute force below
-            true = _true_mvar(t["m"].to_numpy(), process)
+        t = allan.allan_variance(y, 0.01, m=ms, kind=kind, noise=noise_type)
         inside = (t["dev_lo"] ** 2 <= true) & (true <= t["dev_hi"] ** 2)
         hits += inside.to_numpy(int)
         total += 1
     return hits / total
 
 
-def _true_mvar(ms, process, draws=20000, seed=99):
-    """Modified Allan variance by brute force: the mean over many independent records of
-    the squared second-level difference (independent of the code's estimator and EDF)."""
-    rng = np.random.default_rng(seed)
-    out = []
-    for m in ms:
-        e = rng.standard_normal((draws, 3 * m))
-        y = e if process == "white" else np.cumsum(e, axis=1)
-        x = np.cumsum(y, axis=1) * 0.01                                 # phase
-        x = np.c_[np.zeros(draws), x]
-        d = x[:, 2 * m:3 * m + 1][:, :m] - 2 * x[:, m:2 * m] + x[:, :m]   # m second differences
-        out.append(np.mean(d.mean(axis=1) ** 2) / (2 * (m * 0.01) ** 2))
-    return np.array(out)
+def _true_var(kind, m, process):
+    """Modified Allan or overlapping Hadamard variance of one term by brute force, written
+    from the definitions (NIST SP 1065 Eqs. 14, 18), independent of the code's estimator
+    and EDF: the m-sample averages of the rate (modified: of m consecutive second
+    differences) differenced, squared and scaled. The term is linear in the iid steps e
+    that drive the record, so instead of averaging over random records (20 000 of them
+    leave a 1 % error, as large as the 68 % interval at m = 1, 2) the same computation is
+    run on each unit impulse of e and the squares summed: the exact expectation."""
+    span = 4 * m                                             # rate samples one term reaches, with room
+    e = np.eye(span)                                         # one record per unit impulse of e
+    y = e if process == "white" else np.cumsum(e, axis=1)    # rate
+    x = np.c_[np.zeros(span), np.cumsum(y, axis=1)]          # phase, units of rate·τ₀
+    if kind == "modified":
+        d2 = np.stack([x[:, i + 2 * m] - 2 * x[:, i + m] + x[:, i] for i in range(m)], axis=1)
+        return np.sum(d2.mean(axis=1) ** 2) / (2 * m**2)
+    ybar = y[:, : 3 * m].reshape(span, 3, m).mean(axis=2)    # three consecutive m-averages
+    return np.sum((ybar[:, 2] - 2 * ybar[:, 1] + ybar[:, 0]) ** 2) / 6
 
 
-@pytest.mark.parametrize("kind, process", [("allan", "white"), ("allan", "random_walk")])
+CASES = [("allan", "white"), ("allan", "random_walk"), ("modified", "white"), ("modified", "random_walk"), ("hadamard", "white"), ("hadamard", "random_walk")]
+
+
+@pytest.mark.parametrize("kind, process", [("allan", "white"), ("allan", "random_walk"), ("modified", "white"), ("hadamard", "white"), ("modified", "random_walk")])
 def test_allan_confidence_interval_covers_the_truth_reduced(kind, process):
     cover = _coverage(kind, process, runs=300)
     lo, hi = _coverage_band(0.683, 300)
@@ -77,11 +88,24 @@ def test_allan_confidence_interval_covers_the_truth_reduced(kind, process):
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("kind, process", [("allan", "white"), ("allan", "random_walk"), ("modified", "white")])
+@pytest.mark.parametrize("kind, process", CASES)
 def test_allan_confidence_interval_covers_the_truth_full(kind, process):
     cover = _coverage(kind, process, runs=2000, seed=2)
     lo, hi = _coverage_band(0.683, 2000)
     assert np.all((cover >= lo) & (cover <= hi)), cover
+
+
+def test_true_variances_meet_closed_forms():
+    """The brute-force truths against closed forms for white rate noise of unit variance:
+    Mod σ² = (m² + 1)/(2m³) (the squared weights of the averaged second differences
+    summed by hand; 1 at m = 1, where it is the Allan variance), Hadamard = Allan = 1/m; for a rate random walk
+    Mod σ² = Allan at m = 1 and the Hadamard variance at m = 1 is var(e₂ − e₁)/6 = 1/3."""
+    for m in (1, 2, 5):
+        assert _true_var("modified", m, "white") == pytest.approx((m**2 + 1) / (2 * m**3), rel=1e-12)
+    assert _true_var("modified", 1, "random_walk") == pytest.approx(_random_walk_avar(1, 1.0), rel=1e-12)
+    for m in (1, 3, 8):
+        assert _true_var("hadamard", m, "white") == pytest.approx(1.0 / m, rel=1e-12)
+    assert _true_var("hadamard", 1, "random_walk") == pytest.approx(1.0 / 3.0, rel=1e-12)
 
 
 def _arma_ratios(ar, ma, draws, n=1500, seed=5):
