@@ -5,6 +5,7 @@ import numpy as np
 import pandas as pd
 import pytest
 from scipy.optimize import nnls as scipy_nnls
+from scipy.signal import correlate as scipy_correlate
 
 from atomnav import _core
 from atomnav.noise import allan, synth
@@ -182,3 +183,65 @@ def test_fit_of_exact_variances_with_zero_terms_converges():
     assert fit.bias_instability == pytest.approx(b, rel=1e-9)
     assert fit.rrw == pytest.approx(k, rel=1e-9)
     assert fit.quantization == 0.0 and fit.ramp == 0.0
+
+
+# Equivalent degrees of freedom of the modified Allan and overlapping Hadamard variances
+# (d, modified) of Greenhall & Riley 2003; α of each noise type.
+GREENHALL = {"modified": (2, True), "hadamard": (3, False)}
+ALPHA = {"white_pm": 2, "flicker_pm": 1, "white_fm": 0, "flicker_fm": -1, "random_walk_fm": -2}
+#: noise types whose differenced phase has finite memory: their EDF at (d+1)m ≤ 100 is the
+#: exact one of the sampled estimator (docs/departures.md#allan-edf), not Greenhall's model
+SAMPLED = ("white_pm", "white_fm", "random_walk_fm")
+
+
+def _exact_edf(kind, noise, n_phase, m):
+    """2E[V]²/Var[V] of the estimator V = Σ z_i²/M on sampled noise, by brute force: the
+    weights g of one term z on the iid noise that drives the record (phase iid for white PM,
+    rate iid for white FM, rate steps iid for random-walk FM), the autocovariance of the
+    terms from g, and Var[V] = 2 Σ_{|l|<M} (M − |l|) γ(l)²/M²."""
+    d = GREENHALL[kind][0]
+    h = np.zeros(d * m + 1)
+    h[::m] = [1, -2, 1] if d == 2 else [-1, 3, -3, 1]       # d-th difference at lag m, on phase
+    if kind == "modified":
+        h = np.convolve(h, np.ones(m))                       # sum of m consecutive differences
+    g = h
+    for _ in range({"white_pm": 0, "white_fm": 1, "random_walk_fm": 2}[noise]):
+        g = -np.cumsum(g)[:-1]                               # weights on the increments of the series
+    gamma = scipy_correlate(g, g)[g.size - 1:]
+    terms = n_phase - h.size + 1
+    lag = np.arange(min(gamma.size, terms))
+    return terms * gamma[0] ** 2 / (gamma[0] ** 2 + 2 * np.sum((1 - lag[1:] / terms) * gamma[lag[1:]] ** 2))
+
+
+@pytest.mark.parametrize("kind", list(GREENHALL))
+@pytest.mark.parametrize("noise", list(ALPHA))
+def test_edf_agrees_with_greenhall_of_allantools(kind, noise, capsys):
+    """Greenhall & Riley 2003 against allantools.edf_greenhall (overlapping estimators) to
+    1e-9, over N and m that reach every regime of the algorithm (few terms: r ≤ d + 1;
+    many: the tables; filter factor F = m and ∞); where the sampled estimator's EDF is
+    exact (and where allantools lacks case 4 with ⌈r⌉ ≤ d) against the brute-force one."""
+    d, modified = GREENHALL[kind]
+    peer = exact = 0
+    for n in (12, 20, 50, 101, 200, 229, 250, 400, 4097, 100_000):
+        for m in (1, 2, 3, 5, 10, 25, 26, 33, 34, 40, 100, 300, 1000, 3000, 20_000):
+            if n - (3 * m - 1 if modified else d * m) < 1:
+                continue
+            ours = _core.allan_edf(kind, noise, n, [m])[0]
+            if noise in SAMPLED and (d + 1) * m <= 100:
+                assert ours == pytest.approx(_exact_edf(kind, noise, n, m), rel=1e-9), (n, m)
+                exact += 1
+                continue
+            try:
+                want = allantools.edf_greenhall(ALPHA[noise], d, m, n, overlapping=True, modified=modified, verbose=True)
+            except NotImplementedError:
+                assert ours == pytest.approx(_exact_edf(kind, noise, n, m), rel=1e-9), (n, m)
+                exact += 1
+                continue
+            assert ours == pytest.approx(want, rel=1e-9), (n, m)
+            peer += 1
+    cases = {line.split()[1] for line in capsys.readouterr().out.splitlines() if line.startswith("case")}
+    # F = m at (d+1)m ≤ 100 (case 2.1a) is the sampled range of white and random-walk FM
+    want_cases = {"modified": {"1.1", "1.2", "1.3"}, "white_pm": {"4.2"}, "flicker_pm": {"3.1", "3.2", "3.3"}, "flicker_fm": {"2.1a", "2.1b", "2.2", "2.3"}}
+    assert want_cases.get("modified" if modified else noise, {"2.1b", "2.2", "2.3"}) <= cases, cases
+    assert peer >= 20 and (noise not in SAMPLED or exact >= 20), (peer, exact)
+
