@@ -91,8 +91,9 @@ def allan_variance(data, tau0: float, m="octave", kind: str = "allan", data_type
     taus : array_like (K,), optional
         Averaging times, s, positive multiples of ``tau0``; given, they replace ``m``.
     noise : str, default "white_fm"
-        Noise type for the equivalent degrees of freedom (Howe's approximation), one of
-        :data:`NOISE_TYPES`.
+        Power-law noise type assumed by the equivalent degrees of freedom, one of
+        :data:`NOISE_TYPES` ("white_pm", "flicker_pm", "white_fm", "flicker_fm",
+        "random_walk_fm": α = 2 … −2 of S_y(f) ∝ f^α).
     confidence : float, default 0.683
         Probability of the χ² confidence interval, in (0, 1).
 
@@ -100,10 +101,13 @@ def allan_variance(data, tau0: float, m="octave", kind: str = "allan", data_type
     -------
     pandas.DataFrame
         One row per averaging factor. Columns: ``m``, ``tau_s`` (s), ``var`` (U²),
-        ``dev`` (U), ``n_terms``, ``edf`` (equivalent degrees of freedom: Howe's
-        approximation for the overlapping Allan variance with the given ``noise`` type;
-        the conservative non-overlapping count for modified and Hadamard; with gaps,
-        that of a gap-free record of the same number of samples), and the χ² confidence
+        ``dev`` (U), ``n_terms``, ``edf`` (equivalent degrees of freedom for the given
+        ``noise`` type, dimensionless: Howe's approximations for the overlapping Allan
+        variance (NIST SP 1065 Table 12); for the modified Allan and Hadamard variances
+        the exact EDF of the sampled estimator for white PM, white FM and random-walk FM
+        at (d+1)m ≤ 100 (d = 2 modified, 3 Hadamard) and Greenhall & Riley 2003
+        otherwise, see Notes; with gaps, that of a gap-free record of the same number of
+        samples), and the χ² confidence
         interval ``dev_lo``, ``dev_hi`` (U) at ``confidence``. ``table.attrs["n_missing"]``
         counts the NaN samples.
 
@@ -127,13 +131,25 @@ def allan_variance(data, tau0: float, m="octave", kind: str = "allan", data_type
     ±inf anywhere, raise :class:`atomnav.InputError`. A constant series (a stuck or
     quantised sensor) has variance 0 at every τ.
 
+    **Confidence interval.** ``var·edf/χ²`` quantiles at ``confidence``. The EDF of the
+    modified Allan and Hadamard variances is 2E[V]²/Var[V] of the estimator V: summed
+    exactly over the correlation of its overlapping terms (Greenhall & Riley 2003 Eq. 10
+    with the autocovariance of the samples) where the differenced noise has finite memory
+    and m is small, Greenhall & Riley's algorithm (as Stable32 and allantools'
+    ``edf_greenhall``) otherwise. Over 2000 records of 4096 samples of white and
+    random-walk rate noise the 68.3 % interval covers the true variance in 0.67–0.70 of
+    records at m = 1 … 16 for every kind (docs/departures.md, "Allan EDF").
+
     References
     ----------
     IEEE Std 952-1997, *IEEE Standard Specification Format Guide and Test Procedure for
     Single-Axis Interferometric Fiber Optic Gyros*, Annex C. IEEE Std 1139-2008,
     *Standard Definitions of Physical Quantities for Fundamental Frequency and Time
     Metrology*. W. J. Riley, *Handbook of Frequency Stability Analysis*, NIST SP 1065
-    (2008).
+    (2008). C. A. Greenhall and W. J. Riley, "Uncertainty of stability variances based on
+    finite differences", Proc. 35th PTTI Meeting (2003). D. A. Howe, D. W. Allan and
+    J. A. Barnes, "Properties of signal sources and measurement methods", Proc. 35th
+    Frequency Control Symposium (1981) (the Allan EDF of NIST SP 1065 Table 12).
     """
     tau0 = positive(tau0, "tau0")
     confidence = probability(confidence, "confidence")
