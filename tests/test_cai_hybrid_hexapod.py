@@ -48,3 +48,12 @@ def test_spec_absolute_thresholds_match_the_filter_sigma(hexapod20):
     measured = np.mean(np.all(err < thr, axis=1))
     predicted = float(np.prod(1 - 2 * norm.sf(thr / res.sigma[:, -1, 9:15].mean(axis=0))))
     assert abs(measured - predicted) <= 3 * np.sqrt(predicted * (1 - predicted) / res.runs), (measured, predicted)
+
+
+def test_hexapod_preset_takes_its_motion_parameters():
+    """Site, tilt, pitch delay and heading reach the motion (the preset used to pin them)."""
+    kw = dict(origin=(0.9, 0.2, 100.0), max_tilt=0.03, pitch_delay=3.0, heading=0.5)
+    res = cai.hexapod(1, seed=2, progress=False, **kw)
+    assert res.params == {"origin": (0.9, 0.2, 100.0), "max_tilt_rad": 0.03, "pitch_delay_s": 3.0, "heading_rad": 0.5}
+    paper = cai.hexapod(1, seed=2, progress=False)
+    assert not np.array_equal(res.free, paper.free)

@@ -326,7 +326,8 @@ def satellite(days: float = 4.0, seed: int = 2021, *, drift: bool = True, progre
                              "sigma_p": sensor.sigma_p, "q_rw": setup.accel_bias_psd})
 
 
-def hexapod(runs: int = 100, seed: int = 2000, *, progress: bool = True) -> HybridResult:
+def hexapod(runs: int = 100, seed: int = 2000, *, origin=HANNOVER, max_tilt: float = 0.0654, pitch_delay: float = 5.0,
+            heading: float = 0.0, progress: bool = True) -> HybridResult:
     """Hexapod scenario of Tennstedt et al. 2021 (§5.3): 170 s tilt sequence at 1 kHz; a MEMS IMU
     (preset ``mems``: biases (2e-3, −1.5e-3, 1e-3) m/s², (5e-5, −4e-5, 3e-5) rad/s) corrected
     by a CAI emulated from a navigation-grade reference IMU (preset ``navigation``):
@@ -339,6 +340,14 @@ def hexapod(runs: int = 100, seed: int = 2000, *, progress: bool = True) -> Hybr
         Number of Monte-Carlo runs.
     seed : int
         Master seed (0 … 2⁶⁴ − 1); run r uses stream r, so any subset reproduces.
+    origin : array_like (3,), default Hannover (52.38° N, 9.72° E, 60 m)
+        Site: latitude (rad), longitude (rad), height (m).
+    max_tilt : float, default 0.0654
+        Largest tilt of the sequence, rad (the paper's 3.75°).
+    pitch_delay : float, default 5.0
+        Delay of the pitch tilts after the roll tilts, s.
+    heading : float, default 0.0
+        Heading of the hexapod, rad.
     progress : bool
         Show a progress bar over runs.
 
@@ -347,7 +356,8 @@ def hexapod(runs: int = 100, seed: int = 2000, *, progress: bool = True) -> Hybr
     HybridResult
         The Monte-Carlo result (see :func:`atomnav.cai.run_campaign`).
     """
-    motion = _core.Motion.hexapod(vector(HANNOVER, 3, "origin"), 0.0654, 5.0, 0.0)
+    motion = _core.Motion.hexapod(vector(origin, 3, "origin"), finite_scalar(max_tilt, "max_tilt"),
+                                  finite_scalar(pitch_delay, "pitch_delay"), finite_scalar(heading, "heading"))
     mems, nav = ImuErrors.preset("mems"), ImuErrors.preset("navigation")
     q_a = mems.accel.white**2 + nav.accel.white**2
     q_g = mems.gyro.white**2 + nav.gyro.white**2
@@ -356,7 +366,9 @@ def hexapod(runs: int = 100, seed: int = 2000, *, progress: bool = True) -> Hybr
                         mems.gyro.bias_rw**2 + nav.gyro.bias_rw**2, 10, sigma0=(1e-6, 1e-6, 1e-5, 3e-3, 1e-4))
     config = ScenarioConfig(sensor, setup, imu="mems", reference="navigation", gravity="earth", rate_hz=1000.0, truth_rate_hz=None,
                             phase_source="reference")
-    return run_campaign(motion, config, runs=runs, seed=seed, name="hexapod", progress=progress)
+    return run_campaign(motion, config, runs=runs, seed=seed, name="hexapod", progress=progress,
+                        params={"origin": tuple(map(float, origin)), "max_tilt_rad": float(max_tilt),
+                                "pitch_delay_s": float(pitch_delay), "heading_rad": float(heading)})
 
 
 def slalom_covariance(gravity: str = "earth", *, duration: float = 60.0, attitude_sigma: float | None = None,
