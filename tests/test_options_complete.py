@@ -22,6 +22,8 @@ HERE = {
     "Discretization": ("method", lambda: fl.Scenario(np.zeros((1, 2, 2)), np.zeros((1, 2, 2)), [0.1], np.eye(2), np.eye(2),
                                                      np.eye(2), [True, True], method="nope").sigmas()),
     "DiffForm": ("p_diff", lambda: astro.Vasilyuk2024().run(1, p_diff="nope")),
+    "MountCovariance": ("covariance", lambda: astro.calibrate(np.tile(np.eye(3), (3, 1, 1)), np.tile(np.eye(3), (3, 1, 1)),
+                                                              covariance="nope")),
 }
 
 #: option → the test file holding its bad-value case (None: the option is an output only)
@@ -36,7 +38,7 @@ ELSEWHERE = {
     "Interpolation": "test_cai_options.py", "MlMethod": "test_cai_options.py", "OmegaDot": "test_cai_options.py",
     "PhaseSource": "test_cai_options.py", "CaiData": "test_cai_options.py", "IncompleteShots": "test_cai_own_data.py",
     "Ellipsoid": "test_bad_input.py", "ImuKind": "test_bad_input.py", "Vertical": "test_bad_input.py",
-    "BiasKind": "test_filter_aided_config.py",
+    "BiasKind": "test_filter_aided_config.py", "UpdateForm": "test_filter_engine.py",
     "Verdict": None,
 }
 
