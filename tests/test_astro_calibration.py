@@ -232,3 +232,20 @@ def test_covariance_options_are_checked(stand_truth):
         with pytest.raises(atomnav.InputError) as err:
             astro.calibrate(ds_imu, ds_imu, **kw)
         assert err.value.parameter == name, (kw.keys(), err.value)
+
+
+def test_one_covariance_matrix_serves_every_epoch(stand_truth):
+    """e_imu and p_avu may each be one (3, 3) matrix: the same result as the tiled stacks,
+    in calibrate and model_covariance; a stack of the wrong length still names itself."""
+    _, ds_imu = stand_truth
+    m = len(ds_imu)
+    e, p = np.eye(3) * 1e-12, np.diag([1e-10, 2e-10, 3e-10])
+    one = astro.calibrate(ds_imu, ds_imu, e_imu=e, p_avu=p)
+    tiled = astro.calibrate(ds_imu, ds_imu, e_imu=np.tile(e, (m, 1, 1)), p_avu=np.tile(p, (m + 1, 1, 1)))
+    assert np.array_equal(one.p_beta, tiled.p_beta)
+    a = astro.model_covariance(one, ds_imu, ds_imu, e, p)
+    b = astro.model_covariance(one, ds_imu, ds_imu, np.tile(e, (m, 1, 1)), np.tile(p, (m + 1, 1, 1)))
+    assert all(np.array_equal(x, y) for x, y in zip(a, b))
+    with pytest.raises(atomnav.InputError, match=r"or one \(3, 3\) matrix") as err:
+        astro.calibrate(ds_imu, ds_imu, e_imu=np.tile(e, (m - 1, 1, 1)), p_avu=p)
+    assert err.value.parameter == "e_imu"

@@ -377,6 +377,17 @@ def broadcast(x, shape: tuple, name: str) -> np.ndarray:
         raise input_error(name, f"expected shape {shape} or one that broadcasts to it, got {a.shape}") from None
 
 
+def covariances(x, n: int, name: str, size: int = 3) -> np.ndarray:
+    """``x`` as a C-contiguous (n, size, size) stack of covariances: the stack itself, or one
+    (size, size) matrix that serves all n (the values are the core's to check)."""
+    a = as_floats(x, name)
+    if a.shape == (size, size):
+        return np.ascontiguousarray(np.broadcast_to(a, (n, size, size)))
+    if a.shape != (n, size, size):
+        raise input_error(name, f"expected shape ({n}, {size}, {size}), or one ({size}, {size}) matrix for all {n}, got {a.shape}")
+    return np.ascontiguousarray(a)
+
+
 def shaped(x, shape: tuple, name: str) -> np.ndarray:
     """``x`` (``prod(shape)`` finite numbers in any shape) as a C-contiguous float64 array of ``shape``."""
     a = as_floats(x, name)

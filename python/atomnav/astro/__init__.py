@@ -22,7 +22,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .. import _core, plausibility
-from .._validate import as_floats, input_error, instance, integers, path as checked_path, positive, renamed, rows, scalar, vector
+from .._validate import as_floats, covariances, input_error, instance, integers, path as checked_path, positive, renamed, rows, scalar, vector
 from .results import D17_CAVEAT, AstroIncrements, Calibration, Observations, StarAttitudes, _store_rows
 from .scenario import Vasilyuk2024
 
@@ -352,10 +352,10 @@ def calibrate(ds_imu, ds_avu, *, init: str = "axes", c0=None, solver: str = "so3
     covariance : {"model", "residual", "paper_sandwich"}, optional
         Form of P_θ, P_β and P^clb; default "model" when ``e_imu`` and ``p_avu`` are given,
         else "residual".
-    e_imu : array_like, shape (M, 3, 3), optional
+    e_imu : array_like, shape (M, 3, 3) or (3, 3), optional
         Gyro interval covariances E^imu in MF, rad² (e.g. :attr:`Increments.cov`); give
         with ``p_avu``.
-    p_avu : array_like, shape (M + 1, 3, 3), optional
+    p_avu : array_like, shape (M + 1, 3, 3) or (3, 3), optional
         Star-attitude covariances P^avu of the M + 1 epochs in VF, rad² (e.g.
         :attr:`StarAttitudes.p_avu`); give with ``e_imu``.
     increments : Increments, optional
@@ -396,10 +396,12 @@ def calibrate(ds_imu, ds_avu, *, init: str = "axes", c0=None, solver: str = "so3
     """
     c0 = None if c0 is None else rows(c0, 3, "c0")
     jm, jb, sigmas = _constant_terms(increments, model)
-    d = _core.astro_calibrate(_mats(ds_imu, "ds_imu"), _mats(ds_avu, "ds_avu"), init=init, c0=c0, solver=solver,
+    ds_imu = _mats(ds_imu, "ds_imu")
+    m = len(ds_imu)
+    d = _core.astro_calibrate(ds_imu, _mats(ds_avu, "ds_avu"), init=init, c0=c0, solver=solver,
                               max_iter=max_iter, tol=scalar(tol, "tol"), residual_form=residual_form, covariance=covariance,
-                              e_imu=None if e_imu is None else _mats(e_imu, "e_imu"),
-                              p_avu=None if p_avu is None else _mats(p_avu, "p_avu"), j_m=jm, j_b=jb, sigmas=sigmas)
+                              e_imu=None if e_imu is None else covariances(e_imu, m, "e_imu"),
+                              p_avu=None if p_avu is None else covariances(p_avu, m + 1, "p_avu"), j_m=jm, j_b=jb, sigmas=sigmas)
     if d["observability"]["verdict"] == "warn":
         k = d["observability"]["weak_axis_vf"]
         warnings.warn(f"weakly observable mount: kappa = {d['observability']['kappa']:.3e} < 1e-4, "
@@ -585,8 +587,9 @@ def star_attitudes(obs: Observations, n_epochs: int, cameras, sigma_s_rad: float
         Camera mounts C_VF^CFⁱ; camera 0 = identity.
     sigma_s_rad : float
         Star direction noise σ_s, rad.
-    p_alpha : array_like, shape (I, 3, 3), optional
-        Covariance of each camera's mount angles αⁱ, rad² (default zero).
+    p_alpha : array_like, shape (I, 3, 3) or (3, 3), optional
+        Covariance of each camera's mount angles αⁱ, rad² (one (3, 3) for every camera;
+        default zero).
     up_gcrs : array_like, shape (N, 3), optional
         Local vertical in GCRS per epoch; refraction is removed about it (default: no
         refraction correction).
@@ -605,7 +608,7 @@ def star_attitudes(obs: Observations, n_epochs: int, cameras, sigma_s_rad: float
     """
     instance(obs, Observations, "obs")
     cams = _mats(cameras, "cameras")
-    pa = np.zeros_like(cams) if p_alpha is None else _mats(p_alpha, "p_alpha")
+    pa = np.zeros_like(cams) if p_alpha is None else covariances(p_alpha, len(cams), "p_alpha")
     up = None if up_gcrs is None else rows(up_gcrs, 3, "up_gcrs")
     # the observations' fields are checked by the core under their own names: errors name ``obs``
     with renamed(epoch="obs", camera="obs", star_directions="obs", catalog_directions="obs"):
@@ -624,8 +627,8 @@ def astro_increments(s_vf, p_avu) -> AstroIncrements:
     ----------
     s_vf : array_like, shape (N, 3, 3)
         Star attitudes S_GCRS^VF (rotation matrices).
-    p_avu : array_like, shape (N, 3, 3)
-        Their covariances P^avu, rad².
+    p_avu : array_like, shape (N, 3, 3) or (3, 3)
+        Their covariances P^avu, rad² (one (3, 3) for every epoch).
 
     Returns
     -------
@@ -633,7 +636,8 @@ def astro_increments(s_vf, p_avu) -> AstroIncrements:
         ``ds_avu`` (N − 1, 3, 3) the increments ΔS_n^avu and ``e_avu`` (N − 1, 3, 3) their
         covariances E_n^avu, rad²; unpacks as ``ds_avu, e_avu``.
     """
-    return AstroIncrements(*_core.astro_astro_increments(_mats(s_vf, "s_vf"), _mats(p_avu, "p_avu")))
+    s_vf = _mats(s_vf, "s_vf")
+    return AstroIncrements(*_core.astro_astro_increments(s_vf, covariances(p_avu, len(s_vf), "p_avu")))
 
 
 def model_covariance(cal: Calibration, ds_imu, ds_avu, e_imu, p_avu, increments: Increments | None = None,
@@ -652,10 +656,10 @@ def model_covariance(cal: Calibration, ds_imu, ds_avu, e_imu, p_avu, increments:
         Gyro increments ΔS^imu in MF.
     ds_avu : array_like, shape (M, 3, 3)
         Star-attitude increments ΔS^avu in VF.
-    e_imu : array_like, shape (M, 3, 3)
-        Gyro interval covariances E^imu, rad².
-    p_avu : array_like, shape (M + 1, 3, 3)
-        Star-attitude covariances P^avu, rad².
+    e_imu : array_like, shape (M, 3, 3) or (3, 3)
+        Gyro interval covariances E^imu, rad² (one (3, 3) for every interval).
+    p_avu : array_like, shape (M + 1, 3, 3) or (3, 3)
+        Star-attitude covariances P^avu, rad² (one (3, 3) for every epoch).
     increments : Increments, optional
         The gyro increments; needed (with ``j_m``/``j_b``) when ``model.mode`` is
         "consistent", for the constant-error cross terms.
@@ -677,8 +681,10 @@ def model_covariance(cal: Calibration, ds_imu, ds_avu, e_imu, p_avu, increments:
     """
     instance(cal, Calibration, "cal")
     extra = _constant_terms(increments, model)
-    return _core.astro_model_covariance(rows(cal.c, 3, "c"), _mats(ds_imu, "ds_imu"), _mats(ds_avu, "ds_avu"),
-                                        _mats(e_imu, "e_imu"), _mats(p_avu, "p_avu"), *extra)
+    ds_imu = _mats(ds_imu, "ds_imu")
+    m = len(ds_imu)
+    return _core.astro_model_covariance(rows(cal.c, 3, "c"), ds_imu, _mats(ds_avu, "ds_avu"),
+                                        covariances(e_imu, m, "e_imu"), covariances(p_avu, m + 1, "p_avu"), *extra)
 
 
 def aberration(directions, velocity_mps) -> np.ndarray:

@@ -22,7 +22,7 @@ import numpy as np
 import pandas as pd
 
 from .. import _core, plausibility
-from .._validate import as_floats, input_error, instance, nonnegative, positive, rows, scalar, table, vector
+from .._validate import as_floats, covariances, input_error, instance, nonnegative, positive, rows, scalar, table, vector
 from .aided import AidedIns, InsSetup
 from .engine import _floats
 
@@ -97,7 +97,7 @@ class _Fixes(_Mounted):
         #: The fixes (M, 3), SI units.
         self.value: np.ndarray = self._plausible(value)
         #: Their covariances (M, 3, 3), SI units squared.
-        self.cov: np.ndarray = _covariances(cov, len(t))
+        self.cov: np.ndarray = covariances(cov, len(t), "cov")
         self._native()  # the core checks every fix now, naming this call's arguments
 
     def _read(self, df: pd.DataFrame, with_sigma: bool, epoch):
@@ -349,16 +349,6 @@ def _lever(lever_arm) -> np.ndarray:
     if a.ndim != 1:
         raise input_error("lever_arm", f"expected the 3 values (m, body frame), got shape {a.shape}")
     return a
-
-
-def _covariances(cov, m: int) -> np.ndarray:
-    """``cov`` as a C-contiguous (m, 3, 3) stack; one (3, 3) matrix serves every fix."""
-    c = as_floats(cov, "cov")
-    if c.shape == (3, 3):
-        c = np.broadcast_to(c, (m, 3, 3))
-    if c.ndim != 3 or c.shape[1:] != (3, 3):
-        raise input_error("cov", f"expected shape (M, 3, 3) or (3, 3), got {c.shape}")
-    return np.ascontiguousarray(c)
 
 
 def aided_ins(setup: InsSetup, sources) -> "SourcedIns":
