@@ -665,6 +665,9 @@ mod tests {
         CaiConfig {
             contrast: 0.9,
             omega_dot: OmegaDot::Zero,
+            // the closed forms of the in-shot noise below are those of linear interpolation
+            // (hat-function sample weights)
+            interpolation: Interpolation::Linear,
             substeps: 2,
             misalignment: Some(1e-12),
             lever_arm: Some(1e-12),
