@@ -229,6 +229,20 @@ pub struct IncrementErrors<'a> {
     pub constant: Option<&'a ConstantGyroErrors<'a>>,
 }
 
+impl<'a> IncrementErrors<'a> {
+    /// The error models as given: E^imu and P^avu together or neither, and the constant
+    /// gyro errors only with them.
+    pub fn given(e_imu: Option<&'a [Mat3]>, p_avu: Option<&'a [Mat3]>, constant: Option<&'a ConstantGyroErrors<'a>>) -> Result<Option<Self>> {
+        match (e_imu, p_avu) {
+            (Some(e_imu), Some(p_avu)) => Ok(Some(IncrementErrors { e_imu, p_avu, constant })),
+            (None, None) if constant.is_none() => Ok(None),
+            (None, None) => Err(invalid("e_imu", "the constant gyro errors j_m, j_b need e_imu and p_avu")),
+            (None, Some(_)) => Err(invalid("e_imu", "give e_imu with p_avu")),
+            (Some(_), None) => Err(invalid("p_avu", "give p_avu with e_imu")),
+        }
+    }
+}
+
 #[derive(Debug, Clone, Copy)]
 pub struct Options {
     pub init: Init,
@@ -573,6 +587,14 @@ pub struct ConstantGyroErrors<'a> {
     pub sigma_b: f64,
 }
 
+/// The per-interval sensitivities (J_m,n, J_b,n) from the two stacks, of equal length.
+pub fn sensitivity_pairs(j_m: Vec<Mat39>, j_b: Vec<Mat3>) -> Result<Vec<(Mat39, Mat3)>> {
+    if j_m.len() != j_b.len() {
+        return Err(invalid("j_b", format!("expected {} sensitivities like j_m, got {}", j_m.len(), j_b.len())));
+    }
+    Ok(j_m.into_iter().zip(j_b).collect())
+}
+
 /// Model-form covariance of β: P_β^model = (HᵀH)⁻¹HᵀΣ_fH(HᵀH)⁻¹ with Σ_f from the
 /// error models — diagonal blocks CᵀE_n^imuC + E_n^avu, the E13 neighbour blocks
 /// cov(ε_n, ε_{n+1}) = −P_n^avu ΔS_{n+1}, and with constant gyro errors the cross blocks
@@ -583,8 +605,11 @@ pub fn model_covariance(c: &Mat3, ds_imu: &[Mat3], ds_avu: &[Mat3], e_imu: &[Mat
     if ds_avu.len() != m {
         return Err(invalid("ds_avu", format!("expected {m} increments like ds_imu, got {}", ds_avu.len())));
     }
-    if e_imu.len() != m || p_avu.len() != m + 1 || constant.is_some_and(|k| k.sensitivities.len() != m) {
-        return Err(invalid("e_imu", format!("expected {m} interval covariances (and sensitivities) and {} epoch covariances", m + 1)));
+    if e_imu.len() != m || p_avu.len() != m + 1 {
+        return Err(invalid("e_imu", format!("expected {m} interval covariances and {} epoch covariances", m + 1)));
+    }
+    if let Some(k) = constant.filter(|k| k.sensitivities.len() != m) {
+        return Err(invalid("j_m", format!("expected {m} sensitivities, got {}", k.sensitivities.len())));
     }
     let h = jacobian_blocks(c, ds_imu, ds_avu);
     let a_inv = h.iter().map(|h| h.transpose() * h).sum::<Mat3>().try_inverse().ok_or_else(|| NavError::Numerical("singular HᵀH".into()))?;

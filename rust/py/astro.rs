@@ -170,11 +170,8 @@ fn constant_errors(j_m: Option<PyReadonlyArray3<'_, f64>>, j_b: Option<PyReadonl
     match (j_m, j_b, sigmas) {
         (None, None, None) => Ok(None),
         (Some(jm), Some(jb), Some(sg)) => {
-            let (jm, jb) = (mats::<3, 9>(&jm, "j_m")?, mats::<3, 3>(&jb, "j_b")?);
-            if jm.len() != jb.len() {
-                return Err(invalid("j_b", format!("expected {} sensitivities like j_m, got {}", jm.len(), jb.len())).into());
-            }
-            Ok(Some((jm.into_iter().zip(jb).collect(), gyro_model(sg, GyroErrorMode::Consistent)?)))
+            let pairs = calibration::sensitivity_pairs(mats::<3, 9>(&jm, "j_m")?, mats::<3, 3>(&jb, "j_b")?)?;
+            Ok(Some((pairs, gyro_model(sg, GyroErrorMode::Consistent)?)))
         }
         _ => Err(invalid("j_m", "give j_m, j_b and sigmas together (consistent gyro mode) or none of them").into()),
     }
@@ -205,18 +202,11 @@ fn astro_calibrate<'py>(
     let c0 = c0.map(|c| mat3_arg(&c, "c0")).transpose()?;
     let max_iter = max_iter.map(|n| index_count(&n, "max_iter", 1, usize::MAX)).transpose()?.unwrap_or(Options::default().max_iter);
     let opt = Options { covariance: covariance.map(|c| c.0), ..Options::new(Init::new(init.0, c0)?, solver.0, max_iter, tol, residual_form.0)? };
-    let covs = match (e_imu, p_avu) {
-        (None, None) => None,
-        (Some(e), Some(p)) => Some((mats::<3, 3>(&e, "e_imu")?, mats::<3, 3>(&p, "p_avu")?)),
-        (None, Some(_)) => return Err(invalid("e_imu", "give e_imu with p_avu").into()),
-        (Some(_), None) => return Err(invalid("p_avu", "give p_avu with e_imu").into()),
-    };
+    let e = e_imu.map(|e| mats::<3, 3>(&e, "e_imu")).transpose()?;
+    let p = p_avu.map(|p| mats::<3, 3>(&p, "p_avu")).transpose()?;
     let sens = constant_errors(j_m, j_b, sigmas)?;
-    if sens.is_some() && covs.is_none() {
-        return Err(invalid("e_imu", "the constant gyro errors j_m, j_b need e_imu and p_avu").into());
-    }
     let constant = sens.as_ref().map(|(s, m)| calibration::ConstantGyroErrors { sensitivities: s, p_m: m.p_m(), sigma_b: m.sigma_b });
-    let errors = covs.as_ref().map(|(e, p)| IncrementErrors { e_imu: e, p_avu: p, constant: constant.as_ref() });
+    let errors = IncrementErrors::given(e.as_deref(), p.as_deref(), constant.as_ref())?;
     let cal = py.detach(|| calibration::calibrate_with(&a, &b, &opt, errors.as_ref()))?;
     calibration_dict(py, &cal)
 }
@@ -306,9 +296,6 @@ fn astro_model_covariance<'py>(
     stars::check_covariances("e_imu", &e, a.len())?;
     stars::check_covariances("p_avu", &p, a.len() + 1)?;
     let sens = constant_errors(j_m, j_b, sigmas)?;
-    if sens.as_ref().is_some_and(|(s, _)| s.len() != a.len()) {
-        return Err(invalid("j_m", format!("expected {} sensitivities, got {}", a.len(), sens.as_ref().map_or(0, |(s, _)| s.len()))).into());
-    }
     let constant = sens.as_ref().map(|(s, m)| calibration::ConstantGyroErrors { sensitivities: s, p_m: m.p_m(), sigma_b: m.sigma_b });
     let (pm, ps) = calibration::model_covariance(&c, &a, &b, &e, &p, constant.as_ref())?;
     Ok((mat_to_py(py, &pm), mat_to_py(py, &ps)))
