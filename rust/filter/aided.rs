@@ -160,8 +160,8 @@ pub struct AidedOutput {
     pub extra: Vec<f64>,
     /// σ of every state, epochs × n.
     pub sigma: Vec<f64>,
-    /// The error-state covariance P of every epoch, epochs × n² (column-major n × n
-    /// blocks; empty unless [`AidedIns::output_covariance`] is on).
+    /// The error-state covariance P of every epoch, epochs × n² (row-major n × n blocks,
+    /// the layout numpy takes as is; empty unless [`AidedIns::output_covariance`] is on).
     pub covariance: Vec<f64>,
     /// Per measurement: its time, number of rows, innovations (concatenated), NIS (summed
     /// over rows), the number of rows the χ² gate rejected and the name of the sensor that
@@ -767,7 +767,9 @@ impl<A: Aiding> AidedIns<A> {
         out.extra.extend(extra.iter());
         out.sigma.extend(self.kf.p.diagonal().iter().map(|d| d.sqrt()));
         if self.covariance_out {
-            out.covariance.extend_from_slice(self.kf.p.as_slice());
+            for row in self.kf.p.row_iter() {
+                out.covariance.extend(row.iter());
+            }
         }
     }
 }

@@ -214,15 +214,14 @@ impl PyAidedIns {
         pyo3::types::PyTuple::new(py, items)
     }
 
-    /// The per-epoch covariances (E, n, n) from their column-major blocks, or None when
+    /// The per-epoch covariances (E, n, n) from their row-major blocks, or None when
     /// they were not asked for.
     fn covariance_stack<'py>(py: Python<'py>, flat: Vec<f64>, epochs: usize, n: usize) -> PyResult<Bound<'py, PyAny>> {
         if flat.is_empty() {
             return Ok(py.None().into_bound(py));
         }
         let blocks = Array3::from_shape_vec((epochs, n, n), flat).map_err(|e| NavError::Numerical(format!("covariance output: {e}")))?;
-        // column-major blocks read row-major are the transposes: swap back
-        Ok(blocks.permuted_axes([0, 2, 1]).as_standard_layout().into_owned().into_pyarray(py).into_any())
+        Ok(blocks.into_pyarray(py).into_any())
     }
 
     fn forward<'py>(py: Python<'py>, f: ForwardPass, n: usize, n_extra: usize) -> PyResult<OutputTuple<'py>> {

@@ -351,10 +351,9 @@ class AidedResult:
         from .analysis import chi2_band
 
         out = self.measurements.copy()
-        dof = out["rows"].to_numpy()
-        band = {m: chi2_band(int(m), 1, p) for m in np.unique(dof)}
-        out["nis_low"] = [band[m][0] for m in dof]
-        out["nis_high"] = [band[m][1] for m in dof]
+        dofs, which = np.unique(out["rows"].to_numpy(), return_inverse=True)
+        band = np.array([chi2_band(int(m), 1, p) for m in dofs]).reshape(-1, 2)  # one per distinct row count
+        out["nis_low"], out["nis_high"] = band[which, 0], band[which, 1]
         out["inside"] = (out["nis"] >= out["nis_low"]) & (out["nis"] <= out["nis_high"])
         return out
 
