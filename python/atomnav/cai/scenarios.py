@@ -416,7 +416,7 @@ def slalom_covariance(gravity: str = "earth", *, duration: float = 60.0, attitud
         covariance), ``hybrid_true_vel_rms_mps`` (its true error), in m/s, and the ratios
         ``ratio`` = free / hybrid and ``ratio_true`` = free / hybrid true.
     """
-    from ..filter import BiasModel, Scenario, covariance_analysis, ins_error_model
+    from ..filter import Scenario, covariance_analysis
     from ..filter.analysis import true_error_analysis
     from ..trajectory import slalom as slalom_trajectory
 
@@ -424,28 +424,8 @@ def slalom_covariance(gravity: str = "earth", *, duration: float = 60.0, attitud
     sensor, setup = seed003_sensor(lever), seed003_filter()
     with renamed(rate_hz="duration"):  # the shot rate is fixed: only the duration can make too many epochs
         traj = slalom_trajectory(rate_hz=1.0 / (2 * sensor.T), origin=HANNOVER, duration=positive(duration, "duration"), ellipsoid=ell)
-    imu = traj.ideal_imu("rates")
-    f_b = imu[["accel_x_mps2", "accel_y_mps2", "accel_z_mps2"]].to_numpy()
-    df = traj.df
-    f, qc = ins_error_model(df[["lat_rad", "lon_rad", "h_m"]].to_numpy(), df[["vn_mps", "ve_mps", "vd_mps"]].to_numpy(),
-                            df[["qw", "qx", "qy", "qz"]].to_numpy(), f_b, gyro_psd=setup.gyro_psd, accel_psd=setup.accel_psd,
-                            gyro_bias=BiasModel("random_walk", psd=setup.gyro_bias_psd),
-                            accel_bias=BiasModel("random_walk", psd=setup.accel_bias_psd),
-                            ellipsoid=ell)
-    # H of one shot at the mean specific force (the phase Jacobian varies little along the path)
-    t = np.arange(0.0, 2 * sensor.T + 1e-12, 0.005)
-    fm = np.tile(f_b.mean(axis=0), (len(t), 1))
-    jac = phase_jacobian(t, fm, np.zeros_like(fm), [0.0], sensor.T, sensor.channels, omega_dot="zero")[0]
-    half_c = 0.5 * sensor.contrast
+    f, qc, h, r, r_true, cross = _cai_error_model(traj, sensor, setup, ell, 0.005)
     m = len(sensor.channels)
-    h = np.zeros((m, 15))
-    h[:, 9:15] = half_c * jac[:, :6]
-    # the filter's R (its inflation PSDs) and the truth (the IMU's noise, same values here)
-    sigma_f, _ = in_shot_noise(sensor, 0.005, *sensor.inflation)
-    sigma_t, cross = in_shot_noise(sensor, 0.005, setup.accel_psd, setup.gyro_psd, f[:-1])
-    r = sensor.sigma_p**2 * np.eye(m) + half_c**2 * sigma_f
-    r_true = sensor.sigma_p**2 * np.eye(m) + half_c**2 * sigma_t
-    cross = half_c * cross
     if attitude_sigma is not None:
         ha = np.zeros((3, 15))
         ha[:, 6:9] = np.eye(3)
@@ -461,8 +441,45 @@ def slalom_covariance(gravity: str = "earth", *, duration: float = 60.0, attitud
     p0 = setup.p0(0)
     n = len(dt)
     vel = lambda cov: np.sqrt((cov.iloc[:, 4:7].to_numpy() ** 2).sum(axis=1))  # noqa: E731
-    free = vel(covariance_analysis(Scenario(f[:-1], qc[:-1], dt, p0, h, r, [False] * (n + 1), times=traj.time)))
-    scn = Scenario(f[:-1], qc[:-1], dt, p0, h, r, [False] + [True] * n, times=traj.time)
+    free = vel(covariance_analysis(Scenario(f, qc, dt, p0, h, r, [False] * (n + 1), times=traj.time)))
+    scn = Scenario(f, qc, dt, p0, h, r, [False] + [True] * n, times=traj.time)
     hyb, true = vel(covariance_analysis(scn)), vel(true_error_analysis(scn, r_true, cross))
     return pd.DataFrame({"time_s": traj.time, "free_vel_rms_mps": free, "hybrid_vel_rms_mps": hyb, "hybrid_true_vel_rms_mps": true,
                          "ratio": free / hyb, "ratio_true": free / true})
+
+
+def _cai_error_model(traj, sensor: CaiSensor, setup: FilterSetup, ellipsoid: str, dt: float):
+    """The linear model of the CAI-aided INS along ``traj``, sampled once per filter step, each
+    step the window of one shot: the 15-state error model (F, Q_c per step, with the bias
+    random walks of ``setup``), one stacked CAI update H = (C/2) ∂φ/∂(b_a, b_g) from the
+    predictor at the mean specific force, the filter's R (σ_p² plus the in-shot IMU noise of
+    the sensor's inflation PSDs), the true R (the in-shot noise of the IMU, whose white PSDs
+    are the filter's) and the cross-covariance of each step's process noise with its shot's
+    readout noise (:func:`in_shot_noise`, Tennstedt et al. 2021, §2.4), for an IMU sampled
+    every ``dt`` s.
+
+    Returns ``(f, qc, h, r, r_true, cross)``: f, qc (steps, 15, 15), h (C, 15), r and r_true
+    (C, C), cross (steps, 15, C)."""
+    from ..filter import BiasModel, ins_error_model
+
+    f_b = traj.ideal_imu("rates")[["accel_x_mps2", "accel_y_mps2", "accel_z_mps2"]].to_numpy()
+    df = traj.df
+    f, qc = ins_error_model(df[["lat_rad", "lon_rad", "h_m"]].to_numpy(), df[["vn_mps", "ve_mps", "vd_mps"]].to_numpy(),
+                            df[["qw", "qx", "qy", "qz"]].to_numpy(), f_b, gyro_psd=setup.gyro_psd, accel_psd=setup.accel_psd,
+                            gyro_bias=BiasModel("random_walk", psd=setup.gyro_bias_psd),
+                            accel_bias=BiasModel("random_walk", psd=setup.accel_bias_psd),
+                            ellipsoid=ellipsoid)
+    # H of one shot at the mean specific force (the phase Jacobian varies little along the path)
+    t = np.arange(0.0, 2 * sensor.T + 1e-12, dt)
+    fm = np.tile(f_b.mean(axis=0), (len(t), 1))
+    jac = phase_jacobian(t, fm, np.zeros_like(fm), [0.0], sensor.T, sensor.channels, omega_dot="zero")[0]
+    half_c = 0.5 * sensor.contrast
+    m = len(sensor.channels)
+    h = np.zeros((m, 15))
+    h[:, 9:15] = half_c * jac[:, :6]
+    # the filter's R (its inflation PSDs) and the truth (the IMU's noise, the filter's PSDs)
+    sigma_f, _ = in_shot_noise(sensor, dt, *sensor.inflation)
+    sigma_t, cross = in_shot_noise(sensor, dt, setup.accel_psd, setup.gyro_psd, f[:-1])
+    r = sensor.sigma_p**2 * np.eye(m) + half_c**2 * sigma_f
+    r_true = sensor.sigma_p**2 * np.eye(m) + half_c**2 * sigma_t
+    return f[:-1], qc[:-1], h, r, r_true, half_c * cross

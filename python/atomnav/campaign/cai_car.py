@@ -1,0 +1,251 @@
+"""The campaign scenario ``cai_car``: one Monte-Carlo run of the CAI-aided INS on the car
+profile of Tennstedt et al. 2023 (§2.8), with its covariance predictor, the linear analysis
+of the filter's true error (the filter is suboptimal: its R is inflated by the in-shot IMU
+noise that also drives the navigation error)."""
+
+from __future__ import annotations
+
+import json
+from functools import lru_cache
+
+import numpy as np
+import pandas as pd
+
+from .. import _core
+from .._validate import choice, finite_scalar, input_error, integer, positive, scalar
+from ..cai.campaign import _scenario
+from ..cai.predictor import K_RB87, Channels
+from ..cai.scenarios import GRAVITY_OPTIONS, HANNOVER, ScenarioConfig, _cai_error_model
+from ..cai.sensor import CaiSensor, FilterSetup
+from ..imu import ImuErrors, TriadErrors, preset_names
+from .scenario import predicted_by
+
+#: IMU rate of the scenario (Hz), as in Tennstedt et al. 2023.
+RATE_HZ = 200.0
+#: Length of the car profile (s).
+DURATION_S = 40.0
+#: Launch speed of the A/B ensembles (m/s), Tennstedt et al. 2023, §2.8.
+V0_MPS = 2.8
+#: Initial σ of position (m), velocity (m/s) and attitude (rad) in the filter: the run
+#: starts at the truth (see :func:`atomnav.cai.seed003_filter`).
+NAV_SIGMA0 = (1e-6, 1e-6, 1e-7)
+_COLUMNS = ("pos_error_m", "vel_error_mps", "att_error_rad")
+
+
+def _linear_grade(imu) -> ImuErrors:
+    """The preset ``imu`` if its errors are those the linear analysis carries: a random
+    turn-on bias, white noise and a bias random walk per triad."""
+    if not isinstance(imu, str):
+        raise TypeError(f"imu: expected an IMU preset name (str), got {type(imu).__name__}")
+    errors = ImuErrors.preset(choice(imu, preset_names(), "imu"))
+    for name in ("accel", "gyro"):
+        triad = getattr(errors, name)
+        extra = [term for term, present in (("a fixed bias", np.any(np.asarray(triad.bias) != 0)),
+                                             ("scale-factor errors", np.any(np.asarray(triad.scale) != 0)),
+                                             ("misalignment", np.any(np.asarray(triad.misalignment) != 0)),
+                                             ("a Gauss–Markov term", triad.gauss_markov is not None),
+                                             ("a flicker term", triad.flicker is not None)) if present]
+        if extra:
+            raise input_error("imu", f"preset {imu!r} has {', '.join(extra)} in its {name} triad; the linear analysis of this scenario "
+                                     "carries only a random turn-on bias, white noise and a bias random walk")
+    return errors
+
+
+def _points(T, shot_rate, imu, lever, gravity, contrast, checkpoint_s) -> tuple:
+    """The checked parameters as a hashable key: (T, shot period, IMU errors as JSON, lever,
+    gravity, contrast, checkpoint spacing, filter steps per prediction)."""
+    T = positive(T, "T")
+    steps = 2 * T * RATE_HZ
+    if abs(steps - round(steps)) > 1e-9 * steps or round(steps) < 1:
+        raise input_error("T", f"2T must be a whole number of {1e3 / RATE_HZ:g} ms IMU samples (the filter predicts every 2T), got T = {T} s")
+    if 2 * T > DURATION_S:
+        raise input_error("T", f"a shot of 2T = {2 * T} s does not fit the {DURATION_S:g} s profile")
+    if shot_rate is None:
+        period = 2 * T
+    else:
+        rate = positive(shot_rate, "shot_rate")
+        if rate * 2 * T > 1 + 1e-12:
+            raise input_error("shot_rate", f"{rate} Hz exceeds one shot per 2T = {1 / (2 * T):g} Hz (shots cannot overlap)")
+        period = 1.0 / rate
+    errors = _linear_grade(imu)
+    contrast = scalar(contrast, "contrast")
+    if not 0.0 < contrast <= 1.0:
+        raise input_error("contrast", f"must be in (0, 1], got {contrast}")
+    checkpoint_s = positive(checkpoint_s, "checkpoint_s")
+    if checkpoint_s > DURATION_S:
+        raise input_error("checkpoint_s", f"must be at most the {DURATION_S:g} s profile, got {checkpoint_s}")
+    return (T, period, json.dumps(errors._to_core()), finite_scalar(lever, "lever"), choice(gravity, GRAVITY_OPTIONS, "gravity"),
+            contrast, checkpoint_s, int(round(steps)))
+
+
+def _configuration(key: tuple) -> ScenarioConfig:
+    """The CAI, the filter derived from the IMU grade, and the scenario of ``key``."""
+    T, period, imu_json, lever, gravity, contrast, _, steps = key
+    accel, gyro = (TriadErrors._from_core(d) for d in json.loads(imu_json))
+    q = (accel.white**2, gyro.white**2)
+    sensor = CaiSensor(Channels.cyclic(K_RB87, V0_MPS, lever=(0.0, 0.0, lever)), T, shot_period=period, contrast=contrast, inflation=q,
+                       interpolation="cubic", omega_dot="pwl")
+    setup = FilterSetup(*q, accel.bias_rw**2, gyro.bias_rw**2, steps, sigma0=(*NAV_SIGMA0, accel.bias_sigma, gyro.bias_sigma))
+    imu = ImuErrors(accel, gyro)
+    return ScenarioConfig(sensor, setup, imu=imu, gravity=gravity, rate_hz=RATE_HZ)
+
+
+@lru_cache(maxsize=4)
+def _core_scenario(key: tuple):
+    """The built core scenario of ``key`` (truth, ideal IMU, true phases, filter), kept so
+    the seeds of one parameter point share it; a run does not change it."""
+    motion = _core.Motion.car(np.asarray(HANNOVER, dtype=float), 0.0, True)
+    return _scenario(motion, _configuration(key))[0]
+
+
+def _checkpoints(key: tuple) -> tuple[np.ndarray, np.ndarray]:
+    """Output epochs (indices into the filter's epochs every 2T from 0) nearest to every
+    multiple of the checkpoint spacing and the end of the profile, and their times (s)."""
+    T, *_, checkpoint_s, steps = key
+    step_s = steps / RATE_HZ
+    last = int(np.floor(DURATION_S / step_s + 1e-9))
+    want = np.append(np.arange(checkpoint_s, DURATION_S + 1e-9, checkpoint_s), DURATION_S)
+    idx = np.unique(np.clip(np.round(want / step_s).astype(int), 1, last))
+    return idx, idx * steps / RATE_HZ
+
+
+def _table(times: np.ndarray, pos, vel, att) -> pd.DataFrame:
+    return pd.DataFrame({"time_s": times, **dict(zip(_COLUMNS, (np.asarray(pos), np.asarray(vel), np.asarray(att))))})
+
+
+def _cai_car_covariance(*, T=0.025, shot_rate=None, imu="navigation", lever=0.0, gravity="earth", contrast=1.0,
+                        checkpoint_s=5.0) -> pd.DataFrame:
+    """Predicted RMS over seeds of the errors of :func:`cai_car`: the linear analysis of the
+    true error of the filter as built (:func:`atomnav.filter.analysis.true_error_analysis`).
+
+    The 15-state error model runs along the car profile one filter step (2T) at a time, with
+    the IMU's turn-on biases in P0, its bias random walks and white noise; every shot is one
+    stacked update at the step it ends in, H from the predictor at the mean specific force,
+    the filter's R inflated by the in-shot IMU noise while the true readout noise is the
+    in-shot noise itself, correlated with the step's process noise (Tennstedt et al. 2021,
+    §2.4). Fringe slips (phase errors beyond ±π/2) are outside this analysis.
+
+    Parameters
+    ----------
+    T, shot_rate, imu, lever, gravity, contrast, checkpoint_s
+        As for :func:`cai_car`.
+
+    Returns
+    -------
+    pandas.DataFrame
+        The rows of :func:`cai_car`: ``time_s`` and the predicted RMS norms
+        ``pos_error_m``, ``vel_error_mps``, ``att_error_rad`` (√ of the trace of each
+        3 × 3 block of the true-error covariance).
+
+    Raises
+    ------
+    atomnav.InputError
+        As for :func:`cai_car`.
+    """
+    from ..filter import Scenario
+    from ..filter.analysis import true_error_analysis
+    from ..trajectory import Trajectory
+
+    key = _points(T, shot_rate, imu, lever, gravity, contrast, checkpoint_s)
+    config = _configuration(key)
+    sensor, setup, steps = config.sensor, config.setup, key[-1]
+    ell = _core.cai_gravity_ellipsoid(config.gravity)
+    traj = Trajectory.from_motion(_core.Motion.car(np.asarray(HANNOVER, dtype=float), 0.0, True), RATE_HZ / steps, ell)
+    f, qc, h, r, r_true, cross = _cai_error_model(traj, sensor, setup, ell, 1.0 / RATE_HZ)
+    step_s = steps / RATE_HZ
+    measure = np.zeros(len(traj.time), dtype=bool)
+    ends = sensor.shots(sensor.first_shot, DURATION_S) + 2 * sensor.T
+    measure[np.clip(np.round(ends / step_s).astype(int), 1, len(measure) - 1)] = True
+    times = np.arange(len(traj.time)) * step_s
+    scn = Scenario(f, qc, np.diff(times), setup.p0(0), h, r, measure.tolist(), times=times)
+    sig = true_error_analysis(scn, r_true, cross).iloc[:, 1:16].to_numpy()
+    idx, t = _checkpoints(key)
+    return _table(t, *(np.sqrt((sig[idx, 3 * i:3 * i + 3] ** 2).sum(axis=1)) for i in range(3)))
+
+
+@predicted_by(_cai_car_covariance)
+def cai_car(*, seed=0, T=0.025, shot_rate=None, imu="navigation", lever=0.0, gravity="earth", contrast=1.0,
+            checkpoint_s=5.0) -> pd.DataFrame:
+    """One Monte-Carlo run of the CAI-aided INS on the car profile of Tennstedt et al. 2023
+    (§2.8): the 40 s car-like drive with vibration, the 26 s shock and the ×2 vibration
+    window 33–35 s at Hannover; a 200 Hz IMU of grade ``imu``; the six-channel CAI (k =
+    4π/780.241 nm along each body axis, ±2.8 m/s ensembles, σ_p² = 1e-3, predictor with
+    cubic inputs and ω̇ from the gyro interpolant as :func:`atomnav.cai.seed003_sensor`);
+    the 15-state filter predicting every 2T.
+
+    The filter follows the IMU grade: its white-noise and bias random-walk PSDs are the
+    grade's, its initial bias σ the grade's turn-on bias σ, and the CAI's R is inflated by
+    the grade's in-shot white noise (Tennstedt et al. 2021, §2.4). The run starts at the
+    truth. The built scenario (truth, ideal IMU, true phases) is kept for the last few
+    parameter points, so consecutive seeds of one point build it once; a run is the same
+    bit for bit either way.
+
+    Parameters
+    ----------
+    seed : int
+        Seed of the run (0 … 2⁶⁴ − 1): the IMU errors and the readout noise.
+    T : float
+        Pulse separation (s); 2T must be a whole number of 5 ms IMU samples.
+    shot_rate : float, optional
+        Shots per second (Hz), at most 1/(2T); None: one shot per 2T.
+    imu : str
+        IMU grade, an :meth:`atomnav.imu.ImuErrors.preset` name whose errors are a random
+        turn-on bias, white noise and a bias random walk (``navigation``, ``precise``,
+        ``medium``, ``coarse``). The CAI's capture range is ±π/2 of phase: the turn-on
+        accelerometer bias σ_b gives a phase σ of k T² σ_b (0.20 rad for ``navigation`` at
+        T = 25 ms, 2.0 rad for ``precise``), so the coarser grades slip fringes at all but
+        the shortest T.
+    lever : float
+        IMU → release-point lever arm along the body z axis (m); its Euler phase
+        k T² l ω̇ must be predicted from the 200 Hz gyro under the profile's 15.1 Hz
+        angular vibration (see :func:`atomnav.cai.car_mc`).
+    gravity : {"earth", "kinematic"}
+        "earth" (WGS84 gravity and Earth rate) or "kinematic" (none, the paper's
+        kinematic mode).
+    contrast : float
+        Readout contrast C ∈ (0, 1].
+    checkpoint_s : float
+        Spacing of the checkpoints (s): the filter epochs nearest to its multiples and the
+        end of the profile.
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row per checkpoint: ``time_s``, and the norms of the hybrid solution's errors
+        against the truth ``pos_error_m`` (NED position), ``vel_error_mps`` (NED
+        velocity) and ``att_error_rad`` (attitude ψ).
+
+    Raises
+    ------
+    atomnav.InputError
+        Naming ``seed``, ``T``, ``shot_rate`` (above 1/(2T)), ``imu`` (unknown, or with
+        errors the linear analysis does not carry), ``lever``, ``gravity``, ``contrast``
+        or ``checkpoint_s``.
+
+    Notes
+    -----
+    ``cai_car.predict(**params)`` is the covariance predictor of the RMS over seeds.
+
+    References
+    ----------
+    Tennstedt, B., Rajagopalan, A., Weddig, N. B., Abend, S., Schön, S., Rasel, E. M.
+    (2023). Atom Strapdown: toward integrated quantum inertial navigation systems.
+    NAVIGATION 70(4), §2.8. Tennstedt, B., Weddig, N., Schön, S. (2021). Improved inertial
+    navigation with cold atom interferometry. Gyroscopy and Navigation, §2.4.
+
+    Examples
+    --------
+    >>> from atomnav.campaign.cai_car import cai_car
+    >>> cai_car(seed=1, T=0.025).columns.tolist()  # doctest: +SKIP
+    ['time_s', 'pos_error_m', 'vel_error_mps', 'att_error_rad']
+    """
+    seed = integer(seed, "seed", 0, 2**64 - 1)
+    key = _points(T, shot_rate, imu, lever, gravity, contrast, checkpoint_s)
+    run = _core_scenario(key).monte_carlo(seed, [0])
+    _, t = _checkpoints(key)
+    time = np.asarray(run["time"])
+    k = np.minimum(np.searchsorted(time, t - 1e-9), len(time) - 1)
+    if np.any(np.abs(time[k] - t) > 1e-9):
+        raise RuntimeError(f"cai_car: the filter's epochs {time[:3]} … do not hold the checkpoints {t}")
+    e = np.asarray(run["hybrid"])[0, k]
+    return _table(t, *(np.linalg.norm(e[:, 3 * i:3 * i + 3], axis=1) for i in range(3)))
