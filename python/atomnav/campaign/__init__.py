@@ -1,0 +1,15 @@
+"""Design studies at scale: campaigns of a scenario over parameter points and seeds, run in
+this process or on a Dask cluster, every finished run written at once to a Parquet dataset
+and resumed from it.
+
+- :mod:`~atomnav.campaign.scenario`: what a scenario and its covariance predictor are.
+- :class:`Campaign`: a scenario, its points (grid or list) and seeds; each run's seed
+  depends on (campaign seed, run id) only.
+- :func:`run`, :func:`load`, :func:`timing`: execute or resume a campaign, read it back.
+"""
+
+from .execute import load, run, timing
+from .plan import Campaign
+from .scenario import parameters, predicted_by
+
+__all__ = ["Campaign", "run", "load", "timing", "parameters", "predicted_by"]
