@@ -20,7 +20,7 @@ from ._core import InputError, NumericalError
 __version__ = "0.1.0"
 
 #: Public submodules, imported on first attribute access. A new submodule is one entry here.
-_SUBMODULES = ("units", "rotation", "earth", "trajectory", "strapdown", "imu", "diagnostics", "cai", "noise", "filter", "astro", "gnss", "io", "plots", "alignment")
+_SUBMODULES = ("units", "rotation", "earth", "trajectory", "strapdown", "imu", "diagnostics", "cai", "noise", "filter", "astro", "gnss", "io", "plots", "alignment", "campaign")
 
 #: Public names defined in a submodule: name -> submodule. A new export is one entry here.
 _NAMES = {"UnitWarning": "plausibility"}
@@ -28,7 +28,7 @@ _NAMES = {"UnitWarning": "plausibility"}
 __all__ = ["InputError", "NumericalError", *_NAMES, *_SUBMODULES, "__version__"]
 
 if _TYPE_CHECKING:  # what static checkers and IDEs see; at run time __getattr__ below does it
-    from . import alignment, astro, cai, diagnostics, earth, filter, gnss, imu, io, noise, plots, rotation, strapdown, trajectory, units
+    from . import alignment, astro, cai, campaign, diagnostics, earth, filter, gnss, imu, io, noise, plots, rotation, strapdown, trajectory, units
     from .plausibility import UnitWarning
 
 

@@ -14,8 +14,8 @@ import pandas as pd
 
 from .._validate import flag, instance, integer
 from .plan import Campaign
-from .scenario import checked_table
-from .store import Store
+from .scenario import _checked_table
+from .store import _Store
 
 #: Length of one Dask task (s) the automatic batching aims at: at ≈ 5 ms of scheduler and
 #: transfer cost per task, it keeps the overhead near 0.5 % of the run time.
@@ -33,7 +33,7 @@ def _execute(campaign: Campaign, runs: list[int], worker: str) -> list[tuple[int
     for r in runs:
         t0 = time.perf_counter()
         params = campaign.point(r // campaign.seeds)
-        table = checked_table(campaign.scenario(seed=campaign.run_seed(r), **params), campaign.scenario)
+        table = _checked_table(campaign.scenario(seed=campaign.run_seed(r), **params), campaign.scenario)
         out.append((r, table, worker, time.perf_counter() - t0))
     return out
 
@@ -47,7 +47,7 @@ def _on_worker(campaign: Campaign, runs: list[int]):
 class _Writer:
     """Collects finished runs and writes them; reports progress."""
 
-    def __init__(self, store: Store, bar, callback, total: int, done: int):
+    def __init__(self, store: _Store, bar, callback, total: int, done: int):
         self.store, self.bar, self.callback, self.total, self.done = store, bar, callback, total, done
         self.pending: list[pd.DataFrame] = []
         self.last = time.monotonic()
@@ -189,7 +189,7 @@ def run(campaign: Campaign, folder, *, client=None, scheduler: str | None = None
         raise TypeError(f"client: expected a dask.distributed Client or None, got {type(client).__name__}")
     if scheduler is not None:
         instance(scheduler, str, "scheduler")
-    store = Store(folder, campaign)
+    store = _Store(folder, campaign)
     done = store.done()
     missing = [r for r in range(campaign.n_runs) if r not in done]
     with tqdm(total=campaign.n_runs, initial=len(done), desc=campaign.name, disable=not progress, unit="run") as bar:
@@ -263,7 +263,7 @@ def timing(folder, name: str) -> pd.DataFrame:
     return _stored(folder, name).timing()
 
 
-def _stored(folder, name: str) -> Store:
+def _stored(folder, name: str) -> _Store:
     import json
 
     from .._validate import input_error, path
@@ -271,4 +271,4 @@ def _stored(folder, name: str) -> Store:
     config = path(folder, "folder") / instance(name, str, "name") / "campaign.json"
     if not config.is_file():
         raise input_error("name", f"no campaign {name!r} in {folder}")
-    return Store(folder, Campaign.from_dict(json.loads(config.read_text())))
+    return _Store(folder, Campaign.from_dict(json.loads(config.read_text())))

@@ -37,7 +37,7 @@ def _json_value(value, name: str):
     raise TypeError(f"{name}: expected numbers, strings, bools or lists of them, got {type(value).__name__}")
 
 
-def scenario_path(scenario: Callable) -> str:
+def _scenario_path(scenario: Callable) -> str:
     """``module:qualname`` of a module-level scenario function (how its configuration names it)."""
     return f"{scenario.__module__}:{scenario.__qualname__}"
 
@@ -179,7 +179,7 @@ class Campaign:
 
     def to_dict(self) -> dict:
         """The campaign as JSON-able data (what ``campaign.json`` holds)."""
-        return {"scenario": scenario_path(self.scenario), "points": self._list if self._grid is None else self._grid,
+        return {"scenario": _scenario_path(self.scenario), "points": self._list if self._grid is None else self._grid,
                 "seeds": self.seeds, "seed": self.seed, "fixed": self.fixed, "name": self.name}
 
     def to_json(self) -> str:

@@ -132,21 +132,34 @@ def predicted_by(predictor: Callable) -> Callable:
     return attach
 
 
-def predictor(scenario: Callable, name: str = "scenario") -> Callable:
+def predictor(scenario: Callable) -> Callable:
     """The covariance predictor attached to ``scenario``.
+
+    Parameters
+    ----------
+    scenario : callable
+        A scenario function.
+
+    Returns
+    -------
+    callable
+        Its predictor ``g(**params) -> pandas.DataFrame``.
 
     Raises
     ------
+    TypeError
+        ``scenario`` is not a scenario function.
     atomnav.InputError
-        ``scenario`` has none (see :func:`predicted_by`).
+        ``scenario`` has no predictor (see :func:`predicted_by`).
     """
+    parameters(scenario)
     g = getattr(scenario, "predict", None)
     if not callable(g):
-        raise input_error(name, f"{getattr(scenario, '__name__', scenario)!r} has no covariance predictor (attach one with predicted_by)")
+        raise input_error("scenario", f"{scenario.__name__!r} has no covariance predictor (attach one with predicted_by)")
     return g
 
 
-def checked_table(table, scenario: Callable) -> pd.DataFrame:
+def _checked_table(table, scenario: Callable) -> pd.DataFrame:
     """One run's table, checked to be a DataFrame starting with ``time_s``."""
     if not isinstance(table, pd.DataFrame):
         raise TypeError(f"scenario: {scenario.__name__} returned {type(table).__name__}, expected a pandas DataFrame")

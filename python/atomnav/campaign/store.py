@@ -31,7 +31,7 @@ def _differences(a: dict, b: dict) -> list[str]:
     return sorted(k for k in set(a) | set(b) if a.get(k) != b.get(k))
 
 
-class Store:
+class _Store:
     """The on-disk dataset of one campaign (see the module docstring).
 
     Parameters

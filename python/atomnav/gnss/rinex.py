@@ -185,6 +185,8 @@ def read_nav(path, n_leap: float | None = None, datum: str = "identity", week_st
         unknown RINEX version, or files without GPS or GLONASS records.
     """
     paths = [_file(p, "nav") for p in (list(path) if isinstance(path, (list, tuple)) else [path])]
+    if not paths:
+        raise input_error("path", "an empty list names no navigation file")
     files = [_core.gnss_read_rinex_nav(str(p)) for p in paths]
     gps = np.vstack([f["gps"] for f in files])
     glo = np.vstack([f["glonass"] for f in files])
