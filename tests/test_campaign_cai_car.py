@@ -1,0 +1,169 @@
+"""The campaign scenario cai_car (the car profile of Tennstedt et al. 2023, §2.8) against its
+covariance predictor: the Monte-Carlo RMS over seeds of each error norm must agree with the
+linear true-error analysis."""
+
+import numpy as np
+import pandas as pd
+import pytest
+from scipy.stats import chi2
+
+import atomnav as an
+from atomnav.campaign.cai_car import _configuration, _core_scenario, _points, cai_car
+from atomnav.imu import ImuErrors
+
+COLUMNS = ["pos_error_m", "vel_error_mps", "att_error_rad"]
+
+
+def _mc_rms(runs: int, **params) -> tuple[pd.DataFrame, pd.DataFrame]:
+    """RMS over seeds 0 … runs − 1 of each metric, and the prediction."""
+    tables = [cai_car(seed=s, **params) for s in range(runs)]
+    for t in tables[1:]:
+        assert np.array_equal(t["time_s"], tables[0]["time_s"])
+    rms = np.sqrt(np.mean([t[COLUMNS].to_numpy() ** 2 for t in tables], axis=0))
+    pred = cai_car.predict(**params)
+    assert list(pred.columns) == ["time_s", *COLUMNS] and np.array_equal(pred["time_s"], tables[0]["time_s"])
+    return pd.DataFrame(rms, columns=COLUMNS).assign(time_s=pred["time_s"]), pred
+
+
+def _ratios(runs: int, **params) -> pd.DataFrame:
+    rms, pred = _mc_rms(runs, **params)
+    ratio = rms[COLUMNS] / pred[COLUMNS]
+    ratio.insert(0, "time_s", pred["time_s"])
+    print(params, f"{runs} seeds: MC RMS / prediction\n{ratio.round(3).to_string()}")
+    return ratio
+
+
+def _rms_band(runs: int, p: float = 0.99) -> tuple[float, float]:
+    """Two-sided p band of MC RMS / true RMS over ``runs`` seeds when each run's |e|² is
+    (tr Σ)·χ²₁, the widest spread a Gaussian error vector's squared norm can have (one axis
+    dominating; three equal axes would give χ²₃/3): N·RMS²/tr Σ ~ χ²_N."""
+    lo, hi = chi2.ppf([(1 - p) / 2, (1 + p) / 2], runs)
+    return float(np.sqrt(lo / runs)), float(np.sqrt(hi / runs))
+
+
+def test_ci_point_matches_the_true_error_prediction():
+    # 30 seeds: the 99 % band of the RMS ratio is √(χ²₃₀(0.005)/30) … √(χ²₃₀(0.995)/30)
+    # = √(13.79/30) … √(53.67/30) = 0.678 … 1.338 (statistics alone; the full check with
+    # 60 seeds and ±30 % is the slow sweep below)
+    lo, hi = _rms_band(30)
+    assert abs(lo - 0.678) < 1e-3 and abs(hi - 1.338) < 1e-3
+    ratio = _ratios(30)
+    final = ratio[COLUMNS].iloc[-1]
+    assert ((final > lo) & (final < hi)).all(), final
+
+
+# 3 × 3 sweep in Earth gravity: T × shot period (2T, 4T, 10T), navigation grade. The other
+# grades the linear model carries (precise, medium, coarse) have in-shot phase noise beyond
+# the CAI's ±π/2 capture range even at T = 10 ms (precise: σ 1.3 rad; Monte-Carlo RMS 1.7–1.9 ×
+# the prediction). 60 seeds: the RMS of 60 runs is known to √(1/(2·60)) = 9 % (1σ) even when
+# one axis dominates.
+# At T = 40 ms the in-shot phase σ is 0.82 rad (0.98 rad with the turn-on biases; 11 % of the
+# shot-channels beyond ±π/2): the Monte-Carlo RMS at 40 s is 1.34–1.72 × the linear
+# prediction, which ignores the readout's sine and fringe slips (the predictor warns). The
+# diagnosis is test_linear_regime_at_40_ms_is_predicted below.
+_NONLINEAR = pytest.mark.xfail(strict=True, reason="T = 40 ms: phase σ 0.98 rad, beyond the linear analysis (readout sine, fringe slips)")
+SWEEP = [pytest.param(dict(T=T, shot_rate=None if k is None else 1.0 / (k * T)), id=f"T{T}-period{k or 2}T",
+                      marks=[pytest.mark.slow] + ([_NONLINEAR, pytest.mark.filterwarnings("ignore::RuntimeWarning")] if T == 0.04 else []))
+         for T in (0.01, 0.025, 0.04) for k in (None, 4, 10)]
+
+
+@pytest.mark.parametrize("params", SWEEP)
+def test_sweep_matches_the_true_error_prediction_within_30_percent(params):
+    ratio = _ratios(60, **params)
+    final = ratio[COLUMNS].iloc[-1]
+    assert (np.abs(final - 1) < 0.3).all(), final
+
+
+@pytest.mark.slow
+def test_linear_regime_at_40_ms_is_predicted(monkeypatch):
+    """The excess at T = 40 ms is the readout's nonlinearity plus the vibration: with the
+    navigation grade's white noise halved (in-shot phase σ 0.41 rad) and no vibration the
+    prediction holds again (measured 1.01–1.05 ×), and the predictor does not warn."""
+    import warnings
+
+    from atomnav import imu
+
+    quiet = ImuErrors.preset("navigation")
+    quiet.accel.white *= 0.5
+    quiet.gyro.white *= 0.5
+    monkeypatch.setitem(imu._USER_PRESETS, "navigation_half_white", quiet)
+    params = dict(T=0.04, imu="navigation_half_white", vibration=False)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", RuntimeWarning)
+        ratio = _ratios(60, **params)
+    final = ratio[COLUMNS].iloc[-1]
+    assert (np.abs(final - 1) < 0.3).all(), final
+
+
+def test_predictor_warns_beyond_the_linear_regime():
+    import warnings
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", RuntimeWarning)
+        cai_car.predict(T=0.025)
+    with pytest.warns(RuntimeWarning, match="beyond ±π/2"):
+        cai_car.predict(T=0.04)
+
+
+def test_run_is_bit_identical_whatever_the_cache_holds():
+    first = cai_car(seed=7, T=0.02)
+    cai_car(seed=8, T=0.025)  # another point in between
+    _core_scenario.cache_clear()
+    again = cai_car(seed=7, T=0.02)
+    pd.testing.assert_frame_equal(first, again, check_exact=True)
+    assert not first.equals(cai_car(seed=8, T=0.02))
+    assert list(first.columns) == ["time_s", *COLUMNS] and (first[COLUMNS] >= 0).all().all()
+    # checkpoints every 5 s: the filter epochs (every 2T = 40 ms) nearest to them, and the end
+    assert np.allclose(first["time_s"], [5, 10, 15, 20, 25, 30, 35, 40])
+
+
+def test_filter_follows_the_imu_grade():
+    grade = ImuErrors.preset("precise")
+    cfg = _configuration(_points(0.01, None, "precise", 0.0, "earth", True, 1.0, 5.0))
+    s = cfg.setup
+    assert (s.accel_psd, s.gyro_psd) == (grade.accel.white**2, grade.gyro.white**2)
+    assert (s.accel_bias_psd, s.gyro_bias_psd) == (grade.accel.bias_rw**2, grade.gyro.bias_rw**2)
+    assert s.sigma0[3:] == (grade.accel.bias_sigma, grade.gyro.bias_sigma)
+    assert cfg.sensor.inflation == (grade.accel.white**2, grade.gyro.white**2)
+    assert s.predict_every == 4 and cfg.sensor.shot_period == 0.02
+
+
+BAD = {
+    "unknown grade": (dict(imu="strategic"), "imu"),
+    "grade with flicker": (dict(imu="tactical"), "imu"),
+    "grade with fixed biases": (dict(imu="mems"), "imu"),
+    "shot rate above 1/(2T)": (dict(T=0.025, shot_rate=20.5), "shot_rate"),
+    "zero shot rate": (dict(shot_rate=0.0), "shot_rate"),
+    "T = 0": (dict(T=0.0), "T"),
+    "T < 0": (dict(T=-0.01), "T"),
+    "2T off the IMU samples": (dict(T=0.0123), "T"),
+    "unknown gravity": (dict(gravity="moon"), "gravity"),
+    "contrast > 1": (dict(contrast=1.5), "contrast"),
+    "lever NaN": (dict(lever=float("nan")), "lever"),
+    "checkpoint spacing 0": (dict(checkpoint_s=0.0), "checkpoint_s"),
+}
+
+
+@pytest.mark.parametrize("case", list(BAD), ids=list(BAD))
+@pytest.mark.parametrize("call", ["run", "predict"])
+def test_bad_input_names_the_parameter(case, call):
+    params, name = BAD[case]
+    fn = cai_car if call == "run" else cai_car.predict
+    with pytest.raises(an.InputError) as e:
+        fn(**params)
+    assert e.value.parameter == name, str(e.value)
+
+
+@pytest.mark.parametrize("params", [dict(vibration="yes"), dict(imu=3), dict(gravity=None)], ids=["vibration", "imu", "gravity"])
+def test_wrong_types_are_type_errors(params):
+    (name,) = params
+    with pytest.raises(TypeError, match=name):
+        cai_car(**params)
+    with pytest.raises(TypeError, match=name):
+        cai_car.predict(**params)
+
+
+def test_bad_seed_names_seed():
+    with pytest.raises(an.InputError) as e:
+        cai_car(seed=-1)
+    assert e.value.parameter == "seed"
