@@ -59,6 +59,7 @@ def _grade(key: tuple) -> imu_errors.ImuErrors:
         triad.white *= noise_scale
         triad.gauss_markov = None if gm is None else imu_errors.GaussMarkov(bias_scale * gm.sigma, gm.tau)
         triad.flicker = None if fl is None else imu_errors.Flicker(bias_scale * fl.b, fl.f_lo, fl.f_hi)
+    imu_errors.ImuSimulator(errors, 1.0 / key[3], "increments")  # checks the grade at this rate (flicker band below Nyquist)
     return errors
 
 
