@@ -113,7 +113,7 @@ def _campaign(args: argparse.Namespace) -> int:
         before = 0
     t0 = time.perf_counter()
     try:
-        with renamed(folder="output"), _local_cluster(where.workers) as client:
+        with renamed(folder="output"), _local_cluster(where.workers if before < study.n_runs else None) as client:
             table = run(study, spec.output, client=client, scheduler=where.scheduler, progress=args.progress)
     except InputError as e:  # another campaign in the folder, a parameter value the scenario rejects
         parser.error(f"{args.file}: {e}")
