@@ -180,17 +180,24 @@ def test_monte_carlo_report_equals_the_rms_over_the_runs(tmp_path):
         assert row["pos_error_m_mc_se"] == pytest.approx(se, rel=1e-12)
         assert row["pos_error_m_cov"] == pytest.approx(closed_form(q, 0.0, 2, 75.0), rel=1e-14)
         assert row["pos_error_m_ratio"] == pytest.approx(row["pos_error_m_mc"] / row["pos_error_m_cov"], rel=1e-14)
-    again = compare(load(tmp_path, "walk"), walk, 75.0)  # the same report from the stored table
-    np.testing.assert_allclose(again["pos_error_m_mc"], out["pos_error_m_mc"], rtol=1e-14)
+    table = load(tmp_path, "walk")
+    again = compare(table, campaign, 75.0)  # the same report from the stored table
+    pd.testing.assert_frame_equal(again, out)
+    shuffled = table.sample(frac=1.0, random_state=1).rename(columns={"q": "renamed"})  # parameters come from the campaign
+    pd.testing.assert_frame_equal(compare(shuffled, campaign, 75.0), out)
+    one = compare(table[table["point"] == 1], campaign)  # a part of the table, at the last checkpoint
+    assert one["point"].tolist() == [1] and one["time_s"].tolist() == [100.0]
+    assert one["pos_error_m_cov"].iloc[0] == pytest.approx(closed_form(1.0, 0.0, 2, 100.0), rel=1e-14)
 
 
-def _confirm(scenario, metric, target, at, space, seeds, folder, fixed=None):
-    """The boundary of ``requirements`` and the Monte Carlo 15 % inside and outside it."""
+def _confirm(scenario, metric, target, at, space, seeds, folder, fixed=None, step=0.15):
+    """The boundary of ``requirements`` and the Monte Carlo ``step`` (relative) inside and
+    outside it."""
     (name, _), = ((k, v) for k, v in space.items() if isinstance(v, tuple))
     boundary = requirements(scenario, {metric: target}, at, space, fixed=fixed)
     assert boundary["feasible"].tolist() == ["below"]
     b = boundary[name].iloc[0]
-    mc = sweep(scenario, {name: [0.85 * b, 1.15 * b]}, fixed=fixed, method="monte_carlo", seeds=seeds, at=at,
+    mc = sweep(scenario, {name: [(1 - step) * b, (1 + step) * b]}, fixed=fixed, method="monte_carlo", seeds=seeds, at=at,
                folder=folder, progress=False)
     rms, se = mc[metric + "_mc"].to_numpy(), mc[metric + "_mc_se"].to_numpy()
     assert np.all(se < 0.03 * rms)  # the MC RMS is known to a few %
@@ -202,6 +209,22 @@ def _confirm(scenario, metric, target, at, space, seeds, folder, fixed=None):
 def test_monte_carlo_confirms_the_requirement_boundary_on_both_sides(tmp_path):
     b, mc = _confirm(walk, "pos_error_m", 10.0, 100.0, {"q": (0.01, 2.0)}, 1000, tmp_path)
     assert b == pytest.approx(1.0 / 3.0, abs=1e-5)
+
+
+def test_monte_carlo_confirms_the_bias_a_free_ins_tolerates(tmp_path):
+    from atomnav.campaign.strapdown_free import strapdown_free
+
+    fixed = {"duration": 120.0, "checkpoint_s": 60.0, "rate_hz": 20.0}
+    b, mc = _confirm(strapdown_free, "pos_error_m", 100.0, 120.0, {"bias_scale": (0.1, 3.0)}, 300, tmp_path, fixed)
+    assert 0.1 < b < 3.0
+
+
+@pytest.mark.slow
+def test_monte_carlo_confirms_the_bias_a_moving_free_ins_tolerates_within_ten_percent(tmp_path):
+    from atomnav.campaign.strapdown_free import strapdown_free
+
+    fixed = {"duration": 300.0, "checkpoint_s": 60.0, "rate_hz": 50.0, "motion": "sinusoidal", "imu": "navigation"}
+    _confirm(strapdown_free, "hpos_error_m", 20.0, 300.0, {"bias_scale": (0.05, 5.0)}, 1000, tmp_path, fixed, step=0.1)
 
 
 # ---- plots --------------------------------------------------------------------------
@@ -298,7 +321,17 @@ def test_throughput_counts_runs_per_worker(tmp_path):
     (lambda: requirements(walk, {"pos_error_m": 1.0}, 100.0, {"q": (0.1, 1.0)}, tol=1.5), "tol"),
     (lambda: requirements(walk, {"pos_error_m": 1.0}, 100.0, {"q": (0.1, 1.0)}, samples=2), "samples"),
     (lambda: requirements(walk, {"pos_error_m": 1.0}, 100.0, {"q": (0.1, 1.0)}, method="monte_carlo"), "method"),
-    (lambda: compare(pd.DataFrame({"point": [0], "q": [1.0]}), walk), "table"),
+    (lambda: compare(pd.DataFrame({"point": [0], "q": [1.0]}), Campaign(walk, {"q": [1.0]})), "table"),
+    (lambda: compare(pd.DataFrame({"point": [0, 2], "time_s": 100.0, "pos_error_m": 1.0, "hpos_error_m": 1.0}),
+                     Campaign(walk, {"q": [1.0, 2.0]})), "table"),
+    (lambda: compare(pd.DataFrame({"point": [0], "time_s": 100.0, "pos_error_m": 1.0, "hpos_error_m": 1.0}),
+                     Campaign(walk, {"q": [1.0]})), "table"),
+    (lambda: compare(pd.DataFrame({"point": [0, 0], "time_s": 100.0, "pos_error_m": [1.0, np.nan], "hpos_error_m": 1.0}),
+                     Campaign(walk, {"q": [1.0]})), "table"),
+    (lambda: compare(pd.DataFrame({"point": [0, 0], "time_s": 100.0, "pos_error_m": 1.0, "hpos_error_m": 1.0}),
+                     Campaign(walk, {"q": [1.0]}), at=50.0), "at"),
+    (lambda: compare(pd.DataFrame({"point": [0, 0], "time_s": 1.0, "err_m": 1.0}), Campaign(no_predictor, {"x": [1.0]})),
+     "campaign"),
     (lambda: cplots.error_vs_parameter(pd.DataFrame({"q": [1.0]}), "q", "pos_error_m"), "metric"),
 ])
 def test_bad_input_names_the_argument(call, parameter):
@@ -313,4 +346,6 @@ def test_wrong_types_are_type_errors():
     with pytest.raises(TypeError, match="target"):
         requirements(walk, [("pos_error_m", 1.0)], 100.0, {"q": (0.1, 1.0)})
     with pytest.raises(TypeError, match="table"):
-        compare([1, 2], walk)
+        compare([1, 2], Campaign(walk, {"q": [1.0]}))
+    with pytest.raises(TypeError, match="campaign"):
+        compare(pd.DataFrame({"point": [0]}), walk)

@@ -29,7 +29,7 @@ def _at(report: pd.DataFrame) -> str:
     """Title suffix naming the checkpoint time(s) of a report, if it has ``time_s``."""
     if "time_s" not in report.columns:
         return ""
-    times = np.unique(read_table(report, ["time_s"], "report"))
+    times = np.unique(read_table(report, ["time_s"], "report", epoch=None))
     return f" at t = {times[0]:g} s" if times.size == 1 else f" at t = {times.min():g} … {times.max():g} s"
 
 
@@ -183,7 +183,7 @@ def throughput(table):
         Naming ``table``: a missing column, or a run time that is not finite and > 0.
     """
     instance(table, pd.DataFrame, "table")
-    locate(table, ["worker"], "table")
+    locate(table, ["run", "elapsed_s", "worker"], "table")
     runs = table.drop_duplicates("run")
     d = read_table(runs, ["run", "elapsed_s"], "table")
     bad = np.flatnonzero(d[:, 1] <= 0)

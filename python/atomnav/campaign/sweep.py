@@ -17,13 +17,12 @@ scenario's parameters.
 
 from __future__ import annotations
 
-import json
 import warnings
 
 import numpy as np
 import pandas as pd
 
-from .._validate import choice, flag, input_error, instance, integer, locate, positive, scalar, table as read_table
+from .._validate import choice, flag, input_error, instance, integer, positive, renamed, scalar, table as read_table
 
 #: Methods of :func:`sweep`.
 METHODS = ("covariance", "monte_carlo")
@@ -41,8 +40,9 @@ def sweep(scenario, points, *, method: str = "covariance", seeds: int = 100, see
     Parameters
     ----------
     scenario : callable
-        A campaign scenario ``f(*, seed, **params) -> DataFrame`` with a covariance
-        predictor ``f.predict(**params)`` (:func:`atomnav.campaign.scenario.predicted_by`).
+        A campaign scenario ``f(*, seed, **params)`` (:mod:`atomnav.campaign.scenario`)
+        with a covariance predictor ``f.predict(**params)``
+        (:func:`atomnav.campaign.scenario.predicted_by`).
     points : dict or list of dict
         The parameter points, as :class:`atomnav.campaign.plan.Campaign` takes them: a
         dict name -> list of values (the cartesian product, last name fastest) or a list
@@ -105,79 +105,81 @@ def sweep(scenario, points, *, method: str = "covariance", seeds: int = 100, see
             if value is not None:
                 raise input_error(name, "is used by method='monte_carlo' only; the covariance sweep runs in this process")
         campaign = Campaign(scenario, points, seeds=1, seed=seed, fixed=fixed)
-        shown = [*campaign.varied(), *(k for k in campaign.fixed if k not in campaign.varied())]
-        return _predictions(predict, [campaign.point(i) for i in range(campaign.n_points)], shown, at, progress)
+        return _predictions(predict, [campaign.point(i) for i in range(campaign.n_points)], _shown(campaign), at, progress)
     integer(seeds, "seeds", 2)
     if folder is None:
         raise input_error("folder", "method='monte_carlo' keeps its runs on disk: give the folder to write them to")
     from .execute import run
 
     campaign = Campaign(scenario, points, seeds=seeds, seed=seed, fixed=fixed)
-    return compare(run(campaign, folder, client=client, scheduler=scheduler, progress=progress), scenario, at)
+    return compare(run(campaign, folder, client=client, scheduler=scheduler, progress=progress), campaign, at)
 
 
-def compare(table, scenario, at=None) -> pd.DataFrame:
+def compare(table, campaign, at=None) -> pd.DataFrame:
     """The Monte-Carlo RMS of every metric per parameter point of a campaign, beside the
     scenario's covariance prediction and their ratio.
 
     Parameters
     ----------
     table : pandas.DataFrame
-        A campaign table (:func:`atomnav.campaign.run` or :func:`atomnav.campaign.load`):
-        ``point``, one column per parameter, ``time_s`` (s) and the scenario's metric
-        columns, one row per run and checkpoint.
-    scenario : callable
-        The campaign's scenario, with its covariance predictor ``scenario.predict``.
+        The campaign's table (:func:`atomnav.campaign.run` or
+        :func:`atomnav.campaign.load`), or some of its rows: ``point``, ``time_s`` (s) and
+        the scenario's metric columns, one row per run and checkpoint (other columns are
+        not read: a point's parameters are the campaign's).
+    campaign : atomnav.campaign.Campaign
+        The campaign that made the table; its scenario has a covariance predictor
+        ``scenario.predict``.
     at : float, optional
         The checkpoint time (s) to report; by default each point's last checkpoint.
 
     Returns
     -------
     pandas.DataFrame
-        One row per point, sorted by point: ``point``, the parameters, ``time_s`` (s),
-        ``seeds`` (runs of the point) and per metric ``<metric>_mc`` — the RMS
-        √(mean e²) over the seeds —, ``<metric>_mc_se`` — its standard error,
-        sd(e²) / (2 · RMS · √seeds) by the delta method (Casella and Berger 2002,
-        §5.5.4) —, ``<metric>_cov`` — the prediction, an RMS over seeds by its
-        definition — and ``<metric>_ratio`` = ``_mc`` / ``_cov`` (1 for a covariance
+        One row per point of the table, sorted by point: ``point``, the parameters that
+        vary or are fixed, ``time_s`` (s), ``seeds`` (runs of the point) and per metric
+        ``<metric>_mc`` — the RMS √(mean e²) over the seeds —, ``<metric>_mc_se`` — its
+        standard error, sd(e²) / (2 · RMS · √seeds) by the delta method (Casella and
+        Berger 2002, §5.5.4) —, ``<metric>_cov`` — the prediction, an RMS over seeds by
+        its definition — and ``<metric>_ratio`` = ``_mc`` / ``_cov`` (1 for a covariance
         analysis that matches the Monte Carlo).
 
     Raises
     ------
     atomnav.InputError
-        Naming ``table`` (a missing column, a metric with NaN or inf, a point with fewer
-        than 2 runs), ``at`` (not a checkpoint of some point) or ``scenario`` (no
-        predictor).
+        Naming ``table`` (a missing column, a metric with NaN or inf, a point that is not
+        one of the campaign's, a point with fewer than 2 runs), ``at`` (not a checkpoint
+        of some point) or ``campaign`` (its scenario has no predictor).
     """
-    from .scenario import parameters, predictor
+    from .plan import Campaign
+    from .scenario import predictor
 
     instance(table, pd.DataFrame, "table")
-    predict = predictor(scenario)
-    defaults = parameters(scenario)
-    locate(table, ["point", "time_s"], "table")
-    names = [c for c in table.columns if c in defaults]
-    times = read_table(table, ["time_s"], "table").ravel()
-    point = table["point"].to_numpy()
-    first = table.groupby("point", sort=True).head(1)
-    keys = first["point"].to_numpy()
+    instance(campaign, Campaign, "campaign")
+    with renamed(scenario="campaign"):
+        predict = predictor(campaign.scenario)
     at = None if at is None else _finite(at, "at")
+    point, times = read_table(table, ["point", "time_s"], "table", epoch=None).T
+    keys = np.unique(point)
+    alien = keys[(keys != np.round(keys)) | (keys < 0) | (keys >= campaign.n_points)]
+    if alien.size:
+        raise input_error("table", f"column 'point': {alien[0]:g} is not a point of the campaign (0 … {campaign.n_points - 1})")
     chosen = []
     for key in keys:
         checkpoints = np.unique(times[point == key])
-        chosen.append(checkpoints[_checkpoint(checkpoints, at, f"the runs of point {key}")])
+        chosen.append(checkpoints[_checkpoint(checkpoints, at, f"the runs of point {key:g}")])
     chosen = np.array(chosen)
-    params = [{k: _decoded(v, defaults[k]) for k, v in row.items()} for row in first[names].to_dict("records")]
-    report = _predictions(predict, [{**defaults, **p} for p in params], names, chosen, False)
+    keys = keys.astype(np.int64)
+    report = _predictions(predict, [campaign.point(int(k)) for k in keys], _shown(campaign), chosen, False)
     report["point"] = keys
     metrics = [c[: -len(COV)] for c in report.columns if c.endswith(COV)]
-    runs = table.loc[times == pd.Series(chosen, index=keys).loc[point].to_numpy()]
-    squares = pd.DataFrame(read_table(runs, metrics, "table") ** 2, columns=metrics).groupby(runs["point"].to_numpy())
-    n = squares.size().loc[keys].to_numpy()
+    rows = times == chosen[np.searchsorted(keys, point)]
+    squares = pd.DataFrame(read_table(table.loc[rows], metrics, "table") ** 2, columns=metrics).groupby(point[rows])
+    n = squares.size().to_numpy()
     if np.any(n < 2):
         few = np.argmax(n < 2)
         raise input_error("table", f"point {keys[few]} has {n[few]} run at {chosen[few]} s; an RMS over seeds and its "
                                    "standard error need 2 or more")
-    mean, sd = squares.mean().loc[keys], squares.std(ddof=1).loc[keys]
+    mean, sd = squares.mean(), squares.std(ddof=1)
     columns = {"seeds": n}
     for m in metrics:
         rms = np.sqrt(mean[m].to_numpy())
@@ -187,8 +189,7 @@ def compare(table, scenario, at=None) -> pd.DataFrame:
         with np.errstate(divide="ignore", invalid="ignore"):
             ratio = np.where(cov > 0, rms / cov, np.where(rms > 0, np.inf, 1.0))
         columns.update({m + MC: rms, m + MC_SE: se, m + COV: cov, m + RATIO: ratio})
-    head = report[["point", *names, "time_s"]].reset_index(drop=True)
-    return pd.concat([head, pd.DataFrame(columns)], axis=1)
+    return pd.concat([report.drop(columns=[m + COV for m in metrics]), pd.DataFrame(columns)], axis=1)
 
 
 def requirements(scenario, target: dict, at, space: dict, *, fixed=None, tol: float = 1e-6, samples: int = 17,
@@ -328,6 +329,13 @@ def _predict_at(predict, params: dict, at) -> tuple[float, dict]:
     return float(data[k, j]), values
 
 
+def _shown(campaign) -> list[str]:
+    """The parameters a report shows: those that vary over the campaign's points, then the
+    fixed ones (as the campaign's table)."""
+    varied = campaign.varied()
+    return [*varied, *(k for k in campaign.fixed if k not in varied)]
+
+
 def _checkpoint(times: np.ndarray, at, what: str) -> int:
     """The index of checkpoint ``at`` (s; None: the last) in ``times`` (s, increasing), of
     ``what``."""
@@ -352,14 +360,6 @@ def _predictions(predict, points: list, shown: list, at, progress: bool) -> pd.D
         t, values = _predict_at(predict, params, at if at is None or np.ndim(at) == 0 else at[i])
         rows.append({"point": i, **{k: params[k] for k in shown}, "time_s": t, **{m + COV: v for m, v in values.items()}})
     return pd.DataFrame(rows)
-
-
-def _decoded(value, default):
-    """A parameter value read back from a campaign table: JSON text of a list parameter
-    as the list, a numpy scalar as the Python one."""
-    if isinstance(value, str) and not isinstance(default, str):
-        return json.loads(value)
-    return value.item() if isinstance(value, np.generic) else value
 
 
 def _space(scenario, space) -> tuple[dict, dict]:
