@@ -1,9 +1,11 @@
 """Campaign throughput: one campaign of short runs (default 1,000 free-inertial runs of 60 s,
 a few tens of ms each) in this process and on a dask.distributed LocalCluster of 1 and of 2
 single-threaded worker processes, side by side; prints the wall time, the speed-up of
-2 workers over 1 (goal ≥ 1.8×) and the scheduler overhead per run,
+2 workers over 1 (goal ≥ 1.8×), the scheduler overhead per run,
 (wall time × workers − Σ run time) / runs, from the per-run ``elapsed_s`` the campaign
-stores. Clusters are started and their workers warmed (scenario module imported) before
+stores, and the share of the wall time the workers spent running (busy %). A mean run
+time that grows with the workers means the cores were not free: the speed-up is then
+bounded by the machine, the busy share still says what the scheduling costs. Clusters are started and their workers warmed (scenario module imported) before
 the clock starts; every executor writes to a fresh folder, so nothing is resumed.
 
     python benches/bench_campaign.py [--runs 1000] [--duration 60] [--scenario strapdown_free|toy]
@@ -82,11 +84,12 @@ def main():
         rows.append((f"LocalCluster, {workers} worker{'s' * (workers > 1)}", workers, *on_cluster(plan, workers)))
 
     print(f"{plan.name}: {plan.n_runs} runs over {plan.n_points} points")
-    print(f"{'executor':24s} {'start s':>8s} {'wall s':>8s} {'runs/s':>8s} {'mean run ms':>12s} {'overhead/run ms':>16s}")
+    print(f"{'executor':24s} {'start s':>8s} {'wall s':>8s} {'runs/s':>8s} {'mean run ms':>12s} {'overhead/run ms':>16s} "
+          f"{'busy %':>7s}")
     for label, slots, start, wall, busy in rows:
         overhead = (wall * slots - busy) / plan.n_runs
         print(f"{label:24s} {start:8.2f} {wall:8.2f} {plan.n_runs / wall:8.1f} {busy / plan.n_runs * 1e3:12.2f} "
-              f"{overhead * 1e3:16.2f}")
+              f"{overhead * 1e3:16.2f} {100 * busy / (wall * slots):7.1f}")
     one, two = rows[2][3], rows[3][3]
     print(f"speed-up of 2 workers over 1: {one / two:.2f}x (goal >= 1.8x); "
           f"2 workers vs in process (1 thread): {rows[0][3] / two:.2f}x")

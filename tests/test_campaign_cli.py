@@ -62,8 +62,9 @@ fixed:
 """
 
 
-def _atomnav(*args: str, timeout: float = 300) -> subprocess.CompletedProcess:
-    env = {**os.environ, "PYTHONPATH": os.pathsep.join(filter(None, [str(TESTS), os.environ.get("PYTHONPATH")]))}
+def _atomnav(*args: str, timeout: float = 300, tests_on_path: bool = True) -> subprocess.CompletedProcess:
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join(filter(None, [str(TESTS) if tests_on_path else "",
+                                                                     os.environ.get("PYTHONPATH")]))}
     return subprocess.run([sys.executable, "-m", "atomnav.cli", "campaign", *args], capture_output=True, text=True,
                           timeout=timeout, env=env)
 
@@ -119,10 +120,13 @@ def test_file_writes_the_in_process_table_and_resumes(tmp_path, in_process, name
     pd.testing.assert_frame_equal(campaign.load(tmp_path / "out", "walk"), in_process)
 
 
-def test_local_cluster_writes_the_in_process_table(tmp_path, in_process):
-    path = _write(tmp_path, "campaign.toml", TOML + "\n[executor]\nworkers = 1\n")
-    run = _atomnav(str(path), "--no-progress", "--workers", "2")
+def test_local_cluster_writes_the_in_process_table(tmp_path, in_process, monkeypatch):
+    """Also: a scenario module beside the file is found, by the command and by its workers."""
+    (tmp_path / "walk_of_mine.py").write_text((TESTS / "campaign_toy.py").read_text())
+    path = _write(tmp_path, "campaign.toml", TOML.replace("campaign_toy:", "walk_of_mine:") + "\n[executor]\nworkers = 1\n")
+    run = _atomnav(str(path), "--no-progress", "--workers", "2", tests_on_path=False)
     assert run.returncode == 0, run.stderr
+    monkeypatch.setattr(sys, "path", [str(tmp_path), *sys.path])  # load() imports the scenario named in campaign.json
     pd.testing.assert_frame_equal(campaign.load(tmp_path / "out", "walk"), in_process)
     assert set(campaign.timing(tmp_path / "out", "walk")["worker"]) != {"local"}
 
