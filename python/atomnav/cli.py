@@ -22,7 +22,7 @@ CAMPAIGN = ("Run a design study described by a campaign file (TOML or YAML: the 
             "written at once to OUTPUT/NAME/ (Parquet files and campaign.json); running the same file again resumes it, "
             "computing only the runs missing there. A scenario 'module:function' is imported with the file's folder on "
             "the module path. Exits with status 0 when every run is done, 2 for a bad file or option, 1 when the runs "
-            "cannot execute (an unreachable scheduler).")
+            "cannot execute (an unreachable scheduler), 130 when interrupted (Ctrl-C).")
 
 
 def version() -> str:
@@ -120,6 +120,10 @@ def _campaign(args: argparse.Namespace) -> int:
     except ConnectionError as e:
         print(f"{parser.prog}: error: {e}", file=sys.stderr)
         return 1
+    except KeyboardInterrupt:
+        print(f"{parser.prog}: interrupted with {len(timing(spec.output, study.name))} of {study.n_runs} runs in "
+              f"{spec.output / study.name}; run the same command again to resume", file=sys.stderr)
+        return 130
     done = table["run"].nunique() if len(table) else 0
     print(f"{study.name}: {done - before} new runs, {before} resumed, {done} of {study.n_runs} done, in "
           f"{spec.output / study.name} ({time.perf_counter() - t0:.1f} s)")
