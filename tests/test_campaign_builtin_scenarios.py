@@ -197,7 +197,7 @@ def test_a_run_is_the_same_in_another_process():
 @pytest.mark.parametrize("name, value", [
     ("imu", "ring_laser"), ("motion", "flying"), ("duration", -1.0), ("rate_hz", 0.0), ("checkpoint_s", 0.0),
     ("checkpoint_s", 700.0), ("checkpoint_s", 0.005), ("latitude_deg", 95.0), ("bias_scale", -1.0),
-    ("noise_scale", float("nan")), ("duration", float("inf")),
+    ("noise_scale", float("nan")), ("duration", float("inf")), ("duration", 1e6), ("rate_hz", 1e9),
 ])
 def test_strapdown_free_bad_values_name_the_parameter(name, value):
     for fn in (strapdown_free, strapdown_free.predict):
@@ -214,7 +214,7 @@ def test_strapdown_free_flicker_band_above_nyquist_names_the_term():
 
 @pytest.mark.parametrize("name, value", [
     ("imu_class", "tactical"), ("outage_s", 300.0), ("outage_s", 1.5), ("satellites", 25), ("satellites", -1),
-    ("checkpoint_s", 0.5), ("checkpoint_s", 400.0), ("duration", 0.0), ("rate_hz", 12.5),
+    ("checkpoint_s", 0.5), ("checkpoint_s", 400.0), ("duration", 0.0), ("duration", 1e6), ("rate_hz", 12.5), ("rate_hz", 1e6),
 ])
 def test_gnss_tight_bad_values_name_the_parameter(name, value):
     for fn in (gnss_tight, gnss_tight.predict):

@@ -19,6 +19,10 @@ IMU_CLASSES = tuple(scenarios.INITIAL_ATTITUDE)
 #: Satellites of the nominal GPS constellation: ``satellites`` at this value uses every
 #: satellite above the mask at each epoch.
 ALL_SATELLITES = 24
+#: Longest run (s): the thesis's longest experiment (40 min) and then some.
+MAX_DURATION_S = 4 * 3600.0
+#: Highest IMU rate (Hz).
+MAX_RATE_HZ = 1000.0
 _COLUMNS = ("pos_error_m", "hpos_error_m", "vel_error_mps", "att_error_rad")
 _BLOCKS = (slice(0, 3), slice(0, 2), slice(3, 6), slice(6, 9))
 _NAV_ERRORS = ("dpos_n_m", "dpos_e_m", "dpos_d_m", "dvel_n_mps", "dvel_e_mps", "dvel_d_mps", "psi_n_rad", "psi_e_rad", "psi_d_rad")
@@ -36,6 +40,8 @@ def _scenario(seed: int, imu_class, outage_s, satellites, duration, checkpoint_s
     """The checked parameters as the :class:`atomnav.gnss.scenarios.Scenario` they run."""
     imu_class = choice(imu_class, IMU_CLASSES, "imu_class")
     duration = positive(duration, "duration")
+    if duration > MAX_DURATION_S:
+        raise input_error("duration", f"must be at most {MAX_DURATION_S:g} s, got {duration}")
     checkpoint_s = _whole_seconds(checkpoint_s, "checkpoint_s", 1.0)
     if checkpoint_s > duration:
         raise input_error("checkpoint_s", f"must be at most the duration {duration} s, got {checkpoint_s}")
@@ -44,8 +50,8 @@ def _scenario(seed: int, imu_class, outage_s, satellites, duration, checkpoint_s
         raise input_error("outage_s", f"must be shorter than the duration {duration} s, got {outage_s}")
     satellites = integer(satellites, "satellites", 0, ALL_SATELLITES)
     rate_hz = positive(rate_hz, "rate_hz")
-    if abs(rate_hz - round(rate_hz)) > 1e-9 * rate_hz:
-        raise input_error("rate_hz", f"must be a whole number of samples per 1 s GNSS epoch, got {rate_hz}")
+    if abs(rate_hz - round(rate_hz)) > 1e-9 * rate_hz or rate_hz > MAX_RATE_HZ:
+        raise input_error("rate_hz", f"must be a whole number of samples per 1 s GNSS epoch, at most {MAX_RATE_HZ:g}, got {rate_hz}")
     # the GNSS epochs in the last outage_s seconds, (duration − outage_s, duration], are withheld
     outage = None if outage_s == 0 else (duration - outage_s + 0.5, outage_s)
     return scenarios.Scenario(imu_class, duration_s=duration, n_sats=None if satellites == ALL_SATELLITES else satellites,
@@ -163,12 +169,13 @@ def gnss_tight(*, seed=0, imu_class="precise", outage_s=0.0, satellites=ALL_SATE
         (24, the whole nominal constellation, the default): every satellite above the mask
         at each epoch.
     duration : float
-        Length of the run (s).
+        Length of the run (s), at most :data:`MAX_DURATION_S`.
     checkpoint_s : float
         Spacing of the checkpoints (s, a whole number): the table has a row at every
         multiple of it up to ``duration``.
     rate_hz : float
-        IMU sampling rate (Hz, a whole number); the filter predicts once per second.
+        IMU sampling rate (Hz, a whole number up to :data:`MAX_RATE_HZ`); the filter
+        predicts once per second.
 
     Returns
     -------

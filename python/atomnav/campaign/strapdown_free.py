@@ -21,6 +21,8 @@ MOTIONS = ("stationary", "sinusoidal")
 #: Longest step (s) of the linear analysis: short against the 20 s shortest period of the
 #: sinusoidal motion, and e^{|F|Δt} of the fastest flicker pole (τ ≈ 0.05 s) stays finite.
 ANALYSIS_STEP_S = 1.0
+#: Longest run (s): several Schuler periods (84 min), and a bounded linear analysis.
+MAX_DURATION_S = 6 * 3600.0
 _COLUMNS = ("pos_error_m", "hpos_error_m", "vel_error_mps", "att_error_rad")
 _BIAS_STATES = {"accel": slice(9, 12), "gyro": slice(12, 15)}
 
@@ -31,6 +33,10 @@ def _points(imu, duration, motion, rate_hz, checkpoint_s, latitude_deg, bias_sca
         raise TypeError(f"imu: expected an IMU preset name (str), got {type(imu).__name__}")
     choice(imu, imu_errors.preset_names(), "imu")
     duration, rate_hz = positive(duration, "duration"), positive(rate_hz, "rate_hz")
+    if duration > MAX_DURATION_S:
+        raise input_error("duration", f"must be at most {MAX_DURATION_S:g} s, got {duration}")
+    if duration * rate_hz > trajectory.MAX_SAMPLES:
+        raise input_error("rate_hz", f"{duration} s at {rate_hz} Hz is more than {trajectory.MAX_SAMPLES} samples")
     motion = choice(motion, MOTIONS, "motion")
     checkpoint_s = positive(checkpoint_s, "checkpoint_s")
     if checkpoint_s > duration:
@@ -114,19 +120,34 @@ def _linear(errors: imu_errors.ImuErrors, imu: str) -> None:
                                      "flicker) and white noise only")
 
 
-def _variances(f, qc, dt: float, p0) -> np.ndarray:
+def _variances(models, dt: float, p0) -> np.ndarray:
     """Variance of every state after each step of the linear model ẋ = Fx + w (no
-    measurement): P ← ΦPΦᵀ + Q_d with the exact (Van Loan) discretisation of every step; a
-    model equal to the previous step's is not discretised again. P₀ may be singular (the
-    INS starts at the truth)."""
+    measurement), given the (F, Q_c) of every step: P ← ΦPΦᵀ + Q_d with the exact (Van Loan)
+    discretisation of every step; a model equal to the previous step's is not discretised
+    again. P₀ may be singular (the INS starts at the truth)."""
     p, out, last = np.asarray(p0, dtype=float), [], None
-    for fk, qk in zip(f, qc):
+    for fk, qk in models:
         if last is None or not (np.array_equal(fk, last[0]) and np.array_equal(qk, last[1])):
             last = (fk, qk, *discretize(fk, qk, dt))
         phi, qd = last[2:]
         p = phi @ p @ phi.T + qd
         out.append(np.diag(p).copy())
     return np.array(out)
+
+
+def _with_poles(f, column: int, sigma: np.ndarray, tau: np.ndarray):
+    """(F, Q_c) of every step of the navigation states driven by Gauss–Markov poles (σ, τ)
+    that enter where the bias state ``column`` does, without white noise; built one step at
+    a time."""
+    n = f.shape[1] + len(tau)
+    qa = np.zeros((n, n))
+    qa[15:, 15:] = np.diag(2.0 * sigma**2 / tau)
+    for fk in f:
+        fa = np.zeros((n, n))
+        fa[:15, :15] = fk
+        fa[:15, 15:] = fk[:, column][:, None]
+        fa[15:, 15:] = np.diag(-1.0 / tau)
+        yield fa, qa
 
 
 def _strapdown_free_covariance(*, imu="tactical", duration=600.0, motion="stationary", rate_hz=100.0, checkpoint_s=60.0,
@@ -180,23 +201,14 @@ def _strapdown_free_covariance(*, imu="tactical", duration=600.0, motion="statio
     for name, triad in (("accel", a), ("gyro", g)):
         b = np.asarray(triad.bias, dtype=float)
         p0[_BIAS_STATES[name], _BIAS_STATES[name]] = np.diag(np.full(3, triad.bias_sigma**2)) + np.outer(b, b)
-    var = _variances(f, qc, step, p0)[:, :9]
+    var = _variances(zip(f, qc), step, p0)[:, :9]
     for name, triad in (("accel", a), ("gyro", g)):
         poles = _poles(triad)
-        if not poles:
-            continue
-        sigma, tau = np.array(poles).T
-        k = len(poles)
-        for axis in range(3):
-            fa = np.zeros((len(f), 15 + k, 15 + k))
-            fa[:, :15, :15] = f
-            fa[:, :15, 15:] = f[:, :15, _BIAS_STATES[name].start + axis][:, :, None]
-            fa[:, 15:, 15:] = np.diag(-1.0 / tau)
-            qa = np.zeros_like(fa)
-            qa[:, 15:, 15:] = np.diag(2.0 * sigma**2 / tau)
-            pa = np.zeros((15 + k, 15 + k))
-            pa[15:, 15:] = np.diag(sigma**2)
-            var += _variances(fa, qa, step, pa)[:, :9]
+        if poles:
+            sigma, tau = np.array(poles).T
+            for axis in range(3):  # each axis's poles start stationary, independent of the rest
+                pa = np.diag(np.r_[np.zeros(15), sigma**2])
+                var += _variances(_with_poles(f, _BIAS_STATES[name].start + axis, sigma, tau), step, pa)[:, :9]
     var = var[sub - 1::sub]
     return _table(times, (np.sqrt(var[:, s].sum(axis=1)) for s in (slice(0, 3), slice(0, 2), slice(3, 6), slice(6, 9))))
 
@@ -222,14 +234,15 @@ def strapdown_free(*, seed=0, imu="tactical", duration=600.0, motion="stationary
         IMU grade, an :meth:`atomnav.imu.ImuErrors.preset` name (``tactical``,
         ``navigation``, ``precise``, ``medium``, ``coarse``, ``mems``, ...).
     duration : float
-        Length of the run (s).
+        Length of the run (s), at most :data:`MAX_DURATION_S`.
     motion : {"stationary", "sinusoidal"}
         At rest, level and north-pointing (:func:`atomnav.trajectory.stationary`), or the
         default sinusoidal motion of :func:`atomnav.trajectory.sinusoidal` (metres of
         displacement, tenths of a radian of attitude, periods 20–60 s).
     rate_hz : float
-        IMU sampling rate (Hz); a grade with a flicker term needs its band below the
-        Nyquist frequency rate_hz/2.
+        IMU sampling rate (Hz), at most :data:`atomnav.trajectory.MAX_SAMPLES` samples over
+        the run; a grade with a flicker term needs its band below the Nyquist frequency
+        rate_hz/2.
     checkpoint_s : float
         Spacing of the checkpoints (s), a whole number of IMU samples: the table has a row
         at every multiple of it up to ``duration``.
@@ -252,10 +265,10 @@ def strapdown_free(*, seed=0, imu="tactical", duration=600.0, motion="stationary
     Raises
     ------
     atomnav.InputError
-        Naming ``seed``, ``imu`` (unknown), ``duration``, ``motion``, ``rate_hz`` (or
-        ``imu.flicker.f_hi`` above its Nyquist frequency), ``checkpoint_s`` (longer than the
-        run, or not a whole number of samples), ``latitude_deg``, ``bias_scale`` or
-        ``noise_scale``.
+        Naming ``seed``, ``imu`` (unknown), ``duration``, ``motion``, ``rate_hz`` (too many
+        samples), ``accel.flicker.f_hi`` or ``gyro.flicker.f_hi`` (the grade's flicker band
+        above the Nyquist frequency), ``checkpoint_s`` (longer than the run, or not a whole
+        number of samples), ``latitude_deg``, ``bias_scale`` or ``noise_scale``.
 
     Notes
     -----
