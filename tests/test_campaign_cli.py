@@ -200,6 +200,9 @@ def test_a_bad_key_is_a_usage_error_naming_it(tmp_path, capsys, monkeypatch, ext
      "points: the lists must have equal lengths (point i takes the i-th value of each), got steps: 1, sigma_m: 2"),
     (TOML.replace("[grid]", "[points]") + "[grid]\ndt_s = [1.0]\n", "points: give the parameter points"),
     (TOML.split("[grid]")[0], "points: missing"),
+    (TOML.replace('scenario = "campaign_toy:random_walk"', ""), "scenario: missing"),
+    (TOML.split("[grid]")[0] + "grid = 3\n", "grid: expected a table of parameter names and values, got int"),
+    ("- a\n- list\n", "not valid TOML"),
     (TOML.replace("seeds = 3", "seeds = "), "not valid TOML"),
     (TOML.replace("dt_s = 0.5", "bogus = 1.0"), "fixed: 'bogus' is not a parameter of random_walk"),
     (TOML.replace("dt_s = 0.5", "dt_s = nan"), "fixed.dt_s: must be finite"),
@@ -224,6 +227,11 @@ def test_unknown_builtin_lists_the_builtins_and_a_missing_file_is_named(tmp_path
     assert f"{tmp_path / 'missing.yaml'}: No such file or directory" in run.stderr
     run = _atomnav(str(_write(tmp_path, "c.json", "{}")))
     assert run.returncode == 2 and "expected a .toml, .yaml or .yml file, got 'c.json'" in run.stderr
+    (tmp_path / "latin1.yaml").write_bytes("scenario: caf\xe9".encode("latin-1"))
+    run = _atomnav(str(tmp_path / "latin1.yaml"))
+    assert run.returncode == 2 and "Traceback" not in run.stderr and "latin1.yaml: not UTF-8 text" in run.stderr
+    run = _atomnav(str(_write(tmp_path, "list.yaml", "- a\n- list\n")))
+    assert run.returncode == 2 and "list.yaml: expected a table of keys at the top of the file, got list" in run.stderr
 
 
 def test_yaml_without_pyyaml_says_what_to_install(tmp_path, capsys, monkeypatch):

@@ -57,6 +57,7 @@ _Value = Union[bool, int, float, str, tuple]  # a parameter value: a scalar or a
 _DOTTED = re.compile(r"^[A-Za-z_]\w*(\.[A-Za-z_]\w*)*$")
 _NAME = re.compile(r"^[A-Za-z_]\w*$")
 _SUFFIXES = {".toml": "TOML", ".yaml": "YAML", ".yml": "YAML"}
+_KEYS = ("scenario", "name", "seeds", "seed", "output", "grid", "points", "fixed", "executor")
 
 
 @dataclasses.dataclass(frozen=True)
@@ -228,8 +229,8 @@ def load(path) -> CampaignFile:
     Raises
     ------
     InputError
-        Another suffix, a file that is no valid TOML or YAML, a top level that is not a
-        table, an unknown key, or any error of :class:`CampaignFile` (``parameter``
+        Another suffix, a file that is no valid UTF-8 TOML or YAML, a top level that is
+        not a table, an unknown key, no ``scenario``, or any error of :class:`CampaignFile` (``parameter``
         names the key, e.g. ``seeds`` or ``executor.workers``; ``path`` for the whole file).
     TypeError
         ``path`` not a str or path-like; a value of the wrong type, naming the key.
@@ -252,13 +253,18 @@ def load(path) -> CampaignFile:
     kind = _SUFFIXES.get(path.suffix.lower())
     if kind is None:
         raise input_error("path", f"expected a .toml, .yaml or .yml file, got {path.name!r}")
-    text = path.read_text(encoding="utf-8")
+    try:
+        text = path.read_text(encoding="utf-8")
+    except UnicodeDecodeError as e:
+        raise input_error("path", f"not UTF-8 text ({e.reason} at byte {e.start})") from None
     data = _parse_toml(text) if kind == "TOML" else _parse_yaml(text)
     if not isinstance(data, Mapping):
         raise input_error("path", f"expected a table of keys at the top of the file, got {type(data).__name__}")
     unknown = sorted(set(data) - set(_KEYS), key=str)
     if unknown:
         raise input_error(str(unknown[0]), f"unknown key; the keys are {', '.join(_KEYS)}")
+    if "scenario" not in data:
+        raise input_error("scenario", "missing: name a built-in scenario or 'package.module:function'")
     fields = {k: v for k, v in data.items() if k not in ("executor", "points", "output")}
     if "points" in data:
         fields["points"] = _zipped(data["points"]) if isinstance(data["points"], Mapping) else data["points"]
@@ -275,9 +281,6 @@ def load(path) -> CampaignFile:
             raise input_error(str(extra[0]), "unknown key; the keys are scheduler, workers")
         fields["executor"] = Executor(**table)
     return CampaignFile(**fields)
-
-
-_KEYS = ("scenario", "name", "seeds", "seed", "output", "grid", "points", "fixed", "executor")
 
 
 def _parse_toml(text: str):
