@@ -185,6 +185,12 @@ def test_monte_carlo_report_equals_the_rms_over_the_runs(tmp_path):
     pd.testing.assert_frame_equal(again, out)
     shuffled = table.sample(frac=1.0, random_state=1).rename(columns={"q": "renamed"})  # parameters come from the campaign
     pd.testing.assert_frame_equal(compare(shuffled, campaign, 75.0), out)
+    other = Campaign(walk, {"q": [0.2, 1.5], "dims": [2]}, seeds=seeds, seed=7)
+    with pytest.raises(InputError, match="'q' holds 1.0 at point 1 where the campaign has 1.5") as e:
+        compare(table, other)  # the table of another campaign
+    assert e.value.parameter == "table"
+    with pytest.raises(InputError, match="'q' holds '0.2'"):
+        compare(table.astype({"q": str}), campaign)
     one = compare(table[table["point"] == 1], campaign)  # a part of the table, at the last checkpoint
     assert one["point"].tolist() == [1] and one["time_s"].tolist() == [100.0]
     assert one["pos_error_m_cov"].iloc[0] == pytest.approx(closed_form(1.0, 0.0, 2, 100.0), rel=1e-14)
@@ -249,7 +255,9 @@ def test_error_vs_parameter_draws_the_predictions_and_the_monte_carlo(tmp_path):
 
 def test_error_vs_parameter_of_a_covariance_sweep_per_series(tmp_path):
     out = sweep(walk, {"dims": [1, 3], "q": [0.1, 0.2, 0.4]}, progress=False)
-    fig = cplots.error_vs_parameter(out, "q", "pos_error_m", by="dims")
+    with pytest.raises(InputError, match="monte_carlo=False"):
+        cplots.error_vs_parameter(out, "q", "pos_error_m", by="dims")
+    fig = cplots.error_vs_parameter(out, "q", "pos_error_m", monte_carlo=False, by="dims")
     fig.savefig(tmp_path / "s.png")
     for dims in (1, 3):
         (line,) = [ln for ln in fig.axes[0].lines if ln.get_label() == f"covariance, dims = {dims}"]
@@ -332,7 +340,7 @@ def test_throughput_counts_runs_per_worker(tmp_path):
                      Campaign(walk, {"q": [1.0]}), at=50.0), "at"),
     (lambda: compare(pd.DataFrame({"point": [0, 0], "time_s": 1.0, "err_m": 1.0}), Campaign(no_predictor, {"x": [1.0]})),
      "campaign"),
-    (lambda: cplots.error_vs_parameter(pd.DataFrame({"q": [1.0]}), "q", "pos_error_m"), "metric"),
+    (lambda: cplots.error_vs_parameter(pd.DataFrame({"q": [1.0], "time_s": 1.0}), "q", "pos_error_m"), "report"),
 ])
 def test_bad_input_names_the_argument(call, parameter):
     with pytest.raises(InputError) as e:

@@ -15,7 +15,7 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from .._validate import input_error, instance, locate, positive, table as read_table
+from .._validate import flag, input_error, instance, locate, positive, table as read_table
 from .sweep import COV, MC, MC_SE
 
 
@@ -26,27 +26,29 @@ def _pyplot():
 
 
 def _at(report: pd.DataFrame) -> str:
-    """Title suffix naming the checkpoint time(s) of a report, if it has ``time_s``."""
-    if "time_s" not in report.columns:
-        return ""
+    """Title suffix naming the checkpoint time(s) of a report (its ``time_s``, s)."""
     times = np.unique(read_table(report, ["time_s"], "report", epoch=None))
     return f" at t = {times[0]:g} s" if times.size == 1 else f" at t = {times.min():g} … {times.max():g} s"
 
 
-def error_vs_parameter(report, parameter: str, metric: str, *, by: str | None = None, z: float = 1.96):
-    """An error metric against one parameter: the Monte-Carlo RMS with error bars and the
-    covariance prediction as a line.
+def error_vs_parameter(report, parameter: str, metric: str, *, monte_carlo: bool = True, by: str | None = None,
+                       z: float = 1.96):
+    """An error metric against one parameter: the covariance prediction as a line and the
+    Monte-Carlo RMS with error bars.
 
     Parameters
     ----------
     report : pandas.DataFrame
         A :func:`atomnav.campaign.sweep.sweep` or :func:`~atomnav.campaign.sweep.compare`
-        report: the ``parameter`` column and ``<metric>_cov`` (drawn as a line) and/or
-        ``<metric>_mc`` with ``<metric>_mc_se`` (drawn as points with error bars).
+        report: ``time_s`` (s, the checkpoint, named in the title), the ``parameter``
+        column, ``<metric>_cov`` (drawn as a line) and, with ``monte_carlo``,
+        ``<metric>_mc`` and ``<metric>_mc_se`` (drawn as points with error bars).
     parameter : str
         The numeric parameter on the horizontal axis.
     metric : str
         The metric, e.g. ``"pos_error_m"`` (its unit is in its name).
+    monte_carlo : bool
+        Draw the Monte-Carlo RMS; False for a covariance sweep, which has none.
     by : str, optional
         A further parameter column: one series per value of it. Without it, each value
         of ``parameter`` must appear once.
@@ -65,16 +67,16 @@ def error_vs_parameter(report, parameter: str, metric: str, *, by: str | None = 
     ------
     atomnav.InputError
         Naming ``report`` (a missing column, a repeated ``parameter`` value within a
-        series), ``metric`` (neither ``_cov`` nor ``_mc`` columns) or ``z``.
+        series) or ``z``.
     """
     instance(report, pd.DataFrame, "report")
     instance(parameter, str, "parameter")
     instance(metric, str, "metric")
+    monte_carlo = flag(monte_carlo, "monte_carlo")
     z = positive(z, "z")
-    has_cov, has_mc = metric + COV in report.columns, metric + MC in report.columns
-    if not (has_cov or has_mc):
-        raise input_error("metric", f"the report has neither {metric + COV!r} nor {metric + MC!r}")
-    names = [parameter] + [metric + COV] * has_cov + [metric + MC, metric + MC_SE] * has_mc
+    names = [parameter, metric + COV] + [metric + MC, metric + MC_SE] * monte_carlo
+    if monte_carlo and metric + MC not in report.columns and metric + COV in report.columns:
+        raise input_error("report", f"has no Monte Carlo column {metric + MC!r}: a covariance sweep? give monte_carlo=False")
     values = pd.DataFrame(read_table(report, names, "report"), columns=names)
     if by is not None:
         locate(report, [by], "report")
@@ -91,9 +93,8 @@ def error_vs_parameter(report, parameter: str, metric: str, *, by: str | None = 
             raise input_error("report", f"{parameter} = {x[repeated[0]]} appears more than once"
                                         f"{'' if by is None else f' for {by} = {key}'}; select the rows or give by=")
         suffix = "" if by is None else f", {by} = {key}"
-        if has_cov:
-            ax.plot(x, g[metric + COV].to_numpy(), "-", color=f"C{i}", lw=1.2, label="covariance" + suffix)
-        if has_mc:
+        ax.plot(x, g[metric + COV].to_numpy(), "-", color=f"C{i}", lw=1.2, label="covariance" + suffix)
+        if monte_carlo:
             ax.errorbar(x, g[metric + MC].to_numpy(), yerr=z * g[metric + MC_SE].to_numpy(), fmt="o", ms=4, capsize=3,
                         color=f"C{i}", label=f"Monte Carlo (± {z:g} SE){suffix}")
     ax.set_xlabel(parameter)
@@ -110,8 +111,9 @@ def error_map(report, x: str, y: str, column: str, *, target: float | None = Non
     Parameters
     ----------
     report : pandas.DataFrame
-        A report over the full grid of ``x`` × ``y`` (each pair once), e.g. a
-        covariance :func:`atomnav.campaign.sweep.sweep`.
+        A report over the full grid of ``x`` × ``y`` (each pair once) with ``time_s``
+        (s, the checkpoint, named in the title), e.g. a covariance
+        :func:`atomnav.campaign.sweep.sweep`.
     x, y : str
         The numeric parameters on the horizontal and vertical axes.
     column : str

@@ -22,7 +22,7 @@ import warnings
 import numpy as np
 import pandas as pd
 
-from .._validate import choice, flag, input_error, instance, integer, positive, renamed, scalar, table as read_table
+from .._validate import choice, flag, input_error, instance, integer, locate, positive, renamed, scalar, table as read_table
 
 #: Methods of :func:`sweep`.
 METHODS = ("covariance", "monte_carlo")
@@ -169,6 +169,7 @@ def compare(table, campaign, at=None) -> pd.DataFrame:
         chosen.append(checkpoints[_checkpoint(checkpoints, at, f"the runs of point {key:g}")])
     chosen = np.array(chosen)
     keys = keys.astype(np.int64)
+    _same_parameters(table, campaign, point, keys)
     report = _predictions(predict, [campaign.point(int(k)) for k in keys], _shown(campaign), chosen, False)
     report["point"] = keys
     metrics = [c[: -len(COV)] for c in report.columns if c.endswith(COV)]
@@ -334,6 +335,37 @@ def _shown(campaign) -> list[str]:
     fixed ones (as the campaign's table)."""
     varied = campaign.varied()
     return [*varied, *(k for k in campaign.fixed if k not in varied)]
+
+
+def _same_parameters(table: pd.DataFrame, campaign, point: np.ndarray, keys: np.ndarray) -> None:
+    """An :class:`InputError` naming ``table`` unless its parameter columns (those it has of
+    the campaign's varied and fixed parameters; lists as JSON text, as the campaign's
+    table keeps them) hold the campaign's value of each row's point."""
+    import json
+
+    for name in _shown(campaign):
+        if name not in table.columns:
+            continue
+        column = table.iloc[:, locate(table, [name], "table")[0]].to_numpy()
+        for key in keys:
+            want = campaign.point(int(key))[name]
+            want = json.dumps(list(want)) if isinstance(want, (list, tuple)) else want
+            for v in column[point == key]:
+                if not _equal(v, want):
+                    v = v.item() if isinstance(v, np.generic) else v
+                    raise input_error("table", f"column {name!r} holds {v!r} at point {key} where the campaign has "
+                                               f"{want!r}: the table is not this campaign's")
+
+
+def _equal(value, want) -> bool:
+    """``value`` (from a table) is the parameter value ``want``: a string only equals a
+    string; a missing value (NaN, ``pd.NA``) equals nothing."""
+    if isinstance(value, str) != isinstance(want, str):
+        return False
+    try:
+        return bool(value == want)
+    except TypeError:  # pd.NA
+        return False
 
 
 def _checkpoint(times: np.ndarray, at, what: str) -> int:
