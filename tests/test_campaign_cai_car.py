@@ -62,7 +62,7 @@ def test_ci_point_matches_the_true_error_prediction():
 # prediction, which ignores the readout's sine and fringe slips (the predictor warns). The
 # diagnosis is test_linear_regime_at_40_ms_is_predicted below.
 _NONLINEAR = pytest.mark.xfail(strict=True, reason="T = 40 ms: phase σ 0.98 rad, beyond the linear analysis (readout sine, fringe slips)")
-SWEEP = [pytest.param(dict(T=T, shot_rate=None if k is None else 1.0 / (k * T)), id=f"T{T}-period{k or 2}T",
+SWEEP = [pytest.param(dict(T=T, shot_rate=0.0 if k is None else 1.0 / (k * T)), id=f"T{T}-period{k or 2}T",
                       marks=[pytest.mark.slow] + ([_NONLINEAR, pytest.mark.filterwarnings("ignore::RuntimeWarning")] if T == 0.04 else []))
          for T in (0.01, 0.025, 0.04) for k in (None, 4, 10)]
 
@@ -119,7 +119,7 @@ def test_run_is_bit_identical_whatever_the_cache_holds():
 
 def test_filter_follows_the_imu_grade():
     grade = ImuErrors.preset("precise")
-    cfg = _configuration(_points(0.01, None, "precise", 0.0, "earth", True, 1.0, 5.0))
+    cfg = _configuration(_points(0.01, 0.0, "precise", 0.0, "earth", True, 1.0, 5.0))
     s = cfg.setup
     assert (s.accel_psd, s.gyro_psd) == (grade.accel.white**2, grade.gyro.white**2)
     assert (s.accel_bias_psd, s.gyro_bias_psd) == (grade.accel.bias_rw**2, grade.gyro.bias_rw**2)
@@ -133,7 +133,9 @@ BAD = {
     "grade with flicker": (dict(imu="tactical"), "imu"),
     "grade with fixed biases": (dict(imu="mems"), "imu"),
     "shot rate above 1/(2T)": (dict(T=0.025, shot_rate=20.5), "shot_rate"),
-    "zero shot rate": (dict(shot_rate=0.0), "shot_rate"),
+    "negative shot rate": (dict(shot_rate=-1.0), "shot_rate"),
+    "infinite shot rate": (dict(shot_rate=float("inf")), "shot_rate"),
+    "shot rate below one per profile": (dict(shot_rate=1e-300), "shot_rate"),
     "T = 0": (dict(T=0.0), "T"),
     "T < 0": (dict(T=-0.01), "T"),
     "2T off the IMU samples": (dict(T=0.0123), "T"),

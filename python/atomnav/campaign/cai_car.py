@@ -69,13 +69,14 @@ def _points(T, shot_rate, imu, lever, gravity, vibration, contrast, checkpoint_s
         raise input_error("T", f"2T must be a whole number of {1e3 / RATE_HZ:g} ms IMU samples (the filter predicts every 2T), got T = {T} s")
     if 2 * T > DURATION_S:
         raise input_error("T", f"a shot of 2T = {2 * T} s does not fit the {DURATION_S:g} s profile")
-    if shot_rate is None:
-        period = 2 * T
-    else:
-        rate = positive(shot_rate, "shot_rate")
-        if rate * 2 * T > 1 + 1e-12:
-            raise input_error("shot_rate", f"{rate} Hz exceeds one shot per 2T = {1 / (2 * T):g} Hz (shots cannot overlap)")
-        period = 1.0 / rate
+    rate = scalar(shot_rate, "shot_rate")
+    if not (np.isfinite(rate) and rate >= 0.0):
+        raise input_error("shot_rate", f"must be finite and >= 0 (0: one shot per 2T), got {rate}")
+    if rate * 2 * T > 1 + 1e-12:
+        raise input_error("shot_rate", f"{rate} Hz exceeds one shot per 2T = {1 / (2 * T):g} Hz (shots cannot overlap)")
+    if 0.0 < rate < 1.0 / DURATION_S:
+        raise input_error("shot_rate", f"{rate} Hz gives fewer than one shot per {DURATION_S:g} s profile (0: one shot per 2T)")
+    period = 2 * T if rate == 0.0 else 1.0 / rate
     errors = _linear_grade(imu)
     contrast = scalar(contrast, "contrast")
     if not 0.0 < contrast <= 1.0:
@@ -145,7 +146,7 @@ def _table(times: np.ndarray, pos, vel, att) -> pd.DataFrame:
     return pd.DataFrame({"time_s": times, **dict(zip(_COLUMNS, (np.asarray(pos), np.asarray(vel), np.asarray(att))))})
 
 
-def _cai_car_covariance(*, T=0.025, shot_rate=None, imu="navigation", lever=0.0, gravity="earth", vibration=True, contrast=1.0,
+def _cai_car_covariance(*, T=0.025, shot_rate=0.0, imu="navigation", lever=0.0, gravity="earth", vibration=True, contrast=1.0,
                         checkpoint_s=5.0) -> pd.DataFrame:
     """Predicted RMS over seeds of the errors of :func:`cai_car`: the linear analysis of the
     true error of the filter as built (:func:`atomnav.filter.analysis.true_error_analysis`).
@@ -212,7 +213,7 @@ def _cai_car_covariance(*, T=0.025, shot_rate=None, imu="navigation", lever=0.0,
 
 
 @predicted_by(_cai_car_covariance)
-def cai_car(*, seed=0, T=0.025, shot_rate=None, imu="navigation", lever=0.0, gravity="earth", vibration=True, contrast=1.0,
+def cai_car(*, seed=0, T=0.025, shot_rate=0.0, imu="navigation", lever=0.0, gravity="earth", vibration=True, contrast=1.0,
             checkpoint_s=5.0) -> pd.DataFrame:
     """One Monte-Carlo run of the CAI-aided INS on the car profile of Tennstedt et al. 2023
     (§2.8): the 40 s car-like drive with vibration, the 26 s shock and the ×2 vibration
@@ -234,8 +235,8 @@ def cai_car(*, seed=0, T=0.025, shot_rate=None, imu="navigation", lever=0.0, gra
         Seed of the run (0 … 2⁶⁴ − 1): the IMU errors and the readout noise.
     T : float
         Pulse separation (s); 2T must be a whole number of 5 ms IMU samples.
-    shot_rate : float, optional
-        Shots per second (Hz), at most 1/(2T); None: one shot per 2T.
+    shot_rate : float
+        Shots per second (Hz), at most 1/(2T); 0: one shot per 2T, the most there can be.
     imu : str
         IMU grade, an :meth:`atomnav.imu.ImuErrors.preset` name whose errors are a random
         turn-on bias, white noise and a bias random walk (``navigation``, ``precise``,
