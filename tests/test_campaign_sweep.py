@@ -18,6 +18,7 @@ import pytest  # noqa: E402
 
 from atomnav import InputError  # noqa: E402
 from atomnav.campaign import load  # noqa: E402
+from atomnav.campaign import timing as timing_of  # noqa: E402
 from atomnav.campaign import plots as cplots  # noqa: E402
 from atomnav.campaign.plan import Campaign  # noqa: E402
 from atomnav.campaign.scenario import predicted_by  # noqa: E402
@@ -295,7 +296,17 @@ def test_throughput_counts_runs_per_worker(tmp_path):
     np.testing.assert_array_equal(left["a"].get_ydata(), [1.0, 1.0, 2.0])
     with pytest.raises(InputError) as e:
         cplots.throughput(timing.drop(columns="worker"))
-    assert e.value.parameter == "table"
+    assert e.value.parameter == "timing"
+
+
+def test_throughput_of_a_campaign_run(tmp_path):
+    sweep(walk, {"q": [0.5, 1.0]}, method="monte_carlo", seeds=6, folder=tmp_path, progress=False)
+    timing = timing_of(tmp_path, "walk")
+    assert len(timing) == 12 and (timing["elapsed_s"] > 0).all()
+    fig = cplots.throughput(timing)
+    fig.savefig(tmp_path / "t.png")
+    per = timing.groupby("worker")["elapsed_s"].agg(["size", "sum"]).sort_index()
+    np.testing.assert_allclose([b.get_height() for b in fig.axes[1].patches], per["size"] / per["sum"], rtol=1e-14)
 
 
 # ---- bad input ----------------------------------------------------------------------

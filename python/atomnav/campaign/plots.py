@@ -5,8 +5,8 @@ the requirement's contour, and the run time and throughput of the workers.
 Each function returns a :class:`matplotlib.figure.Figure` (made with
 ``matplotlib.pyplot``, as :mod:`atomnav.plots`; matplotlib is imported inside the
 functions). Tables are read by column name: :func:`atomnav.campaign.sweep.sweep` and
-:func:`~atomnav.campaign.sweep.compare` reports for the first two, a campaign table
-(:func:`atomnav.campaign.run`, :func:`atomnav.campaign.load`) for :func:`throughput`.
+:func:`~atomnav.campaign.sweep.compare` reports for the first two, the run times of
+:func:`atomnav.campaign.timing` for :func:`throughput`.
 A missing column is an :class:`atomnav.InputError` naming the argument and the column.
 """
 
@@ -16,13 +16,8 @@ import numpy as np
 import pandas as pd
 
 from .._validate import flag, input_error, instance, locate, positive, table as read_table
+from ..plots import _pyplot
 from .sweep import COV, MC, MC_SE
-
-
-def _pyplot():
-    import matplotlib.pyplot as plt
-
-    return plt
 
 
 def _at(report: pd.DataFrame) -> str:
@@ -161,16 +156,15 @@ def error_map(report, x: str, y: str, column: str, *, target: float | None = Non
     return fig
 
 
-def throughput(table):
+def throughput(timing):
     """Run time and throughput of a campaign's workers.
 
     Parameters
     ----------
-    table : pandas.DataFrame
-        A campaign table (:func:`atomnav.campaign.run`, :func:`atomnav.campaign.load`)
-        with ``run``, ``elapsed_s`` (the wall time of the run on its worker, s) and
-        ``worker`` (the worker's name); its rows per checkpoint repeat a run's values, each
-        run counts once.
+    timing : pandas.DataFrame
+        The run times of a campaign (:func:`atomnav.campaign.timing`): ``run``,
+        ``elapsed_s`` (the wall time of the scenario call on its worker, s) and
+        ``worker`` (the worker's name), one row per run (a repeated run counts once).
 
     Returns
     -------
@@ -182,15 +176,15 @@ def throughput(table):
     Raises
     ------
     atomnav.InputError
-        Naming ``table``: a missing column, or a run time that is not finite and > 0.
+        Naming ``timing``: a missing column, or a run time that is not finite and > 0.
     """
-    instance(table, pd.DataFrame, "table")
-    locate(table, ["run", "elapsed_s", "worker"], "table")
-    runs = table.drop_duplicates("run")
-    d = read_table(runs, ["run", "elapsed_s"], "table")
+    instance(timing, pd.DataFrame, "timing")
+    locate(timing, ["run", "elapsed_s", "worker"], "timing")
+    runs = timing.drop_duplicates("run")
+    d = read_table(runs, ["run", "elapsed_s"], "timing")
     bad = np.flatnonzero(d[:, 1] <= 0)
     if bad.size:
-        raise input_error("table", f"column 'elapsed_s': run {d[bad[0], 0]:g} took {d[bad[0], 1]} s; expected > 0", bad[0])
+        raise input_error("timing", f"column 'elapsed_s': run {d[bad[0], 0]:g} took {d[bad[0], 1]} s; expected > 0", bad[0])
     workers = runs["worker"].astype(str).to_numpy()
     names = sorted(set(workers))
     plt = _pyplot()

@@ -22,7 +22,8 @@ import warnings
 import numpy as np
 import pandas as pd
 
-from .._validate import choice, flag, input_error, instance, integer, locate, positive, renamed, scalar, table as read_table
+from .._validate import (choice, finite_scalar, flag, input_error, instance, integer, locate, positive, renamed,
+                         table as read_table)
 
 #: Methods of :func:`sweep`.
 METHODS = ("covariance", "monte_carlo")
@@ -99,7 +100,7 @@ def sweep(scenario, points, *, method: str = "covariance", seeds: int = 100, see
     method = choice(method, METHODS, "method")
     progress = flag(progress, "progress")
     predict = predictor(scenario)
-    at = None if at is None else _finite(at, "at")
+    at = None if at is None else finite_scalar(at, "at")
     if method == "covariance":
         for name, value in (("folder", folder), ("client", client), ("scheduler", scheduler)):
             if value is not None:
@@ -157,7 +158,7 @@ def compare(table, campaign, at=None) -> pd.DataFrame:
     instance(campaign, Campaign, "campaign")
     with renamed(scenario="campaign"):
         predict = predictor(campaign.scenario)
-    at = None if at is None else _finite(at, "at")
+    at = None if at is None else finite_scalar(at, "at")
     point, times = read_table(table, ["point", "time_s"], "table", epoch=None).T
     keys = np.unique(point)
     alien = keys[(keys != np.round(keys)) | (keys < 0) | (keys >= campaign.n_points)]
@@ -270,7 +271,7 @@ def requirements(scenario, target: dict, at, space: dict, *, fixed=None, tol: fl
     choice(method, ("covariance",), "method")
     progress = flag(progress, "progress")
     predict = predictor(scenario)
-    at = _finite(at, "at")
+    at = finite_scalar(at, "at")
     tol = positive(tol, "tol")
     if tol >= 1.0:
         raise input_error("tol", f"is relative to the parameter's range and must be < 1, got {tol}")
@@ -301,14 +302,6 @@ def requirements(scenario, target: dict, at, space: dict, *, fixed=None, tol: fl
         rows.append({**{k: combo[k] for k in grid}, name: value,
                      **{m: at_boundary.get(m, np.nan) for m in limits}, "feasible": side})
     return pd.DataFrame(rows)
-
-
-def _finite(x, name: str) -> float:
-    """``x`` as a finite float."""
-    x = scalar(x, name)
-    if not np.isfinite(x):
-        raise input_error(name, f"must be finite, got {x}")
-    return x
 
 
 def _predict_at(predict, params: dict, at) -> tuple[float, dict]:
@@ -408,7 +401,7 @@ def _space(scenario, space) -> tuple[dict, dict]:
         if isinstance(values, tuple):
             if len(values) != 2:
                 raise input_error("space", f"{name!r}: a continuous range is (low, high), got {len(values)} values")
-            low, high = (_finite(v, f"space[{name!r}]") for v in values)
+            low, high = (finite_scalar(v, f"space[{name!r}]") for v in values)
             if not low < high:
                 raise input_error("space", f"{name!r}: the range (low, high) needs low < high, got ({low}, {high})")
             continuous[name] = (low, high)
