@@ -136,11 +136,13 @@ def test_requirements_takes_the_tighter_of_two_targets():
 
 
 def test_requirements_over_two_continuous_parameters_is_the_boundary_curve():
-    low, high, target, t, dims = 0.0, 0.2, 10.0, 100.0, 3
-    out = requirements(walk, {"pos_error_m": target}, t, {"q": (0.01, 0.3), "drift": (low, high)}, fixed={"dims": dims},
-                       samples=7, tol=1e-7)
-    np.testing.assert_allclose(out["q"], np.linspace(0.01, 0.3, 7), rtol=1e-15)
-    exact = np.sqrt(target**2 / dims - out["q"] * t) / t  # dims (q t + (b t)²) = target²
+    low, high, target, t = 0.0, 0.2, 10.0, 100.0
+    out = requirements(walk, {"pos_error_m": target}, t, {"dims": [2, 3], "q": (0.01, 0.3), "drift": (low, high)},
+                       fixed={"dt": 0.5}, samples=7, tol=1e-7)
+    assert out.columns.tolist() == ["dims", "q", "drift", "pos_error_m", "feasible"]
+    assert out["dims"].tolist() == [2] * 7 + [3] * 7
+    np.testing.assert_allclose(out["q"], np.tile(np.linspace(0.01, 0.3, 7), 2), rtol=1e-15)
+    exact = np.sqrt(target**2 / out["dims"] - out["q"] * t) / t  # dims (q t + (b t)²) = target²
     assert np.all(np.abs(out["drift"] - exact) <= 1e-7 * (high - low) / 2)
     assert (out["feasible"] == "below").all()
 

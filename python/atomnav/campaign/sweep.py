@@ -91,8 +91,14 @@ def sweep(scenario, points, *, method: str = "covariance", seeds: int = 100, see
 
     Examples
     --------
-    >>> from atomnav.campaign import strapdown_free                    # doctest: +SKIP
-    >>> sweep(strapdown_free, {"bias_scale": [0.5, 1.0, 2.0]}, progress=False)  # doctest: +SKIP
+    The free INS's position error after 10 min for three bias levels, predicted, then
+    measured over 200 seeds each beside the prediction:
+
+    >>> from atomnav.campaign.strapdown_free import strapdown_free
+    >>> grid = {"bias_scale": [0.5, 1.0, 2.0]}
+    >>> predicted = sweep(strapdown_free, grid, progress=False)  # doctest: +SKIP
+    >>> measured = sweep(strapdown_free, grid, method="monte_carlo", seeds=200,
+    ...                  folder="campaigns")  # doctest: +SKIP
     """
     from .plan import Campaign
     from .scenario import predictor
@@ -262,6 +268,19 @@ def requirements(scenario, target: dict, at, space: dict, *, fixed=None, tol: fl
     -----
     RuntimeWarning
         When a row is ``"non-monotonic"``, naming its parameters and where.
+
+    Examples
+    --------
+    The largest bias scale of a tactical IMU whose free INS stays within 100 m after
+    2 min, per motion:
+
+    >>> from atomnav.campaign.strapdown_free import strapdown_free
+    >>> requirements(strapdown_free, {"pos_error_m": 100.0}, 120.0,
+    ...              {"motion": ["stationary", "sinusoidal"], "bias_scale": (0.1, 3.0)},
+    ...              fixed={"duration": 120.0})  # doctest: +SKIP
+           motion  bias_scale  pos_error_m feasible
+    0  stationary    0.794720    99.999870    below
+    1  sinusoidal    0.808731    99.999872    below
     """
     from tqdm.auto import tqdm
 
