@@ -370,3 +370,15 @@ def test_wrong_types_are_type_errors():
         compare([1, 2], Campaign(walk, {"q": [1.0]}))
     with pytest.raises(TypeError, match="campaign"):
         compare(pd.DataFrame({"point": [0]}), walk)
+
+
+def test_monte_carlo_on_a_dask_client_equals_the_in_process_report(tmp_path):
+    distributed = pytest.importorskip("distributed")
+    points = {"q": [0.5, 1.0]}
+    here = sweep(walk, points, method="monte_carlo", seeds=8, seed=3, folder=tmp_path / "here", progress=False)
+    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=False, dashboard_address=None) as cluster, \
+            distributed.Client(cluster) as client:
+        there = sweep(walk, points, method="monte_carlo", seeds=8, seed=3, folder=tmp_path / "there", client=client,
+                      progress=False)
+    pd.testing.assert_frame_equal(there, here)
+    assert set(timing_of(tmp_path / "there", "walk")["worker"]) <= {"0", "1"}
