@@ -6,10 +6,15 @@ and resumed from it.
 - :class:`Campaign`: a scenario, its points (grid or list) and seeds; each run's seed
   depends on (campaign seed, run id) only.
 - :func:`run`, :func:`load`, :func:`timing`: execute or resume a campaign, read it back.
+- :func:`sweep`, :func:`compare`, :func:`requirements`: covariance predictions over large
+  grids, Monte Carlo to confirm chosen points, and the feasible region of a target.
+- :mod:`~atomnav.campaign.plots`: error versus parameter, error maps, throughput.
 """
 
+from . import plots
 from .execute import load, run, timing
 from .plan import Campaign
 from .scenario import parameters, predicted_by
+from .sweep import compare, requirements, sweep
 
-__all__ = ["Campaign", "run", "load", "timing", "parameters", "predicted_by"]
+__all__ = ["Campaign", "run", "load", "timing", "parameters", "predicted_by", "sweep", "compare", "requirements", "plots"]

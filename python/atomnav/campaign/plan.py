@@ -45,6 +45,16 @@ def _scenario_path(scenario: Callable) -> str:
 def import_scenario(path: str) -> Callable:
     """The scenario function named ``module:qualname``.
 
+    Parameters
+    ----------
+    path : str
+        ``"package.module:function"``.
+
+    Returns
+    -------
+    callable
+        The function.
+
     Raises
     ------
     atomnav.InputError
@@ -162,32 +172,84 @@ class Campaign:
         return len(self._list) * self.seeds
 
     def point(self, index: int) -> dict:
-        """The full parameters of point ``index``: the scenario's defaults, ``fixed``, the point."""
+        """The full parameters of point ``index``.
+
+        Parameters
+        ----------
+        index : int
+            Point number, 0 … ``n_points`` − 1.
+
+        Returns
+        -------
+        dict
+            The scenario's defaults, overridden by ``fixed``, overridden by the point.
+        """
         i = integer(index, "index", 0, self.n_points - 1)
         return {**parameters(self.scenario), **self.fixed, **self._list[i]}
 
     def run_seed(self, run: int) -> int:
-        """The seed of run ``run`` (0 … 2⁶⁴ − 1), from the campaign seed and the run id only."""
+        """The seed of a run, from the campaign seed and the run id only.
+
+        Parameters
+        ----------
+        run : int
+            Run id, 0 … ``n_runs`` − 1.
+
+        Returns
+        -------
+        int
+            Its seed, 0 … 2⁶⁴ − 1.
+        """
         r = integer(run, "run", 0, self.n_runs - 1)
         words = np.random.SeedSequence(self.seed, spawn_key=(r,)).generate_state(2, np.uint32)
         return int(words[0]) | (int(words[1]) << 32)
 
     def varied(self) -> list[str]:
-        """The parameters that vary over the points (their names in the scenario's order)."""
+        """The parameters the points set.
+
+        Returns
+        -------
+        list of str
+            Their names, in the scenario's order.
+        """
         names = {k for p in self._list for k in p}
         return [k for k in parameters(self.scenario) if k in names]
 
     def to_dict(self) -> dict:
-        """The campaign as JSON-able data (what ``campaign.json`` holds)."""
+        """The campaign as data.
+
+        Returns
+        -------
+        dict
+            JSON-able: the scenario's ``module:qualname``, the points (the grid, or the
+            list), seeds, seed, fixed and name; what ``campaign.json`` holds.
+        """
         return {"scenario": _scenario_path(self.scenario), "points": self._list if self._grid is None else self._grid,
                 "seeds": self.seeds, "seed": self.seed, "fixed": self.fixed, "name": self.name}
 
     def to_json(self) -> str:
-        """:meth:`to_dict` as JSON text."""
+        """The campaign as JSON text.
+
+        Returns
+        -------
+        str
+            :meth:`to_dict`, indented.
+        """
         return json.dumps(self.to_dict(), indent=2)
 
     @classmethod
     def from_dict(cls, d: dict) -> "Campaign":
-        """The campaign of :meth:`to_dict` (the scenario is imported by its ``module:qualname``)."""
+        """The campaign of :meth:`to_dict`.
+
+        Parameters
+        ----------
+        d : dict
+            As :meth:`to_dict` gives it; the scenario is imported by its ``module:qualname``.
+
+        Returns
+        -------
+        Campaign
+            The campaign.
+        """
         instance(d, dict, "campaign")
         return cls(import_scenario(d["scenario"]), d["points"], seeds=d["seeds"], seed=d["seed"], fixed=d["fixed"], name=d["name"])
