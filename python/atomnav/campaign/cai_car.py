@@ -115,7 +115,7 @@ def _motion(key: tuple) -> _core.Motion:
 def _checkpoints(key: tuple) -> tuple[np.ndarray, np.ndarray]:
     """Output epochs (indices into the filter's epochs every 2T from 0) nearest to every
     multiple of the checkpoint spacing and the end of the profile, and their times (s)."""
-    T, *_, checkpoint_s, steps = key
+    *_, checkpoint_s, steps = key
     step_s = steps / RATE_HZ
     last = int(np.floor(DURATION_S / step_s + 1e-9))
     want = np.append(np.arange(checkpoint_s, DURATION_S + 1e-9, checkpoint_s), DURATION_S)
