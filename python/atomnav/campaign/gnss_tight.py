@@ -165,7 +165,8 @@ def gnss_tight(*, seed=0, imu_class="precise", outage_s=0.0, satellites=ALL_SATE
         last checkpoints show the INS drift; 0: none.
     satellites : int
         Satellites used: the ``satellites`` highest at the start, kept for the whole run
-        (Demidov 2009, §4); 0: none (the baro-damped INS alone); :data:`ALL_SATELLITES`
+        (Demidov 2009, §4); 0: none (the baro-damped INS alone; so is 1, since the filter
+        differences pairs of satellites); :data:`ALL_SATELLITES`
         (24, the whole nominal constellation, the default): every satellite above the mask
         at each epoch.
     duration : float
