@@ -241,6 +241,10 @@ FIX_TABLE = ('fix_table = pd.DataFrame({"time_s": fixes["fix_time"], "lat_rad": 
              '"lon_rad": fixes["fix_lla"][:, 1], "h_m": fixes["fix_lla"][:, 2], "sigma_n_m": 1.0, "sigma_e_m": 1.0, '
              '"sigma_d_m": 1.0})')
 
+CAMPAIGN = ("import tempfile, atomnav.campaign.sweep, atomnav.campaign.plots\nfrom campaign_toy import random_walk\n"
+            "campaign, folder = an.campaign.Campaign(random_walk, {'dt_s': [0.5, 1.0]}, seeds=4), tempfile.mkdtemp()\n"
+            "table = an.campaign.run(campaign, folder, progress=False)")
+
 CATALOGUE: tuple[Clean, ...] = (
     # strapdown
     _c("atomnav.strapdown.integrate", "an.strapdown.integrate(imu, **init)", "imu = meas", ["imu"], time_origin="t0"),
@@ -591,6 +595,18 @@ CATALOGUE: tuple[Clean, ...] = (
     _c("atomnav.alignment.in_motion", "an.alignment.in_motion(imu, position, velocity, level)", MOTION, ["imu"]),
     _c("atomnav.alignment.MotionAlignment.after", "a.after(imu)",
        MOTION + "\na = an.alignment.in_motion(imu, position, velocity, level)\nimu = car_imu", ["imu"]),
+    # design-study campaigns on the closed-form random walk of tests/campaign_toy.py
+    _c("atomnav.campaign.plan.Campaign", "an.campaign.Campaign(random_walk, {'dt_s': [0.5, 1.0]}, seeds=4)",
+       "import atomnav.campaign\nfrom campaign_toy import random_walk"),
+    _c("atomnav.campaign.sweep.compare", "an.campaign.compare(table, campaign)", CAMPAIGN, ["table"]),
+    _c("atomnav.campaign.plots.error_vs_parameter", "drawn(an.campaign.plots.error_vs_parameter(report, 'dt_s', 'pos_error_m'))",
+       PLOTS + "\n" + CAMPAIGN + "\nreport = an.campaign.compare(table, campaign)", ["report"]),
+    _c("atomnav.campaign.plots.error_map", "drawn(an.campaign.plots.error_map(grid, 'steps', 'dt_s', 'pos_error_m_cov', target=5.0))",
+       PLOTS + "\n" + CAMPAIGN + "\ngrid = an.campaign.sweep(random_walk, {'steps': [10, 20, 40], 'dt_s': [0.5, 1.0]}, "
+       "progress=False)", ["grid"]),
+    _c("atomnav.campaign.plots.throughput", "drawn(an.campaign.plots.throughput(timing))",
+       PLOTS + "\nimport atomnav.campaign.plots\ntiming = pd.DataFrame({'run': range(6), 'point': [0, 0, 0, 1, 1, 1], "
+       "'worker': ['a', 'b', 'a', 'b', 'a', 'a'], 'elapsed_s': [0.5, 1.0, 0.25, 2.0, 0.5, 0.75]})", ["timing"]),
     # vehicle and pedestrian constraints on the 10 s static record
     _c("atomnav.filter.constraints.detect_still",
        'an.filter.constraints.detect_still(time, gyro, accel, kind="increments", lla=lla, window=20)',
@@ -627,6 +643,8 @@ EXEMPT = {
     "atomnav.filter.aided.SmoothedResult": "the result of smoothing an aided INS",
     # its constructor takes an error model and options; the arrays are those of its corrupt()
     "atomnav.imu.ImuSimulator": "takes an error model and options; ImuSimulator.corrupt has the clean call",
+    # campaign scenarios are functions; the tables are what they return
+    "atomnav.campaign.scenario.predicted_by": "takes a predictor function; the table is its output",
 }
 """Public callables whose docstring mentions a table or an array but that take none from
 the user, each with the reason it has no clean call (``table_or_array_callables`` finds
