@@ -143,6 +143,15 @@ def test_killed_client_process_resumes(reference, tmp_path):
     pd.testing.assert_frame_equal(got.drop(columns="sleep_s"), reference)
 
 
+def test_campaign_pickles_whole():
+    import pickle
+
+    c = campaign(fixed={"dt": 0.25})
+    back = pickle.loads(pickle.dumps(c))
+    assert back == c and back.n_runs == c.n_runs and [back.run_seed(r) for r in (0, 199)] == [c.run_seed(r) for r in (0, 199)]
+    assert back.point(7) == c.point(7)
+
+
 def test_config_saved_beside_the_runs(tmp_path):
     c = campaign(points={"q": [1.0]}, seeds=3)
     run(c, tmp_path, progress=False)
@@ -196,3 +205,21 @@ def test_folder_holding_another_campaigns_configuration(tmp_path):
 def test_unreachable_scheduler_is_a_connection_error(tmp_path):
     with pytest.raises(ConnectionError, match="scheduler"):
         run(campaign(points={"q": [1.0]}), tmp_path, scheduler="tcp://127.0.0.1:9", progress=False)
+
+
+def test_dataset_reads_with_pandas_and_without_the_scenario(reference, tmp_path):
+    """The runs are a Hive-partitioned Parquet dataset any reader takes, and load() needs
+    only the folder: the campaign's configuration is read, its scenario not imported."""
+    run(campaign(), tmp_path, progress=False)
+    raw = pd.read_parquet(tmp_path / "random_walk" / "runs").astype({"point": np.int64})
+    raw = raw.sort_values(["run", "time_s"]).reset_index(drop=True)[list(reference.columns)]
+    pd.testing.assert_frame_equal(raw, reference)
+    config = tmp_path / "random_walk" / "campaign.json"
+    config.write_text(config.read_text().replace("test_campaign_engine:random_walk", "gone_module:random_walk"))
+    pd.testing.assert_frame_equal(load(tmp_path, "random_walk"), reference)
+
+
+def test_malformed_scheduler_address_names_scheduler(tmp_path):
+    with pytest.raises(an.InputError) as e:
+        run(campaign(points={"q": [1.0]}), tmp_path, scheduler="nonsense", progress=False)
+    assert e.value.parameter == "scheduler"

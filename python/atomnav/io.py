@@ -8,7 +8,7 @@ stamps. :func:`read_trajectory` gives a :class:`atomnav.trajectory.Trajectory`.
 
 Files are read by pandas: :func:`pandas.read_csv` for ``.csv``/``.txt``/``.tsv`` (and
 their compressed forms, e.g. ``.csv.gz``), :func:`pandas.read_parquet` for ``.parquet``/``.pq``
-(which needs pyarrow: ``pip install "atomnav[parquet]"``). Extra keyword arguments go to
+(pyarrow). Extra keyword arguments go to
 that reader (``sep=";"``, ``decimal=","``, ``skiprows=...``).
 
 Nothing is guessed. ``columns`` maps each of atomnav's names to the file's column, and
@@ -387,10 +387,6 @@ def _read(source, read_options: dict) -> pd.DataFrame:
     p = checked_path(source, "source")
     suffixes = [s.lower() for s in p.suffixes]
     if any(s in _PARQUET for s in suffixes):
-        try:
-            import pyarrow  # noqa: F401  (pandas' Parquet engine)
-        except ImportError:
-            raise ImportError('reading Parquet needs pyarrow: pip install "atomnav[parquet]"') from None
         reader, what = pd.read_parquet, "Parquet"
     elif any(s in _CSV for s in suffixes):
         reader, what = pd.read_csv, "CSV"

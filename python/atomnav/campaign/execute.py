@@ -15,7 +15,7 @@ import pandas as pd
 from .._validate import flag, instance, integer
 from .plan import Campaign
 from .scenario import _checked_table
-from .store import _Store
+from .store import _Dataset, _Store
 
 #: Length of one Dask task (s) the automatic batching aims at: at ≈ 5 ms of scheduler and
 #: transfer cost per task, it keeps the overhead near 0.5 % of the run time.
@@ -49,18 +49,17 @@ class _Writer:
 
     def __init__(self, store: _Store, bar, callback, total: int, done: int):
         self.store, self.bar, self.callback, self.total, self.done = store, bar, callback, total, done
-        self.pending: list[pd.DataFrame] = []
+        self.pending: list = []
         self.last = time.monotonic()
 
     def add(self, results) -> None:
-        for r, table, worker, elapsed in results:
-            self.pending.append(self.store.rows(r, table, worker, elapsed))
+        self.pending.extend(results)
 
     def flush(self, force: bool = True) -> None:
         if not self.pending or (not force and time.monotonic() - self.last < FLUSH_S):
             return
         n = len(self.pending)
-        self.store.write(pd.concat(self.pending, ignore_index=True))
+        self.store.write(self.store.rows(self.pending))
         self.pending, self.last = [], time.monotonic()
         self.done += n
         self.bar.update(n)
@@ -190,7 +189,7 @@ def run(campaign: Campaign, folder, *, client=None, scheduler: str | None = None
     if scheduler is not None:
         instance(scheduler, str, "scheduler")
     store = _Store(folder, campaign)
-    done = store.done()
+    done = store.dataset.done()
     missing = [r for r in range(campaign.n_runs) if r not in done]
     with tqdm(total=campaign.n_runs, initial=len(done), desc=campaign.name, disable=not progress, unit="run") as bar:
         writer = _Writer(store, bar, callback, campaign.n_runs, len(done))
@@ -203,16 +202,20 @@ def run(campaign: Campaign, folder, *, client=None, scheduler: str | None = None
             finally:
                 if own is not None:
                     own.close()
-    return store.table()
+    return store.dataset.table()
 
 
 def _connect(address: str):
     from distributed import Client
 
+    from .._validate import input_error
+
     try:
         return Client(address, timeout="10s")
     except (OSError, TimeoutError) as e:
         raise ConnectionError(f"scheduler: cannot connect to {address} ({e})") from None
+    except ValueError as e:  # an address Dask cannot parse (no port, unknown protocol)
+        raise input_error("scheduler", f"{address!r} is not a scheduler address such as tcp://host:8786 ({e})") from None
 
 
 def load(folder, name: str) -> pd.DataFrame:
@@ -263,12 +266,10 @@ def timing(folder, name: str) -> pd.DataFrame:
     return _stored(folder, name).timing()
 
 
-def _stored(folder, name: str) -> _Store:
-    import json
-
+def _stored(folder, name: str) -> _Dataset:
     from .._validate import input_error, path
 
-    config = path(folder, "folder") / instance(name, str, "name") / "campaign.json"
-    if not config.is_file():
+    d = path(folder, "folder") / instance(name, str, "name")
+    if not (d / "campaign.json").is_file():
         raise input_error("name", f"no campaign {name!r} in {folder}")
-    return _Store(folder, Campaign.from_dict(json.loads(config.read_text())))
+    return _Dataset(d)

@@ -3,8 +3,9 @@ point, with the campaign's configuration beside it as JSON.
 
 ``folder/<name>/campaign.json`` holds :meth:`Campaign.to_dict`;
 ``folder/<name>/runs/point=<k>/part-<first run>.parquet`` hold the finished runs of point
-k, each file written whole (to a temporary name, then renamed), so a process killed at any
-moment leaves only complete files. A folder holds any number of campaigns under their
+k (a Hive-partitioned dataset: ``pandas.read_parquet(folder/<name>/runs)`` and Dask read
+it as it is), each file written whole (to a temporary name, then renamed), so a process
+killed at any moment leaves only complete files. A folder holds any number of campaigns under their
 names; two of them must not share a campaign seed (their runs would draw the same numbers).
 """
 
@@ -54,7 +55,7 @@ class _Store:
             raise input_error("folder", f"{self.root} is a file, not a folder")
         self.campaign = campaign
         self.dir = self.root / campaign.name
-        self.runs_dir = self.dir / "runs"
+        self.dataset = _Dataset(self.dir)
         mine = json.loads(campaign.to_json())
         config = self.dir / "campaign.json"
         if config.exists():
@@ -67,15 +68,59 @@ class _Store:
                 if other != config and json.loads(other.read_text()).get("seed") == campaign.seed:
                     raise input_error("seed", f"campaign {other.parent.name!r} in {self.root} already uses seed {campaign.seed}: "
                                       "its runs would repeat the same random draws; choose another seed")
-        self.runs_dir.mkdir(parents=True, exist_ok=True)
+        self.dataset.runs.mkdir(parents=True, exist_ok=True)
         if not config.exists():
             tmp = config.with_name(f".campaign.json.{uuid.uuid4().hex}")
             tmp.write_text(campaign.to_json())
             os.replace(tmp, config)
         self._params = _parameter_frame(campaign)
 
+    def rows(self, results) -> pd.DataFrame:
+        """Finished runs as stored rows: each run's table with its keys, parameters and
+        timing beside it.
+
+        ``results`` holds (run id, table, worker, elapsed s) per run."""
+        c = self.campaign
+        tables = [table.reset_index(drop=True) for _, table, _, _ in results]
+        counts = np.array([len(t) for t in tables])
+        runs = np.repeat(np.array([r for r, *_ in results], dtype=np.int64), counts)
+        point, replicate = np.divmod(runs, c.seeds)
+        seeds = np.repeat(np.array([c.run_seed(r) for r, *_ in results], dtype=np.uint64), counts)
+        body = pd.concat(tables, ignore_index=True)
+        clash = set(body.columns) & (set(KEYS) | set(self._params.columns) | set(TIMING))
+        if clash:
+            raise input_error("scenario", f"{c.scenario.__name__} returned columns {sorted(clash)} that name a run key, "
+                              "a parameter or a timing column")
+        head = pd.DataFrame({"run": runs, "point": point, "replicate": replicate, "seed": seeds})
+        params = self._params.iloc[point].reset_index(drop=True)
+        timing = pd.DataFrame({"worker": np.repeat([w for *_, w, _ in results], counts),
+                               "elapsed_s": np.repeat([e for *_, e in results], counts).astype(float)})
+        return pd.concat([head, params, body, timing], axis=1)
+
+    def write(self, rows: pd.DataFrame) -> None:
+        """Write stored rows (:meth:`rows`) at once: one file per point, each written to a
+        temporary name and renamed, so a file on disk is always whole."""
+        import pyarrow as pa
+        import pyarrow.parquet as pq
+
+        for point, part in rows.groupby("point", sort=True):
+            d = self.dataset.runs / f"point={int(point)}"
+            d.mkdir(exist_ok=True)
+            target = d / f"part-{int(part['run'].min()):09d}.parquet"
+            tmp = d / f".tmp-{uuid.uuid4().hex}"
+            pq.write_table(pa.Table.from_pandas(part.drop(columns="point"), preserve_index=False), tmp)
+            os.replace(tmp, target)
+
+
+class _Dataset:
+    """The runs on disk of the campaign in ``folder`` (read without its scenario's code)."""
+
+    def __init__(self, folder: Path):
+        self.runs = folder / "runs"
+        self.name = folder.name
+
     def _files(self) -> list[Path]:
-        return sorted(self.runs_dir.glob("point=*/part-*.parquet"))
+        return sorted(self.runs.glob("point=*/part-*.parquet"))
 
     def done(self) -> set[int]:
         """The ids of the runs on disk."""
@@ -86,47 +131,21 @@ class _Store:
             out.update(pq.read_table(f, columns=["run"]).column("run").to_pylist())
         return out
 
-    def rows(self, run: int, table: pd.DataFrame, worker: str, elapsed_s: float) -> pd.DataFrame:
-        """Run ``run``'s table with its keys, parameters and timing in front."""
-        c = self.campaign
-        point, replicate = divmod(run, c.seeds)
-        n = len(table)
-        head = pd.DataFrame({"run": np.full(n, run, np.int64), "point": np.full(n, point, np.int64),
-                             "replicate": np.full(n, replicate, np.int64), "seed": np.full(n, c.run_seed(run), np.uint64)})
-        params = self._params.iloc[[point] * n].reset_index(drop=True)
-        timing = pd.DataFrame({"worker": [worker] * n, "elapsed_s": np.full(n, elapsed_s)})
-        clash = set(table.columns) & (set(KEYS) | set(params.columns) | set(TIMING))
-        if clash:
-            raise input_error("scenario", f"{c.scenario.__name__} returned columns {sorted(clash)} that name a run key, "
-                              "a parameter or a timing column")
-        return pd.concat([head, params, table.reset_index(drop=True), timing], axis=1)
-
-    def write(self, rows: pd.DataFrame) -> None:
-        """Write finished runs (frames of :meth:`rows`, concatenated) at once, one file per point."""
-        import pyarrow as pa
-        import pyarrow.parquet as pq
-
-        for point, part in rows.groupby("point", sort=True):
-            d = self.runs_dir / f"point={int(point):06d}"
-            d.mkdir(exist_ok=True)
-            target = d / f"part-{int(part['run'].min()):09d}.parquet"
-            tmp = d / f".tmp-{uuid.uuid4().hex}"
-            pq.write_table(pa.Table.from_pandas(part, preserve_index=False), tmp)
-            os.replace(tmp, target)
-
     def _frame(self) -> pd.DataFrame:
         import pyarrow as pa
-        import pyarrow.parquet as pq
+        import pyarrow.dataset as ds
 
-        files = self._files()
-        if not files:
+        if not self._files():
             return pd.DataFrame()
+        hive = ds.partitioning(pa.schema([("point", pa.int64())]), flavor="hive")
         try:
-            whole = pa.concat_tables([pq.read_table(f) for f in files])
+            df = ds.dataset(self.runs, format="parquet", partitioning=hive).to_table().to_pandas()
         except pa.ArrowInvalid as e:
-            raise input_error("scenario", f"the runs of {self.campaign.name!r} returned different columns ({e})") from None
-        df = whole.to_pandas()
-        return df.sort_values("run", kind="stable").reset_index(drop=True)
+            raise input_error("scenario", f"the runs of {self.name!r} returned different columns ({e})") from None
+        columns = list(df.columns)
+        columns.remove("point")
+        columns.insert(1, "point")
+        return df[columns].sort_values("run", kind="stable").reset_index(drop=True)
 
     def table(self) -> pd.DataFrame:
         """Every finished run, sorted by run id (keys, parameters, the scenario's columns)."""
