@@ -10,7 +10,6 @@ import pandas as pd
 
 from .._validate import choice, input_error, integer, positive, scalar
 from ..gnss import scenarios
-from ..gnss.observations import simulate
 from ..gnss.tight import tight_ins
 from .scenario import predicted_by
 
@@ -91,28 +90,11 @@ def _run(setup: dict):
                    m[["dv_x_mps", "dv_y_mps", "dv_z_mps"]].to_numpy(), h_ref=setup["h_ref"], chunk_s=300.0, progress=False)
 
 
-def _error_free(setup: dict) -> dict:
-    """``setup`` with error-free data: the ideal IMU, observations with nanometre noise (the
-    satellite clocks are broadcast, the atmosphere modelled as simulated), the exact
-    barometric altitude and the true initial state; the filter's own settings unchanged."""
-    sc, traj = setup["scenario"], setup["trajectory"]
-    t_gnss = np.arange(1.0, sc.duration_s + 1e-9, 1.0)
-    idx = np.rint(t_gnss * sc.rate_hz).astype(int)
-    only = sorted(set(setup["obs"]["sat"])) if sc.n_sats is not None else None
-    outages = [] if sc.outage is None else [(sc.outage[0], sc.outage[0] + sc.outage[1])]
-    obs = simulate(setup["eph"], t_gnss, traj.lla[idx], traj.vel_ned[idx], only=only, outages=outages, sigma_code=1e-9,
-                   sigma_rate=1e-9)
-    imu = traj.ideal_imu("increments")
-    s0 = traj.initial_state()
-    args = {**setup["args"], "lla0": s0["lla"], "vel0": s0["vel_ned"], "q0": s0["q_nb"]}
-    h_ref = None if setup["h_ref"] is None else np.interp(imu["time_s"].to_numpy(), traj.time, traj.lla[:, 2])
-    return {**setup, "imu": imu, "obs": obs, "args": args, "h_ref": h_ref}
-
-
 def _gnss_tight_covariance(*, imu_class="precise", outage_s=0.0, satellites=ALL_SATELLITES, duration=300.0, checkpoint_s=30.0,
                            rate_hz=50.0) -> pd.DataFrame:
     """Predicted RMS over seeds of the errors of :func:`gnss_tight`: the filter's own
-    covariance along the truth, from a run on error-free data (ideal IMU, noise-free
+    covariance along the truth, from a run on error-free data
+    (:func:`atomnav.gnss.scenarios.build` with ``error_free=True``: ideal IMU, noise-free
     observations and altitude, true initial state), which is the linear covariance
     analysis of the filter as built. Over every satellite on the drive the filter is
     consistent (its run-averaged NEES inside the χ² 95 % band at 99.3 % of the epochs,
@@ -137,7 +119,7 @@ def _gnss_tight_covariance(*, imu_class="precise", outage_s=0.0, satellites=ALL_
         As for :func:`gnss_tight`.
     """
     sc = _scenario(0, imu_class, outage_s, satellites, duration, checkpoint_s, rate_hz)
-    nav = _run(_error_free(scenarios.build(sc))).nav
+    nav = _run(scenarios.build(sc, error_free=True)).nav
     times = _checkpoints(sc, checkpoint_s)
     return _table(times, nav[list(_SIGMAS)].to_numpy()[_rows(nav, times)] ** 2)
 

@@ -20,7 +20,7 @@ import numpy as np
 import pandas as pd
 
 from .. import _core, imu, trajectory, units
-from .._validate import finite_scalar, input_error, instance, table, vector
+from .._validate import finite_scalar, flag, input_error, instance, table, vector
 from ..filter.aided import AidedResult
 from ..filter.engine import BiasModel
 from .ephemeris import Ephemerides
@@ -36,6 +36,9 @@ INITIAL_ATTITUDE = {
 ORIGIN = np.array(trajectory.MOSCOW)
 #: Baro loop (Demidov 2009, §3): damping ratio, natural frequency (rad/s), white altitude error σ (m).
 BARO_ZETA, BARO_OMEGA, BARO_SIGMA = 0.707, 0.01, 1.0
+#: Code (m) and rate (m/s) σ of the observations of an error-free :func:`build`: a
+#: nanometre, negligible against the filter's 3 m and 0.05 m/s.
+ERROR_FREE_SIGMA = 1e-9
 
 
 @dataclass(frozen=True)
@@ -117,7 +120,7 @@ def _scenario(sc) -> Scenario:
     return instance(sc, Scenario, "sc")
 
 
-def build(sc: Scenario | str, clock=(0.0, 0.0)) -> dict:
+def build(sc: Scenario | str, clock=(0.0, 0.0), *, error_free: bool = False) -> dict:
     """Everything a scenario run needs, simulated.
 
     Parameters
@@ -127,6 +130,13 @@ def build(sc: Scenario | str, clock=(0.0, 0.0)) -> dict:
     clock : array_like, shape (2,), default (0, 0)
         True receiver clock (bias s, drift s/s): δt_r(t) = bias + drift·t, t (s) from the
         start of the run (the first GNSS epoch is at 1 s).
+    error_free : bool, default False
+        Error-free data for the same filter: the ideal IMU (bias truth 0), observations
+        with code and rate σ of :data:`ERROR_FREE_SIGMA` drawn with seed 0 whatever
+        ``sc.seed`` (the satellite clocks are broadcast and the atmosphere is modelled as
+        simulated, so nothing else is in error), the exact barometric altitude and the
+        true initial state; the filter's settings (P0, noise PSDs) unchanged. A run on it carries the filter's own
+        covariance along the truth, the linear covariance analysis of the filter.
 
     Returns
     -------
@@ -142,14 +152,20 @@ def build(sc: Scenario | str, clock=(0.0, 0.0)) -> dict:
     ------
     atomnav.InputError
         Naming ``sc`` for an unknown scenario name, or ``motion`` for an unknown motion.
+    TypeError
+        ``error_free`` is not a bool.
     """
     sc = _scenario(sc)
     clock = vector(clock, 2, "clock")
+    error_free = flag(error_free, "error_free")
     rng = np.random.default_rng(sc.seed)
     traj = _trajectory(sc)
     dt = 1.0 / sc.rate_hz
     errors = imu.ImuErrors.preset(sc.imu_class)
-    meas = imu.corrupt(traj.ideal_imu("increments"), errors=errors, dt=dt, kind="increments", seed=sc.seed)
+    if error_free:
+        meas = traj.ideal_imu("increments").assign(**dict.fromkeys(imu.BIAS_COLUMNS[0] + imu.BIAS_COLUMNS[1], 0.0))
+    else:
+        meas = imu.corrupt(traj.ideal_imu("increments"), errors=errors, dt=dt, kind="increments", seed=sc.seed)
     t_gnss = np.arange(1.0, sc.duration_s + 1e-9, 1.0)
     eph = Ephemerides.nominal(0.0, sc.duration_s, glonass=False, seed=sc.seed)
     idx = np.rint(t_gnss * sc.rate_hz).astype(int)
@@ -159,16 +175,20 @@ def build(sc: Scenario | str, clock=(0.0, 0.0)) -> dict:
         only = eph.top(sc.n_sats, 0.0, traj.lla[0]) if sc.n_sats > 0 else []
     outages = [] if sc.outage is None else [(sc.outage[0], sc.outage[0] + sc.outage[1])]
     # the simulator's bias is the offset at its first epoch t_gnss[0], the run starts at 0
+    noise = dict(sigma_code=ERROR_FREE_SIGMA, sigma_rate=ERROR_FREE_SIGMA, seed=0) if error_free else dict(seed=sc.seed + 1000)
     obs = simulate(eph, t_gnss, lla, vel, tau_gps=0.0, clock_bias=clock[0] + clock[1] * t_gnss[0], clock_drift=clock[1],
-                   only=only, outages=outages, seed=sc.seed + 1000)
+                   only=only, outages=outages, **noise)
     tilt, heading = INITIAL_ATTITUDE[sc.imu_class]
     a, g = errors.accel, errors.gyro
     p0 = np.diag(np.r_[[10.0 ** 2] * 3, [0.1 ** 2] * 3, [tilt ** 2, tilt ** 2, heading ** 2],
                        [a.bias_sigma ** 2] * 3, [g.bias_sigma ** 2] * 3])
     # initial error δx ~ N(0, P0) of the navigation states (core: filter/initial_error.rs)
     s0 = traj.initial_state()
-    lla0, vel0, q0 = _core.initial_error(np.asarray(s0["lla"], float).tolist(), np.asarray(s0["vel_ned"], float).tolist(),
-                                         np.asarray(s0["q_nb"], float).tolist(), p0, rng.standard_normal(9))
+    if error_free:
+        lla0, vel0, q0 = s0["lla"], s0["vel_ned"], s0["q_nb"]
+    else:
+        lla0, vel0, q0 = _core.initial_error(np.asarray(s0["lla"], float).tolist(), np.asarray(s0["vel_ned"], float).tolist(),
+                                             np.asarray(s0["q_nb"], float).tolist(), p0, rng.standard_normal(9))
     args = dict(t0=s0["t0"], lla0=lla0, vel0=vel0, q0=q0, kind="increments", p0_ins=p0,
                 accel_psd=a.white ** 2, gyro_psd=g.white ** 2,
                 accel_bias=BiasModel("random_walk", psd=a.bias_rw ** 2), gyro_bias=BiasModel("random_walk", psd=g.bias_rw ** 2),
@@ -177,9 +197,9 @@ def build(sc: Scenario | str, clock=(0.0, 0.0)) -> dict:
     # barometric altimeter at 1 Hz, white error σ 1 m (Demidov 2009, §3), held to the IMU samples
     # (sample k covers (t_k − dt, t_k]: the reading of the second it ends in)
     t_imu = meas["time_s"].to_numpy()
-    noise = BARO_SIGMA * rng.standard_normal(int(np.ceil(sc.duration_s)) + 1)
+    baro = BARO_SIGMA * rng.standard_normal(int(np.ceil(sc.duration_s)) + 1)
     h_true = np.interp(t_imu, traj.time, traj.lla[:, 2])
-    h_ref = h_true + noise[np.ceil(np.round(t_imu, 9)).astype(int)]
+    h_ref = h_true if error_free else h_true + baro[np.ceil(np.round(t_imu, 9)).astype(int)]
     return dict(scenario=sc, trajectory=traj, imu=meas, eph=eph, obs=obs, args=args,
                 h_ref=h_ref if sc.vertical == "damped" else None)
 
