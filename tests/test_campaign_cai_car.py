@@ -8,7 +8,7 @@ import pytest
 from scipy.stats import chi2
 
 import atomnav as an
-from atomnav.campaign.cai_car import _configuration, _core_scenario, _points, cai_car
+from atomnav.campaign.cai_car import _configuration, _core_scenario, _linear_model, _motion, _points, _systematic_error, cai_car
 from atomnav.imu import ImuErrors
 
 COLUMNS = ["pos_error_m", "vel_error_mps", "att_error_rad"]
@@ -52,26 +52,36 @@ def test_ci_point_matches_the_true_error_prediction():
     assert ((final > lo) & (final < hi)).all(), final
 
 
-# 3 × 3 sweep in Earth gravity: T × shot period (2T, 4T, 10T), navigation grade. The other
-# grades the linear model carries (precise, medium, coarse) have in-shot phase noise beyond
-# the CAI's ±π/2 capture range even at T = 10 ms (precise: σ 1.3 rad; Monte-Carlo RMS 1.7–1.9 ×
+# Sweep in Earth gravity, navigation grade: T ∈ {10, 20, 25} ms × shot period (2T, 4T, 10T)
+# within the linear regime, and the row T = 40 ms beyond it (strict xfail). The other grades
+# the linear model carries (precise, medium, coarse) have in-shot phase noise beyond the
+# CAI's ±π/2 capture range even at T = 10 ms (precise: σ 1.3 rad; Monte-Carlo RMS 1.7–1.9 ×
 # the prediction). 60 seeds: the RMS of 60 runs is known to √(1/(2·60)) = 9 % (1σ) even when
-# one axis dominates.
+# one axis dominates. Measured MC RMS / prediction at 40 s (pos, vel, att) and the range over
+# every filter epoch after 1 s:
+#   T = 10 ms: 2T 0.91 0.91 0.93 (0.85–1.05), 4T 0.99 0.99 0.98 (0.91–1.07), 10T 0.99 0.99 0.97 (0.90–1.08)
+#   T = 20 ms: 2T 1.10 1.10 1.01 (0.90–1.12), 4T 1.00 1.00 1.03 (0.93–1.08), 10T 1.02 1.01 0.93 (0.82–1.11)
+#   T = 25 ms: 2T 1.00 1.00 1.05 (0.93–1.11), 4T 1.03 1.03 1.05 (0.91–1.12), 10T 1.07 1.10 1.15 (0.91–1.16)
+#   T = 40 ms: 2T 1.38 1.46 1.61 (1.09–1.63), 4T 1.34 1.39 1.49 (1.01–1.49), 10T 1.31 1.35 1.44 (0.87–1.55)
+# Without the seed-independent error of the filter's phase prediction under the vibration
+# (test_systematic_error_matches_a_run_without_noise) T = 20 ms, 10T read 2.0–2.9 at 10, 20,
+# 30 s and 1.52 1.51 1.70 at 40 s, and T = 40 ms, 10T 1.52 1.60 1.72.
 # At T = 40 ms the in-shot phase σ is 0.82 rad (0.98 rad with the turn-on biases; 11 % of the
-# shot-channels beyond ±π/2): the Monte-Carlo RMS at 40 s is 1.34–1.72 × the linear
-# prediction, which ignores the readout's sine and fringe slips (the predictor warns). The
-# diagnosis is test_linear_regime_at_40_ms_is_predicted below.
-_NONLINEAR = pytest.mark.xfail(strict=True, reason="T = 40 ms: phase σ 0.98 rad, beyond the linear analysis (readout sine, fringe slips)")
+# shot-channels beyond ±π/2): the excess is the readout's sine and fringe slips, which the
+# linear prediction ignores (the predictor warns). The diagnosis is
+# test_linear_regime_at_40_ms_is_predicted below.
+_NONLINEAR = pytest.mark.xfail(strict=True, reason="T = 40 ms: phase σ 0.98 rad, beyond the linear analysis (readout sine, fringe slips); "
+                                                   "MC RMS / prediction at 40 s 1.31–1.61")
 SWEEP = [pytest.param(dict(T=T, shot_rate=0.0 if k is None else 1.0 / (k * T)), id=f"T{T}-period{k or 2}T",
                       marks=[pytest.mark.slow] + ([_NONLINEAR, pytest.mark.filterwarnings("ignore::RuntimeWarning")] if T == 0.04 else []))
-         for T in (0.01, 0.025, 0.04) for k in (None, 4, 10)]
+         for T in (0.01, 0.02, 0.025, 0.04) for k in (None, 4, 10)]
 
 
 @pytest.mark.parametrize("params", SWEEP)
 def test_sweep_matches_the_true_error_prediction_within_30_percent(params):
-    ratio = _ratios(60, **params)
-    final = ratio[COLUMNS].iloc[-1]
-    assert (np.abs(final - 1) < 0.3).all(), final
+    # every checkpoint, not only the end: a defect that comes and goes with time shows there
+    ratio = _ratios(60, **params)[COLUMNS]
+    assert (np.abs(ratio - 1) < 0.3).all().all(), ratio
 
 
 @pytest.mark.slow
@@ -93,6 +103,34 @@ def test_linear_regime_at_40_ms_is_predicted(monkeypatch):
         ratio = _ratios(60, **params)
     final = ratio[COLUMNS].iloc[-1]
     assert (np.abs(final - 1) < 0.3).all(), final
+
+
+def test_systematic_error_matches_a_run_without_noise():
+    """The seed-independent error (the filter's phase prediction under the vibration, one
+    shot per 10T = 0.2 s aliasing the 15.1 Hz line to 0.1 Hz) against the peer that has
+    nothing else: the Monte Carlo's own nonlinear simulation with an error-free IMU and
+    σ_p = 1e-9 (R then differs by < 5 %). Measured misfit 11 % (position, velocity) and 8 %
+    (attitude), rms over the epochs; without the vibration the error is < 10 % of this."""
+    import dataclasses
+
+    from atomnav.cai.campaign import _scenario
+    from atomnav.imu import TriadErrors
+
+    key = _points(0.02, 5.0, "navigation", 0.0, "earth", True, 1.0, 5.0)
+    lin = _linear_model(key)
+    quiet = dataclasses.replace(lin.config, imu=ImuErrors(TriadErrors(), TriadErrors()), sensor=dataclasses.replace(lin.config.sensor, sigma_p=1e-9))
+    run = _scenario(_motion(key), quiet)[0].monte_carlo(0, [0])
+    exact = np.asarray(run["hybrid"])[0]
+    linear = _systematic_error(key, lin)[1:]
+    assert np.allclose(np.asarray(run["time"]), np.arange(1, len(linear) + 1) * lin.step_s)
+    for block in (slice(0, 3), slice(3, 6), slice(6, 9)):
+        misfit = np.sqrt(((exact[:, block] - linear[:, block]) ** 2).sum(axis=1).mean() / (exact[:, block] ** 2).sum(axis=1).mean())
+        assert misfit < 0.2, (block, misfit)
+    # the vibration makes it: without, the largest position and velocity errors are < 10 %
+    # (measured 3.6 %)
+    still = _linear_model(_points(0.02, 5.0, "navigation", 0.0, "earth", False, 1.0, 5.0))
+    calm = _systematic_error(_points(0.02, 5.0, "navigation", 0.0, "earth", False, 1.0, 5.0), still)
+    assert np.abs(calm[:, :6]).max() < 0.1 * np.abs(linear[:, :6]).max()
 
 
 def test_predictor_warns_beyond_the_linear_regime():
@@ -136,6 +174,7 @@ BAD = {
     "negative shot rate": (dict(shot_rate=-1.0), "shot_rate"),
     "infinite shot rate": (dict(shot_rate=float("inf")), "shot_rate"),
     "shot rate below one per profile": (dict(shot_rate=1e-300), "shot_rate"),
+    "shot period off the 2T steps": (dict(T=0.02, shot_rate=3.7), "shot_rate"),
     "T = 0": (dict(T=0.0), "T"),
     "T < 0": (dict(T=-0.01), "T"),
     "2T off the IMU samples": (dict(T=0.0123), "T"),
