@@ -105,6 +105,20 @@ def test_linear_regime_at_40_ms_is_predicted(monkeypatch):
     assert (np.abs(final - 1) < 0.3).all(), final
 
 
+@pytest.mark.parametrize("period", [2, 4, 10])
+def test_prediction_updates_at_the_filter_epochs(period):
+    # the core applies shot j at the first filter epoch at or after its end: the Monte Carlo's
+    # epochs are the 2T grid, every shot is processed, and its epoch is the predictor's
+    key = _points(0.02, 1.0 / (period * 0.02), "navigation", 0.0, "earth", True, 1.0, 5.0)
+    lin, core = _linear_model(key), _core_scenario(key)
+    run = core.monte_carlo(0, [0])
+    time = np.asarray(run["time"])
+    assert np.allclose(time, np.arange(1, len(lin.measure)) * lin.step_s, rtol=0, atol=1e-9)
+    assert np.isfinite(np.asarray(run["phase_error"])).all()
+    applied = np.searchsorted(time, np.asarray(core.shots) + 2 * 0.02 - 1e-9) + 1
+    assert np.array_equal(applied, np.flatnonzero(lin.measure))
+
+
 def test_systematic_error_matches_a_run_without_noise():
     """The seed-independent error (the filter's phase prediction under the vibration, one
     shot per 10T = 0.2 s aliasing the 15.1 Hz line to 0.1 Hz) against the peer that has
