@@ -1,11 +1,15 @@
 """Draw the images of docs/plots.md (docs/img/plots_*.png) from a short simulated run:
 two minutes of sinusoidal motion, a tactical-grade IMU, 1 Hz position fixes, an hour of
-a simulated gyro log, and single-point positioning of a real station's RINEX 2.11 file
-(DELF, tests/data/rinex_stations). Run from the repository root:
+a simulated gyro log, single-point positioning of a real station's RINEX 2.11 file
+(DELF, tests/data/rinex_stations), and the README's design study: a campaign of the free
+INS over IMU grade and bias scale (20 seeds per point, campaign seed 1) on a LocalCluster
+of two workers, and the covariance sweep of bias scale against outage length. Run from
+the repository root:
 
     .venv/bin/python docs/make_plot_images.py
 """
 
+import tempfile
 import warnings
 from pathlib import Path
 
@@ -19,6 +23,29 @@ import pandas as pd  # noqa: E402
 import atomnav as an  # noqa: E402
 
 OUT = Path(__file__).parent / "img"
+
+
+def campaign_figures() -> dict:
+    """The three campaign figures of the README's design study (a temporary results folder)."""
+    from distributed import Client, LocalCluster
+
+    from atomnav import campaign
+
+    study = campaign.Campaign(campaign.strapdown_free, {"imu": ["tactical", "navigation"], "bias_scale": [0.5, 1, 2]},
+                              seeds=20, seed=1, fixed={"duration": 600.0})
+    outage = campaign.sweep(campaign.strapdown_free, {"duration": [120.0 * k for k in range(1, 11)],
+                                                      "bias_scale": [0.25 * k for k in range(1, 9)]},
+                            fixed={"imu": "navigation"}, progress=False)
+    with tempfile.TemporaryDirectory() as folder:
+        with LocalCluster(n_workers=2, threads_per_worker=1, dashboard_address=":0") as cluster, Client(cluster) as client:
+            table = campaign.run(study, folder, client=client, progress=False)
+        timing = campaign.timing(folder, study.name)
+    return {
+        "campaign_error_vs_parameter": campaign.plots.error_vs_parameter(campaign.compare(table, study), "bias_scale",
+                                                                         "pos_error_m", by="imu"),
+        "campaign_error_map": campaign.plots.error_map(outage, "bias_scale", "duration", "pos_error_m_cov", target=1000.0),
+        "campaign_throughput": campaign.plots.throughput(timing),
+    }
 
 
 def main() -> None:
@@ -59,6 +86,7 @@ def main() -> None:
         "consistency": an.plots.consistency(nis=res, nees=nees, dof=9),
         "allan": an.plots.allan(table, fit, unit=an.units.DEG_PER_HOUR),
         "spp": an.plots.spp(an.gnss.solve(eph, obs.table[obs.table["sat"].str[0] == "G"], elevation_weight=True), delf),
+        **campaign_figures(),
     }
     for name, fig in figures.items():
         fig.savefig(OUT / f"plots_{name}.png", dpi=55)  # each image under 100 kB
