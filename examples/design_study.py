@@ -91,6 +91,8 @@ computed = writes[-1][0] - (study.n_runs - study.seeds)
 print(f"resume: 0 runs computed when finished, {computed} with point 3 deleted")
 assert computed == study.seeds and writes[-1] == (study.n_runs, study.n_runs), writes
 pd.testing.assert_frame_equal(again, table, check_exact=True)
+ran = campaign.timing("results", "strapdown_free")
+assert set(ran.loc[ran["point"] == 3, "worker"]) == {"local"} and "local" not in set(ran.loc[ran["point"] != 3, "worker"])
 
 # --- the README's sweeps and requirements ----------------------------------------------
 strapdown_free = campaign.strapdown_free
