@@ -83,7 +83,7 @@ impl Choice for OmegaDotKind {
 
 /// Samples kept before a shot start for the interpolation stencils (cubic Hermite tangents
 /// reach one sample further than the interval; the Savitzky–Golay window may need more).
-const STENCIL_PAD: usize = 3;
+pub const STENCIL_PAD: usize = 3;
 
 /// Largest Savitzky–Golay half width accepted (a window of 2m + 1 samples).
 pub const MAX_SAVGOL_HALF_WIDTH: usize = 1000;

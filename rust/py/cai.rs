@@ -639,6 +639,8 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     // column names of CaiSetup.predict / CaiSetup.jacobian (single source of truth)
     m.add("CAI_TERMS", TERM_NAMES.to_vec())?;
     m.add("CAI_JACOBIAN_PARAMS", JACOBIAN_PARAMS.to_vec())?;
+    // IMU samples the predictor holds before a shot start (cubic / "pwl" stencils)
+    m.add("CAI_STENCIL_PAD", crate::cai::predictor::STENCIL_PAD)?;
     register_choices::<OmegaDotKind>(m, "OmegaDot")?;
     register_choices::<Interpolation>(m, "Interpolation")?;
     register_choices::<ClosedForm>(m, "ClosedForm")?;

@@ -40,8 +40,9 @@ MAX_LINEAR_EXCEEDANCE = 1e-3
 #: navigation grade: 0.52 rad at T = 40 ms, which its Monte Carlo bears).
 MAX_START_EXCEEDANCE = 1e-2
 #: IMU samples before a shot start that the filter's in-shot predictor holds (the core's
-#: interpolation stencil pad); with those up to the shot's end it predicts the shot's phase.
-SHOT_PAD = 3
+#: interpolation stencil pad, for the cubic / "pwl" predictor); with those up to the shot's
+#: end it predicts the shot's phase.
+SHOT_PAD = _core.CAI_STENCIL_PAD
 _COLUMNS = ("pos_error_m", "vel_error_mps", "att_error_rad")
 
 
