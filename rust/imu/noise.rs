@@ -20,7 +20,7 @@ use super::ImuKind;
 use crate::error::{check_positive, invalid, Result};
 use rand::Rng;
 use rand_distr::StandardNormal;
-use std::f64::consts::{LN_2, PI};
+use std::f64::consts::{LN_10, LN_2, PI};
 
 fn check_density(field: &str, x: f64) -> Result<()> {
     if x.is_finite() && x >= 0.0 {
@@ -246,7 +246,7 @@ pub struct Flicker {
 impl Flicker {
     /// Correlation times τ_i (s) of the poles for the band [f_lo, f_hi] (Hz).
     pub fn correlation_times(f_lo: f64, f_hi: f64) -> Vec<f64> {
-        let ln_r = std::f64::consts::LN_10 / FLICKER_POLES_PER_DECADE;
+        let ln_r = LN_10 / FLICKER_POLES_PER_DECADE;
         let n_band = ((f_hi / f_lo).ln() / ln_r - 1e-9).ceil().max(0.0) as i32;
         (-FLICKER_EDGE_POLES..=n_band + FLICKER_EDGE_POLES)
             .map(|i| 1.0 / (2.0 * PI * f_lo * (i as f64 * ln_r).exp()))
@@ -255,7 +255,22 @@ impl Flicker {
 
     /// Stationary σ of each pole for bias instability B.
     pub fn pole_sigma(b: f64) -> f64 {
-        b * (std::f64::consts::LN_10 / FLICKER_POLES_PER_DECADE / PI).sqrt()
+        b * (LN_10 / FLICKER_POLES_PER_DECADE / PI).sqrt()
+    }
+
+    /// (σ, τ) of every pole for bias instability B (≥ 0) in the band [f_lo, f_hi] (Hz,
+    /// 0 < f_lo < f_hi): the Gauss–Markov processes whose sum the simulator draws, for a
+    /// linear analysis that augments its state with them.
+    pub fn poles(b: f64, f_lo: f64, f_hi: f64) -> Result<Vec<(f64, f64)>> {
+        check_density("b", b)?;
+        check_positive("f_lo", f_lo)?;
+        check_positive("f_hi", f_hi)?;
+        if f_hi <= f_lo {
+            return Err(invalid("f_hi", format!("must exceed f_lo = {f_lo}, got {f_hi}")));
+        }
+        let s = finite("b", Self::pole_sigma(b), &format!("b = {b}"))?;
+        let args = format!("f_lo = {f_lo} Hz, f_hi = {f_hi} Hz");
+        Self::correlation_times(f_lo, f_hi).into_iter().map(|tau| Ok((s, finite("f_lo", tau, &args)?))).collect()
     }
 
     /// `rng` draws the initial states of all poles (stationary start).
@@ -359,6 +374,25 @@ mod tests {
                 assert!((0.986..=1.001).contains(&ratio), "band [{f_lo}, {f_hi}], f = {f}: {ratio}");
             }
         }
+    }
+
+    #[test]
+    fn flicker_poles_are_the_simulated_ones() {
+        // 3 decades at 2 poles per decade: 6 band steps and 3 edge poles on each side
+        let poles = Flicker::poles(2.0, 1e-4, 0.1).unwrap();
+        assert_eq!(poles.len(), 13);
+        let taus = Flicker::correlation_times(1e-4, 0.1);
+        for ((s, tau), t) in poles.iter().zip(&taus) {
+            assert_eq!((*s, *tau), (Flicker::pole_sigma(2.0), *t));
+        }
+        // σ_p² = B² ln r / π with r = √10; the slowest pole at f_lo/r³
+        assert!(rel(poles[0].0.powi(2), 4.0 * LN_10 / 2.0 / PI) < 1e-15);
+        assert!(rel(poles[0].1, 10f64.powf(1.5) / (2.0 * PI * 1e-4)) < 1e-12);
+        let field = |r: Result<Vec<(f64, f64)>>| r.map_or_else(|e| e.to_string(), |_| String::new());
+        assert!(field(Flicker::poles(-1.0, 1e-4, 0.1)).starts_with("b:"));
+        assert!(field(Flicker::poles(1.0, 0.0, 0.1)).starts_with("f_lo:"));
+        assert!(field(Flicker::poles(1.0, 0.1, 0.1)).starts_with("f_hi:"));
+        assert!(field(Flicker::poles(1.0, 5e-324, 1e-300)).starts_with("f_lo:"));
     }
 
     #[test]

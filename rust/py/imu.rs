@@ -162,6 +162,12 @@ fn imu_flicker_allan_floor(#[pyo3(from_py_with = real)] b: f64) -> PyResult<f64>
     Ok(noise::flicker_allan_floor(b)?)
 }
 
+/// (σ, τ) of the Gauss–Markov poles the simulator sums into a flicker term (B, f_lo, f_hi).
+#[pyfunction]
+fn imu_flicker_poles(#[pyo3(from_py_with = real)] b: f64, #[pyo3(from_py_with = real)] f_lo: f64, #[pyo3(from_py_with = real)] f_hi: f64) -> PyResult<Vec<(f64, f64)>> {
+    Ok(noise::Flicker::poles(b, f_lo, f_hi)?)
+}
+
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<ImuErrorSimulator>()?;
     m.add_function(wrap_pyfunction!(imu_preset_names, m)?)?;
@@ -176,5 +182,6 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(imu_gauss_markov_low_freq_asd, m)?)?;
     m.add_function(wrap_pyfunction!(imu_flicker_psd, m)?)?;
     m.add_function(wrap_pyfunction!(imu_flicker_allan_floor, m)?)?;
+    m.add_function(wrap_pyfunction!(imu_flicker_poles, m)?)?;
     Ok(())
 }
