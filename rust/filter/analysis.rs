@@ -3,7 +3,9 @@
 //!
 //! A scenario is a sequence of continuous (F_k, Q_c,k) over steps Δt_k (from the INS
 //! error model along a trajectory, `ins::error_dynamics`), an initial covariance P₀ and a
-//! measurement z = Hδx + v, v ~ N(0, R), at flagged epochs. The truth is always
+//! measurement z = Hδx + v, v ~ N(0, R), at flagged epochs. P₀ may be singular (e.g. an
+//! INS started at the truth) for the covariance analyses; the Monte Carlo, whose filter
+//! and NEES invert P, needs it positive definite. The truth is always
 //! discretised exactly (Van Loan); the filter uses the method asked for, so the effect
 //! of the first-order option on consistency can be measured.
 
@@ -28,10 +30,13 @@ pub const ANALYSIS_FAER_MIN: usize = 56;
 
 #[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
 pub struct Scenario {
-    /// Filter transition and process noise per step (k → k+1).
+    /// model[k]: the discretised model of step k (k → k+1), an index into the four lists
+    /// below; consecutive steps with the same (F, Q_c, Δt) share one (a vehicle at rest).
+    model: Vec<usize>,
+    /// Filter transition and process noise per distinct model.
     phi: Vec<DMatrix<f64>>,
     qd: Vec<DMatrix<f64>>,
-    /// Truth transition and a square root of its process noise per step.
+    /// Truth transition and a square root of its process noise per distinct model.
     phi_true: Vec<DMatrix<f64>>,
     sqrt_qd_true: Vec<DMatrix<f64>>,
     p0: DMatrix<f64>,
@@ -61,9 +66,44 @@ fn sqrt_psd(field: &str, a: &DMatrix<f64>) -> Result<DMatrix<f64>> {
     Ok(&e.eigenvectors * d * e.eigenvectors.transpose())
 }
 
+/// Appends the σ of every state of epoch `k` from P's diagonal (round-off negatives
+/// clipped to 0); a non-finite diagonal (a model that overflows the floating-point range)
+/// is a numerical error, not a silent NaN or 0.
+fn push_sigmas(out: &mut Vec<f64>, p: &DMatrix<f64>, k: usize) -> Result<()> {
+    if let Some(x) = p.diagonal().iter().find(|x| !x.is_finite()) {
+        return Err(NavError::Numerical(format!("epoch {k}: covariance diagonal {x} (the model overflows the floating-point range)")));
+    }
+    out.extend(p.diagonal().iter().map(|x| x.max(0.0).sqrt()));
+    Ok(())
+}
+
+/// P ← A P Aᵀ + Q on one algebra, with the work matrices of its faer path.
+struct Congruence {
+    algebra: Algebra,
+    out: DMatrix<f64>,
+    t: DMatrix<f64>,
+}
+
+impl Congruence {
+    fn new(n: usize, algebra: Algebra) -> Congruence {
+        Congruence { algebra, out: DMatrix::zeros(n, n), t: DMatrix::zeros(n, n) }
+    }
+
+    fn apply(&mut self, p: &mut DMatrix<f64>, a: &DMatrix<f64>, q: &DMatrix<f64>) {
+        match self.algebra {
+            Algebra::Kernels => *p = a * &*p * a.transpose() + q,
+            Algebra::Faer => {
+                dense::congruence(&mut self.out, a, p, Some(q), &mut self.t);
+                std::mem::swap(p, &mut self.out);
+            }
+        }
+    }
+}
+
 impl Scenario {
-    /// `f`, `qc`: continuous models per step; `dt`: step lengths (s); `measure`: one flag
-    /// per epoch (steps + 1).
+    /// `f`, `qc`: continuous models per step, or one model for every step (a
+    /// time-invariant system); `dt`: step lengths (s); `measure`: one flag per epoch
+    /// (steps + 1); `p0`: positive semi-definite.
     #[allow(clippy::too_many_arguments)]
     pub fn new(
         f: &[DMatrix<f64>],
@@ -76,30 +116,38 @@ impl Scenario {
         method: Discretization,
         sequential: bool,
     ) -> Result<Scenario> {
-        let steps = f.len();
-        if qc.len() != steps || dt.len() != steps {
-            return Err(invalid("qc, dt", format!("expected {steps} steps like f, got {} and {}", qc.len(), dt.len())));
+        let steps = dt.len();
+        if !(f.len() == steps || f.len() == 1) || qc.len() != f.len() {
+            return Err(invalid("f, qc", format!("expected one model per step of dt ({steps}) or one for every step, got {} and {}", f.len(), qc.len())));
         }
         if measure.len() != steps + 1 {
             return Err(invalid("measure", format!("expected one flag per epoch ({}), got {}", steps + 1, measure.len())));
         }
-        check_covariance("p0", &p0, None, true)?;
+        check_covariance("p0", &p0, None, false)?;
         let n = p0.nrows();
         if n == 0 {
             return Err(invalid("p0", "must have at least one state, got 0x0"));
         }
-        for (k, ((fk, qk), &dk)) in f.iter().zip(qc).zip(dt).enumerate() {
-            check_square(&format!("f[{k}]"), fk, Some(n))?;
-            check_covariance(&format!("qc[{k}]"), qk, Some(n), false)?;
-            crate::error::check_positive(&format!("dt[{k}]"), dk)?;
+        // one check and discretisation per run of equal consecutive steps (a vehicle at rest)
+        let (mut model, mut distinct) = (Vec::with_capacity(steps), Vec::<(&DMatrix<f64>, &DMatrix<f64>, f64)>::new());
+        // (cycle repeats a single model over every step; zip stops after the last step of dt)
+        for (k, step) in f.iter().cycle().zip(qc.iter().cycle()).zip(dt).map(|((fk, qk), &dk)| (fk, qk, dk)).enumerate() {
+            if distinct.last() != Some(&step) {
+                let (fk, qk, dk) = step;
+                check_square(&format!("f[{k}]"), fk, Some(n))?;
+                check_covariance(&format!("qc[{k}]"), qk, Some(n), false)?;
+                crate::error::check_positive(&format!("dt[{k}]"), dk)?;
+                distinct.push(step);
+            }
+            model.push(distinct.len().saturating_sub(1));
         }
         if h.ncols() != n {
             return Err(invalid("h", format!("expected {n} columns (state size), got {}", h.ncols())));
         }
         check_covariance("r", &r, Some(h.nrows()), true)?;
-        let filt: Vec<_> = f.par_iter().zip(qc).zip(dt).map(|((fk, qk), &dk)| discretize(fk, qk, dk, method)).collect();
-        let truth: Vec<_> = (f.par_iter().zip(qc).zip(dt).zip(&filt))
-            .map(|(((fk, qk), &dk), filt_k)| {
+        let filt: Vec<_> = distinct.par_iter().map(|&(fk, qk, dk)| discretize(fk, qk, dk, method)).collect();
+        let truth: Vec<_> = (distinct.par_iter().zip(&filt))
+            .map(|(&(fk, qk, dk), filt_k)| {
                 let (p, q) = if method == Discretization::VanLoan { filt_k.clone() } else { discretize(fk, qk, dk, Discretization::VanLoan) };
                 Ok((p, sqrt_psd("qc", &q)?))
             })
@@ -107,7 +155,7 @@ impl Scenario {
         let (phi, qd) = filt.into_iter().unzip();
         let (phi_true, sqrt_qd_true) = truth.into_iter().unzip();
         let (sqrt_p0, sqrt_r) = (sqrt_psd("p0", &p0)?, sqrt_psd("r", &r)?);
-        Ok(Scenario { phi, qd, phi_true, sqrt_qd_true, sqrt_p0, p0, sqrt_r, h, r, measure, sequential })
+        Ok(Scenario { model, phi, qd, phi_true, sqrt_qd_true, sqrt_p0, p0, sqrt_r, h, r, measure, sequential })
     }
 
     pub fn size(&self) -> usize {
@@ -118,25 +166,41 @@ impl Scenario {
         self.measure.len()
     }
 
-    /// Covariance-only analysis: σ of every state after each epoch's update (epochs × n, row-major).
-    // invariant: Scenario::new makes measure (epochs) one longer than phi, qd, phi_true, sqrt_qd_true
-    // (steps; private fields) and P n × n, so k − 1 < steps for 0 < k < epochs and i < n.
+    /// Covariance-only analysis: σ of every state after each epoch's update (epochs × n,
+    /// row-major): P⁻ = Φ P⁺ Φᵀ + Q, P⁺ = (I−KH) P⁻ (I−KH)ᵀ + K R Kᵀ (Joseph form, exact
+    /// for a singular P too), on nalgebra below [`ANALYSIS_FAER_MIN`] states and on faer
+    /// from there on.
+    // invariant: Scenario::new makes measure (epochs) one longer than model (steps), whose
+    // entries index phi and qd (private fields), and P n × n, so k − 1 < steps for
+    // 0 < k < epochs and i < n.
     #[allow(clippy::indexing_slicing)]
     pub fn sigmas(&self) -> Result<Vec<f64>> {
         let n = self.size();
-        let mut kf = Kf::new(self.p0.clone(), LoopMode::Closed)?;
-        let zero = vec![0.0; self.h.nrows()];
+        let mut p = self.p0.clone();
+        let mut congruence = Congruence::new(n, Algebra::by_size(n, ANALYSIS_FAER_MIN));
         let mut out = Vec::with_capacity(self.epochs() * n);
         for k in 0..self.epochs() {
             if k > 0 {
-                kf.predict_unchecked(&self.phi[k - 1], &self.qd[k - 1])?;
+                let m = self.model[k - 1];
+                congruence.apply(&mut p, &self.phi[m], &self.qd[m]);
             }
             if self.measure[k] {
-                kf.update(&zero, &self.h, &self.r, self.sequential, None)?;
+                let (gain, ikh) = self.gain(k, &p)?;
+                congruence.apply(&mut p, &ikh, &(&gain * &self.r * gain.transpose()));
             }
-            out.extend((0..n).map(|i| kf.p[(i, i)].sqrt()));
+            push_sigmas(&mut out, &p, k)?;
         }
         Ok(out)
+    }
+
+    /// Gain K = P Hᵀ S⁻¹ (S = H P Hᵀ + R) of the filter's update at epoch `k` from its
+    /// prior covariance `p`, and I − KH.
+    fn gain(&self, k: usize, p: &DMatrix<f64>) -> Result<(DMatrix<f64>, DMatrix<f64>)> {
+        let s = &self.h * p * self.h.transpose() + &self.r;
+        let chol = s.cholesky().ok_or_else(|| NavError::Numerical(format!("epoch {k}: innovation covariance not positive definite")))?;
+        let gain = chol.solve(&(&self.h * p)).transpose();
+        let ikh = DMatrix::<f64>::identity(p.nrows(), p.nrows()) - &gain * &self.h;
+        Ok((gain, ikh))
     }
 
     /// True-error covariance analysis of the filter as built (suboptimal-filter analysis):
@@ -156,59 +220,50 @@ impl Scenario {
     }
 
     /// [`Scenario::true_sigmas`] with the algebra chosen by the caller (benches and tests).
-    // invariant: Scenario::new makes measure (epochs) one longer than phi, qd, phi_true, sqrt_qd_true
-    // (steps; private fields) and P n × n, so k − 1 < steps for 0 < k < epochs and i < n.
-    // cross has one entry per step (checked above).
+    // invariant: Scenario::new makes measure (epochs) one longer than model (steps), whose
+    // entries index phi, qd, phi_true, sqrt_qd_true (private fields), and P n × n, so
+    // k − 1 < steps for 0 < k < epochs and i < n. cross has one entry per step (checked above).
     #[allow(clippy::indexing_slicing)]
     pub fn true_sigmas_using(&self, r_true: &DMatrix<f64>, cross: &[DMatrix<f64>], algebra: Algebra) -> Result<Vec<f64>> {
         let n = self.size();
         let m = self.h.nrows();
         check_covariance("r_true", r_true, Some(m), false)?;
-        if cross.len() != self.phi.len() {
-            return Err(invalid("cross", format!("expected one n × m matrix per step ({}), got {}", self.phi.len(), cross.len())));
+        if cross.len() != self.model.len() {
+            return Err(invalid("cross", format!("expected one n × m matrix per step ({}), got {}", self.model.len(), cross.len())));
         }
         if let Some((k, c)) = cross.iter().enumerate().find(|(_, c)| c.nrows() != n || c.ncols() != m) {
             return Err(crate::error::invalid_at("cross", k, format!("entry {k} is {} × {}, expected {n} × {m}", c.nrows(), c.ncols())));
         }
         let mut pf = self.p0.clone();
         let mut pt = self.p0.clone();
-        let eye = DMatrix::<f64>::identity(n, n);
-        let (mut out_buf, mut t) = (DMatrix::zeros(n, n), DMatrix::zeros(n, n));
-        // P ← A P Aᵀ + Q on the chosen algebra.
-        let mut congruence = |p: &mut DMatrix<f64>, a: &DMatrix<f64>, q: &DMatrix<f64>| match algebra {
-            Algebra::Kernels => *p = a * &*p * a.transpose() + q,
-            Algebra::Faer => {
-                dense::congruence(&mut out_buf, a, p, Some(q), &mut t);
-                std::mem::swap(p, &mut out_buf);
-            }
-        };
+        let mut congruence = Congruence::new(n, algebra);
         let mut out = Vec::with_capacity(self.epochs() * n);
         for k in 0..self.epochs() {
             if k > 0 {
-                congruence(&mut pf, &self.phi[k - 1], &self.qd[k - 1]);
-                let sq = &self.sqrt_qd_true[k - 1];
-                congruence(&mut pt, &self.phi_true[k - 1], &(sq * sq.transpose()));
+                let j = self.model[k - 1];
+                congruence.apply(&mut pf, &self.phi[j], &self.qd[j]);
+                let sq = &self.sqrt_qd_true[j];
+                congruence.apply(&mut pt, &self.phi_true[j], &(sq * sq.transpose()));
             }
             if self.measure[k] {
-                let s = &self.h * &pf * self.h.transpose() + &self.r;
-                let chol = s.cholesky().ok_or_else(|| NavError::Numerical(format!("epoch {k}: innovation covariance not positive definite")))?;
-                let gain = chol.solve(&(&self.h * &pf)).transpose();
-                let ikh = &eye - &gain * &self.h;
-                congruence(&mut pf, &ikh, &(&gain * &self.r * gain.transpose()));
+                let (gain, ikh) = self.gain(k, &pf)?;
+                congruence.apply(&mut pf, &ikh, &(&gain * &self.r * gain.transpose()));
                 let c = if k > 0 { cross[k - 1].clone() } else { DMatrix::zeros(n, m) };
                 let corr = &ikh * &c * gain.transpose();
-                congruence(&mut pt, &ikh, &(&gain * r_true * gain.transpose() - &corr - corr.transpose()));
+                congruence.apply(&mut pt, &ikh, &(&gain * r_true * gain.transpose() - &corr - corr.transpose()));
             }
-            out.extend((0..n).map(|i| pt[(i, i)].max(0.0).sqrt()));
+            push_sigmas(&mut out, &pt, k)?;
         }
         Ok(out)
     }
 
     /// One Monte-Carlo run with the seed of run `run` under `master_seed` (ChaCha20
     /// stream = run index, so any subset of runs reproduces the same numbers anywhere).
-    // invariant: Scenario::new makes measure (epochs) one longer than phi, qd, phi_true, sqrt_qd_true
-    // (steps; private fields) and P n × n, so k − 1 < steps for 0 < k < epochs and i < n.
-    // res.nis has one entry per epoch.
+    /// Its filter and NEES need a positive definite P₀: a singular one is an error naming
+    /// `p0`.
+    // invariant: Scenario::new makes measure (epochs) one longer than model (steps), whose
+    // entries index phi, qd, phi_true, sqrt_qd_true (private fields), and P n × n, so
+    // k − 1 < steps for 0 < k < epochs and i < n. res.nis has one entry per epoch.
     #[allow(clippy::indexing_slicing)]
     pub fn run(&self, master_seed: u64, run: u64, mode: LoopMode) -> Result<RunResult> {
         let n = self.size();
@@ -223,8 +278,9 @@ impl Scenario {
         let mut res = RunResult { error: Vec::with_capacity(epochs * n), sigma: Vec::with_capacity(epochs * n), nees: Vec::with_capacity(epochs), nis: vec![f64::NAN; epochs] };
         for k in 0..epochs {
             if k > 0 {
-                e = &self.phi_true[k - 1] * &e + &self.sqrt_qd_true[k - 1] * normal(n);
-                kf.predict_unchecked(&self.phi[k - 1], &self.qd[k - 1])?;
+                let j = self.model[k - 1];
+                e = &self.phi_true[j] * &e + &self.sqrt_qd_true[j] * normal(n);
+                kf.predict_unchecked(&self.phi[j], &self.qd[j])?;
             }
             if self.measure[k] {
                 let z = &self.h * &e + &self.sqrt_r * normal(m);
@@ -248,6 +304,12 @@ impl Scenario {
 
     /// Runs `runs` in parallel (rayon), in the order given.
     pub fn monte_carlo(&self, master_seed: u64, runs: &[u64], mode: LoopMode) -> Result<Vec<RunResult>> {
+        check_covariance("p0", &self.p0, None, true).map_err(|e| match e {
+            NavError::InvalidInput { field, reason, index } => {
+                NavError::InvalidInput { field, reason: format!("{reason}; the Monte Carlo's filter and NEES need a positive definite P0"), index }
+            }
+            other => other,
+        })?;
         runs.par_iter().map(|&r| self.run(master_seed, r, mode)).collect()
     }
 }
@@ -311,7 +373,7 @@ mod tests {
     }
 
     /// The faer true-error analysis equals nalgebra's above the crossover, and the filter
-    /// σ of `sigmas` (whose Kf dispatches by size) equal the R_t = R, S = 0 analysis.
+    /// σ of `sigmas` (on faer there too) equal the R_t = R, S = 0 analysis.
     #[test]
     fn true_sigmas_faer_equals_nalgebra() {
         let (n, steps) = (ANALYSIS_FAER_MIN + 2, 6);
@@ -326,6 +388,41 @@ mod tests {
         assert!(a.iter().zip(&b).all(|(x, y)| (x - y).abs() < 1e-12 * x), "{a:?} {b:?}");
         let own = s.true_sigmas(&r, &vec![DMatrix::zeros(n, 3); steps]).unwrap();
         assert!(own.iter().zip(s.sigmas().unwrap()).all(|(x, y)| (x - y).abs() < 1e-12 * x));
+    }
+
+    /// A singular P₀ (the first state known exactly) in a 2-state random walk: both states
+    /// propagate as P = P₀ + q t without measurements, so the first σ is √(q t), and equal
+    /// consecutive steps share one discretisation while the changed one does not; the
+    /// Monte Carlo refuses the singular P₀, naming it.
+    #[test]
+    fn singular_p0_in_the_covariance_analysis() {
+        let (steps, q) = (8, 0.3);
+        let f = vec![DMatrix::zeros(2, 2); steps];
+        let mut qc = vec![DMatrix::identity(2, 2) * q; steps];
+        qc[5] = DMatrix::identity(2, 2) * (2.0 * q);
+        let p0 = DMatrix::from_diagonal(&DVector::from_vec(vec![0.0, 1.0]));
+        let s = Scenario::new(&f, &qc, &vec![0.5; steps], p0, DMatrix::zeros(0, 2), DMatrix::zeros(0, 0), vec![false; steps + 1], Discretization::VanLoan, false).unwrap();
+        assert_eq!(s.model, vec![0, 0, 0, 0, 0, 1, 2, 2]);
+        // one model for every step: the same analysis as the stack of equal models
+        let p0 = DMatrix::from_diagonal(&DVector::from_vec(vec![0.0, 1.0]));
+        let one = Scenario::new(&f[..1], &qc[..1], &vec![0.5; steps], p0.clone(), DMatrix::zeros(0, 2), DMatrix::zeros(0, 0), vec![false; steps + 1], Discretization::VanLoan, false).unwrap();
+        let stack = Scenario::new(&f, &vec![DMatrix::identity(2, 2) * q; steps], &vec![0.5; steps], p0, DMatrix::zeros(0, 2), DMatrix::zeros(0, 0), vec![false; steps + 1], Discretization::VanLoan, false).unwrap();
+        assert_eq!((one.model.len(), one.sigmas().unwrap()), (steps, stack.sigmas().unwrap()));
+        let sig = s.sigmas().unwrap();
+        let mut v = [0.0, 1.0];
+        for k in 0..=steps {
+            if k > 0 {
+                let dq = if k == 6 { 2.0 * q } else { q } * 0.5;
+                v = [v[0] + dq, v[1] + dq];
+            }
+            for i in 0..2 {
+                assert!((sig[2 * k + i] - v[i].sqrt()).abs() < 1e-14, "epoch {k}, state {i}: {} vs {}", sig[2 * k + i], v[i].sqrt());
+            }
+        }
+        let own = s.true_sigmas(&DMatrix::zeros(0, 0), &vec![DMatrix::zeros(2, 0); steps]).unwrap();
+        assert!(own.iter().zip(&sig).all(|(a, b)| (a - b).abs() < 1e-14));
+        let e = s.monte_carlo(1, &[0], LoopMode::Closed).unwrap_err();
+        assert!(matches!(&e, NavError::InvalidInput { field, .. } if field == "p0"), "{e}");
     }
 
     /// A scenario without states is rejected, not divided by.

@@ -10,10 +10,11 @@ from functools import lru_cache
 import numpy as np
 import pandas as pd
 
+from .. import _core, strapdown, trajectory
 from .. import imu as imu_errors
-from .. import strapdown, trajectory
 from .._validate import choice, input_error, integer, nonnegative, positive, scalar
-from ..filter import BiasModel, discretize, ins_error_model
+from ..filter import BiasModel, ins_error_model
+from ..filter.analysis import Scenario, covariance_analysis
 from .scenario import predicted_by
 
 #: The trajectories the scenario runs on.
@@ -93,21 +94,13 @@ def _table(times: np.ndarray, blocks) -> pd.DataFrame:
     return pd.DataFrame({"time_s": times, **dict(zip(_COLUMNS, (np.asarray(b, dtype=float) for b in blocks)))})
 
 
-def _flicker_poles(fl: imu_errors.Flicker) -> list[tuple[float, float]]:
-    """(σ, τ) of the Gauss–Markov poles whose sum :mod:`atomnav.imu` simulates a flicker term
-    with (Keshner 1982): corner frequencies spaced by r = √10 from f_lo/r³ to at least
-    f_hi·r³, each pole of stationary variance B² ln r / π."""
-    ln_r = np.log(10.0) / 2.0
-    n_band = max(int(np.ceil(np.log(fl.f_hi / fl.f_lo) / ln_r - 1e-9)), 0)
-    sigma = fl.b * np.sqrt(ln_r / np.pi)
-    return [(sigma, 1.0 / (2.0 * np.pi * fl.f_lo * np.exp(i * ln_r))) for i in range(-3, n_band + 4)]
-
-
 def _poles(triad: imu_errors.TriadErrors) -> list[tuple[float, float]]:
-    """(σ, τ) of every Gauss–Markov process in one axis of ``triad``."""
+    """(σ, τ) of every Gauss–Markov process in one axis of ``triad``: its Gauss–Markov term
+    and the poles whose sum :mod:`atomnav.imu` simulates its flicker term with (Keshner
+    1982; the core's own poles)."""
     gm, fl = triad._terms("imu")
     poles = [] if gm is None or gm.sigma == 0 else [(gm.sigma, gm.tau)]
-    return poles + ([] if fl is None or fl.b == 0 else _flicker_poles(fl))
+    return poles + ([] if fl is None or fl.b == 0 else _core.imu_flicker_poles(fl.b, fl.f_lo, fl.f_hi))
 
 
 def _linear(errors: imu_errors.ImuErrors, imu: str) -> None:
@@ -120,34 +113,28 @@ def _linear(errors: imu_errors.ImuErrors, imu: str) -> None:
                                      "flicker) and white noise only")
 
 
-def _variances(models, dt: float, p0) -> np.ndarray:
-    """Variance of every state after each step of the linear model ẋ = Fx + w (no
-    measurement), given the (F, Q_c) of every step: P ← ΦPΦᵀ + Q_d with the exact (Van Loan)
-    discretisation of every step; a model equal to the previous step's is not discretised
-    again. P₀ may be singular (the INS starts at the truth)."""
-    p, out, last = np.asarray(p0, dtype=float), [], None
-    for fk, qk in models:
-        if last is None or not (np.array_equal(fk, last[0]) and np.array_equal(qk, last[1])):
-            last = (fk, qk, *discretize(fk, qk, dt))
-        phi, qd = last[2:]
-        p = phi @ p @ phi.T + qd
-        out.append(np.diag(p).copy())
-    return np.array(out)
+def _variances(f: np.ndarray, qc: np.ndarray, steps: int, dt: float, p0: np.ndarray) -> np.ndarray:
+    """Variance of the 9 navigation states after each of ``steps`` steps of the linear model
+    ẋ = Fx + w (no measurement) with the (F, Q_c) of every step (or one for all), exactly
+    (Van Loan) discretised: the covariance analysis of
+    :class:`atomnav.filter.analysis.Scenario`. P₀ may be singular (the INS starts at the
+    truth)."""
+    n = p0.shape[0]
+    scenario = Scenario(f, qc, np.full(steps, dt), p0, np.zeros((0, n)), np.zeros((0, 0)), [False] * (steps + 1))
+    return covariance_analysis(scenario).to_numpy()[1:, 1:10] ** 2
 
 
-def _with_poles(f, column: int, sigma: np.ndarray, tau: np.ndarray):
-    """(F, Q_c) of every step of the navigation states driven by Gauss–Markov poles (σ, τ)
-    that enter where the bias state ``column`` does, without white noise; built one step at
-    a time."""
+def _with_poles(f: np.ndarray, column: int, sigma: np.ndarray, tau: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(F, Q_c) of each model ``f`` of the navigation states driven by Gauss–Markov poles
+    (σ, τ) that enter where the bias state ``column`` does, without white noise."""
     n = f.shape[1] + len(tau)
-    qa = np.zeros((n, n))
-    qa[15:, 15:] = np.diag(2.0 * sigma**2 / tau)
-    for fk in f:
-        fa = np.zeros((n, n))
-        fa[:15, :15] = fk
-        fa[:15, 15:] = fk[:, column][:, None]
-        fa[15:, 15:] = np.diag(-1.0 / tau)
-        yield fa, qa
+    fa = np.zeros((len(f), n, n))
+    fa[:, :15, :15] = f
+    fa[:, :15, 15:] = f[:, :, column][:, :, None]
+    fa[:, 15:, 15:] = np.diag(-1.0 / tau)
+    qa = np.zeros((len(f), n, n))
+    qa[:, 15:, 15:] = np.diag(2.0 * sigma**2 / tau)
+    return fa, qa
 
 
 def _strapdown_free_covariance(*, imu="tactical", duration=600.0, motion="stationary", rate_hz=100.0, checkpoint_s=60.0,
@@ -164,7 +151,8 @@ def _strapdown_free_covariance(*, imu="tactical", duration=600.0, motion="statio
     independent of the rest: each sensor axis runs as its own linear system, the navigation
     states augmented with that axis's poles (stationary start), and the covariances add.
     The steps are at most :data:`ANALYSIS_STEP_S` long, the model taken at the middle of
-    each and discretised exactly (Van Loan); at rest the model is constant.
+    each and discretised exactly (Van Loan); at rest the model is constant. The covariance
+    loop is :func:`atomnav.filter.analysis.covariance_analysis`.
 
     Parameters
     ----------
@@ -197,18 +185,21 @@ def _strapdown_free_covariance(*, imu="tactical", duration=600.0, motion="statio
     f, qc = ins_error_model(mid.lla[at], mid.vel_ned[at], mid.q_nb[at], rates[[f"accel_{x}_mps2" for x in "xyz"]].to_numpy()[at],
                             gyro_psd=g.white**2, accel_psd=a.white**2,
                             gyro_bias=BiasModel("random_walk", psd=g.bias_rw**2), accel_bias=BiasModel("random_walk", psd=a.bias_rw**2))
+    steps = len(f)
+    if np.all(f == f[0]) and np.all(qc == qc[0]):  # at rest: one model for every step
+        f, qc = f[:1], qc[:1]
     p0 = np.zeros((15, 15))
     for name, triad in (("accel", a), ("gyro", g)):
         b = np.asarray(triad.bias, dtype=float)
         p0[_BIAS_STATES[name], _BIAS_STATES[name]] = np.diag(np.full(3, triad.bias_sigma**2)) + np.outer(b, b)
-    var = _variances(zip(f, qc), step, p0)[:, :9]
+    var = _variances(f, qc, steps, step, p0)
     for name, triad in (("accel", a), ("gyro", g)):
         poles = _poles(triad)
         if poles:
             sigma, tau = np.array(poles).T
             for axis in range(3):  # each axis's poles start stationary, independent of the rest
                 pa = np.diag(np.r_[np.zeros(15), sigma**2])
-                var += _variances(_with_poles(f, _BIAS_STATES[name].start + axis, sigma, tau), step, pa)[:, :9]
+                var += _variances(*_with_poles(f, _BIAS_STATES[name].start + axis, sigma, tau), steps, step, pa)
     var = var[sub - 1::sub]
     return _table(times, (np.sqrt(var[:, s].sum(axis=1)) for s in (slice(0, 3), slice(0, 2), slice(3, 6), slice(6, 9))))
 

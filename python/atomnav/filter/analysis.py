@@ -26,14 +26,19 @@ class Scenario:
 
     Parameters
     ----------
-    f : array_like (N, n, n)
-        Continuous system matrices F_k per step, 1/s.
-    qc : array_like (N, n, n)
-        Continuous process-noise PSDs Q_c,k per step, squared state units per s.
+    f : array_like (N, n, n) or (1, n, n)
+        Continuous system matrices F_k per step, 1/s, or one F for every step (a
+        time-invariant system).
+    qc : array_like (N, n, n) or (1, n, n)
+        Continuous process-noise PSDs Q_c,k per step, squared state units per s, or one
+        for every step (as many as ``f``).
     dt : array_like (N,)
         Step lengths, s.
     p0 : array_like (n, n)
-        Initial covariance P₀, squared state units.
+        Initial covariance P₀, squared state units: positive semi-definite, so singular
+        (e.g. an INS started at the truth) for :func:`covariance_analysis` and
+        :func:`true_error_analysis`; :func:`monte_carlo`, whose filter and NEES invert
+        P, needs it positive definite.
     h : array_like (m, n)
         Measurement matrix H.
     r : array_like (m, m)
@@ -379,11 +384,13 @@ def monte_carlo(scenario: Scenario, runs: int, seed: int, mode: str = "closed", 
     TypeError
         ``timeout`` is not a number or None, or ``client`` not a Dask client.
     atomnav.InputError
-        Naming ``runs``, ``seed``, ``chunk``, ``retries`` or ``timeout``.
+        Naming ``runs``, ``seed``, ``chunk``, ``retries`` or ``timeout``, or ``p0`` when
+        the scenario's P₀ is singular.
     """
     runs, seed = integer(runs, "runs", 1, 2**32), integer(seed, "seed", 0, 2**64 - 1)
     chunk, retries = integer(chunk, "chunk", 1, 2**32), integer(retries, "retries", 0, 1000)
     ids = list(range(runs))
+    _runs(scenario, seed, [], mode)  # no run: the core's checks (a positive definite P₀) before any is sent
     if client is None:
         return _result(scenario, ids, [_runs(scenario, seed, ids, mode)])
     groups = [ids[i:i + chunk] for i in range(0, len(ids), chunk)]
