@@ -11,14 +11,15 @@ The format (TOML; YAML takes the same keys and nesting)::
     output = "results"        # results folder, relative to this file's folder (default: that folder)
 
     [grid]                    # every combination, last key fastest ...
-    T = [0.01, 0.02, 0.05]
-    lever_arm_m = [[0.0, 0.0, 0.1], [0.0, 0.0, 0.3]]
+    T = [0.01, 0.02, 0.025]
+    shot_rate = [0.0, 5.0]    # Hz (0: one shot per 2T)
 
     # ... or [points]: lists of equal length, point i takes the i-th value of each,
     # or [[points]] tables, one per point. One of [grid] and [points], not both.
 
     [fixed]                   # parameters shared by every point
-    duration_s = 600.0
+    imu = "navigation"
+    lever = 0.1
 
     [executor]                # optional; the command line's --workers / --scheduler win
     workers = 2               # a LocalCluster of 2 single-threaded worker processes ...
