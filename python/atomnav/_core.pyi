@@ -37,6 +37,8 @@ class AstroScenario:
 
 CAI_JACOBIAN_PARAMS: list[str]
 
+CAI_STENCIL_PAD: int
+
 CAI_TERMS: list[str]
 
 class CaiChannels:
@@ -295,6 +297,8 @@ def gnss_source(eph, time, sat, channel, code, rate, options): ...
 def gnss_spp(eph, time, sat, channel, code, rate, options, *, code2=None): ...
 
 def imu_flicker_allan_floor(b): ...
+
+def imu_flicker_poles(b, f_lo, f_hi): ...
 
 def imu_flicker_psd(b, f): ...
 
