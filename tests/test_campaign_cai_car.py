@@ -180,10 +180,74 @@ def test_filter_follows_the_imu_grade():
     assert s.predict_every == 4 and cfg.sensor.shot_period == 0.02
 
 
+def _flicker_start_variance(fl) -> float:
+    """Variance at the start of the simulated flicker, from the construction :mod:`atomnav.imu`
+    documents: Gauss–Markov poles 2 per decade over [f_lo, f_hi] and 3 past each edge, all
+    of one σ, started stationary. Poles log-spaced by r sum to the one-sided PSD
+    Σ 4σ²τᵢ/(1 + (2πfτᵢ)²) ≈ (4σ²/ln r) ∫ τ/(1 + (2πfτ)²) d ln τ = σ²/(f ln r), which is
+    B²/(πf) for σ² = B² ln r/π, r = √10."""
+    poles = round(2 * np.log10(fl.f_hi / fl.f_lo)) + 1 + 2 * 3
+    return poles * fl.b**2 * np.log(np.sqrt(10.0)) / np.pi
+
+
+@pytest.mark.parametrize("grade", ["tactical", "mems"])
+def test_grades_beyond_the_linear_model_run_with_the_filter_mapped_from_the_grade(grade):
+    """The filter's bias model (random constant + random walk) for a grade with terms it
+    lacks, computed here from the preset's numbers: initial variance = turn-on σ² + largest
+    fixed bias² + flicker variance at the start; random-walk PSD = K² + the random walk
+    whose Allan variance K²τ/3 meets the flicker floor (2 ln 2/π) B² at τ = 40 s (IEEE Std
+    952-1997, Annex C)."""
+    errors = ImuErrors.preset(grade)
+    s = _configuration(_points(0.025, 0.0, grade, 0.0, "earth", True, 1.0, 5.0)).setup
+    for triad, sigma0, psd in ((errors.accel, s.sigma0[3], s.accel_bias_psd), (errors.gyro, s.sigma0[4], s.gyro_bias_psd)):
+        var0, rw = triad.bias_sigma**2 + max(abs(b) for b in triad.bias) ** 2, triad.bias_rw**2
+        if triad.flicker is not None:
+            var0 += _flicker_start_variance(triad.flicker)
+            rw += 3 * (2 * np.log(2) / np.pi) * triad.flicker.b**2 / 40.0
+        assert np.isclose(sigma0, np.sqrt(var0), rtol=1e-12, atol=0) and np.isclose(psd, rw, rtol=1e-12, atol=0), (sigma0, psd)
+    assert (s.accel_psd, s.gyro_psd) == (errors.accel.white**2, errors.gyro.white**2)
+    # the preset's terms as the mapping must see them (a silent change of a preset shows here)
+    assert (errors.accel.flicker is not None) == (grade == "tactical") and (np.any(errors.accel.bias)) == (grade == "mems")
+    # deterministic: the same seed gives the same table, another seed another
+    first = cai_car(seed=3, imu=grade)
+    pd.testing.assert_frame_equal(first, cai_car(seed=3, imu=grade), check_exact=True)
+    assert not first.equals(cai_car(seed=4, imu=grade))
+    assert list(first.columns) == ["time_s", *COLUMNS] and np.isfinite(first[COLUMNS].to_numpy()).all()
+
+
+def test_gauss_markov_term_maps_to_initial_sigma_and_driving_psd(monkeypatch):
+    from atomnav import imu
+    from atomnav.imu import GaussMarkov
+
+    grade = ImuErrors.preset("navigation")
+    grade.accel.gauss_markov = GaussMarkov(3e-5, 20.0)
+    monkeypatch.setitem(imu._USER_PRESETS, "navigation_gm", grade)
+    s = _configuration(_points(0.025, 0.0, "navigation_gm", 0.0, "earth", True, 1.0, 5.0)).setup
+    assert np.isclose(s.sigma0[3], np.hypot(2e-5, 3e-5), rtol=1e-12, atol=0)
+    assert np.isclose(s.accel_bias_psd, 3e-5**2 + 2 * 3e-5**2 / 20.0, rtol=1e-12, atol=0)
+    assert (s.sigma0[4], s.gyro_bias_psd) == (grade.gyro.bias_sigma, grade.gyro.bias_rw**2)
+
+
+def test_tactical_hybrid_stays_bounded_beside_the_free_ins():
+    """At T = 25 ms the tactical grade's phase error is ≈ 100 rad (turn-on bias 1 mg,
+    k T² = 1.0e4 rad/(m/s²)): the CAI's sine readout carries almost nothing, the filter's R
+    (inflated by the in-shot white noise) keeps its gain small, and the hybrid follows the
+    free INS of the same IMU. Measured over 8 seeds, RMS at 40 s hybrid / free: position
+    14.12 / 14.10 m, velocity 0.664 / 0.663 m/s, attitude 5.5e-4 / 5.5e-4 rad (30 seeds,
+    T = 5–25 ms: 1.00–1.02 ×). Only finiteness is asserted: nothing guarantees that a
+    suboptimal filter whose readout slips fringes beats the free INS."""
+    key = _points(0.025, 0.0, "tactical", 0.0, "earth", True, 1.0, 5.0)
+    run = _core_scenario(key).monte_carlo(0, list(range(8)))
+    assert abs(np.asarray(run["time"])[-1] - 40.0) < 1e-9
+    hybrid, free = (np.asarray(run[k])[:, -1] for k in ("hybrid", "free"))
+    rms = {k: [np.sqrt((np.linalg.norm(e[:, 3 * i:3 * i + 3], axis=1) ** 2).mean()) for i in range(3)] for k, e in (("hybrid", hybrid), ("free", free))}
+    print("RMS at 40 s (pos m, vel m/s, att rad):", rms)
+    assert np.isfinite(np.asarray(run["hybrid"])).all() and np.isfinite(np.asarray(run["free"])).all()
+
+
 BAD = {
     "unknown grade": (dict(imu="strategic"), "imu"),
-    "grade with flicker": (dict(imu="tactical"), "imu"),
-    "grade with fixed biases": (dict(imu="mems"), "imu"),
+    "grade without gyro errors": (dict(imu="electrostatic_space"), "imu"),
     "shot rate above 1/(2T)": (dict(T=0.025, shot_rate=20.5), "shot_rate"),
     "negative shot rate": (dict(shot_rate=-1.0), "shot_rate"),
     "infinite shot rate": (dict(shot_rate=float("inf")), "shot_rate"),
@@ -207,6 +271,27 @@ def test_bad_input_names_the_parameter(case, call):
     with pytest.raises(an.InputError) as e:
         fn(**params)
     assert e.value.parameter == name, str(e.value)
+
+
+@pytest.mark.parametrize("imu", ["tactical", "mems"])
+def test_predictor_refuses_a_grade_beyond_its_linear_model_and_points_to_the_monte_carlo(imu):
+    # tactical: flicker; mems: fixed biases. The run takes them (test_grades_beyond_the_linear_model_run)
+    with pytest.raises(an.InputError, match="monte_carlo") as e:
+        cai_car.predict(imu=imu)
+    assert e.value.parameter == "imu", str(e.value)
+
+
+def test_grade_with_a_flicker_band_beyond_nyquist_names_imu(monkeypatch):
+    from atomnav import imu
+    from atomnav.imu import Flicker
+
+    fast = ImuErrors.preset("navigation")
+    fast.accel.flicker = Flicker(1e-5, 1e-3, 150.0)  # valid at 400 Hz and above, not at the car's 200 Hz
+    monkeypatch.setitem(imu._USER_PRESETS, "navigation_fast_flicker", fast)
+    for fn in (cai_car, cai_car.predict):
+        with pytest.raises(an.InputError, match="200 Hz") as e:
+            fn(imu="navigation_fast_flicker")
+        assert e.value.parameter == "imu", str(e.value)
 
 
 @pytest.mark.parametrize("params", [dict(vibration="yes"), dict(imu=3), dict(gravity=None)], ids=["vibration", "imu", "gravity"])

@@ -19,7 +19,7 @@ from ..cai.campaign import _scenario
 from ..cai.predictor import K_RB87, Channels
 from ..cai.scenarios import GRAVITY_OPTIONS, HANNOVER, ScenarioConfig, _cai_error_model
 from ..cai.sensor import CaiSensor, FilterSetup
-from ..imu import ImuErrors, TriadErrors, preset_names
+from ..imu import ImuErrors, ImuSimulator, TriadErrors, flicker_allan_floor, preset_names
 from ..plausibility import UnitWarning
 from .scenario import predicted_by
 
@@ -46,12 +46,27 @@ SHOT_PAD = _core.CAI_STENCIL_PAD
 _COLUMNS = ("pos_error_m", "vel_error_mps", "att_error_rad")
 
 
-def _linear_grade(imu) -> ImuErrors:
-    """The preset ``imu`` if its errors are those the linear analysis carries: a random
-    turn-on bias, white noise and a bias random walk per triad."""
+def _grade(imu) -> ImuErrors:
+    """The preset ``imu``, checked at the car's IMU rate :data:`RATE_HZ` (its flicker
+    bands below the Nyquist frequency)."""
     if not isinstance(imu, str):
         raise TypeError(f"imu: expected an IMU preset name (str), got {type(imu).__name__}")
     errors = ImuErrors.preset(choice(imu, preset_names(), "imu"))
+    try:
+        ImuSimulator(errors, 1.0 / RATE_HZ, "rates")
+    except _core.InputError as e:
+        raise input_error("imu", f"preset {imu!r} cannot be simulated at the car's {RATE_HZ:g} Hz: {e}") from None
+    for name in ("accel", "gyro"):
+        if _bias_model(getattr(errors, name))[0] == 0.0:
+            raise input_error("imu", f"preset {imu!r} has no bias in its {name} triad: the filter's {name} bias state would start "
+                                     "with σ = 0, a singular initial covariance the aided INS cannot start from")
+    return errors
+
+
+def _linear_grade(imu: str) -> None:
+    """Refuse, naming ``imu``, a preset with errors the linear analysis does not carry: it
+    carries a random turn-on bias, white noise and a bias random walk per triad."""
+    errors = ImuErrors.preset(imu)
     for name in ("accel", "gyro"):
         triad = getattr(errors, name)
         extra = [term for term, present in (("a fixed bias", np.any(np.asarray(triad.bias) != 0)),
@@ -61,8 +76,41 @@ def _linear_grade(imu) -> ImuErrors:
                                              ("a flicker term", triad.flicker is not None)) if present]
         if extra:
             raise input_error("imu", f"preset {imu!r} has {', '.join(extra)} in its {name} triad; the linear analysis of this scenario "
-                                     "carries only a random turn-on bias, white noise and a bias random walk")
-    return errors
+                                     "carries only a random turn-on bias, white noise and a bias random walk. For this grade "
+                                     "use the Monte Carlo: cai_car runs, sweep(cai_car, points, method=\"monte_carlo\", ...) "
+                                     "or atomnav.campaign.run")
+
+
+def _bias_model(triad: TriadErrors) -> tuple[float, float]:
+    """The filter's model of the biases of one triad, a random constant plus a random walk:
+    its initial σ (m/s² or rad/s) and random-walk PSD (m²/s⁵ or rad²/s³).
+
+    Second moments add over the triad's terms. Initial variance: the turn-on σ², the
+    largest fixed bias² of the three axes (a bias the filter does not know is to it a draw
+    of that second moment; its σ is one for all axes), the Gauss–Markov σ² and the
+    flicker's variance at the start, Σσᵢ² over the Gauss–Markov poles the simulator sums
+    it from, each started stationary (:mod:`atomnav.imu`). Random-walk PSD: the triad's
+    K², the Gauss–Markov driving PSD 2σ²/τ and, for flicker of bias instability B
+    (one-sided PSD B²/(πf)), the random walk equivalent to its bias instability over the
+    profile: the Allan variance of B²/(πf) is flat at (2 ln 2/π) B² for 1/f_hi ≪ τ ≪
+    1/f_lo, that of a rate random walk of PSD K² is K² τ/3 (IEEE Std 952-1997, Annex C;
+    El-Sheimy et al. 2008), and they meet at the profile's length
+    :data:`DURATION_S` for K² = 3 (2 ln 2/π) B² / DURATION_S. Within the profile that
+    random walk wanders no further than the flicker in the Allan sense (its Allan
+    deviation rises as √τ to the floor), while the flicker's level, the slow poles that
+    stay put for the whole drive, is in the initial σ. Scale-factor and misalignment
+    errors are not modelled.
+    """
+    gm, fl = triad._terms("imu")
+    var0 = triad.bias_sigma**2 + float(np.max(np.abs(triad.bias))) ** 2
+    psd = triad.bias_rw**2
+    if gm is not None:
+        var0 += gm.sigma**2
+        psd += 2.0 * gm.sigma**2 / gm.tau
+    if fl is not None and fl.b > 0:
+        var0 += sum(sigma**2 for sigma, _ in _core.imu_flicker_poles(fl.b, fl.f_lo, fl.f_hi))
+        psd += 3.0 * flicker_allan_floor(fl.b) ** 2 / DURATION_S
+    return float(np.sqrt(var0)), float(psd)
 
 
 def _points(T, shot_rate, imu, lever, gravity, vibration, contrast, checkpoint_s) -> tuple:
@@ -86,7 +134,7 @@ def _points(T, shot_rate, imu, lever, gravity, vibration, contrast, checkpoint_s
         raise input_error("shot_rate", f"the shot period 1/shot_rate = {period:g} s must be a whole number of filter steps 2T = {2 * T:g} s: the "
                                        "filter updates at the first IMU sample at or after a shot's end, and one ending between its steps "
                                        "adds an epoch there and shifts every later step")
-    errors = _linear_grade(imu)
+    errors = _grade(imu)
     contrast = scalar(contrast, "contrast")
     if not 0.0 < contrast <= 1.0:
         raise input_error("contrast", f"must be in (0, 1], got {contrast}")
@@ -104,7 +152,8 @@ def _configuration(key: tuple) -> ScenarioConfig:
     q = (accel.white**2, gyro.white**2)
     sensor = CaiSensor(Channels.cyclic(K_RB87, V0_MPS, lever=(0.0, 0.0, lever)), T, shot_period=period, contrast=contrast, inflation=q,
                        interpolation="cubic", omega_dot="pwl")
-    setup = FilterSetup(*q, accel.bias_rw**2, gyro.bias_rw**2, steps, sigma0=(*NAV_SIGMA0, accel.bias_sigma, gyro.bias_sigma))
+    (sigma_a, psd_a), (sigma_g, psd_g) = _bias_model(accel), _bias_model(gyro)
+    setup = FilterSetup(*q, psd_a, psd_g, steps, sigma0=(*NAV_SIGMA0, sigma_a, sigma_g))
     imu = ImuErrors(accel, gyro)
     return ScenarioConfig(sensor, setup, imu=imu, gravity=gravity, rate_hz=RATE_HZ)
 
@@ -268,7 +317,9 @@ def _cai_car_covariance(*, T=0.025, shot_rate=0.0, imu="navigation", lever=0.0, 
     Raises
     ------
     atomnav.InputError
-        As for :func:`cai_car`.
+        As for :func:`cai_car`, and naming ``imu`` for a grade with errors the linear
+        analysis does not carry (fixed bias, scale factor, misalignment, Gauss–Markov or
+        flicker terms: ``tactical``, ``mems``); its Monte Carlo runs.
 
     Warns
     -----
@@ -281,6 +332,7 @@ def _cai_car_covariance(*, T=0.025, shot_rate=0.0, imu="navigation", lever=0.0, 
     from ..filter.analysis import true_error_analysis
 
     key = _points(T, shot_rate, imu, lever, gravity, vibration, contrast, checkpoint_s)
+    _linear_grade(imu)
     lin = _linear_model(key)
     f, qc, h, r, r_true, cross = lin.model
     setup = lin.config.setup
@@ -305,7 +357,14 @@ def cai_car(*, seed=0, T=0.025, shot_rate=0.0, imu="navigation", lever=0.0, grav
 
     The filter follows the IMU grade: its white-noise and bias random-walk PSDs are the
     grade's, its initial bias σ the grade's turn-on bias σ, and the CAI's R is inflated by
-    the grade's in-shot white noise (Tennstedt et al. 2021, §2.4). The run starts at the
+    the grade's in-shot white noise (Tennstedt et al. 2021, §2.4). A grade with terms the
+    filter's bias model (a random constant plus a random walk) lacks runs with a filter
+    that approximates them: a fixed bias and a Gauss–Markov σ widen the initial bias σ, a
+    Gauss–Markov term adds its driving PSD 2σ²/τ to the random walk, a flicker term its
+    level at the start to the initial σ and the random walk equivalent to its bias
+    instability over the 40 s profile (IEEE Std 952-1997; El-Sheimy et al. 2008);
+    scale-factor and misalignment errors are not modelled. Such a grade has no covariance
+    prediction (``cai_car.predict`` refuses it). The run starts at the
     truth. The built scenario (truth, ideal IMU, true phases) is kept for the last few
     parameter points, so consecutive seeds of one point build it once; a run is the same
     bit for bit either way.
@@ -320,12 +379,19 @@ def cai_car(*, seed=0, T=0.025, shot_rate=0.0, imu="navigation", lever=0.0, grav
         Shots per second (Hz), at most 1/(2T), the shot period 1/shot_rate a whole number
         of filter steps 2T; 0: one shot per 2T, the most there can be.
     imu : str
-        IMU grade, an :meth:`atomnav.imu.ImuErrors.preset` name whose errors are a random
+        IMU grade, an :meth:`atomnav.imu.ImuErrors.preset` name (:func:`atomnav.imu.preset_names`)
+        with a bias in each triad that can be simulated at 200 Hz: every built-in grade
+        but the satellite accelerometers ``electrostatic_space`` and
+        ``electrostatic_space_drift`` (no gyro errors: the filter's gyro-bias state would
+        start with σ = 0). The predictor takes only the grades whose errors are a random
         turn-on bias, white noise and a bias random walk (``navigation``, ``precise``,
         ``medium``, ``coarse``). The CAI's capture range is ±π/2 of phase: the turn-on
         accelerometer bias σ_b gives a phase σ of k T² σ_b (0.20 rad for ``navigation`` at
         T = 25 ms, 2.0 rad for ``precise``), so the coarser grades slip fringes at all but
-        the shortest T.
+        the shortest T. For ``tactical`` the phase error is 6 rad RMS even at T = 5 ms and
+        the hybrid follows the free INS (RMS position error at 40 s 1.00–1.02 × the free
+        INS's 13.2 m, 30 seeds, T = 5–25 ms); ``mems`` is aided at T = 5 ms (0.32 m against
+        6.7 m free) and slips fringes beyond (T = 10 ms: 1.23 ×).
     lever : float
         IMU → release-point lever arm along the body z axis (m); its Euler phase
         k T² l ω̇ must be predicted from the 200 Hz gyro under the profile's 15.1 Hz
@@ -353,9 +419,9 @@ def cai_car(*, seed=0, T=0.025, shot_rate=0.0, imu="navigation", lever=0.0, grav
     ------
     atomnav.InputError
         Naming ``seed``, ``T``, ``shot_rate`` (above 1/(2T), or its period off the 2T
-        steps), ``imu`` (unknown, or with
-        errors the linear analysis does not carry), ``lever``, ``gravity``, ``vibration``,
-        ``contrast`` or ``checkpoint_s``.
+        steps), ``imu`` (unknown, a flicker band beyond the 100 Hz Nyquist frequency, or
+        a triad without bias), ``lever``, ``gravity``, ``vibration``, ``contrast`` or
+        ``checkpoint_s``.
 
     Notes
     -----
@@ -366,7 +432,10 @@ def cai_car(*, seed=0, T=0.025, shot_rate=0.0, imu="navigation", lever=0.0, grav
     Tennstedt, B., Rajagopalan, A., Weddig, N. B., Abend, S., Schön, S., Rasel, E. M.
     (2023). Atom Strapdown: toward integrated quantum inertial navigation systems.
     NAVIGATION 70(4), §2.8. Tennstedt, B., Weddig, N., Schön, S. (2021). Improved inertial
-    navigation with cold atom interferometry. Gyroscopy and Navigation, §2.4.
+    navigation with cold atom interferometry. Gyroscopy and Navigation, §2.4. IEEE Std
+    952-1997, Annex C (Allan variance of the noise terms). El-Sheimy, N., Hou, H., Niu, X.
+    (2008). Analysis and modeling of inertial sensors using Allan variance. IEEE Trans.
+    Instrum. Meas. 57(1).
 
     Examples
     --------
