@@ -462,7 +462,8 @@ def test_the_docs_images_script_runs_and_keeps_each_image_small(tmp_path, monkey
     monkeypatch.setattr(script, "OUT", tmp_path)
     script.main()
     images = sorted(p.name for p in tmp_path.iterdir())
-    assert images == [f"plots_{n}.png" for n in ("allan", "consistency", "errors", "imu_errors", "spp", "trajectory")]
+    assert images == [f"plots_{n}.png" for n in ("allan", "campaign_error_map", "campaign_error_vs_parameter", "campaign_throughput",
+                                                 "consistency", "errors", "imu_errors", "spp", "trajectory")]
     assert max(p.stat().st_size for p in tmp_path.iterdir()) < 100_000
 
 

@@ -42,12 +42,12 @@ def _scenario_path(scenario: Callable) -> str:
     return f"{scenario.__module__}:{scenario.__qualname__}"
 
 
-def import_scenario(path: str) -> Callable:
+def import_scenario(scenario: str) -> Callable:
     """The scenario function named ``module:qualname``.
 
     Parameters
     ----------
-    path : str
+    scenario : str
         ``"package.module:function"``.
 
     Returns
@@ -60,15 +60,15 @@ def import_scenario(path: str) -> Callable:
     atomnav.InputError
         The module or the function cannot be found (``parameter`` is "scenario").
     """
-    module, _, qualname = instance(path, str, "scenario").partition(":")
+    module, _, qualname = instance(scenario, str, "scenario").partition(":")
     try:
         obj = importlib.import_module(module)
         for part in qualname.split("."):
             obj = getattr(obj, part)
     except (ImportError, AttributeError, ValueError) as e:
-        raise input_error("scenario", f"cannot import {path!r} ({e})") from None
+        raise input_error("scenario", f"cannot import {scenario!r} ({e})") from None
     if not callable(obj):
-        raise input_error("scenario", f"{path!r} is not a function")
+        raise input_error("scenario", f"{scenario!r} is not a function")
     return obj
 
 
