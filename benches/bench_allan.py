@@ -10,7 +10,7 @@ import numpy as np
 
 from atomnav import _core
 from atomnav.noise import allan, filters
-from timing import best_of
+from timing import best_of, record
 
 
 
@@ -27,10 +27,15 @@ def main(n: int = 10_000_000) -> None:
     print(f"  allantools.oadev          {t_peer:8.3f} s")
     print(f"  atomnav core (_core)      {t_core:8.3f} s   ratio {t_peer / t_core:6.1f}x")
     print(f"  atomnav.noise.allan (+EDF/CI table) {t_api:8.3f} s   ratio {t_peer / t_api:6.1f}x")
+    record(f"overlapping ADEV, {n:.0e} samples, octave tau (core)", "allantools.oadev", t_peer / t_core,
+           note=f"max relative difference to the peer {rel:.1e}")
+    record(f"overlapping ADEV, {n:.0e} samples, octave tau (with EDF/CI table)", "allantools.oadev", t_peer / t_api,
+           note=f"max relative difference to the peer {rel:.1e}")
     model = filters.ArimaStateSpace.paper()
     for name, kw in [("fixed", {}), ("adaptive (differenced, Eq. 17)", {"adaptive": "differenced"})]:
         t_kf, _ = best_of(lambda: filters.kalman(y, model, record=False, **kw), 2)
         print(f"  Kalman {name:32s} {t_kf:8.3f} s for {n:.0e} samples ({t_kf / n * 1e9:.0f} ns/sample)")
+        record(f"ARIMA Kalman {name}, {n:.0e} samples", None, None, note=f"{t_kf / n * 1e9:.0f} ns/sample")
 
 
 if __name__ == "__main__":

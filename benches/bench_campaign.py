@@ -27,6 +27,9 @@ from pathlib import Path
 
 from atomnav import campaign
 
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from timing import record  # noqa: E402
+
 ROOT = Path(__file__).resolve().parents[1]
 POINTS = 4  # parameter points; runs / POINTS seeds each
 
@@ -93,6 +96,8 @@ def main():
     one, two = rows[2][3], rows[3][3]
     print(f"speed-up of 2 workers over 1: {one / two:.2f}x (goal >= 1.8x); "
           f"2 workers vs in process (1 thread): {rows[0][3] / two:.2f}x")
+    record(f"campaign of {plan.n_runs} {plan.name} runs", None, None,
+           note=f"2 workers over 1: {one / two:.2f}x (goal 1.8x); 2 workers {plan.n_runs / two:.1f} runs/s")
 
 
 if __name__ == "__main__":

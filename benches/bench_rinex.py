@@ -20,6 +20,7 @@ from __future__ import annotations
 import argparse
 import shutil
 import subprocess
+import sys
 import tempfile
 import time
 import warnings
@@ -30,6 +31,9 @@ import pandas as pd
 
 import atomnav as an
 from atomnav.gnss import rinex
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from timing import record  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]
 CONF = ROOT / "tests" / "data" / "rinex_stations" / "rtklib_spp_gps.conf"
@@ -69,8 +73,9 @@ def main():
             g2 = time.perf_counter()
         print(f"georinex: nav {g1 - s:.2f} s, obs {g2 - g1:.2f} s ({ds.time.size} epochs); "
               f"atomnav / georinex reading speed ratio {(g2 - s) / (t2 - t0):.0f}x")
+        record(f"RINEX reading, {obs.n_epochs} epochs", "georinex", (g2 - s) / (t2 - t0))
 
-    theirs = None
+    theirs, rt = None, None
     if shutil.which("rnx2rtkp"):
         with tempfile.TemporaryDirectory() as d:
             rnx = args.obs
@@ -92,6 +97,7 @@ def main():
     else:
         print("rnx2rtkp not installed (Debian: apt-get install rtklib): no side-by-side time")
 
+    e = r = None
     if args.truth:
         marker = np.array(args.truth)
         lla = an.earth.ecef_to_lla(marker)
@@ -101,6 +107,8 @@ def main():
         if theirs is not None:
             r = np.linalg.norm(theirs - arp, axis=1)
             print(f"RTKLIB 3-D error:  mean {r.mean():.2f} m, worst {r.max():.2f} m over {len(r)} epochs")
+    record(f"RINEX read + SPP, {n} epochs", None if rt is None else "RTKLIB rnx2rtkp", None if rt is None else rt / (t3 - t0),
+           None if e is None else e.mean(), None if r is None else r.mean(), "m mean 3-D error")
 
 
 if __name__ == "__main__":

@@ -17,7 +17,7 @@ import numpy as np
 import pandas as pd
 
 import atomnav as an
-from timing import best_of
+from timing import best_of, record
 
 
 
@@ -62,6 +62,8 @@ def main():
     print(f"atomnav : {n / t_an:12.0f} samples/s  ({t_an:.3f} s)  final position error {np.linalg.norm(d_an):.2e} m")
     print(f"pyins   : {n / t_py:12.0f} samples/s  ({t_py:.3f} s)  final position error {np.linalg.norm(d_py):.2e} m")
     print(f"ratio atomnav/pyins throughput: {t_py / t_an:.1f}x")
+    record(f"strapdown {args.hours:g} h at 100 Hz (increments)", "pyins", t_py / t_an, np.linalg.norm(d_an),
+           np.linalg.norm(d_py), "m final position error (ideal IMU)", note=f"atomnav {n / t_an:.3g} samples/s")
 
 
 if __name__ == "__main__":

@@ -26,7 +26,7 @@ from pathlib import Path
 import numpy as np
 
 import atomnav as an
-from timing import best_of
+from timing import best_of, record
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "examples"))
@@ -57,6 +57,8 @@ def synthetic(hours: float, repeat: int) -> None:
     print(f"\nsynthetic {hours:g} h at 100 Hz, 4 Hz fixes, {len(windows)} outages of 15 s: {n} samples in "
           f"{seconds:.2f} s = {n / seconds / 1e6:.2f} M samples/s (forward + smoother + scoring)")
     print(out.table.groupby("solution")[["max_error_m", "end_error_m"]].max().to_string())
+    record(f"synthetic {hours:g} h pipeline (tactical IMU, 15 s outages)", None, None, out.table["max_error_m"].max(),
+           unit="m largest outage error", note=f"{n / seconds / 1e6:.2f} M samples/s")
 
 
 def peer(path: Path, repeat: int, windows, reference) -> tuple[float, dict]:
@@ -100,12 +102,18 @@ def main():
     print(f"the recorded walk: {n} IMU samples in {seconds:.3f} s = {n / seconds / 1e6:.2f} M samples/s "
           "(read, align in motion, forward + smoother, score)")
     print(walk.outages.table.to_string(index=False))
+    ours = walk.outages.table["max_error_m"].max()
+    if args.peer is None:
+        record("recorded walk pipeline", None, None, ours, unit="m largest outage error",
+               note=f"{n / seconds / 1e6:.2f} M samples/s; peer needs --peer (rtklibexplorer/GNSS_IMU)")
     if args.peer is not None:
         times, tables = peer(args.peer, args.repeat, walk.outages.windows, walk.reference)
         for name, table in tables.items():
             print(f"\n{name}: {times[name]:.2f} s = {n / times[name] / 1e3:.1f} k samples/s; "
                   f"atomnav / peer speed ratio {times[name] / seconds:.0f}x")
             print(table.to_string(index=False))
+            record("recorded walk pipeline", f"GNSS_IMU ({name})", times[name] / seconds, ours,
+                   table["max_error_m"].max(), "m largest outage error")
     synthetic(args.hours, args.repeat)
 
 
