@@ -131,12 +131,24 @@ pub const MIN_TERMS: usize = 2;
 /// that is too large is an error naming its index; a named set of which no factor has
 /// enough terms is an error naming `data`.
 pub fn resolve_m(set: &TauSet, kind: Kind, data_type: DataType, np: &[usize]) -> Result<Vec<usize>> {
-    let terms = |m: usize| np.iter().map(|&p| kind.terms(p, m)).sum::<usize>();
+    let longest = np.iter().max().map_or(0, |p| p - usize::from(data_type == DataType::Rate));
+    resolve_factors(
+        set,
+        |m| np.iter().map(|&p| kind.terms(p, m)).sum::<usize>(),
+        |m, i, terms| kind.too_few_terms(data_type, m, i, terms),
+        &format!("the stretches between NaN samples are too short (at most {longest} samples)"),
+    )
+}
+
+/// The averaging factors of `set` that leave at least `MIN_TERMS` terms, `terms(m)`
+/// counting them: a user factor with fewer is the error `too_few(m, index, terms)`, a
+/// named set without any factor the error naming `data` with `why`. Ascending, no repeats.
+pub(crate) fn resolve_factors(set: &TauSet, terms: impl Fn(usize) -> usize, too_few: impl Fn(usize, usize, usize) -> NavError, why: &str) -> Result<Vec<usize>> {
     let ok = |m: usize| m >= 1 && terms(m) >= MIN_TERMS;
     let gen = |f: &dyn Fn(usize) -> usize| -> Result<Vec<usize>> {
         let ms: Vec<usize> = (0..).map(f).take_while(|&m| ok(m)).collect();
         match ms.is_empty() {
-            true => Err(invalid("data", format!("no averaging factor has {MIN_TERMS} terms: the stretches between NaN samples are too short (at most {} samples)", np.iter().max().map_or(0, |p| p - usize::from(data_type == DataType::Rate))))),
+            true => Err(invalid("data", format!("no averaging factor has {MIN_TERMS} terms: {why}"))),
             false => Ok(ms),
         }
     };
@@ -160,7 +172,7 @@ pub fn resolve_m(set: &TauSet, kind: Kind, data_type: DataType, np: &[usize]) ->
                     return Err(invalid_at("m", i, format!("averaging factor 0 at index {i}; τ must be ≥ τ₀")));
                 }
                 if !ok(m) {
-                    return Err(kind.too_few_terms(data_type, m, i, terms(m)));
+                    return Err(too_few(m, i, terms(m)));
                 }
             }
             let mut v = ms.clone();
@@ -276,7 +288,7 @@ unsafe fn sum_sq_avx2<const K: usize>(s: [&[f64]; K], c: [f64; K]) -> f64 {
     sum_sq_impl(s, c)
 }
 
-fn sum_sq<const K: usize>(s: [&[f64]; K], c: [f64; K]) -> f64 {
+pub(crate) fn sum_sq<const K: usize>(s: [&[f64]; K], c: [f64; K]) -> f64 {
     #[cfg(target_arch = "x86_64")]
     if std::arch::is_x86_feature_detected!("avx2") {
         // SAFETY: the CPU supports AVX2 (checked just above).
@@ -414,6 +426,16 @@ pub fn variance(data: &[f64], tau0: f64, data_type: DataType, kind: Kind, set: &
         n,
         missing,
     };
+    check_overflow(&res)?;
+    Ok(res)
+}
+
+/// Time variance σ²_x(τ) = τ²/3 · MVAR(τ) (NIST SP 1065 §5.2.6): the modified Allan
+/// variance of [`variance`] scaled, in (phase unit)² for phase data and (rate unit · s)²
+/// for rate data; the terms, gaps and τ set are those of the modified Allan variance.
+pub fn time_variance(data: &[f64], tau0: f64, data_type: DataType, set: &TauSet) -> Result<AllanResult> {
+    let mut res = variance(data, tau0, data_type, Kind::Modified, set)?;
+    res.var.iter_mut().zip(&res.tau).for_each(|(v, t)| *v *= t * t / 3.0);
     check_overflow(&res)?;
     Ok(res)
 }

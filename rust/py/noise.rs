@@ -1,4 +1,5 @@
-//! Bindings of noise/: Allan family (batch, streaming, EDF, five-term fit), NNLS, ARIMA
+//! Bindings of noise/: Allan family (batch, streaming, EDF, five-term fit), time
+//! variance and time interval error, NNLS, ARIMA
 //! state space and the Kalman filters (batch, streaming, steady state).
 
 use super::convert::{counts, flags, flat_to_py, index_count, mat, mat_to_py, real, real_opt, register_choices, set_floats, vec_to_py, vector, Wrap};
@@ -6,6 +7,7 @@ use crate::error::invalid;
 use crate::noise::allan::{self, AllanResult, AllanStream, DataType, Kind, NoiseType, TauGrid, TauSet};
 use crate::noise::arma_filter::{self, Adaptive, ArimaStateSpace, ArmaFilterConfig, FilterOutput, Kalman, NoiseForm, X0, MAX_DIM};
 use crate::noise::nnls::nnls;
+use crate::noise::time_error;
 use nalgebra::DVector;
 use numpy::{IntoPyArray, PyArray1, PyArray2, PyReadonlyArray1, PyReadonlyArray2};
 use pyo3::prelude::*;
@@ -31,13 +33,41 @@ fn allan_var<'py>(
     set: Wrap<TauGrid>,
     m: Option<Bound<'py, PyAny>>,
 ) -> PyResult<AllanArrays<'py>> {
-    let ts = match m {
-        Some(m) => TauSet::List(counts(&m, "m", 1, usize::MAX)?),
-        None => set.0.into(),
-    };
+    let ts = tau_set(set, m)?;
     let x = data.as_slice().map_err(|_| invalid("data", "array must be C-contiguous"))?;
     let r = py.detach(|| allan::variance(x, tau0, data_type.0, kind.0, &ts))?;
     Ok(result_to_py(py, r))
+}
+
+/// The τ set of a binding: the factors `m` when given, else the named grid `set`.
+fn tau_set(set: Wrap<TauGrid>, m: Option<Bound<'_, PyAny>>) -> PyResult<TauSet> {
+    Ok(match m {
+        Some(m) => TauSet::List(counts(&m, "m", 1, usize::MAX)?),
+        None => set.0.into(),
+    })
+}
+
+/// Time variance τ²/3 · MVAR at the named τ grid `set`, or at the factors `m`:
+/// returns (m, tau_s, var, n_terms, missing samples).
+#[pyfunction]
+#[pyo3(signature = (data, tau0, data_type=Wrap(DataType::Phase), set=Wrap(TauGrid::Octave), m=None))]
+fn time_var<'py>(py: Python<'py>, data: PyReadonlyArray1<'py, f64>, #[pyo3(from_py_with = real)] tau0: f64, data_type: Wrap<DataType>, set: Wrap<TauGrid>, m: Option<Bound<'py, PyAny>>) -> PyResult<AllanArrays<'py>> {
+    let ts = tau_set(set, m)?;
+    let x = data.as_slice().map_err(|_| invalid("data", "array must be C-contiguous"))?;
+    let r = py.detach(|| allan::time_variance(x, tau0, data_type.0, &ts))?;
+    Ok(result_to_py(py, r))
+}
+
+/// MTIE and TIE rms of phase data at the named τ grid `set`, or at the factors `m`:
+/// returns (m, tau_s, mtie, tie_rms, n_windows).
+#[pyfunction]
+#[pyo3(signature = (data, tau0, set=Wrap(TauGrid::Octave), m=None))]
+#[allow(clippy::type_complexity)]
+fn time_interval_error<'py>(py: Python<'py>, data: PyReadonlyArray1<'py, f64>, #[pyo3(from_py_with = real)] tau0: f64, set: Wrap<TauGrid>, m: Option<Bound<'py, PyAny>>) -> PyResult<(Bound<'py, PyArray1<usize>>, Arr<'py>, Arr<'py>, Arr<'py>, Bound<'py, PyArray1<usize>>)> {
+    let ts = tau_set(set, m)?;
+    let x = data.as_slice().map_err(|_| invalid("data", "array must be C-contiguous"))?;
+    let r = py.detach(|| time_error::time_interval_error(x, tau0, &ts))?;
+    Ok((r.m.into_pyarray(py), r.tau.into_pyarray(py), r.mtie.into_pyarray(py), r.tie_rms.into_pyarray(py), r.n.into_pyarray(py)))
 }
 
 /// Equivalent degrees of freedom per averaging factor (`np` phase points).
@@ -217,6 +247,8 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     register_choices::<X0>(m, "X0")?;
     m.add_function(wrap_pyfunction!(allan_var, m)?)?;
     m.add_function(wrap_pyfunction!(allan_edf, m)?)?;
+    m.add_function(wrap_pyfunction!(time_var, m)?)?;
+    m.add_function(wrap_pyfunction!(time_interval_error, m)?)?;
     m.add_function(wrap_pyfunction!(allan_fit, m)?)?;
     m.add_function(wrap_pyfunction!(nnls_solve, m)?)?;
     m.add_function(wrap_pyfunction!(arima_state_space, m)?)?;

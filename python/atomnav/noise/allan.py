@@ -1,4 +1,5 @@
-"""Allan family and the metrics of Niu et al. 2025.
+"""Allan family, time deviation and time interval error, and the metrics of Niu et
+al. 2025.
 
 All functions are unit-agnostic: a rate series in some unit U sampled every ``tau0``
 seconds gives variances in U², fit coefficients A_k in U²·s^k, ARW in U·√s, bias
@@ -157,6 +158,124 @@ def allan_variance(data, tau0: float, m="octave", kind: str = "allan", data_type
     ms = _m_list(m, taus, tau0)
     mm, tau, var, n, missing = _core.allan_var(x, tau0, data_type, kind, **({"set": m} if ms is None else {"m": ms}))
     return _table(mm, tau, var, n, missing, kind, _phase_points(x.size - missing, data_type), noise, confidence)
+
+
+def time_deviation(data, tau0: float, m="octave", data_type: str = "phase", taus=None, noise: str = "white_pm", confidence: float = 0.683) -> pd.DataFrame:
+    """Time deviation TDEV σ_x(τ) = τ/√3 · MDEV(τ) of a phase (time-error) series or of a
+    rate series sampled every ``tau0`` s (NIST SP 1065 §5.2.6).
+
+    Parameters
+    ----------
+    data : array_like (N,)
+        Phase (time error) in some unit X (e.g. s, rad), or with ``data_type="rate"`` a
+        rate in some unit U (e.g. fractional frequency); NaN marks a missing rate sample,
+        as in :func:`allan_variance`.
+    tau0 : float
+        Sampling interval, s.
+    m : str or sequence of int, default "octave"
+        Averaging factors, as in :func:`allan_variance` (those of the modified Allan
+        variance: at least two terms, 3m − 1 ≤ N − 2 for phase data).
+    data_type : {"phase", "rate"}, default "phase"
+        Whether ``data`` is the phase or its rate.
+    taus : array_like (K,), optional
+        Averaging times, s, positive multiples of ``tau0``; given, they replace ``m``.
+    noise : str, default "white_pm"
+        Noise type for the equivalent degrees of freedom, as in :func:`allan_variance`.
+    confidence : float, default 0.683
+        Probability of the χ² confidence interval, in (0, 1).
+
+    Returns
+    -------
+    pandas.DataFrame
+        The table of :func:`allan_variance` with ``kind="modified"`` scaled by τ²/3:
+        columns ``m``, ``tau_s`` (s), ``var`` (time variance, X² for phase data, (U·s)²
+        for rate data), ``dev`` (TDEV, X or U·s), ``n_terms``, ``edf`` (that of the
+        modified Allan variance, which the scaling does not change), ``dev_lo``,
+        ``dev_hi`` (X or U·s).
+
+    Raises
+    ------
+    atomnav.InputError
+        Naming ``tau0``, ``confidence``, ``data``, ``m`` or ``taus``.
+
+    References
+    ----------
+    W. J. Riley, *Handbook of Frequency Stability Analysis*, NIST SP 1065 (2008), §5.2.6.
+    D. W. Allan, M. A. Weiss and J. L. Jespersen, "A frequency-domain view of time-domain
+    characterization of clocks and time and frequency distribution systems", Proc. 45th
+    Frequency Control Symposium (1991).
+
+    Examples
+    --------
+    >>> x = np.cumsum(np.random.default_rng(1).normal(size=1000)) * 1e-9  # phase, s
+    >>> time_deviation(x, tau0=1.0)[["tau_s", "dev"]]
+    """
+    tau0 = positive(tau0, "tau0")
+    confidence = probability(confidence, "confidence")
+    x = _series(data, "data", check_finite=False)
+    ms = _m_list(m, taus, tau0)
+    mm, tau, var, n, missing = _core.time_var(x, tau0, data_type, **({"set": m} if ms is None else {"m": ms}))
+    return _table(mm, tau, var, n, missing, "modified", _phase_points(x.size - missing, data_type), noise, confidence)
+
+
+def time_interval_error(phase, tau0: float, m="octave", taus=None) -> pd.DataFrame:
+    """Maximum and rms time interval error (MTIE, TIE rms) of a phase (time-error) series
+    sampled every ``tau0`` s.
+
+    MTIE(mτ₀) is the largest peak-to-peak phase excursion over any m + 1 consecutive
+    samples (ITU-T G.810 Appendix II; NIST SP 1065 §5.2.14); TIE rms(mτ₀) is
+    √(mean of (x_{i+m} − x_i)²) over the N − m differences (NIST SP 1065 §5.2.15).
+    Phase data only: a rate (fractional frequency) y is integrated first,
+    ``x = tau0 * np.concatenate([[0.0], np.cumsum(y)])``; its mean is part of the time
+    error and must not be removed.
+
+    Parameters
+    ----------
+    phase : array_like (N,)
+        Phase (time error) samples in some unit X (e.g. s, ns, rad), finite, N ≥ 3.
+    tau0 : float
+        Sampling interval, s.
+    m : str or sequence of int, default "octave"
+        Averaging factors (τ = mτ₀): "octave", "decade", "all" as in
+        :func:`allan_variance`, or a list of integers; each must leave at least two windows
+        (m ≤ N − 2): the named sets stop there, a larger listed factor raises
+        :class:`atomnav.InputError` naming ``m`` and its index.
+    taus : array_like (K,), optional
+        Averaging times, s, positive multiples of ``tau0``; given, they replace ``m``.
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row per factor. Columns ``m``, ``tau_s`` (s), ``mtie`` and ``tie_rms`` (both in
+        the unit X of ``phase``), ``n_windows`` (N − m).
+
+    Raises
+    ------
+    atomnav.InputError
+        Naming ``phase`` (NaN, ±inf, fewer than 3 samples), ``tau0``, ``m`` or ``taus``.
+
+    Notes
+    -----
+    MTIE is computed by one pass per τ with monotonic deques of the window's candidate
+    maxima and minima, O(N) per τ rather than O(N·m).
+
+    References
+    ----------
+    ITU-T Recommendation G.810, *Definitions and terminology for synchronization
+    networks* (1996). W. J. Riley, *Handbook of Frequency Stability Analysis*, NIST SP 1065
+    (2008), §5.2.14–5.2.15.
+
+    Examples
+    --------
+    >>> x = np.cumsum(np.random.default_rng(1).normal(size=1000)) * 1e-9  # phase, s
+    >>> time_interval_error(x, tau0=1.0)[["tau_s", "mtie", "tie_rms"]]
+    """
+    tau0 = positive(tau0, "tau0")
+    x = _series(phase, "phase", check_finite=False)
+    ms = _m_list(m, taus, tau0)
+    with renamed(data="phase"):
+        mm, tau, mtie, tie, n = _core.time_interval_error(x, tau0, **({"set": m} if ms is None else {"m": ms}))
+    return pd.DataFrame({"m": mm, "tau_s": tau, "mtie": mtie, "tie_rms": tie, "n_windows": n})
 
 
 def _phase_points(samples: int, data_type: str) -> int:
