@@ -310,6 +310,10 @@ CATALOGUE: tuple[Clean, ...] = (
     # sensor noise
     _c("atomnav.noise.allan.allan_variance", "an.noise.allan.allan_variance(data, tau0=1.0)",
        "data = pd.Series(omega, name='omega_deg_h')", ["data"]),
+    _c("atomnav.noise.allan.time_deviation", "an.noise.allan.time_deviation(data, tau0=1.0)",
+       "data = pd.Series(np.cumsum(omega), name='phase_s')", ["data"]),
+    _c("atomnav.noise.allan.time_interval_error", "an.noise.allan.time_interval_error(phase, tau0=1.0)",
+       "phase = pd.Series(np.cumsum(omega), name='phase_s')", ["phase"]),
     # (the fit carries its input table; the fit itself is compared)
     _c("atomnav.noise.allan.fit_allan_table",
        "dataclasses.replace(an.noise.allan.fit_allan_table(table, n_samples=2048), table=None)",
