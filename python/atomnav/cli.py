@@ -96,37 +96,37 @@ def _campaign(args: argparse.Namespace) -> int:
     if args.workers is not None and args.workers < 1:
         parser.error(f"--workers: must be ≥ 1, got {args.workers}")
     try:
-        spec = config_file.load(args.file)
+        study_file = config_file.load(args.file)
         sys.path.insert(0, str(Path(args.file).resolve().parent))
-        study = spec.campaign()
+        study = study_file.campaign()
     except (InputError, TypeError) as e:
         parser.error(f"{args.file}: {str(e).removeprefix('path: ') if getattr(e, 'parameter', None) == 'path' else e}")
     except (OSError, ImportError) as e:
         parser.error(f"{args.file}: {getattr(e, 'strerror', None) or e}")
-    where = spec.executor if args.workers is None and args.scheduler is None else config_file.Executor(args.scheduler, args.workers)
+    where = study_file.executor if args.workers is None and args.scheduler is None else config_file.Executor(args.scheduler, args.workers)
     if (where.workers or where.scheduler) and importlib.util.find_spec("distributed") is None:
         parser.error("a cluster (--workers, --scheduler or [executor]) needs dask.distributed: "
                      "pip install 'atomnav[dask]'")
     try:
-        before = len(timing(spec.output, study.name))
+        before = len(timing(study_file.output, study.name))
     except InputError:  # no campaign of this name in the folder yet
         before = 0
     t0 = time.perf_counter()
     try:
         with renamed(folder="output"), _local_cluster(where.workers if before < study.n_runs else None) as client:
-            table = run(study, spec.output, client=client, scheduler=where.scheduler, progress=args.progress)
+            table = run(study, study_file.output, client=client, scheduler=where.scheduler, progress=args.progress)
     except InputError as e:  # another campaign in the folder, a parameter value the scenario rejects
         parser.error(f"{args.file}: {e}")
     except ConnectionError as e:
         print(f"{parser.prog}: error: {e}", file=sys.stderr)
         return 1
     except KeyboardInterrupt:
-        print(f"{parser.prog}: interrupted with {len(timing(spec.output, study.name))} of {study.n_runs} runs in "
-              f"{spec.output / study.name}; run the same command again to resume", file=sys.stderr)
+        print(f"{parser.prog}: interrupted with {len(timing(study_file.output, study.name))} of {study.n_runs} runs in "
+              f"{study_file.output / study.name}; run the same command again to resume", file=sys.stderr)
         return 130
     done = table["run"].nunique() if len(table) else 0
     print(f"{study.name}: {done - before} new runs, {before} resumed, {done} of {study.n_runs} done, in "
-          f"{spec.output / study.name} ({time.perf_counter() - t0:.1f} s)")
+          f"{study_file.output / study.name} ({time.perf_counter() - t0:.1f} s)")
     return 0
 
 

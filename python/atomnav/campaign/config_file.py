@@ -148,8 +148,8 @@ class CampaignFile:
     Examples
     --------
     >>> from atomnav.campaign.config_file import CampaignFile
-    >>> spec = CampaignFile("cai_car", grid={"T": [0.01, 0.02]}, seeds=4)
-    >>> spec.grid
+    >>> study = CampaignFile("cai_car", grid={"T": [0.01, 0.02]}, seeds=4)
+    >>> study.grid
     (('T', (0.01, 0.02)),)
     """
 
@@ -246,8 +246,8 @@ def load(path) -> CampaignFile:
     >>> from atomnav.campaign.config_file import load
     >>> folder = pathlib.Path(tempfile.mkdtemp())
     >>> _ = (folder / "study.toml").write_text('scenario = "cai_car"\\nseeds = 3\\n[grid]\\nT = [0.01, 0.02]\\n')
-    >>> spec = load(folder / "study.toml")
-    >>> spec.seeds, spec.grid, spec.output == folder.resolve()
+    >>> study = load(folder / "study.toml")
+    >>> study.seeds, study.grid, study.output == folder.resolve()
     (3, (('T', (0.01, 0.02)),), True)
     """
     path = _path(path, "path")
